@@ -1,0 +1,195 @@
+//! The validated parameter sections of a scenario, with their defaults.
+//!
+//! Defaults describe an s-bot-like robot (small differential drive, BLDC hub motors with Hall
+//! sensors) on 12 cm cells, a 1 kHz lockstep physics step and a coordinator that never
+//! publishes a commit before its log record is durable.
+
+use serde::{Deserialize, Serialize};
+
+/// Robot geometry and drive limits (`[robot]`).
+#[derive(Clone, PartialEq, Debug, Serialize)]
+pub struct RobotParams {
+    /// Wheel radius in metres.
+    pub wheel_radius_m: f64,
+    /// Distance between the wheel contact points (track width) in metres.
+    pub axle_track_m: f64,
+    /// Radius of the round body in metres; the body must fit in a cell.
+    pub body_radius_m: f64,
+    /// Largest wheel speed in rad/s.
+    pub max_wheel_speed_rad_s: f64,
+    /// Largest wheel acceleration in rad/s^2.
+    pub max_wheel_accel_rad_s2: f64,
+    /// First-order motor time constant in seconds (0 = ideal motor).
+    pub motor_lag_s: f64,
+    /// Hall ticks per wheel revolution: `6 * pole_pairs * gear_ratio` unless given directly.
+    pub ticks_per_rev: f64,
+    /// Edge length of a grid cell in metres.
+    pub cell_size_m: f64,
+}
+
+impl RobotParams {
+    /// Default motor pole pairs (3 Hall sensors give 6 states per electrical revolution).
+    pub const DEFAULT_POLE_PAIRS: u32 = 7;
+
+    /// Highest agent speed in cells/s the wheels allow when driving straight.
+    pub fn max_speed_cells_s(&self) -> f64 {
+        self.max_wheel_speed_rad_s * self.wheel_radius_m / self.cell_size_m
+    }
+}
+
+impl Default for RobotParams {
+    fn default() -> Self {
+        RobotParams {
+            wheel_radius_m: 0.021,
+            axle_track_m: 0.10,
+            body_radius_m: 0.058,
+            max_wheel_speed_rad_s: 20.0,
+            max_wheel_accel_rad_s2: 200.0,
+            motor_lag_s: 0.02,
+            ticks_per_rev: 6.0 * f64::from(Self::DEFAULT_POLE_PAIRS),
+            cell_size_m: 0.12,
+        }
+    }
+}
+
+/// How the simulator's clock advances (`[sim] clock`).
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ClockMode {
+    /// Advance a control period only when every live agent has sent its command for it, so
+    /// a run is deterministic for a given seed.
+    #[default]
+    Lockstep,
+    /// Follow the wall clock; late commands are simply late, as on hardware.
+    Realtime,
+}
+
+/// Physics stepper parameters (`[sim]`).
+#[derive(Clone, PartialEq, Debug, Serialize)]
+pub struct SimParams {
+    /// Physics step in milliseconds.
+    pub step_ms: u32,
+    /// Odometry (Hall tick) publication rate in Hz; at most one message per step.
+    pub odometry_hz: u32,
+    /// Clock mode.
+    pub clock: ClockMode,
+    /// Seed of every random choice of the run (slip noise, generated agents).
+    pub seed: u64,
+    /// Standard deviation of relative wheel slip (0 = no slip).
+    pub slip_std: f64,
+    /// Motor watchdog: wheels brake when the last command is older than this.
+    pub watchdog_ms: u32,
+}
+
+impl Default for SimParams {
+    fn default() -> Self {
+        SimParams { step_ms: 1, odometry_hz: 100, clock: ClockMode::Lockstep, seed: 0, slip_std: 0.0, watchdog_ms: 100 }
+    }
+}
+
+/// When the consensus log is flushed to disk (`[coordinator] fsync`).
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FsyncPolicy {
+    /// fsync every record before its commit is published (durable, the default).
+    #[default]
+    EveryRecord,
+    /// fsync groups of records; a crash may lose the last few.
+    Batched,
+    /// Never fsync (benchmarks only).
+    None,
+}
+
+/// Coordinator parameters (`[coordinator]`).
+#[derive(Clone, PartialEq, Debug, Serialize)]
+pub struct CoordinatorParams {
+    /// How long a round waits for candidates; missing agents count as standing still.
+    pub round_deadline_ms: u32,
+    /// Log durability policy.
+    pub fsync: FsyncPolicy,
+    /// Rounds an agent may stay blocked before the coordinator replans it globally.
+    pub replan_after_rounds: u32,
+    /// Wall-clock limit of the whole run in seconds.
+    pub time_limit_s: f64,
+}
+
+impl Default for CoordinatorParams {
+    fn default() -> Self {
+        CoordinatorParams {
+            round_deadline_ms: 50,
+            fsync: FsyncPolicy::EveryRecord,
+            replan_after_rounds: 3,
+            time_limit_s: 120.0,
+        }
+    }
+}
+
+/// When the supervisor restarts a process of a role.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RestartPolicy {
+    /// Never restart.
+    Never,
+    /// Restart after an abnormal exit (non-zero status or a signal).
+    #[default]
+    OnFailure,
+    /// Restart after any exit before the run ends.
+    Always,
+}
+
+/// Restart rule of one role.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Serialize)]
+pub struct RestartRule {
+    /// When to restart.
+    pub policy: RestartPolicy,
+    /// Restarts allowed over the whole run.
+    pub max_restarts: u32,
+    /// Delay before a restart in milliseconds.
+    pub backoff_ms: u64,
+}
+
+impl RestartRule {
+    /// `policy` with the default cap (3) and backoff (100 ms).
+    pub const fn with_policy(policy: RestartPolicy) -> Self {
+        RestartRule { policy, max_restarts: 3, backoff_ms: 100 }
+    }
+}
+
+/// Restart rules per role (`[restart]`). Agents and the coordinator are restarted on failure
+/// by default (both resume from the consensus log); the simulator is not, because its
+/// ground-truth state cannot be rebuilt, so losing it ends the run.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Serialize)]
+pub struct RestartConfig {
+    /// Rule for agent processes.
+    pub agent: RestartRule,
+    /// Rule for the coordinator.
+    pub coordinator: RestartRule,
+    /// Rule for the simulator.
+    pub sim: RestartRule,
+}
+
+impl Default for RestartConfig {
+    fn default() -> Self {
+        RestartConfig {
+            agent: RestartRule::with_policy(RestartPolicy::OnFailure),
+            coordinator: RestartRule::with_policy(RestartPolicy::OnFailure),
+            sim: RestartRule::with_policy(RestartPolicy::Never),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_consistent() {
+        let r = RobotParams::default();
+        assert_eq!(r.ticks_per_rev, 42.0);
+        assert!(2.0 * r.body_radius_m <= r.cell_size_m, "default body fits in a cell");
+        assert!((r.max_speed_cells_s() - 3.5).abs() < 1e-9);
+        assert_eq!(RestartConfig::default().sim.policy, RestartPolicy::Never);
+        assert_eq!(SimParams::default().clock, ClockMode::Lockstep);
+        assert_eq!(CoordinatorParams::default().fsync, FsyncPolicy::EveryRecord);
+    }
+}

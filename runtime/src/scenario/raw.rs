@@ -1,0 +1,130 @@
+//! The scenario file as `serde` sees it, before validation.
+//!
+//! Everything a semantic check may complain about is wrapped in [`Spanned`] so the error can
+//! name its line; every table denies unknown keys so a typo is an error, not a silently
+//! ignored setting. Coordinates are `Vec<i64>`: a negative or three-element coordinate then
+//! reaches the validator (which names it precisely) instead of failing inside serde, whose
+//! fixed-size arrays would also silently accept extra elements.
+
+use serde::Deserialize;
+use toml::Spanned;
+
+use super::params::{ClockMode, FsyncPolicy, RestartPolicy};
+
+/// Top level.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawScenario {
+    pub name: Spanned<String>,
+    pub map: Spanned<RawMap>,
+    pub robot: Option<RawRobot>,
+    pub sim: Option<RawSim>,
+    pub coordinator: Option<RawCoordinator>,
+    pub restart: Option<RawRestart>,
+    #[serde(default)]
+    pub agents: Vec<Spanned<RawAgent>>,
+    #[serde(default)]
+    pub faults: Vec<Spanned<RawFault>>,
+}
+
+/// `[map]`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawMap {
+    pub file: Option<Spanned<String>>,
+    pub rows: Option<Spanned<Vec<Spanned<String>>>>,
+    pub corner_cutting: Option<bool>,
+}
+
+/// `[robot]`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawRobot {
+    pub wheel_radius_m: Option<Spanned<f64>>,
+    pub axle_track_m: Option<Spanned<f64>>,
+    pub body_radius_m: Option<Spanned<f64>>,
+    pub max_wheel_speed_rad_s: Option<Spanned<f64>>,
+    pub max_wheel_accel_rad_s2: Option<Spanned<f64>>,
+    pub motor_lag_s: Option<Spanned<f64>>,
+    pub ticks_per_rev: Option<Spanned<f64>>,
+    pub pole_pairs: Option<Spanned<u32>>,
+    pub gear_ratio: Option<Spanned<f64>>,
+    pub cell_size_m: Option<Spanned<f64>>,
+}
+
+/// `[sim]`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSim {
+    pub step_ms: Option<Spanned<u32>>,
+    pub odometry_hz: Option<Spanned<u32>>,
+    pub clock: Option<ClockMode>,
+    pub seed: Option<u64>,
+    pub slip_std: Option<Spanned<f64>>,
+    pub watchdog_ms: Option<Spanned<u32>>,
+}
+
+/// `[coordinator]`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawCoordinator {
+    pub round_deadline_ms: Option<Spanned<u32>>,
+    pub fsync: Option<FsyncPolicy>,
+    pub replan_after_rounds: Option<Spanned<u32>>,
+    pub time_limit_s: Option<Spanned<f64>>,
+}
+
+/// `[restart]`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawRestart {
+    pub agent: Option<RawRestartRule>,
+    pub coordinator: Option<RawRestartRule>,
+    pub sim: Option<RawRestartRule>,
+}
+
+/// One role's restart rule.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawRestartRule {
+    pub policy: Option<RestartPolicy>,
+    pub max_restarts: Option<u32>,
+    pub backoff_ms: Option<u64>,
+}
+
+/// One `[[agents]]` entry.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawAgent {
+    pub start: Spanned<Vec<i64>>,
+    pub goal: Spanned<Vec<i64>>,
+    pub speed: Option<Spanned<f64>>,
+    pub priority: Option<Spanned<f64>>,
+}
+
+/// What a fault does (only killing a process so far).
+#[derive(Deserialize, Debug, Clone, Copy)]
+#[serde(rename_all = "kebab-case")]
+pub(super) enum RawFaultAction {
+    Kill,
+}
+
+/// Which process a fault hits.
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub(super) enum RawRole {
+    Agent,
+    Coordinator,
+    Sim,
+}
+
+/// One `[[faults]]` entry.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawFault {
+    pub at_round: u64,
+    pub action: RawFaultAction,
+    pub role: RawRole,
+    pub index: Option<Spanned<i64>>,
+    pub signal: Option<super::FaultSignal>,
+}

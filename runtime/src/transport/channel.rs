@@ -1,0 +1,344 @@
+//! Fixed-size payload channels: publisher + notifier, subscriber + listener.
+
+use core::fmt::Debug;
+
+use iceoryx2::node::Node;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::port::update_connections::UpdateConnections;
+use iceoryx2::port::backpressure_strategy::BackpressureStrategy;
+use iceoryx2::prelude::{EventId, ServiceName, ZeroCopySend};
+use iceoryx2::sample::Sample;
+use iceoryx2::service::builder::event::{EventCreateError, EventOpenError, EventOpenOrCreateError};
+use iceoryx2::service::builder::publish_subscribe::{
+    PublishSubscribeCreateError, PublishSubscribeOpenError, PublishSubscribeOpenOrCreateError,
+};
+use iceoryx2::service::port_factory::event::PortFactory as EventFactory;
+
+use super::{event_id, Delivery, Ipc, Qos, TransportError};
+
+/// How often and how long opening a service is retried while another process is creating or
+/// removing it (iceoryx2's builder docs ask callers to retry these "with a little delay").
+const OPEN_ATTEMPTS: u32 = 20;
+const OPEN_BACKOFF: std::time::Duration = std::time::Duration::from_millis(5);
+
+/// Runs `open` until it succeeds, fails for good, or the transient failures run out of tries.
+pub(crate) fn open_with_retry<T, E: Debug>(
+    op: &'static str,
+    name: &ServiceName,
+    transient: impl Fn(&E) -> bool,
+    mut open: impl FnMut() -> Result<T, E>,
+) -> Result<T, TransportError> {
+    let mut attempt = 0;
+    loop {
+        match open() {
+            Ok(v) => return Ok(v),
+            Err(e) if transient(&e) && attempt + 1 < OPEN_ATTEMPTS => {
+                attempt += 1;
+                tracing::debug!(service = name.as_str(), ?e, attempt, "retrying {op}");
+                std::thread::sleep(OPEN_BACKOFF * attempt);
+            }
+            Err(e) => return Err(TransportError::ipc(op, name.as_str(), e)),
+        }
+    }
+}
+
+/// Opens (or creates) a publish-subscribe service with a run's QoS. A macro because iceoryx2's
+/// builder has separate `open_or_create` impls for sized and slice payloads.
+macro_rules! open_pubsub {
+    ($node:expr, $name:expr, $qos:expr, $payload:ty $(, $header:ty)?) => {
+        $crate::transport::channel::open_with_retry(
+            "open publish-subscribe service",
+            $name,
+            $crate::transport::channel::pubsub_transient,
+            || {
+                $node
+                    .service_builder($name)
+                    .publish_subscribe::<$payload>()
+                    $(.user_header::<$header>())?
+                    .max_publishers($qos.max_publishers)
+                    .max_subscribers($qos.max_subscribers)
+                    .max_nodes($qos.max_nodes())
+                    .subscriber_max_buffer_size($qos.buffer)
+                    .history_size($qos.history)
+                    .enable_safe_overflow($qos.delivery == $crate::transport::Delivery::LatestOnly)
+                    .open_or_create()
+            },
+        )
+    };
+}
+pub(crate) use open_pubsub;
+
+pub(crate) fn pubsub_transient(e: &PublishSubscribeOpenOrCreateError) -> bool {
+    use PublishSubscribeCreateError as C;
+    use PublishSubscribeOpenError as O;
+    use PublishSubscribeOpenOrCreateError as E;
+    matches!(
+        e,
+        E::SystemInFlux
+            | E::PublishSubscribeOpenError(
+                O::IsMarkedForDestruction | O::HangsInCreation | O::ServiceInCorruptedState
+            )
+            | E::PublishSubscribeCreateError(
+                C::IsBeingCreatedByAnotherInstance | C::HangsInCreation | C::AlreadyExists
+            )
+    )
+}
+
+fn event_transient(e: &EventOpenOrCreateError) -> bool {
+    use EventCreateError as C;
+    use EventOpenError as O;
+    use EventOpenOrCreateError as E;
+    matches!(
+        e,
+        E::SystemInFlux
+            | E::EventOpenError(
+                O::IsMarkedForDestruction | O::HangsInCreation | O::ServiceInCorruptedState
+            )
+            | E::EventCreateError(
+                C::IsBeingCreatedByAnotherInstance | C::AlreadyExists
+            )
+    )
+}
+
+/// Opens (or creates) the event service that accompanies a data service of the same name.
+pub(crate) fn open_event(
+    node: &Node<Ipc>,
+    name: &ServiceName,
+    qos: &Qos,
+) -> Result<EventFactory<Ipc>, TransportError> {
+    open_with_retry("open event service", name, event_transient, || {
+        node.service_builder(name)
+            .event()
+            .max_notifiers(qos.max_publishers)
+            .max_listeners(qos.max_subscribers)
+            .max_nodes(qos.max_nodes())
+            .event_id_max_value(event_id::MAX)
+            .notifier_created_event(EventId::new(event_id::PEER_UP))
+            .notifier_dropped_event(EventId::new(event_id::PEER_LEFT))
+            .notifier_dead_event(EventId::new(event_id::PEER_DEAD))
+            .open_or_create()
+    })
+}
+
+pub(crate) fn backpressure(qos: &Qos) -> BackpressureStrategy {
+    match qos.delivery {
+        Delivery::LatestOnly => BackpressureStrategy::DiscardData,
+        Delivery::Reliable => BackpressureStrategy::RetryUntilDelivered,
+    }
+}
+
+pub(crate) fn create_notifier(
+    events: &EventFactory<Ipc>,
+    name: &ServiceName,
+) -> Result<Notifier<Ipc>, TransportError> {
+    events
+        .notifier_builder()
+        .default_event_id(EventId::new(event_id::DATA))
+        .create()
+        .map_err(|e| TransportError::ipc("create notifier", name.as_str(), e))
+}
+
+pub(crate) fn create_listener(
+    events: &EventFactory<Ipc>,
+    name: &ServiceName,
+) -> Result<Listener<Ipc>, TransportError> {
+    events
+        .listener_builder()
+        .create()
+        .map_err(|e| TransportError::ipc("create listener", name.as_str(), e))
+}
+
+/// What woke a receiver: the events gathered since the last call, by kind.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Wakeup {
+    /// Samples were published (coalesced: one or more).
+    pub data: bool,
+    /// A publisher appeared.
+    pub peer_up: bool,
+    /// A publisher left cleanly.
+    pub peer_left: bool,
+    /// A publisher's process died and its node was cleaned up.
+    pub peer_dead: bool,
+}
+
+impl Wakeup {
+    pub(crate) fn record(&mut self, id: EventId) {
+        match id.as_value() {
+            event_id::DATA => self.data = true,
+            event_id::PEER_UP => self.peer_up = true,
+            event_id::PEER_LEFT => self.peer_left = true,
+            event_id::PEER_DEAD => self.peer_dead = true,
+            _ => {}
+        }
+    }
+}
+
+/// Drains a listener without blocking and reports what it had gathered.
+pub(crate) fn take_wakeup(
+    listener: &Listener<Ipc>,
+    name: &ServiceName,
+) -> Result<Wakeup, TransportError> {
+    let mut wakeup = Wakeup::default();
+    listener
+        .try_wait(|activation| wakeup.record(activation.id))
+        .map_err(|e| TransportError::ipc("drain listener", name.as_str(), e))?;
+    Ok(wakeup)
+}
+
+/// The sending half of a topic: a publisher of `T` plus a notifier that wakes receivers.
+pub struct Sender<T: Debug + ZeroCopySend + 'static> {
+    name: ServiceName,
+    publisher: Publisher<Ipc, T, ()>,
+    notifier: Notifier<Ipc>,
+}
+
+impl<T: Debug + ZeroCopySend + 'static> Sender<T> {
+    pub(crate) fn open(node: &Node<Ipc>, name: ServiceName, qos: Qos) -> Result<Self, TransportError> {
+        let service = open_pubsub!(node, &name, qos, T)?;
+        let publisher = service
+            .publisher_builder()
+            .backpressure_strategy(backpressure(&qos))
+            .create()
+            .map_err(|e| TransportError::ipc("create publisher", name.as_str(), e))?;
+        let events = open_event(node, &name, &qos)?;
+        let notifier = create_notifier(&events, &name)?;
+        // Connect to subscribers that already exist, so the first sample is not lost.
+        publisher
+            .update_connections()
+            .map_err(|e| TransportError::ipc("connect publisher", name.as_str(), e))?;
+        Ok(Self {
+            name,
+            publisher,
+            notifier,
+        })
+    }
+
+    /// The full service name.
+    pub fn name(&self) -> &str {
+        self.name.as_str()
+    }
+
+    /// Writes `value` into a loaned shared-memory chunk, publishes it and wakes the receivers.
+    /// Returns how many subscribers received it.
+    pub fn send(&self, value: T) -> Result<usize, TransportError> {
+        let sample = self
+            .publisher
+            .loan_uninit()
+            .map_err(|e| TransportError::ipc("loan sample", self.name.as_str(), e))?;
+        let reached = sample
+            .write_payload(value)
+            .send()
+            .map_err(|e| TransportError::ipc("send sample", self.name.as_str(), e))?;
+        self.notify()?;
+        Ok(reached)
+    }
+
+    /// Loans a default-initialised chunk, lets `fill` write the payload in place (no copy of a
+    /// large message through the stack), publishes it and wakes the receivers.
+    pub fn send_in_place(&self, fill: impl FnOnce(&mut T)) -> Result<usize, TransportError>
+    where
+        T: Default,
+    {
+        let mut sample = self
+            .publisher
+            .loan()
+            .map_err(|e| TransportError::ipc("loan sample", self.name.as_str(), e))?;
+        fill(sample.payload_mut());
+        let reached = sample
+            .send()
+            .map_err(|e| TransportError::ipc("send sample", self.name.as_str(), e))?;
+        self.notify()?;
+        Ok(reached)
+    }
+
+    fn notify(&self) -> Result<(), TransportError> {
+        self.notifier
+            .notify()
+            .map(|_| ())
+            .map_err(|e| TransportError::ipc("notify", self.name.as_str(), e))
+    }
+
+    /// Connects to subscribers that joined since the last send.
+    pub fn update_connections(&self) -> Result<(), TransportError> {
+        self.publisher
+            .update_connections()
+            .map_err(|e| TransportError::ipc("connect publisher", self.name.as_str(), e))
+    }
+
+    /// The underlying iceoryx2 publisher, for what this layer does not wrap.
+    pub fn publisher(&self) -> &Publisher<Ipc, T, ()> {
+        &self.publisher
+    }
+}
+
+/// The receiving half of a topic: a subscriber of `T` plus a listener to block on.
+///
+/// Attach [`Receiver::listener`] to a [`WaitSet`](iceoryx2::prelude::WaitSet); when it fires,
+/// call [`Receiver::take_wakeup`] and then [`Receiver::drain`] (or [`Receiver::receive`]).
+pub struct Receiver<T: Debug + ZeroCopySend + 'static> {
+    name: ServiceName,
+    subscriber: Subscriber<Ipc, T, ()>,
+    listener: Listener<Ipc>,
+}
+
+impl<T: Debug + ZeroCopySend + 'static> Receiver<T> {
+    pub(crate) fn open(node: &Node<Ipc>, name: ServiceName, qos: Qos) -> Result<Self, TransportError> {
+        let service = open_pubsub!(node, &name, qos, T)?;
+        let subscriber = service
+            .subscriber_builder()
+            .buffer_size(qos.buffer)
+            .create()
+            .map_err(|e| TransportError::ipc("create subscriber", name.as_str(), e))?;
+        let events = open_event(node, &name, &qos)?;
+        let listener = create_listener(&events, &name)?;
+        subscriber
+            .update_connections()
+            .map_err(|e| TransportError::ipc("connect subscriber", name.as_str(), e))?;
+        Ok(Self {
+            name,
+            subscriber,
+            listener,
+        })
+    }
+
+    /// The full service name.
+    pub fn name(&self) -> &str {
+        self.name.as_str()
+    }
+
+    /// The listener to attach to a WaitSet.
+    pub fn listener(&self) -> &Listener<Ipc> {
+        &self.listener
+    }
+
+    /// Consumes the pending wake-up events and reports what they were.
+    pub fn take_wakeup(&self) -> Result<Wakeup, TransportError> {
+        take_wakeup(&self.listener, &self.name)
+    }
+
+    /// Takes the oldest unread sample, if any. The sample stays in shared memory (zero-copy)
+    /// until it is dropped.
+    pub fn receive(&self) -> Result<Option<Sample<Ipc, T, ()>>, TransportError> {
+        self.subscriber
+            .receive()
+            .map_err(|e| TransportError::ipc("receive", self.name.as_str(), e))
+    }
+
+    /// Hands every unread sample to `f` in publication order and returns how many there were.
+    pub fn drain(&self, mut f: impl FnMut(&T)) -> Result<usize, TransportError> {
+        let mut n = 0;
+        while let Some(sample) = self.receive()? {
+            f(sample.payload());
+            n += 1;
+        }
+        Ok(n)
+    }
+
+    /// The underlying iceoryx2 subscriber, for what this layer does not wrap.
+    pub fn subscriber(&self) -> &Subscriber<Ipc, T, ()> {
+        &self.subscriber
+    }
+}

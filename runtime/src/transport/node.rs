@@ -1,0 +1,290 @@
+//! The process's node in a run, its ports, and the run's liveness view.
+
+use core::fmt::Debug;
+use std::time::Duration;
+
+use iceoryx2::config::Config;
+use iceoryx2::node::{Node, NodeState, NodeView};
+use iceoryx2::prelude::{
+    CallbackProgression, NodeBuilder, NodeName, SignalHandlingMode, WaitSet, WaitSetBuilder,
+    ZeroCopySend,
+};
+use iceoryx2::service::Service as _;
+
+use super::{
+    run_config, Ipc, Qos, Receiver, RunId, Sender, SliceReceiver, SliceSender, TransportError,
+};
+
+/// Builds a [`Transport`].
+#[derive(Debug)]
+pub struct TransportBuilder {
+    run: RunId,
+    name: Option<String>,
+    handle_signals: bool,
+}
+
+impl TransportBuilder {
+    /// The node name other processes see (`agent-3`, `coordinator`, ...); at most 128 bytes.
+    pub fn node_name(mut self, name: &str) -> Self {
+        self.name = Some(name.to_string());
+        self
+    }
+
+    /// Whether iceoryx2 turns SIGINT/SIGTERM into a termination request that
+    /// [`WaitSet::wait_and_process`] returns (default `true`). Turn it off when the process
+    /// handles signals itself.
+    pub fn handle_signals(mut self, yes: bool) -> Self {
+        self.handle_signals = yes;
+        self
+    }
+
+    /// Creates the node.
+    pub fn create(self) -> Result<Transport, TransportError> {
+        let config = run_config(&self.run);
+        let signals = if self.handle_signals {
+            SignalHandlingMode::HandleTerminationRequests
+        } else {
+            SignalHandlingMode::Disabled
+        };
+        let mut builder = NodeBuilder::new().config(&config).signal_handling_mode(signals);
+        if let Some(name) = &self.name {
+            let node_name = NodeName::new(name).map_err(|e| TransportError::InvalidName {
+                name: name.clone(),
+                why: format!("{e:?}"),
+            })?;
+            builder = builder.name(&node_name);
+        }
+        let node = builder
+            .create::<Ipc>()
+            .map_err(|e| TransportError::ipc("create node", self.name.as_deref().unwrap_or(""), e))?;
+        Ok(Transport {
+            run: self.run,
+            config,
+            node,
+            signals,
+        })
+    }
+}
+
+/// One process's membership in a run: an iceoryx2 node under the run's config, and the
+/// factory of its typed ports.
+pub struct Transport {
+    run: RunId,
+    config: Config,
+    node: Node<Ipc>,
+    signals: SignalHandlingMode,
+}
+
+impl Transport {
+    /// Starts building the transport of `run`.
+    pub fn builder(run: &RunId) -> TransportBuilder {
+        TransportBuilder {
+            run: run.clone(),
+            name: None,
+            handle_signals: true,
+        }
+    }
+
+    /// The run this transport belongs to.
+    pub fn run(&self) -> &RunId {
+        &self.run
+    }
+
+    /// The run's iceoryx2 config.
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// The underlying iceoryx2 node.
+    pub fn node(&self) -> &Node<Ipc> {
+        &self.node
+    }
+
+    /// Opens the sending half of `topic` (`hnav/<run>/<topic>`).
+    pub fn sender<T: Debug + ZeroCopySend + 'static>(
+        &self,
+        topic: &str,
+        qos: Qos,
+    ) -> Result<Sender<T>, TransportError> {
+        Sender::open(&self.node, self.run.service_name(topic)?, qos)
+    }
+
+    /// Opens the receiving half of `topic`.
+    pub fn receiver<T: Debug + ZeroCopySend + 'static>(
+        &self,
+        topic: &str,
+        qos: Qos,
+    ) -> Result<Receiver<T>, TransportError> {
+        Receiver::open(&self.node, self.run.service_name(topic)?, qos)
+    }
+
+    /// Opens the sending half of a slice topic whose samples hold at most `max_len` elements.
+    pub fn slice_sender<E, H>(
+        &self,
+        topic: &str,
+        max_len: usize,
+        qos: Qos,
+    ) -> Result<SliceSender<E, H>, TransportError>
+    where
+        E: Debug + ZeroCopySend + 'static,
+        H: Debug + ZeroCopySend + Default + 'static,
+    {
+        SliceSender::open(&self.node, self.run.service_name(topic)?, max_len, qos)
+    }
+
+    /// Opens the receiving half of a slice topic.
+    pub fn slice_receiver<E, H>(
+        &self,
+        topic: &str,
+        qos: Qos,
+    ) -> Result<SliceReceiver<E, H>, TransportError>
+    where
+        E: Debug + ZeroCopySend + 'static,
+        H: Debug + ZeroCopySend + 'static,
+    {
+        SliceReceiver::open(&self.node, self.run.service_name(topic)?, qos)
+    }
+
+    /// A WaitSet with the same signal handling as the node.
+    pub fn waitset(&self) -> Result<WaitSet<Ipc>, TransportError> {
+        WaitSetBuilder::new()
+            .signal_handling_mode(self.signals)
+            .create::<Ipc>()
+            .map_err(|e| TransportError::ipc("create waitset", self.run.as_str(), e))
+    }
+
+    /// Every node of this run, alive or dead.
+    pub fn nodes(&self) -> Result<Vec<NodeInfo>, TransportError> {
+        nodes_in(&self.config)
+    }
+
+    /// Removes the stale resources of the run's dead nodes (after a SIGKILL, say).
+    pub fn cleanup_dead_nodes(&self) -> Result<CleanupReport, TransportError> {
+        cleanup_dead_nodes_in(&self.config)
+    }
+
+    /// Like [`Transport::cleanup_dead_nodes`], but waits up to `timeout` for another cleaner.
+    pub fn blocking_cleanup_dead_nodes(&self, timeout: Duration) -> u64 {
+        self.node.blocking_cleanup_dead_nodes(timeout).cleanups
+    }
+
+    /// The names of the run's services (`hnav/<run>/...`), sorted, each listed once.
+    pub fn services(&self) -> Result<Vec<String>, TransportError> {
+        services_in(&self.config)
+    }
+
+    /// The nodes of another run, for tools such as `hnav ps` that are not part of it.
+    pub fn nodes_of(run: &RunId) -> Result<Vec<NodeInfo>, TransportError> {
+        nodes_in(&run_config(run))
+    }
+
+    /// Removes the stale resources of another run's dead nodes, without joining the run (a
+    /// node created in the run would already clean up as it starts).
+    pub fn cleanup_dead_nodes_of(run: &RunId) -> Result<CleanupReport, TransportError> {
+        cleanup_dead_nodes_in(&run_config(run))
+    }
+
+    /// The services of another run.
+    pub fn services_of(run: &RunId) -> Result<Vec<String>, TransportError> {
+        services_in(&run_config(run))
+    }
+}
+
+/// Whether a node's process still holds its liveness lock.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NodeLiveness {
+    /// The process is running.
+    Alive,
+    /// The process died without cleaning up (SIGKILL, crash).
+    Dead,
+    /// The node cannot be inspected (permissions) or is half created.
+    Unknown,
+}
+
+/// A node seen in a run.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct NodeInfo {
+    /// The node name (empty if the node has none).
+    pub name: String,
+    /// The process id, if known.
+    pub pid: Option<i32>,
+    /// Liveness.
+    pub liveness: NodeLiveness,
+}
+
+/// The outcome of a dead-node cleanup.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct CleanupReport {
+    /// Dead nodes whose resources were removed.
+    pub removed: Vec<NodeInfo>,
+    /// Dead nodes whose cleanup failed (another process was cleaning them, say).
+    pub failed: Vec<NodeInfo>,
+    /// Nodes found alive.
+    pub alive: usize,
+}
+
+fn describe<V: NodeView>(view: &V, liveness: NodeLiveness) -> NodeInfo {
+    let (name, pid) = view
+        .details()
+        .as_ref()
+        .map(|d| (d.name().as_str().to_string(), Some(d.process_id().value())))
+        .unwrap_or_default();
+    NodeInfo {
+        name,
+        pid,
+        liveness,
+    }
+}
+
+pub(crate) fn nodes_in(config: &Config) -> Result<Vec<NodeInfo>, TransportError> {
+    let mut out = Vec::new();
+    Node::<Ipc>::list(config, |state| {
+        out.push(match &state {
+            NodeState::Alive(v) => describe(v, NodeLiveness::Alive),
+            NodeState::Dead(v) => describe(v, NodeLiveness::Dead),
+            NodeState::Inaccessible(_) | NodeState::Undefined(_) => NodeInfo {
+                name: String::new(),
+                pid: None,
+                liveness: NodeLiveness::Unknown,
+            },
+        });
+        CallbackProgression::Continue
+    })
+    .map_err(|e| TransportError::ipc("list nodes", "", e))?;
+    Ok(out)
+}
+
+pub(crate) fn cleanup_dead_nodes_in(config: &Config) -> Result<CleanupReport, TransportError> {
+    let mut report = CleanupReport::default();
+    Node::<Ipc>::list(config, |state| {
+        match state {
+            NodeState::Alive(_) => report.alive += 1,
+            NodeState::Dead(v) => {
+                let info = describe(&v, NodeLiveness::Dead);
+                match v.try_remove_stale_resources() {
+                    Ok(()) => report.removed.push(info),
+                    Err(e) => {
+                        tracing::warn!(node = info.name, ?e, "dead node cleanup failed");
+                        report.failed.push(info);
+                    }
+                }
+            }
+            NodeState::Inaccessible(_) | NodeState::Undefined(_) => {}
+        }
+        CallbackProgression::Continue
+    })
+    .map_err(|e| TransportError::ipc("list nodes", "", e))?;
+    Ok(report)
+}
+
+fn services_in(config: &Config) -> Result<Vec<String>, TransportError> {
+    let mut out = Vec::new();
+    Ipc::list(config, |service| {
+        out.push(service.static_details.name().as_str().to_string());
+        CallbackProgression::Continue
+    })
+    .map_err(|e| TransportError::ipc("list services", "", e))?;
+    out.sort();
+    out.dedup();
+    Ok(out)
+}

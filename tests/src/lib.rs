@@ -1,0 +1,144 @@
+//! # hnav-tests
+//!
+//! Multi-process integration and fault-injection tests of HNAV, and what they share:
+//!
+//! - [`TestRun`]: a unique run id per test, child processes started with bounded waits on
+//!   their output and exit, and clean-up of the run's shared memory in `Drop`, so a failing
+//!   test leaves nothing behind in `/dev/shm`;
+//! - the `hnav-test-peer` binary (`src/bin/hnav-test-peer.rs`): small publisher and
+//!   subscriber roles the tests run as separate processes;
+//! - [`pattern`]: the deterministic payloads both sides of a test agree on.
+//!
+//! Tests that SIGKILL processes live in their own test binaries (`tests/*_kill.rs`).
+
+pub mod pattern;
+
+use std::io::{BufRead, BufReader};
+use std::process::{Command, ExitStatus, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use hnav_runtime::transport::{purge_run, RunId};
+use nix::sys::signal::{kill, Signal};
+use nix::unistd::Pid;
+
+/// A child process of a test, with its stdout lines and exit status delivered on channels so
+/// that every wait on it is bounded.
+pub struct Peer {
+    /// OS process id.
+    pub pid: u32,
+    lines: mpsc::Receiver<String>,
+    exit: mpsc::Receiver<ExitStatus>,
+    exited: Option<ExitStatus>,
+}
+
+impl Peer {
+    /// Waits up to `timeout` for the next stdout line.
+    pub fn next_line(&mut self, timeout: Duration) -> Result<String, String> {
+        self.lines
+            .recv_timeout(timeout)
+            .map_err(|e| format!("no output from pid {} within {timeout:?}: {e}", self.pid))
+    }
+
+    /// Waits up to `timeout` for a stdout line starting with `prefix`, skipping others.
+    pub fn wait_for_line(&mut self, prefix: &str, timeout: Duration) -> Result<String, String> {
+        let deadline = std::time::Instant::now() + timeout;
+        loop {
+            let left = deadline.saturating_duration_since(std::time::Instant::now());
+            let line = self.next_line(left)?;
+            if line.starts_with(prefix) {
+                return Ok(line);
+            }
+        }
+    }
+
+    /// Waits up to `timeout` for the process to exit.
+    pub fn wait_exit(&mut self, timeout: Duration) -> Result<ExitStatus, String> {
+        if let Some(s) = self.exited {
+            return Ok(s);
+        }
+        let status = self
+            .exit
+            .recv_timeout(timeout)
+            .map_err(|e| format!("pid {} did not exit within {timeout:?}: {e}", self.pid))?;
+        self.exited = Some(status);
+        Ok(status)
+    }
+
+    /// Sends `signal` to the process.
+    pub fn signal(&self, signal: Signal) -> Result<(), String> {
+        kill(Pid::from_raw(self.pid as i32), signal).map_err(|e| e.to_string())
+    }
+}
+
+/// One test's run: a unique [`RunId`] and the processes started for it.
+///
+/// Dropping it kills the processes still running, reaps them and purges the run's
+/// shared-memory resources, also when the test failed.
+pub struct TestRun {
+    /// The run id (unique per test and process).
+    pub run: RunId,
+    peers: Vec<(u32, mpsc::Receiver<ExitStatus>)>,
+}
+
+impl TestRun {
+    /// A run with a fresh id tagged `tag`.
+    pub fn new(tag: &str) -> Self {
+        Self {
+            run: RunId::unique(tag),
+            peers: Vec::new(),
+        }
+    }
+
+    /// Starts `program` with `args` (the run id is passed as `--run <id>` first).
+    pub fn spawn(&mut self, program: &str, args: &[&str]) -> Result<Peer, String> {
+        let mut child = Command::new(program)
+            .arg("--run")
+            .arg(self.run.as_str())
+            .args(args)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .map_err(|e| format!("cannot start {program}: {e}"))?;
+        let pid = child.id();
+        let stdout = child.stdout.take().ok_or("no stdout")?;
+        let (line_tx, lines) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+                if line_tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        let (exit_tx, exit) = mpsc::channel();
+        let (guard_tx, guard_rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            if let Ok(status) = child.wait() {
+                let _ = exit_tx.send(status);
+                let _ = guard_tx.send(status);
+            }
+        });
+        self.peers.push((pid, guard_rx));
+        Ok(Peer {
+            pid,
+            lines,
+            exit,
+            exited: None,
+        })
+    }
+}
+
+impl Drop for TestRun {
+    fn drop(&mut self) {
+        for (pid, exit) in &self.peers {
+            if exit.try_recv().is_err() {
+                let _ = kill(Pid::from_raw(*pid as i32), Signal::SIGKILL);
+                let _ = exit.recv_timeout(Duration::from_secs(10));
+            }
+        }
+        if let Err(e) = purge_run(&self.run) {
+            eprintln!("cleanup of run {} failed: {e}", self.run);
+        }
+    }
+}
