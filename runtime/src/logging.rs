@@ -6,6 +6,8 @@
 //! limited to errors: iceoryx2 warns about things HNAV does on purpose (running without a
 //! config file, cleaning up after killed processes).
 
+use iceoryx2::prelude::{set_log_level, LogLevel};
+use tracing::level_filters::LevelFilter;
 use tracing_subscriber::EnvFilter;
 
 /// The filter used when neither `HNAV_LOG` nor `RUST_LOG` is set.
@@ -23,4 +25,31 @@ pub fn init() {
         .with_env_filter(filter)
         .with_writer(std::io::stderr)
         .try_init();
+    // iceoryx2 filters by its own level before its message reaches `tracing`; open it exactly
+    // as far as the most verbose directive, so the tracing filter decides and nothing more
+    // is formatted than could be shown.
+    set_log_level(iceoryx2_level(LevelFilter::current()));
+}
+
+fn iceoryx2_level(max: LevelFilter) -> LogLevel {
+    match max.into_level() {
+        None => LogLevel::Fatal,
+        Some(tracing::Level::ERROR) => LogLevel::Error,
+        Some(tracing::Level::WARN) => LogLevel::Warn,
+        Some(tracing::Level::INFO) => LogLevel::Info,
+        Some(tracing::Level::DEBUG) => LogLevel::Debug,
+        Some(tracing::Level::TRACE) => LogLevel::Trace,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn iceoryx2_level_follows_the_most_verbose_directive() {
+        assert_eq!(iceoryx2_level(LevelFilter::TRACE), LogLevel::Trace);
+        assert_eq!(iceoryx2_level(LevelFilter::INFO), LogLevel::Info);
+        assert_eq!(iceoryx2_level(LevelFilter::OFF), LogLevel::Fatal);
+    }
 }

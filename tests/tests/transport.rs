@@ -83,3 +83,64 @@ fn two_runs_do_not_see_each_other() {
         .iter()
         .all(|p| !p.to_string_lossy().contains(b.run.as_str())));
 }
+
+#[test]
+fn iceoryx2_logs_go_through_tracing_without_config_noise() {
+    let run = TestRun::new("quiet");
+    let out = std::process::Command::new(PEER)
+        .args(["--run", run.run.as_str(), "probe"])
+        .env_remove("RUST_LOG")
+        .env_remove("HNAV_LOG")
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "READY");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("No config file"), "stderr: {stderr}");
+    assert!(stderr.trim().is_empty(), "a clean run prints nothing on stderr: {stderr}");
+
+    // With iceoryx2's debug logs enabled they arrive as tracing events, with tracing's format.
+    let out = std::process::Command::new(PEER)
+        .args(["--run", run.run.as_str(), "probe"])
+        .env("HNAV_LOG", "iceoryx2_bb_loggers=trace")
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("iceoryx2_bb_loggers::tracing"),
+        "iceoryx2 logs should be tracing events: {stderr}"
+    );
+}
+
+#[test]
+fn qos_sized_from_the_swarm_admits_every_agent_as_a_publisher() {
+    let run = TestRun::new("qos");
+    let t = Transport::builder(&run.run).node_name("swarm").create().unwrap();
+    let agents = 16;
+    let qos = Qos::reliable(agents);
+    let rx = t.receiver::<Candidate>("candidates", qos).unwrap();
+    let senders: Vec<_> = (0..agents)
+        .map(|_| t.sender::<Candidate>("candidates", qos).unwrap())
+        .collect();
+    for (i, tx) in senders.iter().enumerate() {
+        tx.send(Candidate {
+            agent: i as u32,
+            ..Candidate::default()
+        })
+        .unwrap();
+    }
+    let mut seen = vec![false; agents];
+    rx.drain(|c| seen[c.agent as usize] = true).unwrap();
+    assert!(seen.iter().all(|s| *s));
+    // iceoryx2's default (two publishers per service) would have refused the third.
+    let default_sized = TestRun::new("qos-default");
+    let t2 = Transport::builder(&default_sized.run).create().unwrap();
+    let two = Qos {
+        max_publishers: 2,
+        ..Qos::reliable(1)
+    };
+    let _a = t2.sender::<Candidate>("c", two).unwrap();
+    let _b = t2.sender::<Candidate>("c", two).unwrap();
+    assert!(t2.sender::<Candidate>("c", two).is_err());
+}

@@ -36,6 +36,8 @@ enum Role {
     RecvSlice { len: usize },
     /// Holds publishers and blocks until killed.
     Hold,
+    /// Opens a sender and a receiver, prints READY and exits cleanly.
+    Probe,
 }
 
 fn main() -> ExitCode {
@@ -60,6 +62,7 @@ fn run(args: Args) -> Result<(), String> {
         Role::PubCandidates { .. } | Role::PubSlice { .. } => "sender",
         Role::RecvCandidates { .. } | Role::RecvSlice { .. } => "receiver",
         Role::Hold => "holder",
+        Role::Probe => "probe",
     };
     let t = Transport::builder(&run)
         .node_name(name)
@@ -71,6 +74,12 @@ fn run(args: Args) -> Result<(), String> {
         Role::PubSlice { len } => pub_slice(&t, len),
         Role::RecvSlice { len } => recv_slice(&t, len),
         Role::Hold => hold(&t),
+        Role::Probe => {
+            let _tx = t.sender::<Candidate>("candidates", qos()).map_err(|e| e.to_string())?;
+            let _rx = t.receiver::<Candidate>("candidates", qos()).map_err(|e| e.to_string())?;
+            ready();
+            Ok(())
+        }
     }
 }
 

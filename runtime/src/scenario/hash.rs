@@ -1,0 +1,177 @@
+//! The scenario hash written into the consensus log's run header.
+//!
+//! FNV-1a 64 over a canonical byte encoding, so the hash does not depend on TOML formatting,
+//! comments, key order, the file's location or the Rust version. It covers everything that
+//! changes what a run does:
+//!
+//! * the map: width, height, every cell's MovingAI character, the terrain layer if any, and
+//!   the corner-cutting rule;
+//! * `[robot]`, `[sim]` (including the seed), `[coordinator]` and `[restart]`, every field;
+//! * every agent (start, goal, speed, priority) in order, and every fault in order.
+//!
+//! It does **not** cover the scenario `name`, the source file name, or the map file's path
+//! (only the map's content), so renaming or moving files keeps the hash.
+//!
+//! Encoding: the tag `hnav-scenario-v1`, then each value in the order above; integers as
+//! little-endian `u64`, floats as the little-endian bits of the `f64`, booleans and enum
+//! variants as one `u64` code, options as a presence code then the value.
+
+use super::params::{ClockMode, FsyncPolicy, RestartPolicy, RestartRule};
+use super::{FaultAction, FaultSignal, FaultTarget, Scenario};
+use crate::grid::{CornerCutting, TerrainKind};
+
+/// FNV-1a 64-bit hasher.
+#[derive(Clone, Copy, Debug)]
+pub struct Fnv1a64(u64);
+
+impl Fnv1a64 {
+    const OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
+
+    /// A fresh hasher.
+    pub fn new() -> Self {
+        Fnv1a64(Self::OFFSET)
+    }
+
+    /// Feeds bytes.
+    pub fn bytes(&mut self, bytes: &[u8]) -> &mut Self {
+        for &b in bytes {
+            self.0 ^= u64::from(b);
+            self.0 = self.0.wrapping_mul(Self::PRIME);
+        }
+        self
+    }
+
+    /// Feeds an integer (as little-endian `u64`).
+    pub fn u64(&mut self, v: u64) -> &mut Self {
+        self.bytes(&v.to_le_bytes())
+    }
+
+    /// Feeds a float (its bits, little-endian).
+    pub fn f64(&mut self, v: f64) -> &mut Self {
+        self.u64(v.to_bits())
+    }
+
+    /// The hash so far.
+    pub fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+impl Default for Fnv1a64 {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+fn rule(h: &mut Fnv1a64, r: &RestartRule) {
+    let policy = match r.policy {
+        RestartPolicy::Never => 0,
+        RestartPolicy::OnFailure => 1,
+        RestartPolicy::Always => 2,
+    };
+    h.u64(policy).u64(r.max_restarts.into()).u64(r.backoff_ms);
+}
+
+/// The hash described in the [module docs](self).
+pub(super) fn scenario_hash(s: &Scenario) -> u64 {
+    let mut h = Fnv1a64::new();
+    h.bytes(b"hnav-scenario-v1");
+    let g = &s.map.grid;
+    h.u64(g.width().into()).u64(g.height().into());
+    for t in g.tiles() {
+        h.bytes(&[t.to_char() as u8]);
+    }
+    match g.terrain() {
+        None => h.u64(0),
+        Some(t) => {
+            h.u64(match t.kind() {
+                TerrainKind::Elevation => 1,
+                TerrainKind::Cost => 2,
+            });
+            for v in t.values() {
+                h.bytes(&v.to_bits().to_le_bytes());
+            }
+            &mut h
+        }
+    };
+    h.u64(match s.map.corner_cutting {
+        CornerCutting::Allowed => 1,
+        CornerCutting::Forbidden => 0,
+    });
+
+    let r = &s.robot;
+    for v in [
+        r.wheel_radius_m,
+        r.axle_track_m,
+        r.body_radius_m,
+        r.max_wheel_speed_rad_s,
+        r.max_wheel_accel_rad_s2,
+        r.motor_lag_s,
+        r.ticks_per_rev,
+        r.cell_size_m,
+    ] {
+        h.f64(v);
+    }
+
+    let sim = &s.sim;
+    h.u64(sim.step_ms.into()).u64(sim.odometry_hz.into());
+    h.u64(match sim.clock {
+        ClockMode::Lockstep => 0,
+        ClockMode::Realtime => 1,
+    });
+    h.u64(sim.seed).f64(sim.slip_std).u64(sim.watchdog_ms.into());
+
+    let c = &s.coordinator;
+    h.u64(c.round_deadline_ms.into());
+    h.u64(match c.fsync {
+        FsyncPolicy::EveryRecord => 0,
+        FsyncPolicy::Batched => 1,
+        FsyncPolicy::None => 2,
+    });
+    h.u64(c.replan_after_rounds.into()).f64(c.time_limit_s);
+
+    rule(&mut h, &s.restart.agent);
+    rule(&mut h, &s.restart.coordinator);
+    rule(&mut h, &s.restart.sim);
+
+    h.u64(s.agents.len() as u64);
+    for a in &s.agents {
+        h.u64(a.start.x.into()).u64(a.start.y.into()).u64(a.goal.x.into()).u64(a.goal.y.into());
+        h.f64(a.speed);
+        match a.priority {
+            None => h.u64(0),
+            Some(p) => h.u64(1).f64(p),
+        };
+    }
+    h.u64(s.faults.len() as u64);
+    for f in &s.faults {
+        h.u64(f.at_round);
+        h.u64(match f.action {
+            FaultAction::Kill => 0,
+        });
+        match f.target {
+            FaultTarget::Agent(i) => h.u64(0).u64(i as u64),
+            FaultTarget::Coordinator => h.u64(1),
+            FaultTarget::Sim => h.u64(2),
+        };
+        h.u64(match f.signal {
+            FaultSignal::Kill => 9,
+            FaultSignal::Term => 15,
+        });
+    }
+    h.finish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fnv1a_known_vectors() {
+        // Published FNV-1a 64 test vectors.
+        assert_eq!(Fnv1a64::new().finish(), 0xcbf2_9ce4_8422_2325);
+        assert_eq!(Fnv1a64::new().bytes(b"a").finish(), 0xaf63_dc4c_8601_ec8c);
+        assert_eq!(Fnv1a64::new().bytes(b"foobar").finish(), 0x8594_4171_f739_67e8);
+    }
+}
