@@ -1,1 +1,121 @@
-fn main(){}
+//! `hnav`: the HNAV command line. Argument parsing only; the work is done by
+//! `hnav_runtime::scenario` and `hnav_runtime::grid`.
+//!
+//! Exit codes: 0 all good, 1 checks ran and found problems (or the report could not be
+//! written), 2 the input could not be loaded or is invalid (and for usage errors, via clap).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use hnav_runtime::grid::check::check_map;
+use hnav_runtime::scenario::{default_out_dir, Scenario, ScenarioReport};
+
+/// HNAV swarm-robot runtime.
+#[derive(Parser, Debug)]
+#[command(name = "hnav", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Load and validate a scenario, print a summary and write scenario-report.json.
+    Check {
+        /// The scenario TOML file.
+        scenario: PathBuf,
+        /// Output directory [default: target/hnav-out/NAME, NAME = the scenario name].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Use exactly N agents (the first N, or extra seeded random ones).
+        #[arg(long, value_name = "N")]
+        agents: Option<usize>,
+        /// Seed for generated agents [default: the scenario's sim.seed].
+        #[arg(long, value_name = "S")]
+        seed: Option<u64>,
+    },
+    /// MovingAI map tools.
+    Map {
+        #[command(subcommand)]
+        command: MapCommand,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum MapCommand {
+    /// Load a .map (and a .scen), validate every entry and check every optimal length.
+    Check {
+        /// The .map file.
+        map: PathBuf,
+        /// A .scen file to check against the map.
+        #[arg(long)]
+        scen: Option<PathBuf>,
+    },
+}
+
+fn main() -> ExitCode {
+    match Cli::parse().command {
+        Command::Check {
+            scenario,
+            out,
+            agents,
+            seed,
+        } => check(scenario, out, agents, seed),
+        Command::Map {
+            command: MapCommand::Check { map, scen },
+        } => map_check(map, scen),
+    }
+}
+
+fn check(
+    path: PathBuf,
+    out: Option<PathBuf>,
+    agents: Option<usize>,
+    seed: Option<u64>,
+) -> ExitCode {
+    let loaded = Scenario::load(&path).and_then(|s| match agents {
+        Some(n) => {
+            let seed = seed.unwrap_or(s.sim.seed);
+            s.with_agent_count(n, seed)
+        }
+        None => Ok(s),
+    });
+    let scenario = match loaded {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let report = ScenarioReport::new(&scenario);
+    print!("{}", report.render());
+    let dir = out.unwrap_or_else(|| default_out_dir(&scenario.name));
+    match report.write_json(&dir) {
+        Ok(p) => {
+            println!("report    {}", p.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {}: cannot write report: {e}", dir.display());
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn map_check(map: PathBuf, scen: Option<PathBuf>) -> ExitCode {
+    match check_map(&map, scen.as_deref()) {
+        Ok(c) => {
+            print!("{}", c.render(20));
+            if c.is_ok() {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

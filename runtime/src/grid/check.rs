@@ -72,7 +72,13 @@ impl MapCheck {
         if let Some(scen) = &self.scen_source {
             let good = self.entries - self.invalid.len() - self.mismatches.len();
             let _ = writeln!(out, "scen     {scen}");
-            let _ = writeln!(out, "entries  {} ({good} ok, {} invalid, {} wrong length)", self.entries, self.invalid.len(), self.mismatches.len());
+            let _ = writeln!(
+                out,
+                "entries  {} ({good} ok, {} invalid, {} wrong length)",
+                self.entries,
+                self.invalid.len(),
+                self.mismatches.len()
+            );
         }
         for w in &self.warnings {
             let _ = writeln!(out, "warning: {w}");
@@ -81,7 +87,9 @@ impl MapCheck {
             let _ = writeln!(out, "error: {e}");
         }
         for m in self.mismatches.iter().take(limit) {
-            let found = m.found.map_or_else(|| "unreachable".to_string(), |f| format!("{f:.8}"));
+            let found = m
+                .found
+                .map_or_else(|| "unreachable".to_string(), |f| format!("{f:.8}"));
             let scen = self.scen_source.as_deref().unwrap_or("<scen>");
             let _ = writeln!(
                 out,
@@ -89,7 +97,8 @@ impl MapCheck {
                 m.line, m.expected, m.start, m.goal
             );
         }
-        let hidden = self.invalid.len().saturating_sub(limit) + self.mismatches.len().saturating_sub(limit);
+        let hidden =
+            self.invalid.len().saturating_sub(limit) + self.mismatches.len().saturating_sub(limit);
         if hidden > 0 {
             let _ = writeln!(out, "... and {hidden} more");
         }
@@ -112,12 +121,17 @@ pub fn check_map(map: &Path, scen: Option<&Path>) -> Result<MapCheck, GridError>
         mismatches: Vec::new(),
         warnings: Vec::new(),
     };
-    let Some(scen_path) = scen else { return Ok(check) };
+    let Some(scen_path) = scen else {
+        return Ok(check);
+    };
     let scen = read_scen_file(scen_path)?;
     check.scen_source = Some(scen.source_name.clone());
     check.entries = scen.entries.len();
     check.invalid = validate_scen(&check.grid, &scen);
-    let map_name = map.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let map_name = map
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     if let Some(other) = scen.entries.iter().find(|e| e.map != map_name) {
         check.warnings.push(format!(
             "{}:{}: entry names map {:?}, checking against {:?}",
@@ -128,7 +142,8 @@ pub fn check_map(map: &Path, scen: Option<&Path>) -> Result<MapCheck, GridError>
         if e.validate(&check.grid, &scen.source_name).is_err() {
             continue;
         }
-        let found = octile_shortest_path_len(&check.grid, e.start, e.goal, CornerCutting::Forbidden);
+        let found =
+            octile_shortest_path_len(&check.grid, e.start, e.goal, CornerCutting::Forbidden);
         if found.is_none_or(|f| (f - e.optimal_length).abs() > LENGTH_TOLERANCE) {
             check.mismatches.push(LengthMismatch {
                 line: e.line,

@@ -88,7 +88,10 @@ mod tests {
         // 10 straight + 2 diagonal moves.
         let d = octile(Cell::new(17, 21), Cell::new(5, 19));
         assert!((d - 12.828_427_12).abs() < 1e-8, "{d}");
-        assert_eq!(octile(Cell::new(3, 9), Cell::new(7, 1)), octile(Cell::new(7, 1), Cell::new(3, 9)));
+        assert_eq!(
+            octile(Cell::new(3, 9), Cell::new(7, 1)),
+            octile(Cell::new(7, 1), Cell::new(3, 9))
+        );
     }
 
     #[test]

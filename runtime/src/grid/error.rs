@@ -46,6 +46,15 @@ impl fmt::Display for Endpoint {
     }
 }
 
+/// `"s"` unless `n == 1`, for messages like "row has 1 character".
+fn plural(n: usize) -> &'static str {
+    if n == 1 {
+        ""
+    } else {
+        "s"
+    }
+}
+
 /// Everything that can go wrong while building, reading or validating grids and MovingAI files.
 ///
 /// The field is called `source_name` rather than `source` because `thiserror` treats a field
@@ -130,7 +139,7 @@ pub enum GridError {
         problem: String,
     },
     /// A map row whose length differs from the declared width.
-    #[error("{source_name}:{line}: row has {found} characters, expected {expected}")]
+    #[error("{source_name}:{line}: row has {found} character{}, expected {expected}", plural(*.found))]
     RowWidth {
         /// File name or `"<inline>"`.
         source_name: String,
@@ -164,9 +173,7 @@ pub enum GridError {
         expected: u32,
     },
     /// A character that is not one of `. G S W T @ O`.
-    #[error(
-        "{source_name}:{line}:{column}: unknown map character {ch:?} (known: . G S W T @ O)"
-    )]
+    #[error("{source_name}:{line}:{column}: unknown map character {ch:?} (known: . G S W T @ O)")]
     UnknownChar {
         /// File name or `"<inline>"`.
         source_name: String,
@@ -338,7 +345,10 @@ mod tests {
             found: 31,
             expected: 32,
         };
-        assert_eq!(e.to_string(), "maps/x.map:7: row has 31 characters, expected 32");
+        assert_eq!(
+            e.to_string(),
+            "maps/x.map:7: row has 31 characters, expected 32"
+        );
         assert_eq!(e.line(), Some(7));
         assert_eq!(e.source_name(), Some("maps/x.map"));
     }

@@ -86,7 +86,13 @@ impl Grid {
             });
         }
         let blocked = tiles.iter().map(|t| !t.is_passable()).collect();
-        Ok(Grid { width, height, tiles, blocked, terrain: None })
+        Ok(Grid {
+            width,
+            height,
+            tiles,
+            blocked,
+            terrain: None,
+        })
     }
 
     /// A grid from row-major blocked flags; blocked cells become `@`, free ones `.`.
@@ -175,14 +181,20 @@ impl Grid {
         }
         let w = self.width as usize;
         // Both quotients are < 2^26, so they fit in u32.
-        Some(Cell { x: (index % w) as u32, y: (index / w) as u32 })
+        Some(Cell {
+            x: (index % w) as u32,
+            y: (index / w) as u32,
+        })
     }
 
     /// The dissertation's 1-based row-major cell id, `y * width + x + 1`. Only meaningful for
     /// cells inside the grid (outside cells give a wrapped number, never a panic); see
     /// [`Self::checked_cell_id`].
     pub fn cell_id(&self, cell: Cell) -> u32 {
-        cell.y.wrapping_mul(self.width).wrapping_add(cell.x).wrapping_add(1)
+        cell.y
+            .wrapping_mul(self.width)
+            .wrapping_add(cell.x)
+            .wrapping_add(1)
     }
 
     /// The 1-based cell id, or `None` for a cell outside the grid.
@@ -221,7 +233,14 @@ impl Grid {
 
     /// Blocks (`@`) or frees (`.`) a cell. Returns `false` if the cell is outside the grid.
     pub fn set_blocked(&mut self, cell: Cell, blocked: bool) -> bool {
-        self.set_tile(cell, if blocked { Tile::OutOfBounds } else { Tile::Ground })
+        self.set_tile(
+            cell,
+            if blocked {
+                Tile::OutOfBounds
+            } else {
+                Tile::Ground
+            },
+        )
     }
 
     /// Whether a cell is blocked. Cells outside the grid count as blocked, which is what
@@ -284,7 +303,12 @@ impl Grid {
             return None;
         }
         let start = y as usize * self.width as usize;
-        Some(self.tiles[start..start + self.width as usize].iter().map(|t| t.to_char()).collect())
+        Some(
+            self.tiles[start..start + self.width as usize]
+                .iter()
+                .map(|t| t.to_char())
+                .collect(),
+        )
     }
 }
 
@@ -319,7 +343,10 @@ mod tests {
     #[test]
     fn shape_errors() {
         assert!(matches!(Grid::new(0, 5), Err(GridError::BadShape { .. })));
-        assert!(matches!(Grid::new(1 << 14, 1 << 14), Err(GridError::BadShape { .. })));
+        assert!(matches!(
+            Grid::new(1 << 14, 1 << 14),
+            Err(GridError::BadShape { .. })
+        ));
         assert!(Grid::from_tiles(2, 2, vec![Tile::Ground; 3]).is_err());
     }
 

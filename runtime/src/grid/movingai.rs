@@ -59,8 +59,24 @@ pub fn read_map(text: &str, source_name: &str) -> Result<Grid, GridError> {
                     found: value.into(),
                 })
             }
-            "height" => height = Some(parse_dimension(value, Dimension::Height, height, source_name, line)?),
-            "width" => width = Some(parse_dimension(value, Dimension::Width, width, source_name, line)?),
+            "height" => {
+                height = Some(parse_dimension(
+                    value,
+                    Dimension::Height,
+                    height,
+                    source_name,
+                    line,
+                )?)
+            }
+            "width" => {
+                width = Some(parse_dimension(
+                    value,
+                    Dimension::Width,
+                    width,
+                    source_name,
+                    line,
+                )?)
+            }
             _ => {
                 return Err(GridError::BadHeaderLine {
                     source_name: source_name.into(),
@@ -70,7 +86,11 @@ pub fn read_map(text: &str, source_name: &str) -> Result<Grid, GridError> {
             }
         }
     };
-    let missing = |which| GridError::MissingDimension { source_name: source_name.into(), line: map_line, which };
+    let missing = |which| GridError::MissingDimension {
+        source_name: source_name.into(),
+        line: map_line,
+        which,
+    };
     let height = height.ok_or_else(|| missing(Dimension::Height))?;
     let width = width.ok_or_else(|| missing(Dimension::Width))?;
     let cells = Grid::checked_len(width, height, source_name, map_line)?;
@@ -92,7 +112,11 @@ pub fn read_map(text: &str, source_name: &str) -> Result<Grid, GridError> {
         rows_read += 1;
     }
     if let Some((line, _)) = lines.find(|(_, l)| !l.trim().is_empty()) {
-        return Err(GridError::TooManyRows { source_name: source_name.into(), line, expected: height });
+        return Err(GridError::TooManyRows {
+            source_name: source_name.into(),
+            line,
+            expected: height,
+        });
     }
     Grid::from_tiles(width, height, tiles)
 }
@@ -201,10 +225,21 @@ fn parse_dimension(
 }
 
 /// Appends one row's tiles after checking its width and characters.
-fn push_row(tiles: &mut Vec<Tile>, row: &str, width: u32, source_name: &str, line: usize) -> Result<(), GridError> {
+fn push_row(
+    tiles: &mut Vec<Tile>,
+    row: &str,
+    width: u32,
+    source_name: &str,
+    line: usize,
+) -> Result<(), GridError> {
     let found = row.chars().count();
     if found != width as usize {
-        return Err(GridError::RowWidth { source_name: source_name.into(), line, found, expected: width });
+        return Err(GridError::RowWidth {
+            source_name: source_name.into(),
+            line,
+            found,
+            expected: width,
+        });
     }
     for (i, ch) in row.chars().enumerate() {
         let tile = Tile::from_char(ch).ok_or_else(|| GridError::UnknownChar {
@@ -241,29 +276,75 @@ mod tests {
         let g = read_map(text, "crlf.map").unwrap();
         assert_eq!((g.width(), g.height()), (3, 2));
         assert_eq!(g.tile(Cell::new(2, 0)), Some(Tile::Swamp));
-        assert_eq!(write_map(&g), text.replace("\r\n", "\n").replace("width 3\nheight 2", "height 2\nwidth 3"));
+        assert_eq!(
+            write_map(&g),
+            text.replace("\r\n", "\n")
+                .replace("width 3\nheight 2", "height 2\nwidth 3")
+        );
     }
 
     #[test]
     fn header_errors() {
         let e = read_map("type octile\nheight 4\n", "t.map").unwrap_err();
-        assert_eq!(e, GridError::TruncatedHeader { source_name: "t.map".into(), line: 3 });
+        assert_eq!(
+            e,
+            GridError::TruncatedHeader {
+                source_name: "t.map".into(),
+                line: 3
+            }
+        );
         let e = read_map("type octile\nheight x\nwidth 2\nmap\n", "t.map").unwrap_err();
-        assert!(matches!(e, GridError::BadDimension { line: 2, which: Dimension::Height, .. }), "{e}");
+        assert!(
+            matches!(
+                e,
+                GridError::BadDimension {
+                    line: 2,
+                    which: Dimension::Height,
+                    ..
+                }
+            ),
+            "{e}"
+        );
         let e = read_map("type octile\nheight 0\nwidth 2\nmap\n", "t.map").unwrap_err();
         assert!(matches!(e, GridError::BadDimension { line: 2, .. }), "{e}");
         let e = read_map("type octile\nwidth 2\nwidth 2\nmap\n", "t.map").unwrap_err();
-        assert!(matches!(e, GridError::BadDimension { line: 3, which: Dimension::Width, .. }), "{e}");
+        assert!(
+            matches!(
+                e,
+                GridError::BadDimension {
+                    line: 3,
+                    which: Dimension::Width,
+                    ..
+                }
+            ),
+            "{e}"
+        );
         let e = read_map("type octile\nheight 2\nmap\n..\n..\n", "t.map").unwrap_err();
-        assert!(matches!(e, GridError::MissingDimension { line: 3, which: Dimension::Width, .. }), "{e}");
+        assert!(
+            matches!(
+                e,
+                GridError::MissingDimension {
+                    line: 3,
+                    which: Dimension::Width,
+                    ..
+                }
+            ),
+            "{e}"
+        );
         let e = read_map("type hex\nheight 2\nwidth 2\nmap\n", "t.map").unwrap_err();
-        assert!(matches!(e, GridError::UnsupportedType { line: 1, .. }), "{e}");
+        assert!(
+            matches!(e, GridError::UnsupportedType { line: 1, .. }),
+            "{e}"
+        );
         let e = read_map("type octile\nsize 2\n", "t.map").unwrap_err();
         assert!(matches!(e, GridError::BadHeaderLine { line: 2, .. }), "{e}");
         let e = read_map("type octile\nheight 100000\nwidth 100000\nmap\n", "t.map").unwrap_err();
         assert!(matches!(e, GridError::BadShape { line: 4, .. }), "{e}");
         let e = read_map("", "t.map").unwrap_err();
-        assert!(matches!(e, GridError::TruncatedHeader { line: 1, .. }), "{e}");
+        assert!(
+            matches!(e, GridError::TruncatedHeader { line: 1, .. }),
+            "{e}"
+        );
     }
 
     #[test]
@@ -271,11 +352,40 @@ mod tests {
         let e = read_map("type octile\nheight 2\nwidth 3\nmap\n...\n..\n", "x.map").unwrap_err();
         assert_eq!(e.to_string(), "x.map:6: row has 2 characters, expected 3");
         let e = read_map("type octile\nheight 2\nwidth 3\nmap\n...\n.x.\n", "x.map").unwrap_err();
-        assert_eq!(e, GridError::UnknownChar { source_name: "x.map".into(), line: 6, column: 2, ch: 'x' });
+        assert_eq!(
+            e,
+            GridError::UnknownChar {
+                source_name: "x.map".into(),
+                line: 6,
+                column: 2,
+                ch: 'x'
+            }
+        );
         let e = read_map("type octile\nheight 3\nwidth 3\nmap\n...\n...\n", "x.map").unwrap_err();
-        assert!(matches!(e, GridError::TooFewRows { line: 7, found: 2, expected: 3, .. }), "{e}");
+        assert!(
+            matches!(
+                e,
+                GridError::TooFewRows {
+                    line: 7,
+                    found: 2,
+                    expected: 3,
+                    ..
+                }
+            ),
+            "{e}"
+        );
         let e = read_map("type octile\nheight 1\nwidth 3\nmap\n...\n\n...\n", "x.map").unwrap_err();
-        assert!(matches!(e, GridError::TooManyRows { line: 7, expected: 1, .. }), "{e}");
+        assert!(
+            matches!(
+                e,
+                GridError::TooManyRows {
+                    line: 7,
+                    expected: 1,
+                    ..
+                }
+            ),
+            "{e}"
+        );
         // Trailing blank lines are fine.
         assert!(read_map("type octile\nheight 1\nwidth 3\nmap\n...\n\n\n", "x.map").is_ok());
     }
@@ -285,7 +395,18 @@ mod tests {
         let g = read_map_rows([(3, "..@"), (4, "...")], "s.toml").unwrap();
         assert_eq!((g.width(), g.height()), (3, 2));
         let e = read_map_rows([(3, "..@"), (4, "....")], "s.toml").unwrap_err();
-        assert!(matches!(e, GridError::RowWidth { line: 4, found: 4, expected: 3, .. }), "{e}");
+        assert!(
+            matches!(
+                e,
+                GridError::RowWidth {
+                    line: 4,
+                    found: 4,
+                    expected: 3,
+                    ..
+                }
+            ),
+            "{e}"
+        );
         let e = read_map_rows([(3, "")], "s.toml").unwrap_err();
         assert!(matches!(e, GridError::BadShape { line: 3, .. }), "{e}");
         assert!(read_map_rows(std::iter::empty(), "s.toml").is_err());

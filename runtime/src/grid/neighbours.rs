@@ -44,7 +44,16 @@ pub enum Direction {
 }
 
 /// `(dx, dy)` per direction, indexed by [`Direction::index`].
-const DELTAS: [(i32, i32); 8] = [(0, -1), (1, -1), (1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1)];
+const DELTAS: [(i32, i32); 8] = [
+    (0, -1),
+    (1, -1),
+    (1, 0),
+    (1, 1),
+    (0, 1),
+    (-1, 1),
+    (-1, 0),
+    (-1, -1),
+];
 
 impl Direction {
     /// All directions, clockwise from north.
@@ -128,7 +137,8 @@ pub enum CornerCutting {
 impl Grid {
     /// The neighbour of `cell` in direction `dir`, if it lies inside the grid (blocked or not).
     pub fn step(&self, cell: Cell, dir: Direction) -> Option<Cell> {
-        cell.offset(dir.dx(), dir.dy()).filter(|&c| self.contains(c))
+        cell.offset(dir.dx(), dir.dy())
+            .filter(|&c| self.contains(c))
     }
 
     /// Whether a robot on `cell` may move one step in `dir` under `rule`: the target must be
@@ -144,8 +154,14 @@ impl Grid {
         }
         if dir.is_diagonal() && rule == CornerCutting::Forbidden {
             // Both corners are inside the grid because the diagonal target is.
-            let side_x = Cell { x: target.x, y: cell.y };
-            let side_y = Cell { x: cell.x, y: target.y };
+            let side_x = Cell {
+                x: target.x,
+                y: cell.y,
+            };
+            let side_y = Cell {
+                x: cell.x,
+                y: target.y,
+            };
             return !self.is_blocked(side_x) && !self.is_blocked(side_y);
         }
         true
@@ -154,7 +170,12 @@ impl Grid {
     /// The free neighbours of `cell` reachable in one move under `rule`, in
     /// [`Direction::ALL`] order. Does not allocate.
     pub fn neighbours(&self, cell: Cell, rule: CornerCutting) -> Neighbours<'_> {
-        Neighbours { grid: self, cell, rule, next: 0 }
+        Neighbours {
+            grid: self,
+            cell,
+            rule,
+            next: 0,
+        }
     }
 }
 
@@ -228,7 +249,9 @@ mod tests {
     #[test]
     fn open_centre_has_eight_and_corner_three() {
         let g = Grid::new(3, 3).unwrap();
-        let all: Vec<_> = g.neighbours(Cell::new(1, 1), CornerCutting::Forbidden).collect();
+        let all: Vec<_> = g
+            .neighbours(Cell::new(1, 1), CornerCutting::Forbidden)
+            .collect();
         assert_eq!(all.len(), 8);
         assert_eq!(all[0], (Direction::N, Cell::new(1, 0)));
         assert_eq!(all[7], (Direction::NW, Cell::new(0, 0)));
@@ -251,14 +274,26 @@ mod tests {
         let g = grid(&[".@", "@."]);
         assert!(g.can_move(Cell::new(0, 0), Direction::SE, CornerCutting::Allowed));
         assert!(!g.can_move(Cell::new(0, 0), Direction::SE, CornerCutting::Forbidden));
-        assert_eq!(g.neighbours(Cell::new(0, 0), CornerCutting::Forbidden).count(), 0);
-        assert_eq!(g.neighbours(Cell::new(1, 1), CornerCutting::Allowed).count(), 1);
+        assert_eq!(
+            g.neighbours(Cell::new(0, 0), CornerCutting::Forbidden)
+                .count(),
+            0
+        );
+        assert_eq!(
+            g.neighbours(Cell::new(1, 1), CornerCutting::Allowed)
+                .count(),
+            1
+        );
     }
 
     #[test]
     fn never_leaves_grid() {
         let g = Grid::new(1, 1).unwrap();
-        assert_eq!(g.neighbours(Cell::new(0, 0), CornerCutting::Allowed).count(), 0);
+        assert_eq!(
+            g.neighbours(Cell::new(0, 0), CornerCutting::Allowed)
+                .count(),
+            0
+        );
         assert_eq!(g.step(Cell::new(0, 0), Direction::N), None);
         assert!(!g.can_move(Cell::new(5, 5), Direction::S, CornerCutting::Allowed));
     }

@@ -48,7 +48,14 @@ pub struct ScenEntry {
 
 impl ScenEntry {
     /// An entry made in code (line 0; the length is written with 8 decimals).
-    pub fn new(map: &str, map_width: u32, map_height: u32, start: Cell, goal: Cell, optimal_length: f64) -> Self {
+    pub fn new(
+        map: &str,
+        map_width: u32,
+        map_height: u32,
+        start: Cell,
+        goal: Cell,
+        optimal_length: f64,
+    ) -> Self {
         ScenEntry {
             bucket: 0,
             map: map.into(),
@@ -125,8 +132,17 @@ pub struct ScenFile {
 }
 
 /// Field names, 1-based field `i` is `FIELDS[i - 1]`.
-const FIELDS: [&str; 9] =
-    ["bucket", "map", "map_width", "map_height", "start_x", "start_y", "goal_x", "goal_y", "optimal_length"];
+const FIELDS: [&str; 9] = [
+    "bucket",
+    "map",
+    "map_width",
+    "map_height",
+    "start_x",
+    "start_y",
+    "goal_x",
+    "goal_y",
+    "optimal_length",
+];
 
 /// Reads a `.scen` from text; `source_name` is used in errors and kept in the result.
 pub fn read_scen(text: &str, source_name: &str) -> Result<ScenFile, GridError> {
@@ -135,7 +151,11 @@ pub fn read_scen(text: &str, source_name: &str) -> Result<ScenFile, GridError> {
     let version = match first.trim().split_once(char::is_whitespace) {
         Some(("version", v)) if matches!(v.trim(), "1" | "1.0") => v.trim().to_string(),
         _ => {
-            return Err(GridError::BadVersion { source_name: source_name.into(), line: 1, found: first.into() })
+            return Err(GridError::BadVersion {
+                source_name: source_name.into(),
+                line: 1,
+                found: first.into(),
+            })
         }
     };
     let mut entries = Vec::new();
@@ -145,7 +165,11 @@ pub fn read_scen(text: &str, source_name: &str) -> Result<ScenFile, GridError> {
         }
         entries.push(parse_entry(text, source_name, line)?);
     }
-    Ok(ScenFile { source_name: source_name.into(), version, entries })
+    Ok(ScenFile {
+        source_name: source_name.into(),
+        version,
+        entries,
+    })
 }
 
 /// Reads a `.scen` file; errors and [`ScenFile::source_name`] carry the path as given.
@@ -192,7 +216,11 @@ pub fn validate_scen(grid: &Grid, scen: &ScenFile) -> Vec<GridError> {
 fn parse_entry(text: &str, source_name: &str, line: usize) -> Result<ScenEntry, GridError> {
     let fields: Vec<&str> = text.split('\t').collect();
     if fields.len() != FIELDS.len() {
-        return Err(GridError::FieldCount { source_name: source_name.into(), line, found: fields.len() });
+        return Err(GridError::FieldCount {
+            source_name: source_name.into(),
+            line,
+            found: fields.len(),
+        });
     }
     let bad = |i: usize, expected: &'static str| GridError::BadField {
         source_name: source_name.into(),
@@ -202,7 +230,12 @@ fn parse_entry(text: &str, source_name: &str, line: usize) -> Result<ScenEntry, 
         expected,
         value: fields[i].into(),
     };
-    let int = |i: usize| fields[i].trim().parse::<u32>().map_err(|_| bad(i, "a non-negative integer"));
+    let int = |i: usize| {
+        fields[i]
+            .trim()
+            .parse::<u32>()
+            .map_err(|_| bad(i, "a non-negative integer"))
+    };
     let map = fields[1].trim();
     if map.is_empty() {
         return Err(bad(1, "a map name"));
@@ -240,8 +273,14 @@ mod tests {
         assert_eq!(s.version, "1");
         assert_eq!(s.entries.len(), 2);
         let e = &s.entries[0];
-        assert_eq!((e.bucket, e.map.as_str(), e.map_width, e.map_height), (3, "maze-32-32-2.map", 32, 32));
-        assert_eq!((e.start, e.goal, e.line), (Cell::new(17, 21), Cell::new(15, 16), 2));
+        assert_eq!(
+            (e.bucket, e.map.as_str(), e.map_width, e.map_height),
+            (3, "maze-32-32-2.map", 32, 32)
+        );
+        assert_eq!(
+            (e.start, e.goal, e.line),
+            (Cell::new(17, 21), Cell::new(15, 16), 2)
+        );
         assert_eq!(e.optimal_length, 13.82842712);
         assert_eq!(write_scen(&s), SCEN);
         let s = read_scen("version 1.0\r\n", "b.scen").unwrap();
@@ -261,11 +300,32 @@ mod tests {
     fn errors_have_lines() {
         let e = read_scen("version 2\n", "a.scen").unwrap_err();
         assert!(matches!(e, GridError::BadVersion { line: 1, .. }), "{e}");
-        assert!(matches!(read_scen("", "a.scen"), Err(GridError::BadVersion { .. })));
+        assert!(matches!(
+            read_scen("", "a.scen"),
+            Err(GridError::BadVersion { .. })
+        ));
         let e = read_scen("version 1\n\n0\tm.map\t4\t4\t0\t0\t0\t2\n", "a.scen").unwrap_err();
-        assert_eq!(e, GridError::FieldCount { source_name: "a.scen".into(), line: 3, found: 8 });
+        assert_eq!(
+            e,
+            GridError::FieldCount {
+                source_name: "a.scen".into(),
+                line: 3,
+                found: 8
+            }
+        );
         let e = read_scen("version 1\n0\tm.map\t4\t4\t-1\t0\t0\t2\t0\n", "a.scen").unwrap_err();
-        assert!(matches!(e, GridError::BadField { line: 2, field: 5, name: "start_x", .. }), "{e}");
+        assert!(
+            matches!(
+                e,
+                GridError::BadField {
+                    line: 2,
+                    field: 5,
+                    name: "start_x",
+                    ..
+                }
+            ),
+            "{e}"
+        );
         let e = read_scen("version 1\n0\tm.map\t4\t4\t1\t0\t0\t2\tabc\n", "a.scen").unwrap_err();
         assert!(matches!(e, GridError::BadField { field: 9, .. }), "{e}");
         let e = read_scen("version 1\n0\tm.map\t4\t4\t1\t0\t0\t2\tNaN\n", "a.scen").unwrap_err();
@@ -284,10 +344,43 @@ mod tests {
         let s = read_scen(text, "m.scen").unwrap();
         let errs = validate_scen(&g, &s);
         assert_eq!(errs.len(), 4);
-        assert!(matches!(errs[0], GridError::SizeMismatch { line: 3, scen_height: 3, .. }));
-        assert!(matches!(errs[1], GridError::OutsideMap { line: 4, endpoint: Endpoint::Goal, x: 3, .. }));
-        assert!(matches!(errs[2], GridError::OnObstacle { line: 5, endpoint: Endpoint::Start, ch: '@', .. }));
-        assert!(matches!(errs[3], GridError::OnObstacle { line: 6, endpoint: Endpoint::Goal, .. }));
-        assert_eq!(errs[2].to_string(), "m.scen:5: start (1, 0) is on an obstacle ('@')");
+        assert!(matches!(
+            errs[0],
+            GridError::SizeMismatch {
+                line: 3,
+                scen_height: 3,
+                ..
+            }
+        ));
+        assert!(matches!(
+            errs[1],
+            GridError::OutsideMap {
+                line: 4,
+                endpoint: Endpoint::Goal,
+                x: 3,
+                ..
+            }
+        ));
+        assert!(matches!(
+            errs[2],
+            GridError::OnObstacle {
+                line: 5,
+                endpoint: Endpoint::Start,
+                ch: '@',
+                ..
+            }
+        ));
+        assert!(matches!(
+            errs[3],
+            GridError::OnObstacle {
+                line: 6,
+                endpoint: Endpoint::Goal,
+                ..
+            }
+        ));
+        assert_eq!(
+            errs[2].to_string(),
+            "m.scen:5: start (1, 0) is on an obstacle ('@')"
+        );
     }
 }

@@ -36,7 +36,11 @@ impl PartialOrd for Open {
 }
 impl Ord for Open {
     fn cmp(&self, other: &Self) -> Ordering {
-        other.f.total_cmp(&self.f).then(self.g.total_cmp(&other.g)).then(other.index.cmp(&self.index))
+        other
+            .f
+            .total_cmp(&self.f)
+            .then(self.g.total_cmp(&other.g))
+            .then(other.index.cmp(&self.index))
     }
 }
 
@@ -53,7 +57,11 @@ fn astar(grid: &Grid, start: Cell, goal: Cell, rule: CornerCutting) -> Option<(f
     let mut closed = vec![false; n];
     let mut open = BinaryHeap::new();
     g[start_i] = 0.0;
-    open.push(Open { f: octile(start, goal), g: 0.0, index: start_i });
+    open.push(Open {
+        f: octile(start, goal),
+        g: 0.0,
+        index: start_i,
+    });
     while let Some(Open { g: cost, index, .. }) = open.pop() {
         if closed[index] {
             continue;
@@ -62,14 +70,20 @@ fn astar(grid: &Grid, start: Cell, goal: Cell, rule: CornerCutting) -> Option<(f
         if index == goal_i {
             return Some((cost, parent));
         }
-        let Some(cell) = grid.cell_at(index) else { continue };
+        let Some(cell) = grid.cell_at(index) else {
+            continue;
+        };
         for (dir, next) in grid.neighbours(cell, rule) {
             let ni = grid.index(next);
             let ng = cost + dir.cost();
             if !closed[ni] && ng < g[ni] {
                 g[ni] = ng;
                 parent[ni] = index;
-                open.push(Open { f: ng + octile(next, goal), g: ng, index: ni });
+                open.push(Open {
+                    f: ng + octile(next, goal),
+                    g: ng,
+                    index: ni,
+                });
             }
         }
     }
@@ -78,13 +92,23 @@ fn astar(grid: &Grid, start: Cell, goal: Cell, rule: CornerCutting) -> Option<(f
 
 /// Length of the shortest octile path from `start` to `goal` under `rule`, or `None` if
 /// either end is blocked/outside the grid or the goal is unreachable. `start == goal` gives 0.
-pub fn octile_shortest_path_len(grid: &Grid, start: Cell, goal: Cell, rule: CornerCutting) -> Option<f64> {
+pub fn octile_shortest_path_len(
+    grid: &Grid,
+    start: Cell,
+    goal: Cell,
+    rule: CornerCutting,
+) -> Option<f64> {
     astar(grid, start, goal, rule).map(|(len, _)| len)
 }
 
 /// A shortest octile path as its length and cells (`start` first, `goal` last), or `None`
 /// like [`octile_shortest_path_len`].
-pub fn octile_shortest_path(grid: &Grid, start: Cell, goal: Cell, rule: CornerCutting) -> Option<(f64, Vec<Cell>)> {
+pub fn octile_shortest_path(
+    grid: &Grid,
+    start: Cell,
+    goal: Cell,
+    rule: CornerCutting,
+) -> Option<(f64, Vec<Cell>)> {
     let (len, parent) = astar(grid, start, goal, rule)?;
     let mut cells = vec![goal];
     let mut i = grid.index(goal);
@@ -131,7 +155,12 @@ mod tests {
     #[test]
     fn open_grid_equals_octile() {
         let g = Grid::new(20, 10).unwrap();
-        for (a, b) in [((0, 0), (19, 9)), ((3, 7), (3, 7)), ((5, 1), (12, 1)), ((19, 0), (0, 9))] {
+        for (a, b) in [
+            ((0, 0), (19, 9)),
+            ((3, 7), (3, 7)),
+            ((5, 1), (12, 1)),
+            ((19, 0), (0, 9)),
+        ] {
             let (a, b) = (Cell::new(a.0, a.1), Cell::new(b.0, b.1));
             let len = octile_shortest_path_len(&g, a, b, CornerCutting::Forbidden).unwrap();
             assert!((len - octile(a, b)).abs() < 1e-9, "{a} {b} {len}");
@@ -142,12 +171,18 @@ mod tests {
     fn corner_cutting_changes_length() {
         let g = grid(&[".@", "@."]);
         let (a, b) = (Cell::new(0, 0), Cell::new(1, 1));
-        assert_eq!(octile_shortest_path_len(&g, a, b, CornerCutting::Forbidden), None);
+        assert_eq!(
+            octile_shortest_path_len(&g, a, b, CornerCutting::Forbidden),
+            None
+        );
         let len = octile_shortest_path_len(&g, a, b, CornerCutting::Allowed).unwrap();
         assert!((len - std::f64::consts::SQRT_2).abs() < 1e-12);
         // One blocked corner: forbidden goes around (2 straight moves).
         let g = grid(&["..", "@."]);
-        assert_eq!(octile_shortest_path_len(&g, a, b, CornerCutting::Forbidden), Some(2.0));
+        assert_eq!(
+            octile_shortest_path_len(&g, a, b, CornerCutting::Forbidden),
+            Some(2.0)
+        );
     }
 
     #[test]
@@ -169,11 +204,22 @@ mod tests {
     #[test]
     fn blocked_or_outside_ends() {
         let g = grid(&[".@."]);
-        assert_eq!(octile_shortest_path_len(&g, Cell::new(0, 0), Cell::new(1, 0), CornerCutting::Allowed), None);
-        assert_eq!(octile_shortest_path_len(&g, Cell::new(0, 0), Cell::new(2, 0), CornerCutting::Allowed), None);
-        assert_eq!(octile_shortest_path_len(&g, Cell::new(0, 0), Cell::new(9, 0), CornerCutting::Allowed), None);
+        assert_eq!(
+            octile_shortest_path_len(&g, Cell::new(0, 0), Cell::new(1, 0), CornerCutting::Allowed),
+            None
+        );
+        assert_eq!(
+            octile_shortest_path_len(&g, Cell::new(0, 0), Cell::new(2, 0), CornerCutting::Allowed),
+            None
+        );
+        assert_eq!(
+            octile_shortest_path_len(&g, Cell::new(0, 0), Cell::new(9, 0), CornerCutting::Allowed),
+            None
+        );
         let r = reachable_from(&g, Cell::new(0, 0), CornerCutting::Allowed);
         assert_eq!(r, vec![true, false, false]);
-        assert!(reachable_from(&g, Cell::new(1, 0), CornerCutting::Allowed).iter().all(|&b| !b));
+        assert!(reachable_from(&g, Cell::new(1, 0), CornerCutting::Allowed)
+            .iter()
+            .all(|&b| !b));
     }
 }

@@ -20,7 +20,10 @@ pub struct Loc {
 impl Loc {
     /// A location.
     pub fn new(source_name: &str, line: usize) -> Loc {
-        Loc { source_name: source_name.into(), line }
+        Loc {
+            source_name: source_name.into(),
+            line,
+        }
     }
 }
 
@@ -36,7 +39,9 @@ impl fmt::Display for Loc {
 
 /// Shown after a map error when the map came from a file the scenario references.
 fn referenced(from: &Option<Loc>) -> String {
-    from.as_ref().map(|l| format!(" (map referenced from {l})")).unwrap_or_default()
+    from.as_ref()
+        .map(|l| format!(" (map referenced from {l})"))
+        .unwrap_or_default()
 }
 
 /// Everything that can make a scenario unusable.
@@ -82,7 +87,8 @@ pub enum ScenarioError {
         /// The `file = ...` line for a map file; `None` for inline rows.
         referenced_from: Option<Loc>,
         /// The map error, naming the map file (or the scenario, for inline rows) and line.
-        error: GridError,
+        /// Boxed to keep `Result<_, ScenarioError>` small.
+        error: Box<GridError>,
     },
     /// `[map]` has both `file` and `rows`.
     #[error("{at}: [map] has both `file` and `rows`; give exactly one")]
@@ -271,6 +277,14 @@ pub enum ScenarioError {
 }
 
 impl ScenarioError {
+    /// The wrapped map error, for [`ScenarioError::Map`].
+    pub fn grid_error(&self) -> Option<&GridError> {
+        match self {
+            ScenarioError::Map { error, .. } => Some(error),
+            _ => None,
+        }
+    }
+
     /// The 1-based line the error points at (in the scenario or, for map errors, the map
     /// file), if known.
     pub fn line(&self) -> Option<usize> {
@@ -309,18 +323,33 @@ mod tests {
 
     #[test]
     fn display_names_file_and_line() {
-        let e = ScenarioError::NonPositiveSpeed { at: Loc::new("s.toml", 12), agent: 2, speed: -1.0 };
-        assert_eq!(e.to_string(), "s.toml:12: agent 2 speed must be a positive number of cells/s, got -1");
+        let e = ScenarioError::NonPositiveSpeed {
+            at: Loc::new("s.toml", 12),
+            agent: 2,
+            speed: -1.0,
+        };
+        assert_eq!(
+            e.to_string(),
+            "s.toml:12: agent 2 speed must be a positive number of cells/s, got -1"
+        );
         assert_eq!(e.line(), Some(12));
-        let e = ScenarioError::NoAgents { at: Loc::new("s.toml", 0) };
+        let e = ScenarioError::NoAgents {
+            at: Loc::new("s.toml", 0),
+        };
         assert_eq!(e.to_string(), "s.toml: the scenario has no [[agents]]");
         assert_eq!(e.line(), None);
         let e = ScenarioError::Map {
             referenced_from: Some(Loc::new("s.toml", 3)),
-            error: GridError::TruncatedHeader { source_name: "m.map".into(), line: 2 },
+            error: Box::new(GridError::TruncatedHeader {
+                source_name: "m.map".into(),
+                line: 2,
+            }),
         };
         assert!(e.to_string().starts_with("m.map:2: "), "{e}");
-        assert!(e.to_string().ends_with(" (map referenced from s.toml:3)"), "{e}");
+        assert!(
+            e.to_string().ends_with(" (map referenced from s.toml:3)"),
+            "{e}"
+        );
         assert_eq!(e.line(), Some(2));
     }
 }

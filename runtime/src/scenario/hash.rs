@@ -120,7 +120,9 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
         ClockMode::Lockstep => 0,
         ClockMode::Realtime => 1,
     });
-    h.u64(sim.seed).f64(sim.slip_std).u64(sim.watchdog_ms.into());
+    h.u64(sim.seed)
+        .f64(sim.slip_std)
+        .u64(sim.watchdog_ms.into());
 
     let c = &s.coordinator;
     h.u64(c.round_deadline_ms.into());
@@ -137,7 +139,10 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
 
     h.u64(s.agents.len() as u64);
     for a in &s.agents {
-        h.u64(a.start.x.into()).u64(a.start.y.into()).u64(a.goal.x.into()).u64(a.goal.y.into());
+        h.u64(a.start.x.into())
+            .u64(a.start.y.into())
+            .u64(a.goal.x.into())
+            .u64(a.goal.y.into());
         h.f64(a.speed);
         match a.priority {
             None => h.u64(0),
@@ -172,6 +177,9 @@ mod tests {
         // Published FNV-1a 64 test vectors.
         assert_eq!(Fnv1a64::new().finish(), 0xcbf2_9ce4_8422_2325);
         assert_eq!(Fnv1a64::new().bytes(b"a").finish(), 0xaf63_dc4c_8601_ec8c);
-        assert_eq!(Fnv1a64::new().bytes(b"foobar").finish(), 0x8594_4171_f739_67e8);
+        assert_eq!(
+            Fnv1a64::new().bytes(b"foobar").finish(),
+            0x8594_4171_f739_67e8
+        );
     }
 }

@@ -1,1 +1,274 @@
+//! Scenarios: the TOML description of a run, validated with file/line errors.
+//!
+//! # Format
+//!
+//! ```toml
+//! name = "demo"                        # required; names the output directory
+//!
+//! [map]                                # exactly one of `file` and `rows`
+//! file = "../maps/random-32-32-10.map" # MovingAI .map, relative to the scenario file
+//! # rows = ["....", ".@@.", "....", "...."]   # or inline MovingAI rows (. G S passable, @ O T W blocked)
+//! corner_cutting = false               # may a diagonal pass a blocked corner? default false
+//!
+//! [robot]                              # all optional; s-bot-like defaults shown
+//! wheel_radius_m = 0.021
+//! axle_track_m = 0.10
+//! body_radius_m = 0.058                # the body must fit in a cell (2 r <= cell_size_m)
+//! max_wheel_speed_rad_s = 20.0
+//! max_wheel_accel_rad_s2 = 200.0
+//! motor_lag_s = 0.02                   # first-order motor time constant, >= 0
+//! pole_pairs = 7                       # ticks_per_rev = 6 * pole_pairs * gear_ratio = 42 ...
+//! gear_ratio = 1.0
+//! # ticks_per_rev = 42                 # ... or give it directly (not together with the two above)
+//! cell_size_m = 0.12
+//!
+//! [sim]
+//! step_ms = 1                          # physics step
+//! odometry_hz = 100                    # Hall tick messages; at most one per step
+//! clock = "lockstep"                   # or "realtime"
+//! seed = 0
+//! slip_std = 0.0
+//! watchdog_ms = 100                    # wheels brake when commands are older
+//!
+//! [coordinator]
+//! round_deadline_ms = 50
+//! fsync = "every-record"               # or "batched", "none"
+//! replan_after_rounds = 3
+//! time_limit_s = 120.0
+//!
+//! [restart]                            # per role; defaults: agent and coordinator
+//! agent = { policy = "on-failure", max_restarts = 3, backoff_ms = 100 }   # "on-failure",
+//! coordinator = { policy = "on-failure" }                                 # sim "never"
+//! sim = { policy = "never" }           # policies: "never", "on-failure", "always"
+//!
+//! [[agents]]                           # one table per robot, numbered from 0
+//! start = [0, 0]                       # [x, y]: x = column, y = row, origin top-left
+//! goal = [31, 31]
+//! speed = 1.0                          # cells/s, > 0, default 1.0, within the wheels' limit
+//! priority = 2.0                       # optional, > 0; default 1 / speed
+//!
+//! [[faults]]                           # optional fault plan
+//! at_round = 10
+//! action = "kill"
+//! role = "agent"                       # or "coordinator", "sim"
+//! index = 0                            # agent number; only (and always) with role = "agent"
+//! signal = "KILL"                      # or "TERM"; default "KILL"
+//! ```
+//!
+//! Unknown keys are errors (a typo must not silently fall back to a default). Every semantic
+//! error names the file and line and has its own [`ScenarioError`] variant: a speed that is
+//! not positive, a start or goal outside the map or on an obstacle, two agents sharing a start
+//! or a goal, no agents, both or neither of `map.file`/`map.rows`, a fault naming a missing
+//! agent, and malformed map files (wrapping [`crate::grid::GridError`]).
+//!
+//! # Example
+//!
+//! ```
+//! use hnav_runtime::scenario::Scenario;
+//! use hnav_runtime::grid::Cell;
+//!
+//! let text = r#"
+//! name = "tiny"
+//! [map]
+//! rows = ["....",
+//!         ".@@.",
+//!         "...."]
+//! [[agents]]
+//! start = [0, 0]
+//! goal = [3, 2]
+//! [[agents]]
+//! start = [3, 0]
+//! goal = [0, 2]
+//! speed = 0.5
+//! "#;
+//! let s = Scenario::from_str(text, "<inline>", std::path::Path::new(".")).unwrap();
+//! assert_eq!(s.agents.len(), 2);
+//! assert_eq!(s.agents[1].goal, Cell::new(0, 2));
+//! assert_eq!(s.agents[1].effective_priority(), 2.0);
+//! assert_eq!(s.map.grid.blocked_count(), 2);
+//!
+//! let bad = text.replace("speed = 0.5", "speed = -1");
+//! let err = Scenario::from_str(&bad, "demo.toml", std::path::Path::new(".")).unwrap_err();
+//! assert_eq!(err.to_string(), "demo.toml:13: agent 1 speed must be a positive number of cells/s, got -1");
+//! ```
 
+mod agents;
+mod build;
+mod build_params;
+pub mod error;
+mod hash;
+pub mod params;
+mod raw;
+pub mod report;
+mod validate;
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+pub use agents::SplitMix64;
+pub use error::{Loc, ScenarioError};
+pub use hash::Fnv1a64;
+pub use params::{
+    ClockMode, CoordinatorParams, FsyncPolicy, RestartConfig, RestartPolicy, RestartRule,
+    RobotParams, SimParams,
+};
+pub use report::{default_out_dir, ScenarioReport};
+
+use crate::grid::{Cell, CornerCutting, Grid};
+
+/// The map of a scenario.
+#[derive(Clone, PartialEq, Debug)]
+pub struct MapSpec {
+    /// The occupancy grid.
+    pub grid: Grid,
+    /// The map file (resolved against the scenario's directory), `None` for inline rows.
+    pub file: Option<PathBuf>,
+    /// The diagonal rule for planning and conflict checks.
+    pub corner_cutting: CornerCutting,
+}
+
+/// One robot's task.
+#[derive(Clone, Copy, PartialEq, Debug)]
+pub struct AgentSpec {
+    /// Start cell.
+    pub start: Cell,
+    /// Goal cell.
+    pub goal: Cell,
+    /// Cruise speed in cells/s.
+    pub speed: f64,
+    /// Conflict priority if given (higher wins); see [`AgentSpec::effective_priority`].
+    pub priority: Option<f64>,
+}
+
+impl AgentSpec {
+    /// Speed of agents that do not give one.
+    pub const DEFAULT_SPEED: f64 = 1.0;
+
+    /// The priority used in conflicts: the given one, else the dissertation's `P = 1 / speed`.
+    pub fn effective_priority(&self) -> f64 {
+        self.priority.unwrap_or(1.0 / self.speed)
+    }
+}
+
+/// What a fault does.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+pub enum FaultAction {
+    /// Send a signal to the process.
+    Kill,
+}
+
+/// Which process a fault hits.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+pub enum FaultTarget {
+    /// The agent with this number.
+    Agent(usize),
+    /// The coordinator.
+    Coordinator,
+    /// The simulator.
+    Sim,
+}
+
+/// The signal a kill fault sends.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
+#[serde(rename_all = "UPPERCASE")]
+pub enum FaultSignal {
+    /// SIGKILL: no chance to clean up (the interesting case).
+    #[default]
+    Kill,
+    /// SIGTERM: a polite stop.
+    Term,
+}
+
+/// One planned fault.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+pub struct FaultSpec {
+    /// The decision round at which it fires.
+    pub at_round: u64,
+    /// What to do.
+    pub action: FaultAction,
+    /// To whom.
+    pub target: FaultTarget,
+    /// With which signal.
+    pub signal: FaultSignal,
+}
+
+/// A validated scenario. See the [module docs](self) for the file format.
+///
+/// Fields are public for convenience; after changing them in code, call
+/// [`Scenario::validate`] to re-check the agent and fault rules.
+#[derive(Clone, PartialEq, Debug)]
+pub struct Scenario {
+    /// The scenario's name.
+    pub name: String,
+    /// The file it was read from (as given), or `"<inline>"`.
+    pub source_name: String,
+    /// The map and its corner-cutting rule.
+    pub map: MapSpec,
+    /// Robot geometry and limits.
+    pub robot: RobotParams,
+    /// Simulator parameters.
+    pub sim: SimParams,
+    /// Coordinator parameters.
+    pub coordinator: CoordinatorParams,
+    /// Restart rules per role.
+    pub restart: RestartConfig,
+    /// The robots, numbered from 0.
+    pub agents: Vec<AgentSpec>,
+    /// The fault plan.
+    pub faults: Vec<FaultSpec>,
+}
+
+impl Scenario {
+    /// Reads and validates a scenario file; a map `file` is resolved against its directory.
+    pub fn load(path: impl AsRef<Path>) -> Result<Scenario, ScenarioError> {
+        let path = path.as_ref();
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
+            source_name: name.clone(),
+            message: e.to_string(),
+        })?;
+        let base = path.parent().unwrap_or_else(|| Path::new("."));
+        Scenario::from_str(&text, &name, base)
+    }
+
+    /// Parses and validates scenario text. `source_name` is used in errors; a map `file` is
+    /// resolved against `base_dir`.
+    pub fn from_str(
+        text: &str,
+        source_name: &str,
+        base_dir: &Path,
+    ) -> Result<Scenario, ScenarioError> {
+        build::parse(text, source_name, base_dir)
+    }
+
+    /// Re-checks the agent and fault rules (errors carry no line numbers).
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        validate::revalidate(self)
+    }
+
+    /// A stable FNV-1a 64 hash of the scenario's content, for the consensus log's run header.
+    /// Covers the map cells, corner cutting, every parameter section, the agents and the
+    /// faults; not the name or file paths. See [`Fnv1a64`] and the `hash` module source for
+    /// the exact encoding.
+    pub fn scenario_hash(&self) -> u64 {
+        hash::scenario_hash(self)
+    }
+
+    /// A copy with exactly `n` agents: the first `n` if there are enough, otherwise all of
+    /// them plus agents with seeded random starts and goals (free, distinct starts, distinct
+    /// goals, start != goal, goal reachable under the map's corner-cutting rule; speed 1,
+    /// default priority). Same scenario and seed, same agents, on every platform.
+    ///
+    /// Fails with [`ScenarioError::NoAgents`] for `n == 0`,
+    /// [`ScenarioError::FaultAgentOutOfRange`] if a fault targets a dropped agent, and
+    /// [`ScenarioError::NotEnoughFreeCells`] if the map cannot hold `n` agents.
+    pub fn with_agent_count(&self, n: usize, seed: u64) -> Result<Scenario, ScenarioError> {
+        agents::with_agent_count(self, n, seed)
+    }
+}
+
+#[cfg(test)]
+mod tests;
+#[cfg(test)]
+mod tests_generate;

@@ -83,7 +83,14 @@ pub struct SimParams {
 
 impl Default for SimParams {
     fn default() -> Self {
-        SimParams { step_ms: 1, odometry_hz: 100, clock: ClockMode::Lockstep, seed: 0, slip_std: 0.0, watchdog_ms: 100 }
+        SimParams {
+            step_ms: 1,
+            odometry_hz: 100,
+            clock: ClockMode::Lockstep,
+            seed: 0,
+            slip_std: 0.0,
+            watchdog_ms: 100,
+        }
     }
 }
 
@@ -151,7 +158,11 @@ pub struct RestartRule {
 impl RestartRule {
     /// `policy` with the default cap (3) and backoff (100 ms).
     pub const fn with_policy(policy: RestartPolicy) -> Self {
-        RestartRule { policy, max_restarts: 3, backoff_ms: 100 }
+        RestartRule {
+            policy,
+            max_restarts: 3,
+            backoff_ms: 100,
+        }
     }
 }
 
@@ -186,7 +197,10 @@ mod tests {
     fn defaults_are_consistent() {
         let r = RobotParams::default();
         assert_eq!(r.ticks_per_rev, 42.0);
-        assert!(2.0 * r.body_radius_m <= r.cell_size_m, "default body fits in a cell");
+        assert!(
+            2.0 * r.body_radius_m <= r.cell_size_m,
+            "default body fits in a cell"
+        );
         assert!((r.max_speed_cells_s() - 3.5).abs() < 1e-9);
         assert_eq!(RestartConfig::default().sim.policy, RestartPolicy::Never);
         assert_eq!(SimParams::default().clock, ClockMode::Lockstep);

@@ -1,0 +1,206 @@
+//! Validation of the parameter sections `[robot]`, `[sim]`, `[coordinator]` and `[restart]`:
+//! defaults for missing keys, range checks with the key's line for present ones.
+
+use toml::Spanned;
+
+use super::build::Lines;
+use super::error::{Loc, ScenarioError};
+use super::params::{CoordinatorParams, RestartConfig, RestartRule, RobotParams, SimParams};
+use super::raw::{RawCoordinator, RawRestart, RawRestartRule, RawRobot, RawSim};
+
+/// Reads an optional float with a default and checks it.
+fn float(
+    v: &Option<Spanned<f64>>,
+    default: f64,
+    key: &str,
+    positive: bool,
+    fallback: &Loc,
+    lines: &Lines<'_>,
+) -> Result<f64, ScenarioError> {
+    let Some(s) = v else { return Ok(default) };
+    let x = *s.get_ref();
+    let ok = x.is_finite() && if positive { x > 0.0 } else { x >= 0.0 };
+    if ok {
+        return Ok(x);
+    }
+    let at = lines.at_opt(v, fallback);
+    let problem = if positive {
+        "must be a positive number"
+    } else {
+        "must be a number >= 0"
+    };
+    Err(ScenarioError::InvalidParameter {
+        at,
+        key: key.into(),
+        problem: format!("{problem}, got {x}"),
+    })
+}
+
+/// Reads an optional integer with a default and checks it is at least 1.
+fn count(
+    v: &Option<Spanned<u32>>,
+    default: u32,
+    key: &str,
+    lines: &Lines<'_>,
+) -> Result<u32, ScenarioError> {
+    match v {
+        None => Ok(default),
+        Some(s) if *s.get_ref() >= 1 => Ok(*s.get_ref()),
+        Some(s) => Err(ScenarioError::InvalidParameter {
+            at: lines.at(s),
+            key: key.into(),
+            problem: "must be at least 1".into(),
+        }),
+    }
+}
+
+pub(super) fn build_robot(
+    raw: Option<RawRobot>,
+    lines: &Lines<'_>,
+) -> Result<RobotParams, ScenarioError> {
+    let d = RobotParams::default();
+    let Some(r) = raw else { return Ok(d) };
+    let none = Loc::new(lines.source_name, 0);
+    let pos =
+        |v: &Option<Spanned<f64>>, def: f64, key: &str| float(v, def, key, true, &none, lines);
+    let ticks_per_rev = match (&r.ticks_per_rev, &r.pole_pairs, &r.gear_ratio) {
+        (Some(t), Some(_), _) | (Some(t), _, Some(_)) => {
+            return Err(ScenarioError::InvalidParameter {
+                at: lines.at(t),
+                key: "robot.ticks_per_rev".into(),
+                problem: "conflicts with pole_pairs/gear_ratio; give one or the other".into(),
+            })
+        }
+        (Some(_), None, None) => pos(&r.ticks_per_rev, 0.0, "robot.ticks_per_rev")?,
+        (None, pp, _) => {
+            let pole_pairs = count(
+                pp,
+                RobotParams::DEFAULT_POLE_PAIRS,
+                "robot.pole_pairs",
+                lines,
+            )?;
+            let gear = pos(&r.gear_ratio, 1.0, "robot.gear_ratio")?;
+            6.0 * f64::from(pole_pairs) * gear
+        }
+    };
+    let p = RobotParams {
+        wheel_radius_m: pos(&r.wheel_radius_m, d.wheel_radius_m, "robot.wheel_radius_m")?,
+        axle_track_m: pos(&r.axle_track_m, d.axle_track_m, "robot.axle_track_m")?,
+        body_radius_m: pos(&r.body_radius_m, d.body_radius_m, "robot.body_radius_m")?,
+        max_wheel_speed_rad_s: pos(
+            &r.max_wheel_speed_rad_s,
+            d.max_wheel_speed_rad_s,
+            "robot.max_wheel_speed_rad_s",
+        )?,
+        max_wheel_accel_rad_s2: pos(
+            &r.max_wheel_accel_rad_s2,
+            d.max_wheel_accel_rad_s2,
+            "robot.max_wheel_accel_rad_s2",
+        )?,
+        motor_lag_s: float(
+            &r.motor_lag_s,
+            d.motor_lag_s,
+            "robot.motor_lag_s",
+            false,
+            &none,
+            lines,
+        )?,
+        ticks_per_rev,
+        cell_size_m: pos(&r.cell_size_m, d.cell_size_m, "robot.cell_size_m")?,
+    };
+    // Cells are reserved one robot at a time, which is only collision-free if a robot fits.
+    if 2.0 * p.body_radius_m > p.cell_size_m {
+        let at = lines.at_opt(&r.body_radius_m, &lines.at_opt(&r.cell_size_m, &none));
+        return Err(ScenarioError::InvalidParameter {
+            at,
+            key: "robot.body_radius_m".into(),
+            problem: format!(
+                "{} m: the body (diameter {} m) must fit in a cell of {} m",
+                p.body_radius_m,
+                2.0 * p.body_radius_m,
+                p.cell_size_m
+            ),
+        });
+    }
+    Ok(p)
+}
+
+pub(super) fn build_sim(
+    raw: Option<RawSim>,
+    lines: &Lines<'_>,
+) -> Result<SimParams, ScenarioError> {
+    let d = SimParams::default();
+    let Some(s) = raw else { return Ok(d) };
+    let none = Loc::new(lines.source_name, 0);
+    let p = SimParams {
+        step_ms: count(&s.step_ms, d.step_ms, "sim.step_ms", lines)?,
+        odometry_hz: count(&s.odometry_hz, d.odometry_hz, "sim.odometry_hz", lines)?,
+        clock: s.clock.unwrap_or(d.clock),
+        seed: s.seed.unwrap_or(d.seed),
+        slip_std: float(&s.slip_std, d.slip_std, "sim.slip_std", false, &none, lines)?,
+        watchdog_ms: count(&s.watchdog_ms, d.watchdog_ms, "sim.watchdog_ms", lines)?,
+    };
+    // Odometry is sampled on physics steps, so it cannot be faster than one message per step.
+    if u64::from(p.odometry_hz) * u64::from(p.step_ms) > 1000 {
+        let at = lines.at_opt(&s.odometry_hz, &lines.at_opt(&s.step_ms, &none));
+        return Err(ScenarioError::InvalidParameter {
+            at,
+            key: "sim.odometry_hz".into(),
+            problem: format!(
+                "{} Hz is faster than one message per {} ms step",
+                p.odometry_hz, p.step_ms
+            ),
+        });
+    }
+    Ok(p)
+}
+
+pub(super) fn build_coordinator(
+    raw: Option<RawCoordinator>,
+    lines: &Lines<'_>,
+) -> Result<CoordinatorParams, ScenarioError> {
+    let d = CoordinatorParams::default();
+    let Some(c) = raw else { return Ok(d) };
+    let none = Loc::new(lines.source_name, 0);
+    Ok(CoordinatorParams {
+        round_deadline_ms: count(
+            &c.round_deadline_ms,
+            d.round_deadline_ms,
+            "coordinator.round_deadline_ms",
+            lines,
+        )?,
+        fsync: c.fsync.unwrap_or(d.fsync),
+        replan_after_rounds: count(
+            &c.replan_after_rounds,
+            d.replan_after_rounds,
+            "coordinator.replan_after_rounds",
+            lines,
+        )?,
+        time_limit_s: float(
+            &c.time_limit_s,
+            d.time_limit_s,
+            "coordinator.time_limit_s",
+            true,
+            &none,
+            lines,
+        )?,
+    })
+}
+
+pub(super) fn build_restart(raw: Option<RawRestart>) -> RestartConfig {
+    let d = RestartConfig::default();
+    let Some(r) = raw else { return d };
+    let rule = |raw: Option<RawRestartRule>, d: RestartRule| match raw {
+        None => d,
+        Some(x) => RestartRule {
+            policy: x.policy.unwrap_or(d.policy),
+            max_restarts: x.max_restarts.unwrap_or(d.max_restarts),
+            backoff_ms: x.backoff_ms.unwrap_or(d.backoff_ms),
+        },
+    };
+    RestartConfig {
+        agent: rule(r.agent, d.agent),
+        coordinator: rule(r.coordinator, d.coordinator),
+        sim: rule(r.sim, d.sim),
+    }
+}

@@ -1,0 +1,288 @@
+//! `hnav check`: the facts about a validated scenario, as text for people and JSON for tools.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use super::params::{CoordinatorParams, RestartConfig, RobotParams, SimParams};
+use super::{FaultTarget, Scenario};
+use crate::grid::{octile, octile_shortest_path_len, CornerCutting};
+
+/// The map part of a [`ScenarioReport`].
+#[derive(Clone, PartialEq, Debug, Serialize)]
+pub struct MapReport {
+    /// The map file, or `"inline"`.
+    pub source: String,
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// Blocked cells.
+    pub blocked_cells: usize,
+    /// Blocked cells in percent of all cells.
+    pub blocked_percent: f64,
+    /// Whether diagonals may pass blocked corners.
+    pub corner_cutting: bool,
+}
+
+/// One agent in a [`ScenarioReport`].
+#[derive(Clone, PartialEq, Debug, Serialize)]
+pub struct AgentReport {
+    /// Agent number (0-based, as in faults).
+    pub index: usize,
+    /// Start `[x, y]`.
+    pub start: [u32; 2],
+    /// Goal `[x, y]`.
+    pub goal: [u32; 2],
+    /// Start as the dissertation's 1-based cell id.
+    pub start_id: u32,
+    /// Goal as the dissertation's 1-based cell id.
+    pub goal_id: u32,
+    /// Speed in cells/s.
+    pub speed: f64,
+    /// Conflict priority in effect (given, or `1 / speed`).
+    pub priority: f64,
+    /// Straight-line octile distance, ignoring obstacles.
+    pub octile_distance: f64,
+    /// Shortest octile path length under the map's corner-cutting rule; `None` if unreachable.
+    pub shortest_path_len: Option<f64>,
+}
+
+/// Everything `hnav check` reports.
+#[derive(Clone, PartialEq, Debug, Serialize)]
+pub struct ScenarioReport {
+    /// Scenario name.
+    pub name: String,
+    /// Scenario file.
+    pub source: String,
+    /// [`Scenario::scenario_hash`] as 16 hex digits.
+    pub scenario_hash: String,
+    /// The map.
+    pub map: MapReport,
+    /// The agents.
+    pub agents: Vec<AgentReport>,
+    /// The fault plan, one line per fault.
+    pub faults: Vec<String>,
+    /// `[robot]` in effect.
+    pub robot: RobotParams,
+    /// `[sim]` in effect.
+    pub sim: SimParams,
+    /// `[coordinator]` in effect.
+    pub coordinator: CoordinatorParams,
+    /// `[restart]` in effect.
+    pub restart: RestartConfig,
+    /// Things that are legal but probably unintended (e.g. an unreachable goal).
+    pub warnings: Vec<String>,
+}
+
+impl ScenarioReport {
+    /// Computes the report (runs one shortest-path query per agent).
+    pub fn new(s: &Scenario) -> ScenarioReport {
+        let g = &s.map.grid;
+        let rule = s.map.corner_cutting;
+        let mut warnings = Vec::new();
+        let agents = s
+            .agents
+            .iter()
+            .enumerate()
+            .map(|(index, a)| {
+                let shortest = octile_shortest_path_len(g, a.start, a.goal, rule);
+                if shortest.is_none() {
+                    warnings.push(format!(
+                        "agent {index}: goal {} is unreachable from start {}",
+                        a.goal, a.start
+                    ));
+                }
+                AgentReport {
+                    index,
+                    start: [a.start.x, a.start.y],
+                    goal: [a.goal.x, a.goal.y],
+                    start_id: g.cell_id(a.start),
+                    goal_id: g.cell_id(a.goal),
+                    speed: a.speed,
+                    priority: a.effective_priority(),
+                    octile_distance: octile(a.start, a.goal),
+                    shortest_path_len: shortest,
+                }
+            })
+            .collect();
+        let faults = s
+            .faults
+            .iter()
+            .map(|f| {
+                let target = match f.target {
+                    FaultTarget::Agent(i) => format!("agent {i}"),
+                    FaultTarget::Coordinator => "coordinator".into(),
+                    FaultTarget::Sim => "sim".into(),
+                };
+                format!(
+                    "round {}: {:?} {target} with SIG{:?}",
+                    f.at_round, f.action, f.signal
+                )
+                .to_lowercase()
+            })
+            .collect();
+        ScenarioReport {
+            name: s.name.clone(),
+            source: s.source_name.clone(),
+            scenario_hash: format!("{:016x}", s.scenario_hash()),
+            map: MapReport {
+                source: s
+                    .map
+                    .file
+                    .as_deref()
+                    .map_or_else(|| "inline".into(), |p| tidy_path(p).display().to_string()),
+                width: g.width(),
+                height: g.height(),
+                blocked_cells: g.blocked_count(),
+                blocked_percent: 100.0 * g.blocked_fraction(),
+                corner_cutting: rule == CornerCutting::Allowed,
+            },
+            agents,
+            faults,
+            robot: s.robot.clone(),
+            sim: s.sim.clone(),
+            coordinator: s.coordinator.clone(),
+            restart: s.restart,
+            warnings,
+        }
+    }
+
+    /// The human summary printed by `hnav check`.
+    pub fn render(&self) -> String {
+        let mut o = String::new();
+        let m = &self.map;
+        let _ = writeln!(o, "scenario  {}  ({})", self.name, self.source);
+        let _ = writeln!(o, "hash      {}", self.scenario_hash);
+        let _ = writeln!(
+            o,
+            "map       {} x {}, {} blocked ({:.1} %), corner cutting {}, {}",
+            m.width,
+            m.height,
+            m.blocked_cells,
+            m.blocked_percent,
+            if m.corner_cutting {
+                "allowed"
+            } else {
+                "forbidden"
+            },
+            m.source
+        );
+        let _ = writeln!(
+            o,
+            "run       {} clock, step {} ms, seed {}, round deadline {} ms, time limit {} s",
+            format!("{:?}", self.sim.clock).to_lowercase(),
+            self.sim.step_ms,
+            self.sim.seed,
+            self.coordinator.round_deadline_ms,
+            self.coordinator.time_limit_s
+        );
+        let _ = writeln!(o, "agents    {}", self.agents.len());
+        let _ = writeln!(
+            o,
+            "  {:>4}  {:<12} {:<12} {:>6} {:>8} {:>10} {:>10}",
+            "#", "start", "goal", "speed", "priority", "octile", "shortest"
+        );
+        for a in &self.agents {
+            let shortest = a
+                .shortest_path_len
+                .map_or_else(|| "unreachable".into(), |l| format!("{l:.3}"));
+            let _ = writeln!(
+                o,
+                "  {:>4}  {:<12} {:<12} {:>6.2} {:>8.3} {:>10.3} {:>10}",
+                a.index,
+                format!("({}, {})", a.start[0], a.start[1]),
+                format!("({}, {})", a.goal[0], a.goal[1]),
+                a.speed,
+                a.priority,
+                a.octile_distance,
+                shortest
+            );
+        }
+        if !self.faults.is_empty() {
+            let _ = writeln!(o, "faults    {}", self.faults.join("; "));
+        }
+        for w in &self.warnings {
+            let _ = writeln!(o, "warning: {w}");
+        }
+        o
+    }
+
+    /// Writes `scenario-report.json` into `dir` (created if needed) and returns its path.
+    pub fn write_json(&self, dir: &Path) -> std::io::Result<PathBuf> {
+        std::fs::create_dir_all(dir)?;
+        let path = dir.join("scenario-report.json");
+        let json = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
+        std::fs::write(&path, json + "\n")?;
+        Ok(path)
+    }
+}
+
+/// Removes `.` and `dir/..` pairs lexically (`scenarios/../maps/x.map` -> `maps/x.map`), for
+/// display only: with symbolic links the two spellings may differ, so the scenario keeps the
+/// joined path it actually opened.
+fn tidy_path(p: &Path) -> PathBuf {
+    use std::path::Component;
+    let mut out: Vec<Component<'_>> = Vec::new();
+    for c in p.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    if out.is_empty() {
+        return PathBuf::from(".");
+    }
+    out.iter().collect()
+}
+
+/// The default output directory of a scenario, `target/hnav-out/<name>`, with every character
+/// outside `[A-Za-z0-9._-]` replaced by `_` so a name cannot escape the directory.
+pub fn default_out_dir(name: &str) -> PathBuf {
+    let mut safe: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "._-".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if safe.is_empty() || safe.chars().all(|c| c == '.') {
+        safe = format!("_{safe}");
+    }
+    Path::new("target").join("hnav-out").join(safe)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tidy_path_removes_dot_dot() {
+        assert_eq!(
+            tidy_path(Path::new("scenarios/../maps/x.map")),
+            Path::new("maps/x.map")
+        );
+        assert_eq!(tidy_path(Path::new("./a/./b")), Path::new("a/b"));
+        assert_eq!(tidy_path(Path::new("../../x")), Path::new("../../x"));
+        assert_eq!(tidy_path(Path::new("/a/../b")), Path::new("/b"));
+        assert_eq!(tidy_path(Path::new("a/..")), Path::new("."));
+    }
+
+    #[test]
+    fn out_dir_is_sanitised() {
+        assert_eq!(default_out_dir("demo"), Path::new("target/hnav-out/demo"));
+        assert_eq!(
+            default_out_dir("../x y"),
+            Path::new("target/hnav-out/.._x_y")
+        );
+        assert_eq!(default_out_dir(".."), Path::new("target/hnav-out/_.."));
+        assert_eq!(default_out_dir(""), Path::new("target/hnav-out/_"));
+    }
+}

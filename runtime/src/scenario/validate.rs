@@ -1,0 +1,276 @@
+//! Validation of `[[agents]]` and `[[faults]]`, shared by the TOML path (with lines) and
+//! [`Scenario::validate`] (for scenarios changed in code, without lines).
+
+use std::collections::HashMap;
+
+use toml::Spanned;
+
+use super::build::Lines;
+use super::error::{Loc, ScenarioError};
+use super::params::RobotParams;
+use super::raw::{RawAgent, RawFault, RawFaultAction, RawRole};
+use super::{AgentSpec, FaultAction, FaultSignal, FaultSpec, FaultTarget, Scenario};
+use crate::grid::{Cell, Endpoint, Grid};
+
+/// Lines of one agent's keys, for errors found after conversion.
+#[derive(Clone, Debug)]
+pub(super) struct AgentLocs {
+    pub start: Loc,
+    pub goal: Loc,
+    pub speed: Loc,
+    pub priority: Loc,
+}
+
+impl AgentLocs {
+    /// All keys at one place (used for scenarios built in code).
+    pub(super) fn all(at: Loc) -> Self {
+        AgentLocs {
+            start: at.clone(),
+            goal: at.clone(),
+            speed: at.clone(),
+            priority: at,
+        }
+    }
+}
+
+pub(super) fn build_agent(
+    i: usize,
+    raw: &Spanned<RawAgent>,
+    grid: &Grid,
+    lines: &Lines<'_>,
+) -> Result<(AgentSpec, AgentLocs), ScenarioError> {
+    let entry = lines.at(raw);
+    let a = raw.get_ref();
+    let at = AgentLocs {
+        start: lines.at(&a.start),
+        goal: lines.at(&a.goal),
+        speed: lines.at_opt(&a.speed, &entry),
+        priority: lines.at_opt(&a.priority, &entry),
+    };
+    let start = endpoint(i, Endpoint::Start, a.start.get_ref(), grid, &at.start)?;
+    let goal = endpoint(i, Endpoint::Goal, a.goal.get_ref(), grid, &at.goal)?;
+    let speed = a
+        .speed
+        .as_ref()
+        .map_or(AgentSpec::DEFAULT_SPEED, |s| *s.get_ref());
+    let priority = a.priority.as_ref().map(|p| *p.get_ref());
+    Ok((
+        AgentSpec {
+            start,
+            goal,
+            speed,
+            priority,
+        },
+        at,
+    ))
+}
+
+/// Turns `[x, y]` into a cell inside the map.
+fn endpoint(
+    agent: usize,
+    which: Endpoint,
+    xy: &[i64],
+    grid: &Grid,
+    at: &Loc,
+) -> Result<Cell, ScenarioError> {
+    let &[x, y] = xy else {
+        return Err(ScenarioError::BadCoordinates {
+            at: at.clone(),
+            agent,
+            endpoint: which,
+            len: xy.len(),
+        });
+    };
+    grid.cell_checked(x, y)
+        .ok_or_else(|| outside(agent, which, x, y, grid, at))
+}
+
+fn outside(agent: usize, which: Endpoint, x: i64, y: i64, grid: &Grid, at: &Loc) -> ScenarioError {
+    let (at, width, height) = (at.clone(), grid.width(), grid.height());
+    match which {
+        Endpoint::Start => ScenarioError::StartOutsideMap {
+            at,
+            agent,
+            x,
+            y,
+            width,
+            height,
+        },
+        Endpoint::Goal => ScenarioError::GoalOutsideMap {
+            at,
+            agent,
+            x,
+            y,
+            width,
+            height,
+        },
+    }
+}
+
+/// Starts and goals of the agents checked so far.
+#[derive(Default)]
+pub(super) struct Seen {
+    starts: HashMap<Cell, usize>,
+    goals: HashMap<Cell, usize>,
+}
+
+/// The per-agent rules that do not depend on how the agent was written down.
+pub(super) fn check_agent(
+    i: usize,
+    a: &AgentSpec,
+    at: &AgentLocs,
+    grid: &Grid,
+    robot: &RobotParams,
+    seen: &mut Seen,
+) -> Result<(), ScenarioError> {
+    for (which, cell, loc) in [
+        (Endpoint::Start, a.start, &at.start),
+        (Endpoint::Goal, a.goal, &at.goal),
+    ] {
+        if !grid.contains(cell) {
+            return Err(outside(i, which, cell.x.into(), cell.y.into(), grid, loc));
+        }
+    }
+    for (which, cell, loc) in [
+        (Endpoint::Start, a.start, &at.start),
+        (Endpoint::Goal, a.goal, &at.goal),
+    ] {
+        if let Some(tile) = grid.tile(cell).filter(|t| !t.is_passable()) {
+            let (at, ch) = (loc.clone(), tile.to_char());
+            return Err(match which {
+                Endpoint::Start => ScenarioError::StartOnObstacle {
+                    at,
+                    agent: i,
+                    cell,
+                    ch,
+                },
+                Endpoint::Goal => ScenarioError::GoalOnObstacle {
+                    at,
+                    agent: i,
+                    cell,
+                    ch,
+                },
+            });
+        }
+    }
+    if !(a.speed.is_finite() && a.speed > 0.0) {
+        return Err(ScenarioError::NonPositiveSpeed {
+            at: at.speed.clone(),
+            agent: i,
+            speed: a.speed,
+        });
+    }
+    let max = robot.max_speed_cells_s();
+    if a.speed > max {
+        return Err(ScenarioError::SpeedTooHigh {
+            at: at.speed.clone(),
+            agent: i,
+            speed: a.speed,
+            max,
+        });
+    }
+    if let Some(p) = a.priority.filter(|p| !(p.is_finite() && *p > 0.0)) {
+        return Err(ScenarioError::BadPriority {
+            at: at.priority.clone(),
+            agent: i,
+            priority: p,
+        });
+    }
+    if let Some(&other) = seen.starts.get(&a.start) {
+        return Err(ScenarioError::DuplicateStart {
+            at: at.start.clone(),
+            agent: i,
+            other,
+            cell: a.start,
+        });
+    }
+    if let Some(&other) = seen.goals.get(&a.goal) {
+        return Err(ScenarioError::DuplicateGoal {
+            at: at.goal.clone(),
+            agent: i,
+            other,
+            cell: a.goal,
+        });
+    }
+    seen.starts.insert(a.start, i);
+    seen.goals.insert(a.goal, i);
+    Ok(())
+}
+
+pub(super) fn build_fault(
+    i: usize,
+    raw: &Spanned<RawFault>,
+    agents: usize,
+    lines: &Lines<'_>,
+) -> Result<FaultSpec, ScenarioError> {
+    let at = lines.at(raw);
+    let f = raw.get_ref();
+    let target = match (f.role, &f.index) {
+        (RawRole::Agent, None) => {
+            return Err(ScenarioError::BadFault {
+                at,
+                fault: i,
+                problem: "role = \"agent\" needs an `index`".into(),
+            })
+        }
+        (RawRole::Agent, Some(ix)) => {
+            let index = *ix.get_ref();
+            match usize::try_from(index) {
+                Ok(a) if a < agents => FaultTarget::Agent(a),
+                _ => {
+                    return Err(ScenarioError::FaultAgentOutOfRange {
+                        at: lines.at(ix),
+                        fault: i,
+                        index,
+                        agents,
+                    })
+                }
+            }
+        }
+        (_, Some(ix)) => {
+            return Err(ScenarioError::BadFault {
+                at: lines.at(ix),
+                fault: i,
+                problem: "`index` is only meaningful with role = \"agent\"".into(),
+            })
+        }
+        (RawRole::Coordinator, None) => FaultTarget::Coordinator,
+        (RawRole::Sim, None) => FaultTarget::Sim,
+    };
+    let action = match f.action {
+        RawFaultAction::Kill => FaultAction::Kill,
+    };
+    Ok(FaultSpec {
+        at_round: f.at_round,
+        action,
+        target,
+        signal: f.signal.unwrap_or(FaultSignal::Kill),
+    })
+}
+
+/// Re-checks a scenario built or changed in code (no lines available).
+pub(super) fn revalidate(s: &Scenario) -> Result<(), ScenarioError> {
+    let at = Loc::new(&s.source_name, 0);
+    if s.agents.is_empty() {
+        return Err(ScenarioError::NoAgents { at });
+    }
+    let locs = AgentLocs::all(at.clone());
+    let mut seen = Seen::default();
+    for (i, a) in s.agents.iter().enumerate() {
+        check_agent(i, a, &locs, &s.map.grid, &s.robot, &mut seen)?;
+    }
+    for (i, f) in s.faults.iter().enumerate() {
+        if let FaultTarget::Agent(a) = f.target {
+            if a >= s.agents.len() {
+                let index = i64::try_from(a).unwrap_or(i64::MAX);
+                return Err(ScenarioError::FaultAgentOutOfRange {
+                    at,
+                    fault: i,
+                    index,
+                    agents: s.agents.len(),
+                });
+            }
+        }
+    }
+    Ok(())
+}
