@@ -1,0 +1,87 @@
+//! The HNAV transport (`hnav_runtime::transport`): slice sender and receiver, measured with
+//! the same ping-pong and the same WaitSet pattern as [raw iceoryx2](super::raw).
+
+use anyhow::Result;
+use iceoryx2::prelude::CallbackProgression;
+
+use hnav_runtime::transport::{RunId, SliceReceiver, SliceSender, Transport};
+
+use super::pingpong::{PingPong, Role, ABORT_POLL};
+use super::{Mode, Stamp, BENCH_QOS};
+
+/// One side's ports; the transport (node) is declared last so it is dropped last.
+struct Ports {
+    tx: SliceSender<u8, Stamp>,
+    rx: SliceReceiver<u8, Stamp>,
+    transport: Transport,
+}
+
+fn open(run: &RunId, prefix: &str, role: Role, size: usize) -> Result<Ports> {
+    let (tx_topic, rx_topic) = role.topics();
+    let transport = Transport::builder(run)
+        .node_name(role.node_name())
+        // Ctrl-C must stop a busy-polling benchmark; iceoryx2's handler would only set a flag.
+        .handle_signals(false)
+        .create()?;
+    let tx =
+        transport.slice_sender::<u8, Stamp>(&format!("{prefix}/{tx_topic}"), size, BENCH_QOS)?;
+    let rx = transport.slice_receiver::<u8, Stamp>(&format!("{prefix}/{rx_topic}"), BENCH_QOS)?;
+    Ok(Ports { tx, rx, transport })
+}
+
+/// Plays `role` of an HNAV ping-pong of `size`-byte samples on topics `<prefix>/{a2b,b2a}`.
+///
+/// The sender always notifies (that is built into [`SliceSender`]); in poll mode nobody waits
+/// for the notification, so after the first one iceoryx2 coalesces the rest into an atomic
+/// bit-set update without a syscall.
+pub(crate) fn side(
+    pp: &PingPong,
+    role: Role,
+    run: &RunId,
+    prefix: &str,
+    size: usize,
+    mode: Mode,
+) -> Result<Vec<u64>> {
+    let ports = pp.setup(role, || open(run, prefix, role, size))?;
+    let send = |stamp: Stamp| -> Result<()> {
+        let mut loan = ports.tx.loan(size)?;
+        *loan.header_mut() = stamp;
+        // SAFETY: `u8` has no invalid bit patterns, and the chunk is shared memory that the OS
+        // mapped zero-filled and that only ever held bytes of earlier samples, so every byte
+        // is initialised. Not filling it is deliberate: we measure transfer, not memset.
+        unsafe { loan.assume_init_and_send() }?;
+        Ok(())
+    };
+    let receive = || -> Result<Option<Stamp>> { Ok(ports.rx.receive()?.map(|s| *s.user_header())) };
+
+    match mode {
+        Mode::Poll => pp.run(role, send, || loop {
+            // The benchmark's explicit polling mode; nothing else in HNAV polls.
+            if let Some(stamp) = receive()? {
+                return Ok(stamp);
+            }
+            pp.check()?;
+        }),
+        Mode::Event => {
+            let waitset = ports.transport.waitset()?;
+            let _guard = waitset
+                .attach_notification(ports.rx.listener())
+                .map_err(|e| anyhow::anyhow!("attach listener: {e:?}"))?;
+            pp.run(role, send, || loop {
+                waitset
+                    .wait_and_process_once_with_timeout(
+                        |_| CallbackProgression::Continue,
+                        ABORT_POLL,
+                    )
+                    .map_err(|e| anyhow::anyhow!("wait: {e:?}"))?;
+                // Drains the listener; a wake-up may also be "publisher appeared", hence the
+                // loop when no sample is there.
+                ports.rx.take_wakeup()?;
+                if let Some(stamp) = receive()? {
+                    return Ok(stamp);
+                }
+                pp.check()?;
+            })
+        }
+    }
+}

@@ -1,0 +1,14 @@
+//! # hnav-bench
+//!
+//! Measurements of HNAV against its foundations, run by the `hnav-bench` binary
+//! (`src/main.rs`, one clap subcommand per module here).
+//!
+//! | module | subcommand | what it measures |
+//! |---|---|---|
+//! | [`latency`] | `hnav-bench latency [--quick] --out DIR` | one-way and round-trip latency of raw iceoryx2, the HNAV transport, a Unix domain socket and TCP loopback, in a two-thread ping-pong |
+//!
+//! Results go to stdout as a table and to CSV files in dora-benchmark's schema
+//! (`date,language,platform,name,size_bytes,avg_us,p50_us,p90_us,p99_us,n`), so they can be
+//! plotted next to other frameworks' numbers.
+
+pub mod latency;
