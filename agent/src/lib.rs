@@ -1,1 +1,39 @@
+//! HNAV's agent library: the Hopfield "neural map" and the "path constructor" of the
+//! dissertation, plus single-query planning on top of them.
+//!
+//! A robot's agent builds a neural map of its workspace with the goal as the activation point:
+//! one neuron per cell, a wave of activation spreading from the goal through the free cells.
+//! It then climbs that map by gradient ascent, one cell at a time, and the coordinator may
+//! refuse directions to keep robots apart. Everything here is single-robot and synchronous; the
+//! processes and messages live in `hnav-runtime`.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`neural_map`] | the network (eq. 3.2–3.4, §2.8–2.11): options, the `f32` fast path [`NeuralMap`], the `f64` [`ReferenceMap`], Table 2-2's weight matrix, §2.10 repair |
+//! | [`path_constructor`] | gradient ascent (eq. 3.5 ascent form, Fig. 3-7 corners, eq. 3.7 heading, seed 001's sign flip) |
+//! | [`plan`] | [`plan_query`]: one start-goal query with a JSON-ready [`PlanResult`] |
+//! | [`error`] | [`Error`]: bad cells and bad options, never a panic |
+//!
+//! ```
+//! use hnav_agent::plan::{plan_query, PlanOptions};
+//! use hnav_runtime::grid::{Cell, Grid};
+//!
+//! let grid = Grid::new(10, 10).unwrap();
+//! let r = plan_query(&grid, Cell::new(0, 0), Cell::new(5, 5), &PlanOptions::default()).unwrap();
+//! assert!(r.found);
+//! assert_eq!(r.steps, 5);
+//! ```
 
+pub mod error;
+pub mod neural_map;
+pub mod path_constructor;
+pub mod plan;
+mod serde_cells;
+
+pub use error::{Error, Role};
+pub use neural_map::{
+    Activation, ActivationField, BuildReport, NeuralDynamics, NeuralMap, NeuralMapOptions,
+    ReferenceMap, StopRule,
+};
+pub use path_constructor::{Path, PathConstructor, PathOptions};
+pub use plan::{plan_query, PlanOptions, PlanResult};

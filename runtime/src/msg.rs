@@ -486,7 +486,12 @@ mod tests {
 
     #[test]
     fn enums_round_trip_and_reject_unknown_bytes() {
-        for v in [Verdict::Accept, Verdict::Block, Verdict::Hold, Verdict::Replan] {
+        for v in [
+            Verdict::Accept,
+            Verdict::Block,
+            Verdict::Hold,
+            Verdict::Replan,
+        ] {
             assert_eq!(Verdict::from_u8(v as u8), Some(v));
         }
         for r in [Role::Sim, Role::Coordinator, Role::Agent] {

@@ -20,7 +20,9 @@ fn one_hundred_thousand_candidates_arrive_in_order_through_a_waitset() {
     let mut tx = run
         .spawn(PEER, &["pub-candidates", &count.to_string()])
         .unwrap();
-    let report = rx.wait_for_line("RECEIVED", Duration::from_secs(300)).unwrap();
+    let report = rx
+        .wait_for_line("RECEIVED", Duration::from_secs(300))
+        .unwrap();
     assert!(rx.wait_exit(STEP).unwrap().success(), "receiver failed");
     assert!(tx.wait_exit(STEP).unwrap().success(), "sender failed");
 
@@ -61,17 +63,31 @@ fn two_runs_do_not_see_each_other() {
     let b = TestRun::new("iso");
     let ta = Transport::builder(&a.run).node_name("a").create().unwrap();
     let tb = Transport::builder(&b.run).node_name("b").create().unwrap();
-    let tx_a = ta.sender::<Candidate>("candidates", Qos::reliable(2)).unwrap();
-    let rx_a = ta.receiver::<Candidate>("candidates", Qos::reliable(2)).unwrap();
-    let rx_b = tb.receiver::<Candidate>("candidates", Qos::reliable(2)).unwrap();
-    assert_eq!(tx_a.send(Candidate::default()).unwrap(), 1, "only run a's subscriber");
+    let tx_a = ta
+        .sender::<Candidate>("candidates", Qos::reliable(2))
+        .unwrap();
+    let rx_a = ta
+        .receiver::<Candidate>("candidates", Qos::reliable(2))
+        .unwrap();
+    let rx_b = tb
+        .receiver::<Candidate>("candidates", Qos::reliable(2))
+        .unwrap();
+    assert_eq!(
+        tx_a.send(Candidate::default()).unwrap(),
+        1,
+        "only run a's subscriber"
+    );
     assert_eq!(rx_a.drain(|_| {}).unwrap(), 1);
     assert_eq!(rx_b.drain(|_| {}).unwrap(), 0);
 
     let services_a = ta.services().unwrap();
     let services_b = tb.services().unwrap();
-    assert!(services_a.iter().all(|s| s.starts_with(&format!("hnav/{}/", a.run))));
-    assert!(services_b.iter().all(|s| s.starts_with(&format!("hnav/{}/", b.run))));
+    assert!(services_a
+        .iter()
+        .all(|s| s.starts_with(&format!("hnav/{}/", a.run))));
+    assert!(services_b
+        .iter()
+        .all(|s| s.starts_with(&format!("hnav/{}/", b.run))));
     assert!(!services_a.is_empty() && !services_b.is_empty());
 
     let nodes_b = tb.nodes().unwrap();
@@ -97,7 +113,10 @@ fn iceoryx2_logs_go_through_tracing_without_config_noise() {
     assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "READY");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!stderr.contains("No config file"), "stderr: {stderr}");
-    assert!(stderr.trim().is_empty(), "a clean run prints nothing on stderr: {stderr}");
+    assert!(
+        stderr.trim().is_empty(),
+        "a clean run prints nothing on stderr: {stderr}"
+    );
 
     // With iceoryx2's debug logs enabled they arrive as tracing events, with tracing's format.
     let out = std::process::Command::new(PEER)
@@ -116,7 +135,10 @@ fn iceoryx2_logs_go_through_tracing_without_config_noise() {
 #[test]
 fn qos_sized_from_the_swarm_admits_every_agent_as_a_publisher() {
     let run = TestRun::new("qos");
-    let t = Transport::builder(&run.run).node_name("swarm").create().unwrap();
+    let t = Transport::builder(&run.run)
+        .node_name("swarm")
+        .create()
+        .unwrap();
     let agents = 16;
     let qos = Qos::reliable(agents);
     let rx = t.receiver::<Candidate>("candidates", qos).unwrap();

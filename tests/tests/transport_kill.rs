@@ -13,7 +13,9 @@ const PEER: &str = env!("CARGO_BIN_EXE_hnav-test-peer");
 fn a_killed_publisher_is_reported_dead_and_its_shared_memory_removed() {
     let mut run = TestRun::new("kill");
     let mut holder = run.spawn(PEER, &["hold"]).unwrap();
-    holder.wait_for_line("READY", Duration::from_secs(60)).unwrap();
+    holder
+        .wait_for_line("READY", Duration::from_secs(60))
+        .unwrap();
     assert!(
         !run_shm_files(&run.run).is_empty(),
         "the holder's publishers should have shared memory"

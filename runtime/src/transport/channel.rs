@@ -3,14 +3,15 @@
 use core::fmt::Debug;
 
 use iceoryx2::node::Node;
+use iceoryx2::port::backpressure_strategy::BackpressureStrategy;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::port::update_connections::UpdateConnections;
-use iceoryx2::port::backpressure_strategy::BackpressureStrategy;
-use iceoryx2::prelude::{EventId, ServiceName, ZeroCopySend};
+use iceoryx2::prelude::{EventId, IceoryxSend, ServiceName, ZeroCopySend};
 use iceoryx2::sample::Sample;
+use iceoryx2::sample_mut::SampleMut;
 use iceoryx2::service::builder::event::{EventCreateError, EventOpenError, EventOpenOrCreateError};
 use iceoryx2::service::builder::publish_subscribe::{
     PublishSubscribeCreateError, PublishSubscribeOpenError, PublishSubscribeOpenOrCreateError,
@@ -97,14 +98,12 @@ fn event_transient(e: &EventOpenOrCreateError) -> bool {
             | E::EventOpenError(
                 O::IsMarkedForDestruction | O::HangsInCreation | O::ServiceInCorruptedState
             )
-            | E::EventCreateError(
-                C::IsBeingCreatedByAnotherInstance | C::AlreadyExists
-            )
+            | E::EventCreateError(C::IsBeingCreatedByAnotherInstance | C::AlreadyExists)
     )
 }
 
 /// Opens (or creates) the event service that accompanies a data service of the same name.
-pub(crate) fn open_event(
+fn open_event(
     node: &Node<Ipc>,
     name: &ServiceName,
     qos: &Qos,
@@ -130,7 +129,7 @@ pub(crate) fn backpressure(qos: &Qos) -> BackpressureStrategy {
     }
 }
 
-pub(crate) fn create_notifier(
+fn create_notifier(
     events: &EventFactory<Ipc>,
     name: &ServiceName,
 ) -> Result<Notifier<Ipc>, TransportError> {
@@ -141,7 +140,7 @@ pub(crate) fn create_notifier(
         .map_err(|e| TransportError::ipc("create notifier", name.as_str(), e))
 }
 
-pub(crate) fn create_listener(
+fn create_listener(
     events: &EventFactory<Ipc>,
     name: &ServiceName,
 ) -> Result<Listener<Ipc>, TransportError> {
@@ -176,44 +175,41 @@ impl Wakeup {
     }
 }
 
-/// Drains a listener without blocking and reports what it had gathered.
-pub(crate) fn take_wakeup(
-    listener: &Listener<Ipc>,
-    name: &ServiceName,
-) -> Result<Wakeup, TransportError> {
-    let mut wakeup = Wakeup::default();
-    listener
-        .try_wait(|activation| wakeup.record(activation.id))
-        .map_err(|e| TransportError::ipc("drain listener", name.as_str(), e))?;
-    Ok(wakeup)
-}
-
-/// The sending half of a topic: a publisher of `T` plus a notifier that wakes receivers.
-pub struct Sender<T: Debug + ZeroCopySend + 'static> {
+/// The sending half of a topic: a publisher of `P` (a fixed-size type, or `[E]` for a slice
+/// topic, see [`SliceSender`](super::SliceSender)) with user header `H`, plus a notifier that
+/// wakes receivers.
+pub struct Sender<P, H = ()>
+where
+    P: Debug + IceoryxSend + ?Sized + 'static,
+    H: Debug + ZeroCopySend + 'static,
+{
     name: ServiceName,
-    publisher: Publisher<Ipc, T, ()>,
+    publisher: Publisher<Ipc, P, H>,
     notifier: Notifier<Ipc>,
 }
 
-impl<T: Debug + ZeroCopySend + 'static> Sender<T> {
-    pub(crate) fn open(node: &Node<Ipc>, name: ServiceName, qos: Qos) -> Result<Self, TransportError> {
-        let service = open_pubsub!(node, &name, qos, T)?;
-        let publisher = service
-            .publisher_builder()
-            .backpressure_strategy(backpressure(&qos))
-            .create()
-            .map_err(|e| TransportError::ipc("create publisher", name.as_str(), e))?;
-        let events = open_event(node, &name, &qos)?;
+impl<P, H> Sender<P, H>
+where
+    P: Debug + IceoryxSend + ?Sized + 'static,
+    H: Debug + ZeroCopySend + 'static,
+{
+    /// Completes a sender around a freshly created publisher: its notifier, and connections to
+    /// the subscribers that already exist, so the first sample is not lost.
+    pub(crate) fn assemble(
+        node: &Node<Ipc>,
+        name: ServiceName,
+        qos: &Qos,
+        publisher: Publisher<Ipc, P, H>,
+    ) -> Result<Self, TransportError> {
+        let events = open_event(node, &name, qos)?;
         let notifier = create_notifier(&events, &name)?;
-        // Connect to subscribers that already exist, so the first sample is not lost.
-        publisher
-            .update_connections()
-            .map_err(|e| TransportError::ipc("connect publisher", name.as_str(), e))?;
-        Ok(Self {
+        let sender = Self {
             name,
             publisher,
             notifier,
-        })
+        };
+        sender.update_connections()?;
+        Ok(sender)
     }
 
     /// The full service name.
@@ -221,44 +217,20 @@ impl<T: Debug + ZeroCopySend + 'static> Sender<T> {
         self.name.as_str()
     }
 
-    /// Writes `value` into a loaned shared-memory chunk, publishes it and wakes the receivers.
-    /// Returns how many subscribers received it.
-    pub fn send(&self, value: T) -> Result<usize, TransportError> {
-        let sample = self
-            .publisher
-            .loan_uninit()
-            .map_err(|e| TransportError::ipc("loan sample", self.name.as_str(), e))?;
-        let reached = sample
-            .write_payload(value)
-            .send()
-            .map_err(|e| TransportError::ipc("send sample", self.name.as_str(), e))?;
-        self.notify()?;
-        Ok(reached)
-    }
-
-    /// Loans a default-initialised chunk, lets `fill` write the payload in place (no copy of a
-    /// large message through the stack), publishes it and wakes the receivers.
-    pub fn send_in_place(&self, fill: impl FnOnce(&mut T)) -> Result<usize, TransportError>
-    where
-        T: Default,
-    {
-        let mut sample = self
-            .publisher
-            .loan()
-            .map_err(|e| TransportError::ipc("loan sample", self.name.as_str(), e))?;
-        fill(sample.payload_mut());
+    /// Publishes a written sample and wakes the receivers; returns how many subscribers it
+    /// reached.
+    pub(crate) fn publish(&self, sample: SampleMut<Ipc, P, H>) -> Result<usize, TransportError> {
         let reached = sample
             .send()
             .map_err(|e| TransportError::ipc("send sample", self.name.as_str(), e))?;
-        self.notify()?;
-        Ok(reached)
-    }
-
-    fn notify(&self) -> Result<(), TransportError> {
         self.notifier
             .notify()
-            .map(|_| ())
-            .map_err(|e| TransportError::ipc("notify", self.name.as_str(), e))
+            .map_err(|e| TransportError::ipc("notify", self.name.as_str(), e))?;
+        Ok(reached)
+    }
+
+    pub(crate) fn loan_error(&self, e: impl Debug) -> TransportError {
+        TransportError::ipc("loan sample", self.name.as_str(), e)
     }
 
     /// Connects to subscribers that joined since the last send.
@@ -269,30 +241,77 @@ impl<T: Debug + ZeroCopySend + 'static> Sender<T> {
     }
 
     /// The underlying iceoryx2 publisher, for what this layer does not wrap.
-    pub fn publisher(&self) -> &Publisher<Ipc, T, ()> {
+    pub fn publisher(&self) -> &Publisher<Ipc, P, H> {
         &self.publisher
     }
 }
 
-/// The receiving half of a topic: a subscriber of `T` plus a listener to block on.
+impl<T: Debug + ZeroCopySend + 'static> Sender<T> {
+    pub(crate) fn open(
+        node: &Node<Ipc>,
+        name: ServiceName,
+        qos: Qos,
+    ) -> Result<Self, TransportError> {
+        let service = open_pubsub!(node, &name, qos, T)?;
+        let publisher = service
+            .publisher_builder()
+            .backpressure_strategy(backpressure(&qos))
+            .create()
+            .map_err(|e| TransportError::ipc("create publisher", name.as_str(), e))?;
+        Self::assemble(node, name, &qos, publisher)
+    }
+
+    /// Writes `value` into a loaned shared-memory chunk, publishes it and wakes the receivers.
+    /// Returns how many subscribers received it.
+    pub fn send(&self, value: T) -> Result<usize, TransportError> {
+        let sample = self
+            .publisher
+            .loan_uninit()
+            .map_err(|e| self.loan_error(e))?;
+        self.publish(sample.write_payload(value))
+    }
+
+    /// Loans a default-initialised chunk, lets `fill` write the payload in place (no copy of a
+    /// large message through the stack), publishes it and wakes the receivers.
+    pub fn send_in_place(&self, fill: impl FnOnce(&mut T)) -> Result<usize, TransportError>
+    where
+        T: Default,
+    {
+        let mut sample = self.publisher.loan().map_err(|e| self.loan_error(e))?;
+        fill(sample.payload_mut());
+        self.publish(sample)
+    }
+}
+
+/// The receiving half of a topic: a subscriber of `P` (fixed-size, or `[E]` for a slice topic,
+/// see [`SliceReceiver`](super::SliceReceiver)) with user header `H`, plus a listener to block on.
 ///
 /// Attach [`Receiver::listener`] to a [`WaitSet`](iceoryx2::prelude::WaitSet); when it fires,
-/// call [`Receiver::take_wakeup`] and then [`Receiver::drain`] (or [`Receiver::receive`]).
-pub struct Receiver<T: Debug + ZeroCopySend + 'static> {
+/// call [`Receiver::take_wakeup`] and then `receive` (or `drain`) until nothing is left.
+pub struct Receiver<P, H = ()>
+where
+    P: Debug + IceoryxSend + ?Sized + 'static,
+    H: Debug + ZeroCopySend + 'static,
+{
     name: ServiceName,
-    subscriber: Subscriber<Ipc, T, ()>,
+    subscriber: Subscriber<Ipc, P, H>,
     listener: Listener<Ipc>,
 }
 
-impl<T: Debug + ZeroCopySend + 'static> Receiver<T> {
-    pub(crate) fn open(node: &Node<Ipc>, name: ServiceName, qos: Qos) -> Result<Self, TransportError> {
-        let service = open_pubsub!(node, &name, qos, T)?;
-        let subscriber = service
-            .subscriber_builder()
-            .buffer_size(qos.buffer)
-            .create()
-            .map_err(|e| TransportError::ipc("create subscriber", name.as_str(), e))?;
-        let events = open_event(node, &name, &qos)?;
+impl<P, H> Receiver<P, H>
+where
+    P: Debug + IceoryxSend + ?Sized + 'static,
+    H: Debug + ZeroCopySend + 'static,
+{
+    /// Completes a receiver around a freshly created subscriber: its listener, and connections
+    /// to the publishers that already exist.
+    pub(crate) fn assemble(
+        node: &Node<Ipc>,
+        name: ServiceName,
+        qos: &Qos,
+        subscriber: Subscriber<Ipc, P, H>,
+    ) -> Result<Self, TransportError> {
+        let events = open_event(node, &name, qos)?;
         let listener = create_listener(&events, &name)?;
         subscriber
             .update_connections()
@@ -316,15 +335,42 @@ impl<T: Debug + ZeroCopySend + 'static> Receiver<T> {
 
     /// Consumes the pending wake-up events and reports what they were.
     pub fn take_wakeup(&self) -> Result<Wakeup, TransportError> {
-        take_wakeup(&self.listener, &self.name)
+        let mut wakeup = Wakeup::default();
+        self.listener
+            .try_wait(|activation| wakeup.record(activation.id))
+            .map_err(|e| TransportError::ipc("drain listener", self.name.as_str(), e))?;
+        Ok(wakeup)
+    }
+
+    pub(crate) fn receive_error(&self, e: impl Debug) -> TransportError {
+        TransportError::ipc("receive", self.name.as_str(), e)
+    }
+
+    /// The underlying iceoryx2 subscriber, for what this layer does not wrap.
+    pub fn subscriber(&self) -> &Subscriber<Ipc, P, H> {
+        &self.subscriber
+    }
+}
+
+impl<T: Debug + ZeroCopySend + 'static> Receiver<T> {
+    pub(crate) fn open(
+        node: &Node<Ipc>,
+        name: ServiceName,
+        qos: Qos,
+    ) -> Result<Self, TransportError> {
+        let service = open_pubsub!(node, &name, qos, T)?;
+        let subscriber = service
+            .subscriber_builder()
+            .buffer_size(qos.buffer)
+            .create()
+            .map_err(|e| TransportError::ipc("create subscriber", name.as_str(), e))?;
+        Self::assemble(node, name, &qos, subscriber)
     }
 
     /// Takes the oldest unread sample, if any. The sample stays in shared memory (zero-copy)
     /// until it is dropped.
     pub fn receive(&self) -> Result<Option<Sample<Ipc, T, ()>>, TransportError> {
-        self.subscriber
-            .receive()
-            .map_err(|e| TransportError::ipc("receive", self.name.as_str(), e))
+        self.subscriber.receive().map_err(|e| self.receive_error(e))
     }
 
     /// Hands every unread sample to `f` in publication order and returns how many there were.
@@ -335,10 +381,5 @@ impl<T: Debug + ZeroCopySend + 'static> Receiver<T> {
             n += 1;
         }
         Ok(n)
-    }
-
-    /// The underlying iceoryx2 subscriber, for what this layer does not wrap.
-    pub fn subscriber(&self) -> &Subscriber<Ipc, T, ()> {
-        &self.subscriber
     }
 }

@@ -41,7 +41,7 @@ pub use error::TransportError;
 pub use node::{CleanupReport, NodeInfo, NodeLiveness, Transport, TransportBuilder};
 pub use qos::{Delivery, Qos};
 pub use run::{purge_run, run_config, run_shm_files, RunId};
-pub use slice::{SliceReceiver, SliceSender};
+pub use slice::{SliceLoan, SliceReceiver, SliceSender};
 
 /// The iceoryx2 service variant HNAV uses between processes.
 pub type Ipc = iceoryx2::prelude::ipc::Service;

@@ -46,7 +46,9 @@ impl TransportBuilder {
         } else {
             SignalHandlingMode::Disabled
         };
-        let mut builder = NodeBuilder::new().config(&config).signal_handling_mode(signals);
+        let mut builder = NodeBuilder::new()
+            .config(&config)
+            .signal_handling_mode(signals);
         if let Some(name) = &self.name {
             let node_name = NodeName::new(name).map_err(|e| TransportError::InvalidName {
                 name: name.clone(),
@@ -54,9 +56,9 @@ impl TransportBuilder {
             })?;
             builder = builder.name(&node_name);
         }
-        let node = builder
-            .create::<Ipc>()
-            .map_err(|e| TransportError::ipc("create node", self.name.as_deref().unwrap_or(""), e))?;
+        let node = builder.create::<Ipc>().map_err(|e| {
+            TransportError::ipc("create node", self.name.as_deref().unwrap_or(""), e)
+        })?;
         Ok(Transport {
             run: self.run,
             config,
@@ -129,7 +131,7 @@ impl Transport {
         E: Debug + ZeroCopySend + 'static,
         H: Debug + ZeroCopySend + Default + 'static,
     {
-        SliceSender::open(&self.node, self.run.service_name(topic)?, max_len, qos)
+        SliceSender::open_slice(&self.node, self.run.service_name(topic)?, max_len, qos)
     }
 
     /// Opens the receiving half of a slice topic.
@@ -142,7 +144,7 @@ impl Transport {
         E: Debug + ZeroCopySend + 'static,
         H: Debug + ZeroCopySend + 'static,
     {
-        SliceReceiver::open(&self.node, self.run.service_name(topic)?, qos)
+        SliceReceiver::open_slice(&self.node, self.run.service_name(topic)?, qos)
     }
 
     /// A WaitSet with the same signal handling as the node.

@@ -164,6 +164,9 @@ mod tests {
         let run = RunId::new("r1").unwrap();
         let name = run.service_name("odom/3").unwrap();
         assert_eq!(name.as_str(), "hnav/r1/odom/3");
-        assert_eq!(run_config(&run).global.prefix, FileName::new(b"hnav_r1_").unwrap());
+        assert_eq!(
+            run_config(&run).global.prefix,
+            FileName::new(b"hnav_r1_").unwrap()
+        );
     }
 }

@@ -1,42 +1,36 @@
-//! Slice channels: variable-length arrays (the neural-map snapshot) written in place into
+//! Slice topics: variable-length arrays (the neural-map snapshot) written in place into
 //! loaned shared memory, with a fixed-size user header beside them.
+//!
+//! A slice topic is a [`Sender`]/[`Receiver`] whose payload is `[E]`; this module adds what is
+//! particular to slices: preallocated maximum length and in-place writing through a
+//! [`SliceLoan`].
 
 use core::fmt::Debug;
 use core::mem::MaybeUninit;
 
 use iceoryx2::node::Node;
-use iceoryx2::port::listener::Listener;
-use iceoryx2::port::notifier::Notifier;
-use iceoryx2::port::publisher::Publisher;
-use iceoryx2::port::subscriber::Subscriber;
-use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::{AllocationStrategy, ServiceName, ZeroCopySend};
 use iceoryx2::sample::Sample;
 use iceoryx2::sample_mut_uninit::SampleMutUninit;
 
-use super::channel::{
-    backpressure, create_listener, create_notifier, open_event, open_pubsub, take_wakeup,
-};
-use super::{Ipc, Qos, TransportError, Wakeup};
+use super::channel::{backpressure, open_pubsub};
+use super::{Ipc, Qos, Receiver, Sender, TransportError};
 
 /// The sending half of a slice topic: `[E]` payloads with a header `H`.
 ///
 /// Memory is preallocated for `max_len` elements per sample (iceoryx2's `Static` strategy),
 /// so publishing never reallocates shared memory and subscribers never remap it.
-pub struct SliceSender<E: Debug + ZeroCopySend + 'static, H: Debug + ZeroCopySend + Default + 'static>
-{
-    name: ServiceName,
-    publisher: Publisher<Ipc, [E], H>,
-    notifier: Notifier<Ipc>,
-    max_len: usize,
-}
+pub type SliceSender<E, H> = Sender<[E], H>;
 
-impl<E, H> SliceSender<E, H>
+/// The receiving half of a slice topic.
+pub type SliceReceiver<E, H> = Receiver<[E], H>;
+
+impl<E, H> Sender<[E], H>
 where
     E: Debug + ZeroCopySend + 'static,
     H: Debug + ZeroCopySend + Default + 'static,
 {
-    pub(crate) fn open(
+    pub(crate) fn open_slice(
         node: &Node<Ipc>,
         name: ServiceName,
         max_len: usize,
@@ -50,35 +44,20 @@ where
             .backpressure_strategy(backpressure(&qos))
             .create()
             .map_err(|e| TransportError::ipc("create slice publisher", name.as_str(), e))?;
-        let events = open_event(node, &name, &qos)?;
-        let notifier = create_notifier(&events, &name)?;
-        publisher
-            .update_connections()
-            .map_err(|e| TransportError::ipc("connect publisher", name.as_str(), e))?;
-        Ok(Self {
-            name,
-            publisher,
-            notifier,
-            max_len: max_len.max(1),
-        })
-    }
-
-    /// The full service name.
-    pub fn name(&self) -> &str {
-        self.name.as_str()
+        Self::assemble(node, name, &qos, publisher)
     }
 
     /// The largest slice one sample can carry.
     pub fn max_len(&self) -> usize {
-        self.max_len
+        self.publisher().initial_max_slice_len()
     }
 
     /// Loans `len` elements of shared memory to be written in place.
     pub fn loan(&self, len: usize) -> Result<SliceLoan<'_, E, H>, TransportError> {
         let sample = self
-            .publisher
+            .publisher()
             .loan_slice_uninit(len)
-            .map_err(|e| TransportError::ipc("loan slice", self.name.as_str(), e))?;
+            .map_err(|e| self.loan_error(e))?;
         Ok(SliceLoan {
             sender: self,
             sample,
@@ -95,19 +74,6 @@ where
         let mut loan = self.loan(len)?;
         *loan.header_mut() = header;
         loan.fill_and_send(f)
-    }
-
-    fn finish(
-        &self,
-        sample: iceoryx2::sample_mut::SampleMut<Ipc, [E], H>,
-    ) -> Result<usize, TransportError> {
-        let reached = sample
-            .send()
-            .map_err(|e| TransportError::ipc("send slice", self.name.as_str(), e))?;
-        self.notifier
-            .notify()
-            .map_err(|e| TransportError::ipc("notify", self.name.as_str(), e))?;
-        Ok(reached)
     }
 }
 
@@ -138,8 +104,7 @@ where
 
     /// Writes element `i` as `f(i)` straight into shared memory, then publishes and notifies.
     pub fn fill_and_send(self, f: impl FnMut(usize) -> E) -> Result<usize, TransportError> {
-        let sample = self.sample.write_from_fn(f);
-        self.sender.finish(sample)
+        self.sender.publish(self.sample.write_from_fn(f))
     }
 
     /// Copies `src` (which must have the loaned length) into shared memory, then publishes.
@@ -147,8 +112,7 @@ where
     where
         E: Copy,
     {
-        let sample = self.sample.write_from_slice(src);
-        self.sender.finish(sample)
+        self.sender.publish(self.sample.write_from_slice(src))
     }
 
     /// Publishes what was written through [`SliceLoan::payload_mut`].
@@ -159,61 +123,34 @@ where
     pub unsafe fn assume_init_and_send(self) -> Result<usize, TransportError> {
         // SAFETY: the caller guarantees every element was written.
         let sample = unsafe { self.sample.assume_init() };
-        self.sender.finish(sample)
+        self.sender.publish(sample)
     }
 }
 
-/// The receiving half of a slice topic.
-pub struct SliceReceiver<E: Debug + ZeroCopySend + 'static, H: Debug + ZeroCopySend + 'static> {
-    name: ServiceName,
-    subscriber: Subscriber<Ipc, [E], H>,
-    listener: Listener<Ipc>,
-}
-
-impl<E, H> SliceReceiver<E, H>
+impl<E, H> Receiver<[E], H>
 where
     E: Debug + ZeroCopySend + 'static,
     H: Debug + ZeroCopySend + 'static,
 {
-    pub(crate) fn open(node: &Node<Ipc>, name: ServiceName, qos: Qos) -> Result<Self, TransportError> {
+    pub(crate) fn open_slice(
+        node: &Node<Ipc>,
+        name: ServiceName,
+        qos: Qos,
+    ) -> Result<Self, TransportError> {
         let service = open_pubsub!(node, &name, qos, [E], H)?;
         let subscriber = service
             .subscriber_builder()
             .buffer_size(qos.buffer)
             .create()
             .map_err(|e| TransportError::ipc("create slice subscriber", name.as_str(), e))?;
-        let events = open_event(node, &name, &qos)?;
-        let listener = create_listener(&events, &name)?;
-        subscriber
-            .update_connections()
-            .map_err(|e| TransportError::ipc("connect subscriber", name.as_str(), e))?;
-        Ok(Self {
-            name,
-            subscriber,
-            listener,
-        })
-    }
-
-    /// The full service name.
-    pub fn name(&self) -> &str {
-        self.name.as_str()
-    }
-
-    /// The listener to attach to a WaitSet.
-    pub fn listener(&self) -> &Listener<Ipc> {
-        &self.listener
-    }
-
-    /// Consumes the pending wake-up events and reports what they were.
-    pub fn take_wakeup(&self) -> Result<Wakeup, TransportError> {
-        take_wakeup(&self.listener, &self.name)
+        Self::assemble(node, name, &qos, subscriber)
     }
 
     /// Takes the oldest unread sample; `sample.user_header()` and `sample.payload()` read it in
     /// place in shared memory.
     pub fn receive(&self) -> Result<Option<Sample<Ipc, [E], H>>, TransportError> {
-        self.subscriber
+        self.subscriber()
             .receive()
-            .map_err(|e| TransportError::ipc("receive slice", self.name.as_str(), e))
+            .map_err(|e| self.receive_error(e))
     }
 }

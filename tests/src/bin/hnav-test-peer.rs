@@ -75,8 +75,12 @@ fn run(args: Args) -> Result<(), String> {
         Role::RecvSlice { len } => recv_slice(&t, len),
         Role::Hold => hold(&t),
         Role::Probe => {
-            let _tx = t.sender::<Candidate>("candidates", qos()).map_err(|e| e.to_string())?;
-            let _rx = t.receiver::<Candidate>("candidates", qos()).map_err(|e| e.to_string())?;
+            let _tx = t
+                .sender::<Candidate>("candidates", qos())
+                .map_err(|e| e.to_string())?;
+            let _rx = t
+                .receiver::<Candidate>("candidates", qos())
+                .map_err(|e| e.to_string())?;
             ready();
             Ok(())
         }
@@ -244,7 +248,9 @@ fn hold(t: &Transport) -> Result<(), String> {
     let _map = t
         .slice_sender::<f32, MapHeader>("map/0", 4096, Qos::latest())
         .map_err(|e| e.to_string())?;
-    let never = t.receiver::<u64>("never", qos()).map_err(|e| e.to_string())?;
+    let never = t
+        .receiver::<u64>("never", qos())
+        .map_err(|e| e.to_string())?;
     ready();
     // Blocks until the test kills this process (or PEER_TIMEOUT passes).
     wait_until(t, never.listener(), || Ok(false)).map(|_| ())

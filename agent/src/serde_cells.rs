@@ -1,0 +1,32 @@
+//! Serde helpers: a [`Cell`] as `[x, y]` (the runtime's `Cell` has no serde impls).
+
+/// One cell as `[x, y]`.
+pub(crate) mod cell {
+    use hnav_runtime::grid::Cell;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(c: &Cell, s: S) -> Result<S::Ok, S::Error> {
+        [c.x, c.y].serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Cell, D::Error> {
+        let [x, y] = <[u32; 2]>::deserialize(d)?;
+        Ok(Cell::new(x, y))
+    }
+}
+
+/// A list of cells as `[[x, y], ...]`.
+pub(crate) mod cells {
+    use hnav_runtime::grid::Cell;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(cells: &[Cell], s: S) -> Result<S::Ok, S::Error> {
+        let pairs: Vec<[u32; 2]> = cells.iter().map(|c| [c.x, c.y]).collect();
+        pairs.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Cell>, D::Error> {
+        let pairs = Vec::<[u32; 2]>::deserialize(d)?;
+        Ok(pairs.into_iter().map(|[x, y]| Cell::new(x, y)).collect())
+    }
+}
