@@ -3,13 +3,14 @@
 //! `cargo run --release -p hnav-agent --example sweep_speed [-- --quick]`
 //!
 //! Prints, per grid size and activation: sweeps, neuron updates, time per map and neuron
-//! updates per second (one core), for the target in the centre and in a corner.
+//! updates per second (one core), for the target in the centre and in a corner; then single
+//! plan queries (map + path) corner to corner. Each figure is the best of several runs.
+//! `HNAV_SIMD=avx2` or `HNAV_SIMD=baseline` caps the kernel's instruction set.
 
 use std::time::Instant;
 
-use hnav_agent::neural_map::{
-    Activation, NeuralDynamics, NeuralMap, NeuralMapOptions, StopRule,
-};
+use hnav_agent::neural_map::{Activation, NeuralDynamics, NeuralMap, NeuralMapOptions, StopRule};
+use hnav_agent::plan::{PlanOptions, Planner};
 use hnav_runtime::grid::{Cell, Grid};
 
 fn main() {
@@ -26,21 +27,14 @@ fn main() {
                 ..NeuralMapOptions::default()
             };
             let mut map = NeuralMap::new(&grid, opts).unwrap();
-            for (label, target) in [("centre", Cell::new(n / 2, n / 2)), ("corner", Cell::new(0, 0))] {
-                // Repeat until ~0.3 s (at least 3 runs), keep the best run.
+            for (label, target) in [
+                ("centre", Cell::new(n / 2, n / 2)),
+                ("corner", Cell::new(0, 0)),
+            ] {
                 let budget = if quick { 0.05 } else { 0.3 };
-                let (mut best, mut runs, mut total) = (f64::INFINITY, 0, 0.0);
-                let mut report = None;
-                while runs < 3 || total < budget {
-                    let t0 = Instant::now();
-                    let r = map.build(target, StopRule::FullActivation).unwrap();
-                    let dt = t0.elapsed().as_secs_f64();
-                    best = best.min(dt);
-                    total += dt;
-                    runs += 1;
-                    report = Some(r);
-                }
-                let r = report.unwrap();
+                let (best, r) = best_of(budget, || {
+                    map.build(target, StopRule::FullActivation).unwrap()
+                });
                 println!(
                     "{:>10} {:>7} {:>7} {:>7} {:>14} {:>12} {:>12.3e}",
                     format!("{n}x{n}"),
@@ -52,6 +46,51 @@ fn main() {
                     r.cells_updated as f64 / best
                 );
             }
+        }
+    }
+    plans(if quick { 0.05 } else { 0.3 });
+}
+
+/// Best-of-several wall time of `f`, with at least 3 runs and `budget` seconds in total.
+fn best_of<T>(budget: f64, mut f: impl FnMut() -> T) -> (f64, T) {
+    let (mut best, mut runs, mut total) = (f64::INFINITY, 0, 0.0);
+    loop {
+        let t0 = Instant::now();
+        let out = f();
+        let dt = t0.elapsed().as_secs_f64();
+        best = best.min(dt);
+        total += dt;
+        runs += 1;
+        if runs >= 3 && total >= budget {
+            return (best, out);
+        }
+    }
+}
+
+fn plans(budget: f64) {
+    println!();
+    println!(
+        "{:>10} {:>7} {:>7} {:>7} {:>12}",
+        "grid", "act", "sweeps", "steps", "time/query"
+    );
+    for n in [20u32, 128, 512, 1024] {
+        let grid = Grid::new(n, n).unwrap();
+        for activation in [Activation::Tanh, Activation::Linear] {
+            let options = PlanOptions {
+                activation,
+                ..PlanOptions::default()
+            };
+            let mut planner = Planner::new(&grid, &options).unwrap();
+            let (s, g) = (Cell::new(0, 0), Cell::new(n - 1, n - 1));
+            let (best, r) = best_of(budget, || planner.query(s, g).unwrap());
+            println!(
+                "{:>10} {:>7} {:>7} {:>7} {:>12}",
+                format!("{n}x{n}"),
+                format!("{activation:?}").to_lowercase(),
+                r.iterations,
+                r.steps,
+                fmt_time(best)
+            );
         }
     }
 }

@@ -29,8 +29,6 @@
 //! makes the values strictly increase along the path, so no cell repeats and the walk ends at
 //! the only neuron without a larger neighbour, the target.
 
-use std::collections::HashSet;
-
 use hnav_runtime::grid::{Cell, Direction};
 use serde::{Deserialize, Serialize};
 
@@ -225,9 +223,8 @@ impl PathConstructor {
             cell.offset(d.dx(), d.dy())
                 .filter(|&c| c.x < map.width() && c.y < map.height())
         };
-        let refused = |d: Direction| {
-            mask.is_refused(d) || neighbour(d).is_none_or(|c| map.is_blocked(c))
-        };
+        let refused =
+            |d: Direction| mask.is_refused(d) || neighbour(d).is_none_or(|c| map.is_blocked(c));
         let mut g = Gradients {
             values: [-1.0; 8],
             allowed: 0,
@@ -321,10 +318,18 @@ impl PathConstructor {
             path.outcome = PathOutcome::Unreachable;
             return Ok(path);
         }
-        let max_steps = self.options.max_steps.unwrap_or_else(|| {
-            2 * map.width() as usize * map.height() as usize + 8
-        });
-        let mut left: HashSet<Cell> = HashSet::new();
+        let max_steps = self
+            .options
+            .max_steps
+            .unwrap_or_else(|| 2 * map.width() as usize * map.height() as usize + 8);
+        // Cells the robot has left, one bit per cell.
+        let w = map.width() as usize;
+        let mut left = vec![0u64; (w * map.height() as usize).div_ceil(64)];
+        let bit = |c: Cell| (c.y as usize * w + c.x as usize, 1u64);
+        let is_left = |left: &[u64], c: Cell| {
+            let (i, _) = bit(c);
+            left[i / 64] & (1 << (i % 64)) != 0
+        };
         let mut heading = None;
         let mut cell = start;
         while cell != target {
@@ -332,17 +337,23 @@ impl PathConstructor {
                 path.outcome = PathOutcome::StepLimit;
                 return Ok(path);
             }
-            let g = self.gradients(map, cell, heading, DirectionMask::NONE, |c| left.contains(&c));
+            let g = self.gradients(map, cell, heading, DirectionMask::NONE, |c| {
+                is_left(&left, c)
+            });
             let Some(d) = self.choose(&g) else {
                 path.outcome = PathOutcome::Stuck;
                 return Ok(path);
             };
-            left.insert(cell);
+            let (i, _) = bit(cell);
+            left[i / 64] |= 1 << (i % 64);
             if heading.is_some_and(|h| h != d) {
                 path.turns += 1;
             }
             heading = Some(d);
-            cell = Cell::new(cell.x.wrapping_add_signed(d.dx()), cell.y.wrapping_add_signed(d.dy()));
+            cell = Cell::new(
+                cell.x.wrapping_add_signed(d.dx()),
+                cell.y.wrapping_add_signed(d.dy()),
+            );
             path.cells.push(cell);
             path.steps += 1;
             path.length += d.cost();

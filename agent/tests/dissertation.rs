@@ -4,8 +4,8 @@ mod common;
 
 use common::{id, maze};
 use hnav_agent::neural_map::{
-    Activation, ActivationField, Denominator, NeuralDynamics, NeuralMap, NeuralMapOptions,
-    Outcome, ReferenceMap, StopRule,
+    Activation, ActivationField, Denominator, NeuralDynamics, NeuralMap, NeuralMapOptions, Outcome,
+    ReferenceMap, StopRule,
 };
 use hnav_agent::path_constructor::{PathConstructor, PathOptions};
 
@@ -19,7 +19,11 @@ fn ids(g: &hnav_runtime::grid::Grid, cells: &[hnav_runtime::grid::Cell]) -> Vec<
 fn fig_2_16_reference_counts_and_path() {
     let g = maze();
     for activation in [Activation::Tanh, Activation::Linear] {
-        for denominator in [Denominator::LinkedOnly, Denominator::InGrid, Denominator::AllEight] {
+        for denominator in [
+            Denominator::LinkedOnly,
+            Denominator::InGrid,
+            Denominator::AllEight,
+        ] {
             let opts = NeuralMapOptions {
                 activation,
                 denominator,
@@ -71,7 +75,10 @@ fn fig_2_16_fast_counts_and_path() {
         let partial = map
             .build(id(&g, 56), StopRule::PartialActivation { start: id(&g, 1) })
             .unwrap();
-        assert_eq!((partial.outcome, partial.sweeps), (Outcome::StartReached, 13));
+        assert_eq!(
+            (partial.outcome, partial.sweeps),
+            (Outcome::StartReached, 13)
+        );
         let path = PathConstructor::new(PathOptions::default())
             .unwrap()
             .trace(&map, id(&g, 1))
@@ -83,16 +90,36 @@ fn fig_2_16_fast_counts_and_path() {
 
 /// Table 2-1: the activation matrix of an empty 10 x 10 network with I_56 = 1.
 const TABLE_2_1: [[f64; 10]; 10] = [
-    [0.0034, 0.0071, 0.0113, 0.0155, 0.0187, 0.0198, 0.0185, 0.0151, 0.0104, 0.0052],
-    [0.0071, 0.0153, 0.0249, 0.0349, 0.0429, 0.0459, 0.0426, 0.0341, 0.0229, 0.0113],
-    [0.0113, 0.0249, 0.0423, 0.0625, 0.0799, 0.0868, 0.0794, 0.0612, 0.0393, 0.0187],
-    [0.0155, 0.0349, 0.0625, 0.1017, 0.1417, 0.1598, 0.1412, 0.1001, 0.0585, 0.0267],
-    [0.0187, 0.0429, 0.0799, 0.1417, 0.2591, 0.3103, 0.2585, 0.1398, 0.0752, 0.0330],
-    [0.0198, 0.0459, 0.0868, 0.1598, 0.3103, 1.0000, 0.3097, 0.1578, 0.0819, 0.0355],
-    [0.0185, 0.0426, 0.0794, 0.1412, 0.2585, 0.3097, 0.2579, 0.1393, 0.0748, 0.0328],
-    [0.0151, 0.0341, 0.0612, 0.1001, 0.1398, 0.1578, 0.1393, 0.0985, 0.0573, 0.0261],
-    [0.0104, 0.0229, 0.0393, 0.0585, 0.0752, 0.0819, 0.0748, 0.0573, 0.0366, 0.0173],
-    [0.0052, 0.0113, 0.0187, 0.0267, 0.0330, 0.0355, 0.0328, 0.0261, 0.0173, 0.0085],
+    [
+        0.0034, 0.0071, 0.0113, 0.0155, 0.0187, 0.0198, 0.0185, 0.0151, 0.0104, 0.0052,
+    ],
+    [
+        0.0071, 0.0153, 0.0249, 0.0349, 0.0429, 0.0459, 0.0426, 0.0341, 0.0229, 0.0113,
+    ],
+    [
+        0.0113, 0.0249, 0.0423, 0.0625, 0.0799, 0.0868, 0.0794, 0.0612, 0.0393, 0.0187,
+    ],
+    [
+        0.0155, 0.0349, 0.0625, 0.1017, 0.1417, 0.1598, 0.1412, 0.1001, 0.0585, 0.0267,
+    ],
+    [
+        0.0187, 0.0429, 0.0799, 0.1417, 0.2591, 0.3103, 0.2585, 0.1398, 0.0752, 0.0330,
+    ],
+    [
+        0.0198, 0.0459, 0.0868, 0.1598, 0.3103, 1.0000, 0.3097, 0.1578, 0.0819, 0.0355,
+    ],
+    [
+        0.0185, 0.0426, 0.0794, 0.1412, 0.2585, 0.3097, 0.2579, 0.1393, 0.0748, 0.0328,
+    ],
+    [
+        0.0151, 0.0341, 0.0612, 0.1001, 0.1398, 0.1578, 0.1393, 0.0985, 0.0573, 0.0261,
+    ],
+    [
+        0.0104, 0.0229, 0.0393, 0.0585, 0.0752, 0.0819, 0.0748, 0.0573, 0.0366, 0.0173,
+    ],
+    [
+        0.0052, 0.0113, 0.0187, 0.0267, 0.0330, 0.0355, 0.0328, 0.0261, 0.0173, 0.0085,
+    ],
 ];
 
 /// Single peak at the target, and strictly decreasing along every ray out of it.
@@ -104,18 +131,27 @@ fn assert_single_peak(values: &[f64], w: usize, t: (usize, usize)) {
             if (x, y) == t {
                 continue;
             }
-            let larger = (-1i64..=1).flat_map(|dy| (-1i64..=1).map(move |dx| (dx, dy))).any(
-                |(dx, dy)| {
+            let larger = (-1i64..=1)
+                .flat_map(|dy| (-1i64..=1).map(move |dx| (dx, dy)))
+                .any(|(dx, dy)| {
                     let (nx, ny) = (x as i64 + dx, y as i64 + dy);
                     (0..w as i64).contains(&nx)
                         && (0..h as i64).contains(&ny)
                         && at(nx as usize, ny as usize) > at(x, y)
-                },
-            );
+                });
             assert!(larger, "({x}, {y}) is a local maximum");
         }
     }
-    for (dx, dy) in [(0i64, -1i64), (1, -1), (1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1)] {
+    for (dx, dy) in [
+        (0i64, -1i64),
+        (1, -1),
+        (1, 0),
+        (1, 1),
+        (0, 1),
+        (-1, 1),
+        (-1, 0),
+        (-1, -1),
+    ] {
         let (mut x, mut y) = (t.0 as i64, t.1 as i64);
         let mut last = at(t.0, t.1);
         loop {
@@ -151,7 +187,10 @@ fn table_2_1_shape_and_closest_variant() {
     let mut map = ReferenceMap::new(&g, NeuralMapOptions::table_2_1()).unwrap();
     let r = map.build(target, StopRule::Sweeps(9)).unwrap();
     assert_eq!((r.outcome, r.sweeps), (Outcome::SweepsDone, 9));
-    print_table("ours (tanh, all eight in the denominator, 9 sweeps)", map.values());
+    print_table(
+        "ours (tanh, all eight in the denominator, 9 sweeps)",
+        map.values(),
+    );
     let err = map
         .values()
         .iter()
@@ -163,7 +202,10 @@ fn table_2_1_shape_and_closest_variant() {
     assert_single_peak(map.values(), 10, (5, 5));
 
     // Our default maps have the same qualitative shape.
-    for opts in [NeuralMapOptions::default(), NeuralMapOptions::dissertation()] {
+    for opts in [
+        NeuralMapOptions::default(),
+        NeuralMapOptions::dissertation(),
+    ] {
         let mut map = ReferenceMap::new(&g, opts).unwrap();
         let r = map.build(target, StopRule::FullActivation).unwrap();
         assert_eq!(r.sweeps, 5, "eccentricity of 56 on 10 x 10");
@@ -226,7 +268,10 @@ fn unreachable_goal_is_reported_not_looped_on() {
         assert_eq!(full.outcome, Outcome::FullyActivated);
         assert_eq!(full.cells_on, 36 - 4);
         let path = PathConstructor::default().trace(&*map, start).unwrap();
-        assert_eq!(path.outcome, hnav_agent::path_constructor::PathOutcome::Unreachable);
+        assert_eq!(
+            path.outcome,
+            hnav_agent::path_constructor::PathOutcome::Unreachable
+        );
         assert_eq!(path.steps, 0);
     }
     let r = hnav_agent::plan_query(&g, start, target, &Default::default()).unwrap();

@@ -5,7 +5,11 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 
+use hnav_agent::neural_map::Activation;
+use hnav_agent::plan::PlanStop;
 use hnav_bench::latency::{self, TransportKind};
+use hnav_bench::plan::{self, PlannerKind};
+use hnav_runtime::grid::Cell;
 
 #[derive(Debug, Parser)]
 #[command(name = "hnav-bench", version, about = "HNAV benchmarks")]
@@ -20,6 +24,89 @@ struct Cli {
 enum Command {
     /// One-way and round-trip latency: raw iceoryx2, HNAV transport, Unix socket, TCP.
     Latency(LatencyArgs),
+    /// Plan one query, or every entry of a MovingAI .scen file, with one of HNAV's planners.
+    Plan(PlanCli),
+}
+
+#[derive(Debug, Args)]
+struct PlanCli {
+    /// The planner: hnav (neural map).
+    #[arg(long)]
+    planner: PlannerKind,
+    /// The MovingAI .map file.
+    #[arg(long, value_name = "FILE")]
+    map: PathBuf,
+    /// Start cell, MovingAI x (column), y (row).
+    #[arg(long, value_name = "X,Y", value_parser = plan::parse_cell, requires = "goal", conflicts_with = "scen")]
+    start: Option<Cell>,
+    /// Goal cell.
+    #[arg(long, value_name = "X,Y", value_parser = plan::parse_cell, requires = "start")]
+    goal: Option<Cell>,
+    /// Answer every entry of this .scen file instead (one line each, then a summary line).
+    #[arg(long, value_name = "FILE")]
+    scen: Option<PathBuf>,
+    /// Only the first N entries of the .scen file.
+    #[arg(long, value_name = "N", requires = "scen")]
+    first: Option<usize>,
+    /// Neural-map activation.
+    #[arg(long, value_enum, default_value = "tanh")]
+    activation: ActivationArg,
+    /// Neural-map stop rule: partial (the start is reached) or full (every reachable cell).
+    #[arg(long, value_enum, default_value = "partial")]
+    stop: StopArg,
+    /// Let diagonals pass between two blocked cells (the dissertation's reproductions);
+    /// without it MovingAI's rule applies, in propagation and in the path.
+    #[arg(long)]
+    corner_cutting: bool,
+    /// Print JSON lines instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum ActivationArg {
+    Linear,
+    Tanh,
+}
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum StopArg {
+    Partial,
+    Full,
+}
+
+fn plan_cmd(args: PlanCli) -> Result<()> {
+    let json = args.json;
+    let plan_args = plan::PlanArgs {
+        planner: args.planner,
+        map: args.map,
+        endpoints: args.start.zip(args.goal),
+        scen: args.scen.map(|s| (s, args.first)),
+        activation: match args.activation {
+            ActivationArg::Linear => Activation::Linear,
+            ActivationArg::Tanh => Activation::Tanh,
+        },
+        stop: match args.stop {
+            StopArg::Partial => PlanStop::Partial,
+            StopArg::Full => PlanStop::Full,
+        },
+        corner_cutting: args.corner_cutting,
+    };
+    let summary = plan::run(&plan_args, |line| {
+        if json {
+            println!("{}", serde_json::to_string(line).unwrap_or_default());
+        } else {
+            println!("{}", line.render());
+        }
+    })?;
+    if let Some(s) = summary {
+        if json {
+            println!("{}", serde_json::to_string(&s)?);
+        } else {
+            println!("{}", s.render());
+        }
+    }
+    Ok(())
 }
 
 #[derive(Debug, Args)]
@@ -48,9 +135,18 @@ fn latency(args: LatencyArgs) -> Result<()> {
     Ok(())
 }
 
-fn main() -> Result<()> {
+fn main() -> std::process::ExitCode {
     hnav_runtime::logging::init();
-    match Cli::parse().command {
+    let outcome = match Cli::parse().command {
         Command::Latency(args) => latency(args),
+        Command::Plan(args) => plan_cmd(args),
+    };
+    match outcome {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            // `{:#}` prints the whole context chain on one line, without a backtrace.
+            eprintln!("error: {e:#}");
+            std::process::ExitCode::from(2)
+        }
     }
 }

@@ -1,6 +1,37 @@
 //! # hnav-coordinator
 //!
-//! The central compute block of an HNAV swarm: conflict resolution between candidate steps,
-//! global replanning for blocked agents and the durable consensus log. Its modules arrive with
-//! the coordinator and end-to-end issues; until then the crate is an empty member of the
-//! workspace so that its place in the dependency graph (`runtime` <- `coordinator`) is fixed.
+//! The central compute block of an HNAV swarm. When an agent is blocked for several rounds or
+//! stuck at a local extremum of its neural map, the coordinator replans globally over the
+//! known map (standing agents as obstacles) and answers with waypoints. This crate holds the
+//! global planners for that, and the terrain-hazard model they can plan with, after seed 002
+//! (a thesis on Lazy Theta* for s-bots on rough terrain).
+//!
+//! | module | concept |
+//! |---|---|
+//! | [`planner`] | the [`Planner`](planner::Planner) trait; A*, Basic Theta*, Lazy Theta*; line of sight; single queries for the bench |
+//! | [`terrain`] | slope, roughness and relief from a height map; the hazard index `R`; route hazard `c = sum alpha R` |
+//! | [`experiment`] | seed 002's §4 experiment (random circular obstacles on a 50 x 50 m field) beside its Table 3.1 |
+//! | [`error`] | [`PlanError`], every way a caller's input can be unusable |
+//!
+//! Conflict resolution and the consensus-log writer join this crate with the coordinator
+//! process.
+//!
+//! ```
+//! use hnav_coordinator::planner::{LazyTheta, Planner, PlannerConfig};
+//! use hnav_runtime::grid::{Cell, Grid};
+//! let mut grid = Grid::new(10, 10).unwrap();
+//! for y in 2..10 {
+//!     grid.set_blocked(Cell::new(5, y), true);
+//! }
+//! let mut planner = LazyTheta::new(PlannerConfig::default());
+//! let path = planner.plan(&grid, Cell::new(1, 8), Cell::new(8, 8)).unwrap().unwrap();
+//! assert_eq!(path.cells.len(), 4); // start, two turns at the wall's ends, goal
+//! ```
+
+pub mod error;
+pub mod experiment;
+pub mod planner;
+mod serde_cells;
+pub mod terrain;
+
+pub use error::PlanError;

@@ -77,7 +77,9 @@ pub(crate) fn run<E: SweepEngine>(engine: &mut E, stop: StopRule, cap: u32) -> B
         engine.commit();
         sweeps += 1;
         let done = match stop {
-            StopRule::FullActivation => (!grew && s.above == s.nonzero).then_some(Outcome::FullyActivated),
+            StopRule::FullActivation => {
+                (!grew && s.above == s.nonzero).then_some(Outcome::FullyActivated)
+            }
             StopRule::PartialActivation { start } => {
                 if engine.is_above(start) {
                     Some(Outcome::StartReached)

@@ -50,7 +50,12 @@
 //! clears only the rectangle the previous one touched. The grid is padded with one blocked
 //! cell on each side, so every interior neuron has eight in-bounds neighbours and the kernel
 //! needs no edge cases; `1 / D_i` and the cut-diagonal mask are precomputed per cell. Each
-//! sweep covers the bounding box of the non-zero neurons grown by one cell.
+//! sweep covers the bounding box of the non-zero neurons grown by one cell; boxes (nearly) as
+//! wide as the grid run as one long segment across the padding. The kernel (`kernel.rs`) is
+//! compiled three times, for x86-64's baseline, AVX2 + FMA and AVX-512, and the best the CPU
+//! has is picked at run time (`HNAV_SIMD=avx2` or `baseline` caps it, for benchmarks). tanh is
+//! evaluated only in blocks of 256 cells that hold a value above `2^-13`, so on large maps
+//! tanh costs about what linear does.
 
 use hnav_runtime::grid::{Cell, Direction, Grid};
 
@@ -144,7 +149,7 @@ impl NeuralMap {
     /// below `f32`'s normal range to 0: what the runtime's neural-map snapshot carries. Fails if
     /// `out` does not have one slot per cell.
     pub fn write_values_f32(&self, out: &mut [f32]) -> Result<(), Error> {
-        self.write_with(out, |m, e| xfloat::to_f32_flushed(m, e))
+        self.write_with(out, xfloat::to_f32_flushed)
     }
 
     /// Writes `log2` of every activation (`-inf` for 0) into `out`; never underflows.
@@ -193,8 +198,10 @@ impl NeuralMap {
         if self.flags.mask {
             let links = if free { self.topo.links(cell) } else { 0 };
             let bit = |d: Direction, to: u8| ((links >> d.index()) & 1) << to;
-            self.diag[p] =
-                bit(Direction::NE, 0) | bit(Direction::SE, 1) | bit(Direction::SW, 2) | bit(Direction::NW, 3);
+            self.diag[p] = bit(Direction::NE, 0)
+                | bit(Direction::SE, 1)
+                | bit(Direction::SW, 2)
+                | bit(Direction::NW, 3);
         }
     }
 
@@ -257,7 +264,7 @@ impl SweepEngine for NeuralMap {
             above: k.above,
             changed: k.changed,
             max_delta: f64::from(f32::from_bits(k.max_delta_bits)),
-            cells: region.cells(),
+            cells: k.cells,
         };
         if let Some(t) = self.target {
             // The kernel computed 0 for the target (its 1/D is 0); clamp it back to 1.
@@ -344,8 +351,11 @@ impl ActivationField for NeuralMap {
             .max()
             .unwrap_or(0);
         for (v, &p) in values.iter_mut().zip(&at) {
-            if m[p] != 0.0 {
-                *v = f64::from(m[p]) * f64::from(e[p] - e_ref).exp2();
+            // 2^d built from the bits (exact); a value 2^1022 below the block's largest is
+            // flushed to 0, which cannot change the argmax of the gradients.
+            let d = i64::from(e[p]) - i64::from(e_ref);
+            if m[p] != 0.0 && d >= -1022 {
+                *v = f64::from(m[p]) * f64::from_bits(((d + 1023) as u64) << 52);
             }
         }
         Local {
@@ -393,7 +403,10 @@ impl NeuralDynamics for NeuralMap {
 
     fn continue_sweeps(&mut self, stop: StopRule) -> Result<BuildReport, Error> {
         if self.target.is_none() {
-            return Err(Error::option("target", "build the map before continuing it"));
+            return Err(Error::option(
+                "target",
+                "build the map before continuing it",
+            ));
         }
         self.check_stop(&stop)?;
         Ok(driver::run(self, stop, self.cap()))

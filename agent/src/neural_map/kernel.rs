@@ -1,13 +1,18 @@
 //! The fast path's sweep kernel: one synchronous update of a rectangle of the padded grid.
 //!
-//! Written for the auto-vectoriser: each row is nine equal-length slices (the cell and its
-//! eight neighbours, which exist for every interior cell thanks to the 1-cell padding), the
-//! loop body is straight-line arithmetic with selects instead of branches, and the options
-//! that change the body (activation, cut diagonals, self weight, convergence deltas) are
-//! const generics so that each combination compiles to its own loop. On x86-64 the same body
-//! is also compiled with AVX2 + FMA and picked at run time when the CPU has them.
+//! Written for the auto-vectoriser: a segment of a row reads three rows of each plane (the
+//! padding gives every interior cell eight in-bounds neighbours), the loop body is
+//! straight-line arithmetic with selects instead of branches, and the options that change the
+//! body (activation, cut diagonals, self weight, convergence deltas) are const generics so that
+//! each combination compiles to its own loop. On x86-64 the same body is also compiled with
+//! AVX2 + FMA and with AVX-512 and picked at run time.
+//!
+//! Per neuron: the largest exponent among the linked neighbours, each neighbour's mantissa
+//! scaled by `2^(e_j - e_max)` (built from the exponent bits, flushed below `2^-100`), the
+//! weighted sum times `1 / D_i`, and the renormalisation into mantissa and exponent; see
+//! [`super::fast`] for why this is exact where `f32` is.
 
-use super::xfloat::{pow2, pow2_rel, split, tanh, to_f32_flushed, ZERO_EXP};
+use super::xfloat::{pow2, pow2_biased, split, split_biased, tanh, to_f32_flushed, ZERO_EXP};
 
 /// Loop-invariant numbers of a sweep.
 #[derive(Clone, Copy, Debug)]
@@ -83,10 +88,6 @@ impl Region {
             y1: self.y1.max(o.y1),
         }
     }
-
-    pub fn cells(self) -> u64 {
-        ((self.x1 - self.x0 + 1) * (self.y1 - self.y0 + 1)) as u64
-    }
 }
 
 /// Counts over a sweep (target not yet corrected for; see `fast.rs`).
@@ -98,6 +99,8 @@ pub(crate) struct KStats {
     pub changed: u64,
     /// Bits of the largest `|delta|` (non-negative floats order like their bits).
     pub max_delta_bits: u32,
+    /// Neuron updates computed (padding cells of merged rows included).
+    pub cells: u64,
 }
 
 /// Which instruction set the kernel runs with.
@@ -106,20 +109,43 @@ pub(crate) enum Level {
     Baseline,
     #[cfg(target_arch = "x86_64")]
     Avx2,
+    #[cfg(target_arch = "x86_64")]
+    Avx512,
 }
 
 impl Level {
+    /// The best level the CPU supports, capped by the environment variable `HNAV_SIMD`
+    /// (`baseline`, `avx2`; for benchmarking the kernel variants against each other). Detected
+    /// once per process.
     pub fn detect() -> Level {
+        static LEVEL: std::sync::OnceLock<Level> = std::sync::OnceLock::new();
+        *LEVEL.get_or_init(Self::detect_now)
+    }
+
+    fn detect_now() -> Level {
+        let cap = std::env::var("HNAV_SIMD").unwrap_or_default();
+        if cap == "baseline" {
+            return Level::Baseline;
+        }
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
         {
-            return Level::Avx2;
+            use std::arch::is_x86_feature_detected as has;
+            let avx512 =
+                has!("avx512f") && has!("avx512bw") && has!("avx512vl") && has!("avx512dq");
+            if avx512 && cap != "avx2" {
+                return Level::Avx512;
+            }
+            if has!("avx2") && has!("fma") {
+                return Level::Avx2;
+            }
         }
         Level::Baseline
     }
 }
 
-/// Runs one sweep over `r`: reads `*_in`, writes `*_out` inside `r` only.
+/// Runs one sweep over `r`: reads `*_in`, writes `*_out` inside `r`. When `r` is nearly as wide
+/// as the grid the whole rows `y0..=y1` are written; the cells outside `r` have no non-zero
+/// neighbour (`r` is the support grown by one) and so receive the 0 they already hold.
 pub(crate) fn sweep(level: Level, f: Flags, p: &Params, pl: &mut Planes<'_>, r: Region) -> KStats {
     // Turn the run-time flags into const generics, one at a time.
     if f.tanh {
@@ -129,7 +155,13 @@ pub(crate) fn sweep(level: Level, f: Flags, p: &Params, pl: &mut Planes<'_>, r: 
     }
 }
 
-fn sweep_t<const T: bool>(level: Level, f: Flags, p: &Params, pl: &mut Planes<'_>, r: Region) -> KStats {
+fn sweep_t<const T: bool>(
+    level: Level,
+    f: Flags,
+    p: &Params,
+    pl: &mut Planes<'_>,
+    r: Region,
+) -> KStats {
     if f.mask {
         sweep_tm::<T, true>(level, f, p, pl, r)
     } else {
@@ -176,7 +208,11 @@ fn dispatch<const T: bool, const M: bool, const S: bool, const D: bool>(
         // SAFETY: `Level::Avx2` is only constructed by `Level::detect` after the CPU reported
         // both AVX2 and FMA.
         Level::Avx2 => unsafe { rows_avx2::<T, M, S, D>(p, pl, r) },
-        Level::Baseline => rows::<T, M, S, D>(p, pl, r),
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: `Level::Avx512` is only constructed by `Level::detect` after the CPU reported
+        // AVX-512 F, BW, VL and DQ.
+        Level::Avx512 => unsafe { rows_avx512::<T, M, S, D>(p, pl, r) },
+        Level::Baseline => rows::<T, M, S, D, false>(p, pl, r),
     }
 }
 
@@ -187,27 +223,84 @@ fn rows_avx2<const T: bool, const M: bool, const S: bool, const D: bool>(
     pl: &mut Planes<'_>,
     r: Region,
 ) -> KStats {
-    rows::<T, M, S, D>(p, pl, r)
+    rows::<T, M, S, D, true>(p, pl, r)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512bw,avx512vl,avx512dq,avx2,fma")]
+fn rows_avx512<const T: bool, const M: bool, const S: bool, const D: bool>(
+    p: &Params,
+    pl: &mut Planes<'_>,
+    r: Region,
+) -> KStats {
+    rows::<T, M, S, D, true>(p, pl, r)
 }
 
 #[inline(always)]
-fn rows<const T: bool, const M: bool, const S: bool, const D: bool>(
+fn rows<const T: bool, const M: bool, const S: bool, const D: bool, const FMA: bool>(
     p: &Params,
     pl: &mut Planes<'_>,
     r: Region,
 ) -> KStats {
     let n = r.x1 - r.x0 + 1;
+    let w = pl.pw - 2;
     let mut st = KStats::default();
-    for y in r.y0..=r.y1 {
-        let base = y * pl.pw + r.x0;
-        row::<T, M, S, D>(p, pl, base, n, &mut st);
+    if w - n <= 64 {
+        // (Nearly) full width: run the rows as one segment from (1, y0) to (w, y1). The
+        // padding cells in between compute 0 (their 1/D is 0), so nothing changes but the
+        // loop has no short row ends, which cost more than the few extra cells.
+        let base = r.y0 * pl.pw + 1;
+        row::<T, M, S, D, FMA>(p, pl, base, (r.y1 - r.y0) * pl.pw + w, &mut st);
+    } else {
+        for y in r.y0..=r.y1 {
+            row::<T, M, S, D, FMA>(p, pl, y * pl.pw + r.x0, n, &mut st);
+        }
     }
     st
 }
 
-/// One row segment of `n` cells starting at padded index `base`.
+/// `a * b + c`, fused when the instruction set has FMA (a libm call otherwise, hence the flag).
 #[inline(always)]
-fn row<const TANH: bool, const MASK: bool, const SELF: bool, const DELTA: bool>(
+fn fmadd<const FMA: bool>(a: f32, b: f32, c: f32) -> f32 {
+    if FMA {
+        a.mul_add(b, c)
+    } else {
+        a * b + c
+    }
+}
+
+/// Cells per block. The activation and the counts run block by block after the sums, so
+/// that tanh is skipped for blocks far from the target (most of a big map).
+const BLOCK: usize = 256;
+
+/// One segment of `n` consecutive padded cells starting at index `base`, block by block.
+#[inline(always)]
+fn row<const TANH: bool, const MASK: bool, const SELF: bool, const DELTA: bool, const FMA: bool>(
+    p: &Params,
+    pl: &mut Planes<'_>,
+    base: usize,
+    n: usize,
+    st: &mut KStats,
+) {
+    let mut b = 0;
+    while b < n {
+        let len = BLOCK.min(n - b);
+        block::<TANH, MASK, SELF, DELTA, FMA>(p, pl, base + b, len, st);
+        b += len;
+    }
+    st.cells += n as u64;
+}
+
+/// One block of at most [`BLOCK`] cells: pass 1 computes the weighted averages, pass 2 applies
+/// tanh where it is not the identity, pass 3 counts what needs the final values.
+#[inline(always)]
+fn block<
+    const TANH: bool,
+    const MASK: bool,
+    const SELF: bool,
+    const DELTA: bool,
+    const FMA: bool,
+>(
     p: &Params,
     pl: &mut Planes<'_>,
     base: usize,
@@ -217,20 +310,28 @@ fn row<const TANH: bool, const MASK: bool, const SELF: bool, const DELTA: bool>(
     let pw = pl.pw;
     let (up, dn) = (base - pw, base + pw);
     let (m, e) = (pl.m_in, pl.e_in);
-    // Nine slices of length n: the compiler then proves every index below in bounds.
-    let (m_nw, m_n, m_ne) = (&m[up - 1..][..n], &m[up..][..n], &m[up + 1..][..n]);
-    let (m_w, m_c, m_e) = (&m[base - 1..][..n], &m[base..][..n], &m[base + 1..][..n]);
-    let (m_sw, m_s, m_se) = (&m[dn - 1..][..n], &m[dn..][..n], &m[dn + 1..][..n]);
-    let (e_nw, e_n, e_ne) = (&e[up - 1..][..n], &e[up..][..n], &e[up + 1..][..n]);
-    let (e_w, e_c, e_e) = (&e[base - 1..][..n], &e[base..][..n], &e[base + 1..][..n]);
-    let (e_sw, e_s, e_se) = (&e[dn - 1..][..n], &e[dn..][..n], &e[dn + 1..][..n]);
+    // Three rows of n + 2 cells per plane (fewer live pointers than nine slices, which
+    // matters for the unoptimised test builds); index i is the west neighbour of cell i.
+    let (mu, mm, md) = (
+        &m[up - 1..][..n + 2],
+        &m[base - 1..][..n + 2],
+        &m[dn - 1..][..n + 2],
+    );
+    let (eu, em, ed) = (
+        &e[up - 1..][..n + 2],
+        &e[base - 1..][..n + 2],
+        &e[dn - 1..][..n + 2],
+    );
     let inv = &pl.inv_den[base..][..n];
     let diag: &[u8] = if MASK { &pl.diag[base..][..n] } else { &[] };
     let out_m = &mut pl.m_out[base..][..n];
     let out_e = &mut pl.e_out[base..][..n];
     let (ws, wd, wself) = (p.ws, p.wd, p.wself);
-    let (mut newly_on, mut nonzero, mut above, mut changed) = (0u32, 0u32, 0u32, 0u32);
-    let mut max_delta = 0u32;
+    let (mut newly_on, mut nonzero) = (0u32, 0u32);
+    let mut top = i32::MIN;
+    // Pass 1: the weighted averages (and linear saturation). Integer arithmetic here cannot
+    // overflow (exponents stay within +-2^28); `wrapping_*` only spares the unoptimised test
+    // builds their overflow checks.
     for i in 0..n {
         // A cut diagonal carries nothing and must not set the common exponent.
         let link = |bit: u8, mv: f32, ev: i32| -> (f32, i32) {
@@ -240,39 +341,43 @@ fn row<const TANH: bool, const MASK: bool, const SELF: bool, const DELTA: bool>(
                 (0.0, ZERO_EXP)
             }
         };
-        let (mne, ene) = link(1, m_ne[i], e_ne[i]);
-        let (mse, ese) = link(2, m_se[i], e_se[i]);
-        let (msw, esw) = link(4, m_sw[i], e_sw[i]);
-        let (mnw, enw) = link(8, m_nw[i], e_nw[i]);
-        let (mc, ec) = (m_c[i], e_c[i]);
+        let (m_n, e_n, m_s, e_s) = (mu[i + 1], eu[i + 1], md[i + 1], ed[i + 1]);
+        let (m_w, e_w, m_e, e_e) = (mm[i], em[i], mm[i + 2], em[i + 2]);
+        let (mne, ene) = link(1, mu[i + 2], eu[i + 2]);
+        let (mse, ese) = link(2, md[i + 2], ed[i + 2]);
+        let (msw, esw) = link(4, md[i], ed[i]);
+        let (mnw, enw) = link(8, mu[i], eu[i]);
+        let (mc, ec) = (mm[i + 1], em[i + 1]);
         // Common exponent: the largest neighbour's. Every term is then <= 2 and the sum
         // cannot overflow; terms 2^100 below the largest are flushed (see xfloat::FLUSH).
-        let mut emax = e_n[i].max(e_e[i]).max(e_s[i]).max(e_w[i]);
+        let mut emax = e_n.max(e_e).max(e_s).max(e_w);
         emax = emax.max(ene).max(ese).max(esw).max(enw);
         if SELF {
             emax = emax.max(ec);
         }
-        let straight = m_n[i] * pow2_rel(e_n[i] - emax)
-            + m_e[i] * pow2_rel(e_e[i] - emax)
-            + m_s[i] * pow2_rel(e_s[i] - emax)
-            + m_w[i] * pow2_rel(e_w[i] - emax);
-        let diagonal = mne * pow2_rel(ene - emax)
-            + mse * pow2_rel(ese - emax)
-            + msw * pow2_rel(esw - emax)
-            + mnw * pow2_rel(enw - emax);
-        let mut acc = ws * straight + wd * diagonal;
+        // One subtraction folds the exponent bias into the reference (see pow2_biased).
+        let eb = emax.wrapping_sub(127);
+        let term = |mv: f32, ev: i32| (mv, pow2_biased(ev.wrapping_sub(eb)));
+        let [(a, pa), (b, pb), (c, pc), (d, pd)] = [
+            term(m_n, e_n),
+            term(m_e, e_e),
+            term(m_s, e_s),
+            term(m_w, e_w),
+        ];
+        let straight = fmadd::<FMA>(a, pa, fmadd::<FMA>(b, pb, fmadd::<FMA>(c, pc, d * pd)));
+        let [(a, pa), (b, pb), (c, pc), (d, pd)] = [
+            term(mne, ene),
+            term(mse, ese),
+            term(msw, esw),
+            term(mnw, enw),
+        ];
+        let diagonal = fmadd::<FMA>(a, pa, fmadd::<FMA>(b, pb, fmadd::<FMA>(c, pc, d * pd)));
+        let mut acc = fmadd::<FMA>(ws, straight, wd * diagonal);
         if SELF {
-            acc += wself * mc * pow2_rel(ec - emax);
+            acc = fmadd::<FMA>(wself * mc, pow2_biased(ec.wrapping_sub(eb)), acc);
         }
-        let (mut nm, mut ne) = split(acc * inv[i], emax);
-        if TANH {
-            // tanh(x) rounds to x in f32 below 2^-13, so only larger values need it.
-            let x = nm * pow2(ne.clamp(-13, 1));
-            let (tm, te) = split(tanh(x), 0);
-            let big = ne >= -13;
-            nm = if big { tm } else { nm };
-            ne = if big { te } else { ne };
-        } else {
+        let (mut nm, mut ne) = split_biased(acc * inv[i], eb);
+        if !TANH {
             // Linear saturation: the average of values <= 1 is <= 1 up to rounding.
             let sat = ne >= 0;
             nm = if sat { 1.0 } else { nm };
@@ -280,10 +385,34 @@ fn row<const TANH: bool, const MASK: bool, const SELF: bool, const DELTA: bool>(
         }
         out_m[i] = nm;
         out_e[i] = ne;
-        newly_on += u32::from((mc == 0.0) & (nm != 0.0));
-        nonzero += u32::from(nm != 0.0);
+        top = top.max(ne);
+        // phi keeps 0 at 0 and positive values positive: these counts hold after tanh too.
+        newly_on = newly_on.wrapping_add(u32::from((mc == 0.0) & (nm != 0.0)));
+        nonzero = nonzero.wrapping_add(u32::from(nm != 0.0));
+    }
+    // Pass 2: tanh(x) rounds to x in f32 below 2^-13, so only blocks near the target need it.
+    if TANH && top >= -13 {
+        for (om, oe) in out_m.iter_mut().zip(out_e.iter_mut()) {
+            let x = *om * pow2((*oe).clamp(-13, 1));
+            let (tm, te) = split(tanh(x), 0);
+            let big = *oe >= -13;
+            *om = if big { tm } else { *om };
+            *oe = if big { te } else { *oe };
+        }
+    }
+    st.newly_on += u64::from(newly_on);
+    st.nonzero += u64::from(nonzero);
+    // Pass 3: counts that need the final values.
+    if p.thr_e == ZERO_EXP && !DELTA {
+        st.above += u64::from(nonzero);
+        return;
+    }
+    let (mut above, mut changed, mut max_delta) = (0u32, 0u32, 0u32);
+    for i in 0..n {
+        let (nm, ne) = (out_m[i], out_e[i]);
         above += u32::from((ne > p.thr_e) | ((ne == p.thr_e) & (nm > p.thr_m)));
         if DELTA {
+            let (mc, ec) = (mm[i + 1], em[i + 1]);
             let active = inv[i] > 0.0;
             changed += u32::from(active & ((nm != mc) | (ne != ec)));
             let dv = (to_f32_flushed(nm, ne) - to_f32_flushed(mc, ec)).abs();
@@ -291,8 +420,6 @@ fn row<const TANH: bool, const MASK: bool, const SELF: bool, const DELTA: bool>(
             max_delta = max_delta.max(dv);
         }
     }
-    st.newly_on += u64::from(newly_on);
-    st.nonzero += u64::from(nonzero);
     st.above += u64::from(above);
     st.changed += u64::from(changed);
     st.max_delta_bits = st.max_delta_bits.max(max_delta);

@@ -19,17 +19,21 @@
 //! |---|---|
 //! | here | options ([`NeuralMapOptions`] and its enums), [`StopRule`], [`BuildReport`], the [`ActivationField`] and [`NeuralDynamics`] traits |
 //! | [`fast`] | [`NeuralMap`]: the `f32` fast path with an extended exponent (no underflow), double buffers, a growing bounding box |
-//! | [`reference`] | [`ReferenceMap`]: the plain `f64` reference implementation (exact where `f64` does not underflow) |
+//! | [`reference`](mod@reference) | [`ReferenceMap`]: the plain `f64` reference implementation (exact where `f64` does not underflow) |
 //! | [`weights`] | [`Weights`] and the dense [`WeightMatrix`] builder (Table 2-2) |
 //! | [`repair`] | §2.10: partial correction and rebuild with partial activation |
 //!
 //! # Which variant reproduces what
 //!
-//! * Fig. 2-16 / 2-18 maze (19 sweeps to full activation, 13 to the start, the 13-move path):
-//!   [`NeuralMapOptions::dissertation`] — tanh or linear, any [`Denominator`] except
-//!   [`Denominator::AllEight`] with the `1e-16` threshold (that one needs 21 sweeps because the
-//!   far values stay below `1e-16`), diagonals between two blocked corners on
-//!   ([`DiagonalRule::Always`]), synchronous sweeps.
+//! * Fig. 2-16 / 2-18 maze: 19 sweeps to full activation and 13 to the start need
+//!   synchronous sweeps and diagonals between two blocked corners ([`DiagonalRule::Always`];
+//!   with [`DiagonalRule::NoCornerCutting`] it is 25 and 18), tanh or linear, with
+//!   [`Denominator::LinkedOnly`] or [`Denominator::InGrid`] ([`Denominator::AllEight`] needs 21
+//!   to full activation with the `1e-16` threshold, because its far values stay below it).
+//!   The 13-move path 1, 2, 13, 23, 33, 44, ... comes out with Appendix A's
+//!   [`Denominator::LinkedOnly`] ([`NeuralMapOptions::dissertation`]); counting obstacles as
+//!   zeros lowers cell 33 (three free neighbours) below 34, and the path takes 34 instead:
+//!   also 13 moves of the same length.
 //! * Table 2-1 (empty 10x10, target 56): only qualitatively; the closest variant is tanh with
 //!   [`Denominator::AllEight`] stopped after 9 sweeps ([`NeuralMapOptions::table_2_1`]), max
 //!   error 0.016.
@@ -90,12 +94,14 @@ impl Activation {
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Denominator {
-    /// Appendix A's code: only linked free neighbours (obstacles are `-1` and skipped).
+    /// Appendix A's code: only linked free neighbours (obstacles are `-1` and skipped). The
+    /// default: it reproduces the published Fig. 2-16 path and gives the shortest paths on
+    /// random maps (see the `path_quality` example).
+    #[default]
     LinkedOnly,
     /// Chapter 2's text: every in-grid neighbour; obstacles (and cut diagonals) count as
     /// zero-valued neurons, which makes the "reduced potential" margin along walls.
     /// Off-grid neighbours are absent. Seed 001's proxy law uses this too.
-    #[default]
     InGrid,
     /// All eight neighbours always count (obstacles and off-grid cells as zeros); the closest
     /// variant to Table 2-1.
@@ -202,8 +208,9 @@ pub struct BuildReport {
     pub cells_on: u64,
 }
 
-/// Every option of a neural map. [`Default`] is the Chapter 2 text with the wave-front
-/// threshold; see the presets for the published variants.
+/// Every option of a neural map. [`Default`] is tanh, Appendix A's denominator, every
+/// diagonal, no self weight and the wave-front threshold; see the presets for the published
+/// variants.
 #[derive(Clone, Copy, PartialEq, Debug, Default, Serialize, Deserialize)]
 pub struct NeuralMapOptions {
     /// The activation function.
@@ -226,7 +233,6 @@ impl NeuralMapOptions {
     /// only), every diagonal, `1e-16`.
     pub fn dissertation() -> Self {
         NeuralMapOptions {
-            denominator: Denominator::LinkedOnly,
             on_threshold: OnThreshold::Above(1e-16),
             ..Self::default()
         }
@@ -245,7 +251,6 @@ impl NeuralMapOptions {
     pub fn appendix_a() -> Self {
         NeuralMapOptions {
             activation: Activation::Linear,
-            denominator: Denominator::LinkedOnly,
             on_threshold: OnThreshold::Above(1e-15),
             ..Self::default()
         }
@@ -255,6 +260,7 @@ impl NeuralMapOptions {
     pub fn seed_001() -> Self {
         NeuralMapOptions {
             activation: Activation::Linear,
+            denominator: Denominator::InGrid,
             weights: Weights {
                 self_weight: 1.0,
                 ..Weights::default()
@@ -268,7 +274,10 @@ impl NeuralMapOptions {
         self.weights.validate()?;
         if let OnThreshold::Above(t) = self.on_threshold {
             if !(t.is_finite() && (0.0..1.0).contains(&t)) {
-                return Err(Error::option("on_threshold", format!("{t} is not in [0, 1)")));
+                return Err(Error::option(
+                    "on_threshold",
+                    format!("{t} is not in [0, 1)"),
+                ));
             }
         }
         if self.max_sweeps == Some(0) {
@@ -287,7 +296,10 @@ impl NeuralMapOptions {
 pub(crate) fn validate_stop(stop: &StopRule) -> Result<(), Error> {
     if let StopRule::Converged { tolerance } = stop {
         if !(tolerance.is_finite() && *tolerance >= 0.0) {
-            return Err(Error::option("tolerance", format!("{tolerance} is not >= 0")));
+            return Err(Error::option(
+                "tolerance",
+                format!("{tolerance} is not >= 0"),
+            ));
         }
     }
     Ok(())

@@ -230,7 +230,10 @@ impl NeuralDynamics for ReferenceMap {
 
     fn continue_sweeps(&mut self, stop: StopRule) -> Result<BuildReport, Error> {
         if self.target.is_none() {
-            return Err(Error::option("target", "build the map before continuing it"));
+            return Err(Error::option(
+                "target",
+                "build the map before continuing it",
+            ));
         }
         self.check_stop(&stop)?;
         let cap = self.options.sweep_cap(self.cur.len());

@@ -17,24 +17,32 @@ pub(crate) fn pow2(k: i32) -> f32 {
     f32::from_bits(((k + 127) as u32) << 23)
 }
 
-/// `2^d` for `d <= 0`, flushed to `2^-FLUSH` below that (the mantissa it multiplies is then
-/// dropped relative to the largest term anyway).
+/// `2^(b - 127)` for a biased exponent `b <= 127`, flushed to `2^-FLUSH` below that (the
+/// mantissa it multiplies is then dropped relative to the largest term anyway). Biased, so
+/// that the kernel folds the bias into one subtraction per cell instead of one per term.
 #[inline(always)]
-pub(crate) fn pow2_rel(d: i32) -> f32 {
-    pow2(d.max(-FLUSH))
+pub(crate) fn pow2_biased(b: i32) -> f32 {
+    f32::from_bits((b.max(127 - FLUSH) as u32).wrapping_shl(23))
 }
 
-/// Splits a non-negative normal `f32` (or 0) times `2^e_base` into mantissa and exponent.
+/// Splits a non-negative normal `f32` (or 0) times `2^(b_base - 127)` into mantissa and
+/// exponent (the bias-folded form of [`split`]).
 #[inline(always)]
-pub(crate) fn split(u: f32, e_base: i32) -> (f32, i32) {
+pub(crate) fn split_biased(u: f32, b_base: i32) -> (f32, i32) {
     let bits = u.to_bits();
     let m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
-    let e = e_base + (bits >> 23) as i32 - 127;
+    let e = b_base.wrapping_add((bits >> 23) as i32);
     if bits == 0 {
         (0.0, ZERO_EXP)
     } else {
         (m, e)
     }
+}
+
+/// Splits a non-negative normal `f32` (or 0) times `2^e_base` into mantissa and exponent.
+#[inline(always)]
+pub(crate) fn split(u: f32, e_base: i32) -> (f32, i32) {
+    split_biased(u, e_base.wrapping_sub(127))
 }
 
 /// The value as `f32` when it is a normal `f32`, else 0 (used for convergence deltas).
@@ -82,8 +90,8 @@ pub(crate) fn tanh(x: f32) -> f32 {
     let x = x.min(7.905_311);
     let x2 = x * x;
     let mut p = -2.760_768_5e-16_f32;
-    p = p * x2 + 2.000_187_9e-13;
-    p = p * x2 - 8.604_671_5e-11;
+    p = p * x2 + 2.000_188e-13;
+    p = p * x2 - 8.604_672e-11;
     p = p * x2 + 5.122_297e-8;
     p = p * x2 + 1.485_722_4e-5;
     p = p * x2 + 6.372_619_3e-4;
@@ -91,7 +99,7 @@ pub(crate) fn tanh(x: f32) -> f32 {
     let mut q = 1.198_258_4e-6_f32;
     q = q * x2 + 1.185_347_1e-4;
     q = q * x2 + 2.268_434_6e-3;
-    q = q * x2 + 4.893_525_2e-3;
+    q = q * x2 + 4.893_525e-3;
     (p * x) / q
 }
 
