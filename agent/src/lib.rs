@@ -10,7 +10,7 @@
 //! | module | what |
 //! |---|---|
 //! | [`neural_map`] | the network (eq. 3.2–3.4, §2.8–2.11): options, the `f32` fast path [`NeuralMap`], the `f64` [`ReferenceMap`], Table 2-2's weight matrix, §2.10 repair |
-//! | [`path_constructor`] | gradient ascent (eq. 3.5 ascent form, Fig. 3-7 corners, eq. 3.7 heading, seed 001's sign flip) |
+//! | [`path_constructor`] | gradient ascent (eq. 3.5 ascent form, Fig. 3-7 corners, eq. 3.7 heading, seed 001's sign flip); [`Walker`] for step-by-step use with the coordinator's direction masks |
 //! | [`plan`] | [`plan_query`]: one start-goal query with a JSON-ready [`PlanResult`] |
 //! | [`error`] | [`Error`]: bad cells and bad options, never a panic |
 //!
@@ -35,5 +35,5 @@ pub use neural_map::{
     Activation, ActivationField, BuildReport, NeuralDynamics, NeuralMap, NeuralMapOptions,
     ReferenceMap, StopRule,
 };
-pub use path_constructor::{Path, PathConstructor, PathOptions};
+pub use path_constructor::{DirectionMask, Path, PathConstructor, PathOptions, Walker};
 pub use plan::{plan_query, PlanOptions, PlanResult};

@@ -322,42 +322,95 @@ impl PathConstructor {
             .options
             .max_steps
             .unwrap_or_else(|| 2 * map.width() as usize * map.height() as usize + 8);
-        // Cells the robot has left, one bit per cell.
-        let w = map.width() as usize;
-        let mut left = vec![0u64; (w * map.height() as usize).div_ceil(64)];
-        let bit = |c: Cell| (c.y as usize * w + c.x as usize, 1u64);
-        let is_left = |left: &[u64], c: Cell| {
-            let (i, _) = bit(c);
-            left[i / 64] & (1 << (i % 64)) != 0
-        };
-        let mut heading = None;
-        let mut cell = start;
-        while cell != target {
+        let mut walker = Walker::new(map.width(), map.height(), start);
+        while walker.cell() != target {
             if path.steps >= max_steps {
                 path.outcome = PathOutcome::StepLimit;
                 return Ok(path);
             }
-            let g = self.gradients(map, cell, heading, DirectionMask::NONE, |c| {
-                is_left(&left, c)
-            });
-            let Some(d) = self.choose(&g) else {
+            let (choice, _) = walker.propose(self, map, DirectionMask::NONE);
+            let Some(d) = choice else {
                 path.outcome = PathOutcome::Stuck;
                 return Ok(path);
             };
-            let (i, _) = bit(cell);
-            left[i / 64] |= 1 << (i % 64);
-            if heading.is_some_and(|h| h != d) {
+            if walker.heading().is_some_and(|h| h != d) {
                 path.turns += 1;
             }
-            heading = Some(d);
-            cell = Cell::new(
-                cell.x.wrapping_add_signed(d.dx()),
-                cell.y.wrapping_add_signed(d.dy()),
-            );
-            path.cells.push(cell);
+            path.cells.push(walker.advance(d));
             path.steps += 1;
             path.length += d.cost();
         }
         Ok(path)
+    }
+}
+
+/// A robot climbing a map one step at a time: its cell, heading and the cells it has left
+/// (for [`VisitedRule`]). The coordinator's loop: [`Walker::propose`] with the directions it
+/// refuses, then [`Walker::advance`] once the move is committed (or nothing, to wait).
+#[derive(Clone, Debug)]
+pub struct Walker {
+    cell: Cell,
+    heading: Option<Direction>,
+    width: usize,
+    /// One bit per cell, row-major.
+    left: Vec<u64>,
+}
+
+impl Walker {
+    /// A walker at `start` on a `width x height` map.
+    pub fn new(width: u32, height: u32, start: Cell) -> Walker {
+        let cells = width as usize * height as usize;
+        Walker {
+            cell: start,
+            heading: None,
+            width: width as usize,
+            left: vec![0; cells.div_ceil(64)],
+        }
+    }
+
+    /// The current cell.
+    pub fn cell(&self) -> Cell {
+        self.cell
+    }
+
+    /// The direction of the last move.
+    pub fn heading(&self) -> Option<Direction> {
+        self.heading
+    }
+
+    /// Whether the walker has left `cell` at some point (`false` outside the map).
+    pub fn has_left(&self, cell: Cell) -> bool {
+        let i = cell.y as usize * self.width + cell.x as usize;
+        cell.x < self.width as u32
+            && self
+                .left
+                .get(i / 64)
+                .is_some_and(|w| w & (1 << (i % 64)) != 0)
+    }
+
+    /// The next direction under `mask` and the gradients it was chosen from.
+    pub fn propose<F: ActivationField + ?Sized>(
+        &self,
+        constructor: &PathConstructor,
+        map: &F,
+        mask: DirectionMask,
+    ) -> (Option<Direction>, Gradients) {
+        let g = constructor.gradients(map, self.cell, self.heading, mask, |c| self.has_left(c));
+        (constructor.choose(&g), g)
+    }
+
+    /// Makes the move `d`: the current cell becomes "left" and the walker steps. Returns the
+    /// new cell. The move is not checked against the map (the coordinator has done that).
+    pub fn advance(&mut self, d: Direction) -> Cell {
+        let i = self.cell.y as usize * self.width + self.cell.x as usize;
+        if let Some(w) = self.left.get_mut(i / 64) {
+            *w |= 1 << (i % 64);
+        }
+        self.heading = Some(d);
+        self.cell = Cell::new(
+            self.cell.x.wrapping_add_signed(d.dx()),
+            self.cell.y.wrapping_add_signed(d.dy()),
+        );
+        self.cell
     }
 }

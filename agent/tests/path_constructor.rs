@@ -267,3 +267,33 @@ fn convergence_stop_and_sweep_cap() {
         (hnav_agent::neural_map::Outcome::SweepLimit, 3)
     );
 }
+
+#[test]
+fn walker_follows_the_coordinators_masks() {
+    use hnav_agent::path_constructor::Walker;
+    let g = Grid::new(9, 9).unwrap();
+    let target = Cell::new(8, 4);
+    let map = built(&g, target, NeuralMapOptions::default());
+    let pc = PathConstructor::default();
+    let mut w = Walker::new(9, 9, Cell::new(0, 4));
+    // The coordinator refuses E at the first step (another robot is there).
+    let (d, grads) = w.propose(&pc, &map, DirectionMask::NONE.refuse(Direction::E));
+    assert_eq!(grads.values[Direction::E.index()], -1.0);
+    let d = d.unwrap();
+    assert!(matches!(d, Direction::NE | Direction::SE), "{d}");
+    w.advance(d);
+    assert!(w.has_left(Cell::new(0, 4)));
+    let mut seen = vec![w.cell()];
+    while w.cell() != target {
+        let (d, _) = w.propose(&pc, &map, DirectionMask::NONE);
+        w.advance(d.unwrap());
+        assert!(!seen.contains(&w.cell()), "revisit {}", w.cell());
+        seen.push(w.cell());
+        assert!(seen.len() < 20);
+    }
+    assert_eq!(
+        seen.len(),
+        8,
+        "one detour step costs nothing on an open map"
+    );
+}

@@ -28,6 +28,8 @@
 //! assert_eq!(path.cells.len(), 4); // start, two turns at the wall's ends, goal
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod error;
 pub mod experiment;
 pub mod planner;

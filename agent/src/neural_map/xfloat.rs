@@ -2,9 +2,17 @@
 //! exponent, value `m * 2^e`. See [`super::fast`] for why. All helpers are branch-free
 //! (selects) so that the sweep kernel that inlines them vectorises.
 
-/// The exponent stored with a zero mantissa. Far below any real exponent, and far enough
-/// from `i32::MIN` that `e - e_max` never overflows.
-pub(crate) const ZERO_EXP: i32 = -(1 << 28);
+/// The exponent stored with a zero mantissa: below every real exponent (see [`MIN_EXP`]) and
+/// far enough from `i32::MIN` that `e - e_max` never overflows.
+pub(crate) const ZERO_EXP: i32 = -(1 << 30);
+
+/// Values below `2^MIN_EXP` are flushed to 0, so that real exponents stay above [`ZERO_EXP`]
+/// even if a cut-off region decays for millions of sweeps after a repair. A build from zero
+/// never gets near it: a neuron's arrival value is at least `min(w) / D >= 1 / 9e6` of a
+/// neighbour's (23.1 binades), and values only grow afterwards, so on the largest grid
+/// (`2^26` cells) exponents stay above `-2^26 * 23.1 > -2^31`... and in practice above
+/// `-3.5` binades per cell of link distance (`-3700` on a 1024 x 1024 map).
+pub(crate) const MIN_EXP: i32 = -(1 << 29);
 
 /// Contributions more than `2^-FLUSH` times smaller than the largest neighbour's are dropped.
 /// They are below `f32` rounding (`2^-24`) by 76 binades, so dropping them changes nothing
@@ -32,7 +40,7 @@ pub(crate) fn split_biased(u: f32, b_base: i32) -> (f32, i32) {
     let bits = u.to_bits();
     let m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
     let e = b_base.wrapping_add((bits >> 23) as i32);
-    if bits == 0 {
+    if (bits == 0) | (e < MIN_EXP) {
         (0.0, ZERO_EXP)
     } else {
         (m, e)

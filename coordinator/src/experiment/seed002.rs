@@ -3,11 +3,11 @@
 //!
 //! # Setup
 //!
-//! * **[thesis]** 50 x 50 m area, grid step 1 m (a 50 x 50 grid), random obstacles over 10 / 20 /
+//! * **\[thesis\]** 50 x 50 m area, grid step 1 m (a 50 x 50 grid), random obstacles over 10 / 20 /
 //!   30 % of the area, drawn as circles and inflated into "virtual obstacles"; metrics: path
 //!   length `L` (m) and computation time `t` (s); planning on length alone (Table 3.1 gives no
 //!   hazard).
-//! * **[inferred]** Start and goal at the centres of opposite corner cells, (0.5, 0.5) m and
+//! * **\[inferred\]** Start and goal at the centres of opposite corner cells, (0.5, 0.5) m and
 //!   (49.5, 49.5) m (the table's lengths suggest it). Circle centres uniform over the field,
 //!   radii uniform in [`Seed002Config::radius`]; circles are added until the cells whose centres
 //!   they cover reach the density (the last one may overshoot). The planning grid blocks every
@@ -41,10 +41,10 @@ pub struct Seed002Config {
     pub trials: usize,
     /// Seed of the random streams (2).
     pub seed: u64,
-    /// Smallest and largest obstacle radius, metres (1.0, 3.0). [inferred]
+    /// Smallest and largest obstacle radius, metres (1.0, 3.0). \[inferred\]
     pub radius: (f64, f64),
     /// Margin added to every obstacle's radius for the planning grid, metres (0.25: the
-    /// s-bot's 0.058 m radius plus a safety margin). [inferred]
+    /// s-bot's 0.058 m radius plus a safety margin). \[inferred\]
     pub inflation: f64,
     /// Timed runs of each query; the fastest counts (1).
     pub timing_repeats: usize,

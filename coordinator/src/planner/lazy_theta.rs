@@ -9,7 +9,7 @@
 //!
 //! * Heuristic, moves and ties: as in [`BasicTheta`](super::BasicTheta).
 //! * The start needs no check (its parent is itself).
-//! * With a hazard model [inferred, seed 002 §3.6]: the optimistic cost given to a successor
+//! * With a hazard model \[inferred, seed 002 §3.6\]: the optimistic cost given to a successor
 //!   is the segment's length plus its two end cells' hazard halves, a lower bound of the true
 //!   cost found without walking the segment. `SetVertex` walks it once (line of sight and
 //!   hazard sum together) and then takes the cheaper of the verified path 2 and the best

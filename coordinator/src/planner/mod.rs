@@ -7,7 +7,7 @@
 //! | [`astar`] | [`AStar`]: octile A*, the coordinator's exact grid planner |
 //! | [`theta`] | [`BasicTheta`]: Basic Theta* (Nash, Daniel, Koenig & Felner 2007), eager line of sight |
 //! | [`lazy_theta`] | [`LazyTheta`]: Lazy Theta* (Nash, Koenig & Tovey 2010), one line-of-sight check per expansion |
-//! | [`line_of_sight`] | [`line_of_sight()`](line_of_sight::line_of_sight) and the exact cell walk behind it |
+//! | [`mod@line_of_sight`] | [`line_of_sight()`](fn@line_of_sight) and the exact cell walk behind it |
 //! | [`query`] | [`PlannerKind`], [`run_query`] and [`QueryResult`], the JSON answer of `hnav-bench plan` |
 //! | `open_list`, `search`, `space` (private) | the reusable open list, per-node buffers with generation stamps, and the grid as the planners see it |
 //!
@@ -17,7 +17,7 @@
 //!   A* moves between 8-neighbours (1 straight, `sqrt 2` diagonal); the Theta* variants join
 //!   any two cells with line of sight by a straight segment.
 //! * [`CornerCutting`] decides whether a diagonal may pass a blocked corner (see
-//!   [`line_of_sight`] for the exact rule for long segments). The any-angle planners never
+//!   [`mod@line_of_sight`] for the exact rule for long segments). The any-angle planners never
 //!   squeeze between two diagonally touching blocked cells, even when corners may be cut.
 //! * With a [`HazardMap`] in the config, cells of infinite hazard are obstacles and every
 //!   segment `a -> b` costs its length plus `weight * (R(a)/2 + R(b)/2 + sum alpha * R)` over
@@ -75,7 +75,7 @@ pub trait Planner {
 pub struct PlanStats {
     /// Nodes taken from the open list and expanded (the goal counts when it is taken).
     pub expansions: u64,
-    /// Insertions into the open list plus improvements of a waiting node.
+    /// Pushes onto the open list: a newly reached node or a better `g` for a known one.
     pub generated: u64,
     /// Line-of-sight checks (each one a cell walk of a segment). Always 0 for A*.
     pub los_checks: u64,

@@ -52,7 +52,7 @@ pub enum PathDefect {
 
 /// Checks that `cells` runs from `start` to `goal`, that no waypoint is outside, blocked or
 /// (with a hazard map) impassable, and that each pair of consecutive waypoints has line of
-/// sight under `rule` over the same obstacles (see [`crate::planner::line_of_sight`]).
+/// sight under `rule` over the same obstacles (see [`mod@crate::planner::line_of_sight`]).
 /// A*'s paths pass too: every legal move has line of sight, except a diagonal squeeze
 /// between two blocked cells, which only A* with corners allowed can produce.
 pub fn check_path(

@@ -93,7 +93,7 @@ pub struct QueryResult {
     pub time_us: f64,
     /// Line-of-sight checks (0 for A*).
     pub los_checks: u64,
-    /// Open-list insertions and improvements.
+    /// Pushes onto the open list (new nodes and improvements).
     pub generated: u64,
 }
 

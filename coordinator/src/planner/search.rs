@@ -48,7 +48,7 @@ impl Search {
             self.generation = 0;
         }
         self.generation += 1;
-        self.open.reset(n);
+        self.open.reset();
         self.stats = PlanStats::default();
     }
 
@@ -94,17 +94,25 @@ impl Search {
     #[inline]
     pub(crate) fn open(&mut self, i: usize, g: f64, h: f64, parent: usize) {
         self.set(i, g, parent);
-        self.open.push_or_update(i, g + h, g);
+        self.open.push(i, g + h, g);
         self.stats.generated += 1;
     }
 
     /// Takes the best open node and marks it closed (the caller counts the expansion).
+    /// Skips stale entries: of closed nodes, or pushed before the node's `g` changed.
     #[inline]
     pub(crate) fn pop(&mut self) -> Option<usize> {
-        let i = self.open.pop()?;
-        // Every node on the open list was touched by `open` in this generation.
-        self.nodes[i].closed = true;
-        Some(i)
+        loop {
+            let e = self.open.pop()?;
+            let i = e.node as usize;
+            // Every node with an entry was touched by `open` in this generation.
+            let node = &mut self.nodes[i];
+            if node.closed || node.g != e.g {
+                continue;
+            }
+            node.closed = true;
+            return Some(i);
+        }
     }
 
     /// Puts a just-popped node back on the open list with its current `g` (after a repair
@@ -113,7 +121,7 @@ impl Search {
         let node = &mut self.nodes[i];
         node.closed = false;
         let g = node.g;
-        self.open.push_or_update(i, g + h, g);
+        self.open.push(i, g + h, g);
     }
 
     /// Records that the node's `g` and parent are checked (until its next improvement).
@@ -149,5 +157,30 @@ impl Search {
         cells.reverse();
         let length = cells.windows(2).map(|w| euclid(w[0], w[1])).sum();
         (cells, length)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_new_query_forgets_the_last_even_across_the_stamp_wrap() {
+        let mut s = Search::default();
+        s.begin(4);
+        s.open(2, 1.5, 0.0, 2);
+        assert_eq!(s.pop(), Some(2));
+        assert!(s.is_closed(2) && s.g(2) == 1.5);
+        s.generation = u32::MAX - 1;
+        for _ in 0..3 {
+            s.begin(6);
+            assert!(!s.is_closed(2) && s.g(2).is_infinite() && !s.is_verified(2));
+            s.open(2, 0.5, 1.0, 2);
+            s.open(2, 0.25, 1.0, 2); // improvement: the first entry goes stale
+            assert_eq!(s.pop(), Some(2));
+            assert_eq!(s.g(2), 0.25);
+            assert_eq!(s.pop(), None);
+        }
+        assert!(s.generation < 3, "wrapped and restarted");
     }
 }

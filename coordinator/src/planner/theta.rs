@@ -9,7 +9,7 @@
 //! * Moves: the 8 neighbours under the corner rule, never squeezing between two diagonally
 //!   touching blocked cells (so every path-1 edge also has line of sight).
 //! * Ties: as in A* (smallest `f`, then largest `g`).
-//! * With a hazard model [inferred, seed 002 §3.6]: the line-of-sight walk also sums the
+//! * With a hazard model \[inferred, seed 002 §3.6\]: the line-of-sight walk also sums the
 //!   hazard of the crossed cells, and because a segment's cost is then no longer its length,
 //!   path 2 is taken only if it is not dearer than path 1 (without hazard this is always the
 //!   case by the triangle inequality, and the canonical algorithm does not compare).

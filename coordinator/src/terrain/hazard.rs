@@ -24,7 +24,7 @@ use crate::error::PlanError;
 use crate::planner::line_of_sight::{euclid, walk};
 
 /// The chord length (in cells) below which a crossed cell counts half: half a cell diagonal,
-/// `sqrt 2 / 2`, i.e. `(sqrt 2 / 2) e` in metres. [thesis, threshold read dimensionally]
+/// `sqrt 2 / 2`, i.e. `(sqrt 2 / 2) e` in metres. \[thesis, threshold read dimensionally\]
 pub const ALPHA_THRESHOLD: f64 = std::f64::consts::FRAC_1_SQRT_2;
 
 /// The weight `alpha` of a crossed cell from the route's chord in it, in cell units: 1/2 below

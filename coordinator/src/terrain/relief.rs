@@ -6,12 +6,12 @@
 //! centre's height (the map is extended flat), which is the usual GIS edge treatment.
 //!
 //! * **Slope** (degrees): Horn's (1981) weighted 3x3 gradient, as `gdaldem slope` computes it,
-//!   `atan(|grad h|)`. [inferred method]
+//!   `atan(|grad h|)`. \[inferred method\]
 //! * **Roughness**: the surface-area ratio of Jenness (2004): the eight triangles joining the
 //!   centre to each pair of adjacent neighbours, each cut to the part inside the cell (a
 //!   quarter of its area), summed and divided by `e^2`. It is `>= 1`, `1` on a flat cell and
 //!   `1 / cos(slope)` on an inclined plane: exactly the thesis's definition, 3-D area over
-//!   projected area. [thesis definition, inferred method]
+//!   projected area. \[thesis definition, inferred method\]
 //! * **Relief amplitude** (metres): along each of the four lines through the cell (W-E, N-S
 //!   and the two diagonals) with neighbours `p`, `n` on both sides, the change of rise
 //!   `| |h(n) - h(c)| - |h(c) - h(p)| |`; the largest over the lines. A steady slope (equal
