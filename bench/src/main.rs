@@ -30,7 +30,7 @@ enum Command {
 
 #[derive(Debug, Args)]
 struct PlanCli {
-    /// The planner: hnav (neural map).
+    /// The planner: astar, theta, lazy-theta (the coordinator's) or hnav (the neural map).
     #[arg(long)]
     planner: PlannerKind,
     /// The MovingAI .map file.

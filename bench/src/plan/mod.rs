@@ -16,6 +16,9 @@ use std::str::FromStr;
 use anyhow::{bail, Context, Result};
 use hnav_agent::neural_map::Activation;
 use hnav_agent::plan::{PlanOptions, PlanStop, Planner as HnavPlanner};
+use hnav_coordinator::planner::{
+    run_query_with, Planner as GlobalPlanner, PlannerConfig, PlannerKind as GlobalKind,
+};
 use hnav_runtime::grid::{read_map_file, read_scen_file, Cell, CornerCutting, Grid};
 
 pub use output::{QueryLine, Summary};
@@ -25,6 +28,8 @@ pub use output::{QueryLine, Summary};
 pub enum PlannerKind {
     /// The agent's Hopfield neural map and path constructor.
     Hnav,
+    /// One of the coordinator's global planners (A*, Basic Theta*, Lazy Theta*).
+    Global(GlobalKind),
 }
 
 impl FromStr for PlannerKind {
@@ -32,7 +37,9 @@ impl FromStr for PlannerKind {
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
             "hnav" => Ok(Self::Hnav),
-            other => Err(format!("unknown planner {other:?} (expected hnav)")),
+            other => other.parse().map(Self::Global).map_err(|_| {
+                format!("unknown planner {other:?} (expected astar, theta, lazy-theta or hnav)")
+            }),
         }
     }
 }
@@ -69,6 +76,7 @@ pub fn parse_cell(s: &str) -> Result<Cell, String> {
 /// Builds the planner once per map, so a scenario file's queries share its buffers.
 enum Engine {
     Hnav(Box<HnavPlanner>),
+    Global(Box<dyn GlobalPlanner + Send>),
 }
 
 impl Engine {
@@ -87,12 +95,21 @@ impl Engine {
                 };
                 Ok(Self::Hnav(Box::new(HnavPlanner::new(grid, &options)?)))
             }
+            PlannerKind::Global(kind) => {
+                Ok(Self::Global(kind.build(PlannerConfig::new(corner_cutting))))
+            }
         }
     }
 
-    fn query(&mut self, start: Cell, goal: Cell) -> Result<QueryLine> {
+    fn query(&mut self, grid: &Grid, start: Cell, goal: Cell) -> Result<QueryLine> {
         match self {
             Self::Hnav(p) => Ok(QueryLine::from_hnav(p.query(start, goal)?)),
+            Self::Global(p) => Ok(QueryLine::from_global(run_query_with(
+                p.as_mut(),
+                grid,
+                start,
+                goal,
+            )?)),
         }
     }
 }
@@ -104,7 +121,7 @@ pub fn run(args: &PlanArgs, mut emit: impl FnMut(&QueryLine)) -> Result<Option<S
     let mut engine = Engine::new(args, &grid)?;
     match (&args.endpoints, &args.scen) {
         (Some((start, goal)), None) => {
-            emit(&engine.query(*start, *goal)?);
+            emit(&engine.query(&grid, *start, *goal)?);
             Ok(None)
         }
         (None, Some((scen, first))) => {
@@ -112,7 +129,7 @@ pub fn run(args: &PlanArgs, mut emit: impl FnMut(&QueryLine)) -> Result<Option<S
             let mut summary = Summary::new(args.planner_name());
             for entry in file.entries.iter().take(first.unwrap_or(usize::MAX)) {
                 let mut line = engine
-                    .query(entry.start, entry.goal)
+                    .query(&grid, entry.start, entry.goal)
                     .with_context(|| format!("{}:{}", scen.display(), entry.line))?;
                 line.optimal = Some(entry.optimal_length);
                 summary.add(&line);
@@ -128,6 +145,9 @@ impl PlanArgs {
     fn planner_name(&self) -> &'static str {
         match self.planner {
             PlannerKind::Hnav => "hnav",
+            PlannerKind::Global(GlobalKind::AStar) => "astar",
+            PlannerKind::Global(GlobalKind::Theta) => "theta",
+            PlannerKind::Global(GlobalKind::LazyTheta) => "lazy-theta",
         }
     }
 }

@@ -1,6 +1,7 @@
 //! The JSON lines of `hnav-bench plan` and the summary of a scenario run.
 
 use hnav_agent::plan::PlanResult;
+use hnav_coordinator::planner::QueryResult;
 use hnav_runtime::grid::Cell;
 use serde::Serialize;
 
@@ -12,7 +13,7 @@ pub const OPTIMAL_TOLERANCE: f64 = 1e-6;
 #[derive(Debug, Clone, Serialize)]
 pub struct QueryLine {
     /// The planner's name.
-    pub planner: &'static str,
+    pub planner: String,
     /// Whether a path to the goal was found.
     pub found: bool,
     /// Moves in the path.
@@ -25,6 +26,9 @@ pub struct QueryLine {
     pub path: Vec<[u32; 2]>,
     /// Wall time of the query, µs.
     pub time_us: f64,
+    /// Line-of-sight checks (any-angle planners only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub los_checks: Option<u64>,
     /// The scenario's optimal length (scenario runs only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optimal: Option<f64>,
@@ -38,11 +42,27 @@ impl QueryLine {
     /// From the neural map's answer.
     pub fn from_hnav(r: PlanResult) -> Self {
         Self {
-            planner: "hnav",
+            planner: "hnav".into(),
             found: r.found,
             steps: r.steps,
             length: r.length,
             iterations: u64::from(r.iterations),
+            path: xy(&r.path),
+            time_us: r.time_us,
+            los_checks: None,
+            optimal: None,
+        }
+    }
+
+    /// From a global planner's answer.
+    pub fn from_global(r: QueryResult) -> Self {
+        Self {
+            los_checks: (r.los_checks > 0).then_some(r.los_checks),
+            planner: r.planner,
+            found: r.found,
+            steps: r.steps,
+            length: r.length,
+            iterations: r.iterations,
             path: xy(&r.path),
             time_us: r.time_us,
             optimal: None,
@@ -149,8 +169,9 @@ mod tests {
 
     fn line(length: f64, optimal: f64, found: bool) -> QueryLine {
         QueryLine {
-            planner: "hnav",
+            planner: "hnav".into(),
             found,
+            los_checks: None,
             steps: 3,
             length,
             iterations: 5,
@@ -175,12 +196,24 @@ mod tests {
     #[test]
     fn json_line_has_the_issue_fields() {
         let v = serde_json::to_value(line(2.0, 2.0, true)).unwrap();
-        for key in ["planner", "found", "steps", "length", "iterations", "path", "time_us", "optimal"] {
+        for key in [
+            "planner",
+            "found",
+            "steps",
+            "length",
+            "iterations",
+            "path",
+            "time_us",
+            "optimal",
+        ] {
             assert!(v.get(key).is_some(), "missing {key}");
         }
         assert_eq!(v["path"][1], serde_json::json!([1, 1]));
         let mut single = line(2.0, 2.0, true);
         single.optimal = None;
-        assert!(serde_json::to_value(single).unwrap().get("optimal").is_none());
+        assert!(serde_json::to_value(single)
+            .unwrap()
+            .get("optimal")
+            .is_none());
     }
 }
