@@ -49,6 +49,7 @@ fn main() {
             for denominator in [
                 Denominator::LinkedOnly,
                 Denominator::InGrid,
+                Denominator::OffGridAsZero,
                 Denominator::AllEight,
             ] {
                 for self_weight in [0.0, 1.0] {

@@ -22,6 +22,7 @@ fn fig_2_16_reference_counts_and_path() {
         for denominator in [
             Denominator::LinkedOnly,
             Denominator::InGrid,
+            Denominator::OffGridAsZero,
             Denominator::AllEight,
         ] {
             let opts = NeuralMapOptions {
@@ -34,7 +35,10 @@ fn fig_2_16_reference_counts_and_path() {
             println!("{activation:?} {denominator:?}: full {full:?}");
             let path = PathConstructor::default().trace(&map, id(&g, 1)).unwrap();
             assert_eq!(path.steps, 13);
-            if denominator == Denominator::LinkedOnly {
+            if matches!(
+                denominator,
+                Denominator::LinkedOnly | Denominator::OffGridAsZero
+            ) {
                 assert_eq!(ids(&g, &path.cells), FIG_2_16_PATH, "{activation:?}");
             } else {
                 // Obstacles as zeros lower 33 (three free neighbours, 44 diagonal) below 34

@@ -29,7 +29,11 @@ fn free_cells(g: &Grid, count: usize, seed: u64) -> Vec<Cell> {
 fn variants() -> Vec<NeuralMapOptions> {
     let mut v = Vec::new();
     for activation in [Activation::Tanh, Activation::Linear] {
-        for denominator in [Denominator::LinkedOnly, Denominator::InGrid] {
+        for denominator in [
+            Denominator::LinkedOnly,
+            Denominator::InGrid,
+            Denominator::OffGridAsZero,
+        ] {
             for diagonals in [DiagonalRule::Always, DiagonalRule::NoCornerCutting] {
                 v.push(NeuralMapOptions {
                     activation,

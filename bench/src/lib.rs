@@ -7,6 +7,7 @@
 //! |---|---|---|
 //! | [`latency`] | `hnav-bench latency [--quick] --out DIR` | one-way and round-trip latency of raw iceoryx2, the HNAV transport, a Unix domain socket and TCP loopback, in a two-thread ping-pong |
 //! | [`plan`] | `hnav-bench plan --planner P --map FILE (--start X,Y --goal X,Y \| --scen FILE [--first N]) [--json]` | one planning query, or every entry of a MovingAI scenario against its optimal length |
+//! | (`hnav_coordinator::experiment`) | `hnav-bench seed002 [--trials N] [--seed S]` | seed 002's obstacle-density experiment beside the thesis's Table 3.1 |
 //!
 //! Results go to stdout as a table and to CSV files in dora-benchmark's schema
 //! (`date,language,platform,name,size_bytes,avg_us,p50_us,p90_us,p99_us,n`), so they can be

@@ -26,6 +26,34 @@ enum Command {
     Latency(LatencyArgs),
     /// Plan one query, or every entry of a MovingAI .scen file, with one of HNAV's planners.
     Plan(PlanCli),
+    /// Seed 002's experiment (50x50 m, 1 m cells, 10/20/30 % random circular obstacles):
+    /// A*, Basic Theta* and Lazy Theta*, ours beside the thesis's Table 3.1.
+    Seed002(Seed002Cli),
+}
+
+#[derive(Debug, Args)]
+struct Seed002Cli {
+    /// Solvable maps per obstacle density.
+    #[arg(long, default_value_t = 100)]
+    trials: usize,
+    /// Seed of the obstacle fields.
+    #[arg(long, default_value_t = 2)]
+    seed: u64,
+    /// Timing repetitions per query (the best is kept).
+    #[arg(long, default_value_t = 3)]
+    repeats: usize,
+}
+
+fn seed002(args: Seed002Cli) -> Result<()> {
+    use hnav_coordinator::experiment::seed002::{run, Seed002Config};
+    let config = Seed002Config {
+        trials: args.trials,
+        seed: args.seed,
+        timing_repeats: args.repeats,
+        ..Seed002Config::default()
+    };
+    print!("{}", run(&config)?.render());
+    Ok(())
 }
 
 #[derive(Debug, Args)]
@@ -140,6 +168,7 @@ fn main() -> std::process::ExitCode {
     let outcome = match Cli::parse().command {
         Command::Latency(args) => latency(args),
         Command::Plan(args) => plan_cmd(args),
+        Command::Seed002(args) => seed002(args),
     };
     match outcome {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -11,8 +11,10 @@
 //! wave stops and the gradient ascent sees a flat plain.
 //!
 //! Each neuron therefore stores a mantissa `m` in `[1, 2)` (or 0) as `f32` and an exponent `e`
-//! as `i32`; its value is `m * 2^e`, a float with a 32-bit exponent that cannot underflow on
-//! any grid that fits in memory (a value can fall by at most ~3.4 binades per cell).
+//! as `i32`; its value is `m * 2^e`, a float whose exponent reaches down to `-2^29` (below
+//! that it flushes to 0). A build falls by at most about 3.5 binades per cell of link distance
+//! with the default weights (`2^-3700` across a 1024 x 1024 map), so no grid that fits in
+//! memory comes near the limit (`xfloat.rs` has the bound).
 //!
 //! * **Update.** `u_i = sum_j w_ij m_j 2^e_j / D_i` is computed as
 //!   `2^e_max * (sum_j w_ij m_j 2^(e_j - e_max)) / D_i`, where `e_max` is the largest exponent

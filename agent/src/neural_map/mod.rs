@@ -30,9 +30,10 @@
 //!   with [`DiagonalRule::NoCornerCutting`] it is 25 and 18), tanh or linear, with
 //!   [`Denominator::LinkedOnly`] or [`Denominator::InGrid`] ([`Denominator::AllEight`] needs 21
 //!   to full activation with the `1e-16` threshold, because its far values stay below it).
-//!   The 13-move path 1, 2, 13, 23, 33, 44, ... comes out with Appendix A's
-//!   [`Denominator::LinkedOnly`] ([`NeuralMapOptions::dissertation`]); counting obstacles as
-//!   zeros lowers cell 33 (three free neighbours) below 34, and the path takes 34 instead:
+//!   The 13-move path 1, 2, 13, 23, 33, 44, ... comes out when obstacles stay out of the
+//!   denominator as in Appendix A ([`Denominator::LinkedOnly`], used by
+//!   [`NeuralMapOptions::dissertation`], or [`Denominator::OffGridAsZero`]); counting obstacles
+//!   as zeros lowers cell 33 (three free neighbours) below 34, and the path takes 34 instead:
 //!   also 13 moves of the same length.
 //! * Table 2-1 (empty 10x10, target 56): only qualitatively; the closest variant is tanh with
 //!   [`Denominator::AllEight`] stopped after 9 sweeps ([`NeuralMapOptions::table_2_1`]), max
@@ -103,8 +104,11 @@ pub enum Denominator {
     /// zero-valued neurons, which makes the "reduced potential" margin along walls.
     /// Off-grid neighbours are absent. Seed 001's proxy law uses this too.
     InGrid,
+    /// Linked neighbours plus off-grid positions as zeros; obstacles absent (Appendix A's
+    /// obstacles with zero-valued borders).
+    OffGridAsZero,
     /// All eight neighbours always count (obstacles and off-grid cells as zeros); the closest
-    /// variant to Table 2-1.
+    /// variant to Table 2-1 (on an empty map it equals [`Denominator::OffGridAsZero`]).
     AllEight,
 }
 

@@ -97,6 +97,11 @@ impl Topology {
                 .filter(|&&d| self.step(cell, d).is_some())
                 .map(|&d| w(d))
                 .sum(),
+            Denominator::OffGridAsZero => Direction::ALL
+                .iter()
+                .filter(|&&d| self.linked(cell, d) || self.step(cell, d).is_none())
+                .map(|&d| w(d))
+                .sum(),
             Denominator::AllEight => 4.0 * weights.straight + 4.0 * weights.diagonal,
         };
         weights.gain * (weights.self_weight + sum)

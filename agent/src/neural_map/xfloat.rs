@@ -7,11 +7,11 @@
 pub(crate) const ZERO_EXP: i32 = -(1 << 30);
 
 /// Values below `2^MIN_EXP` are flushed to 0, so that real exponents stay above [`ZERO_EXP`]
-/// even if a cut-off region decays for millions of sweeps after a repair. A build from zero
-/// never gets near it: a neuron's arrival value is at least `min(w) / D >= 1 / 9e6` of a
-/// neighbour's (23.1 binades), and values only grow afterwards, so on the largest grid
-/// (`2^26` cells) exponents stay above `-2^26 * 23.1 > -2^31`... and in practice above
-/// `-3.5` binades per cell of link distance (`-3700` on a 1024 x 1024 map).
+/// even if a region cut off by a repair decays for millions of sweeps. A build from zero does
+/// not get near it: values only grow after the wave arrives, and an arrival value is at least
+/// `min(w) / D` of a neighbour's, under 6.3 binades per cell of link distance for weights
+/// within a factor 10 of each other (every published variant: 3.5 with the defaults). On the
+/// largest grid (`2^26` cells) that stays above `-2^26 * 6.3 > -2^29`.
 pub(crate) const MIN_EXP: i32 = -(1 << 29);
 
 /// Contributions more than `2^-FLUSH` times smaller than the largest neighbour's are dropped.
