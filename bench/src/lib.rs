@@ -6,6 +6,7 @@
 //! | module | subcommand | what it measures |
 //! |---|---|---|
 //! | [`latency`] | `hnav-bench latency [--quick] --out DIR` | one-way and round-trip latency of raw iceoryx2, the HNAV transport, a Unix domain socket and TCP loopback, in a two-thread ping-pong |
+//! | [`neural_map`] | `hnav-bench neural-map [--quick]` | neuron updates per second and time per map for 20x20 to 1024x1024, tanh against linear, and plan queries |
 //! | [`plan`] | `hnav-bench plan --planner P --map FILE (--start X,Y --goal X,Y \| --scen FILE [--first N]) [--json]` | one planning query, or every entry of a MovingAI scenario against its optimal length |
 //! | (`hnav_coordinator::experiment`) | `hnav-bench seed002 [--trials N] [--seed S]` | seed 002's obstacle-density experiment beside the thesis's Table 3.1 |
 //!
@@ -14,4 +15,5 @@
 //! plotted next to other frameworks' numbers.
 
 pub mod latency;
+pub mod neural_map;
 pub mod plan;

@@ -29,6 +29,13 @@ enum Command {
     /// Seed 002's experiment (50x50 m, 1 m cells, 10/20/30 % random circular obstacles):
     /// A*, Basic Theta* and Lazy Theta*, ours beside the thesis's Table 3.1.
     Seed002(Seed002Cli),
+    /// Neural-map speed: updates per second and time per map, 20x20 to 1024x1024, tanh
+    /// against linear, and plan queries corner to corner.
+    NeuralMap {
+        /// Spend 0.05 s a point instead of 0.3 s.
+        #[arg(long)]
+        quick: bool,
+    },
 }
 
 #[derive(Debug, Args)]
@@ -169,6 +176,10 @@ fn main() -> std::process::ExitCode {
         Command::Latency(args) => latency(args),
         Command::Plan(args) => plan_cmd(args),
         Command::Seed002(args) => seed002(args),
+        Command::NeuralMap { quick } => {
+            hnav_bench::neural_map::run(quick);
+            Ok(())
+        }
     };
     match outcome {
         Ok(()) => std::process::ExitCode::SUCCESS,
