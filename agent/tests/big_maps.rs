@@ -55,7 +55,7 @@ fn plan_and_check(g: &Grid, start: Cell, goal: Cell, options: &PlanOptions) -> P
 
 /// The goal in the centre, the robot in each corner: 512 sweeps cover the whole map (about
 /// 1.8e8 neuron updates, ~5 s in a debug build; corner to corner would take twice as long, so
-/// that case runs in the `sweep_speed` example instead). The start's activation is about
+/// that case runs in `hnav-bench neural-map` instead). The start's activation is about
 /// `2^-1700`, far below f64's `2^-1074`.
 #[test]
 fn open_1024_corners_to_centre() {
