@@ -11,6 +11,7 @@
 //! |---|---|
 //! | [`neural_map`] | the network (eq. 3.2–3.4, §2.8–2.11): options, the `f32` fast path [`NeuralMap`], the `f64` [`ReferenceMap`], Table 2-2's weight matrix, §2.10 repair |
 //! | [`path_constructor`] | gradient ascent (eq. 3.5 ascent form, Fig. 3-7 corners, eq. 3.7 heading, seed 001's sign flip); [`Walker`] for step-by-step use with the coordinator's direction masks |
+//! | [`odometry`] | §D.2 dead reckoning from Hall ticks: [`odometry::DeadReckoning`], a pure function of the tick stream |
 //! | [`plan`] | [`plan_query`]: one start-goal query with a JSON-ready [`PlanResult`] |
 //! | [`error`] | [`Error`]: bad cells and bad options, never a panic |
 //!
@@ -26,9 +27,9 @@
 
 pub mod error;
 pub mod neural_map;
+pub mod odometry;
 pub mod path_constructor;
 pub mod plan;
-mod serde_cells;
 
 pub use error::{Error, Role};
 pub use neural_map::{

@@ -161,7 +161,6 @@ pub enum PathOutcome {
 #[derive(Clone, PartialEq, Debug, Serialize, Deserialize)]
 pub struct Path {
     /// Cells from the start to where the walk ended (the target when reached).
-    #[serde(with = "crate::serde_cells::cells")]
     pub cells: Vec<Cell>,
     /// How it ended.
     pub outcome: PathOutcome,

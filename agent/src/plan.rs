@@ -76,7 +76,6 @@ pub struct PlanResult {
     /// Sweeps of the neural map.
     pub iterations: u32,
     /// Cells from start to goal (empty when not found).
-    #[serde(with = "crate::serde_cells::cells")]
     pub path: Vec<Cell>,
     /// Wall time of the query in microseconds.
     pub time_us: f64,

@@ -33,7 +33,6 @@
 pub mod error;
 pub mod experiment;
 pub mod planner;
-mod serde_cells;
 pub mod terrain;
 
 pub use error::PlanError;

@@ -168,7 +168,6 @@ pub enum StopRule {
     /// The start neuron is on (§2.10 Б, Appendix A's `while E[start] < 1e-15`).
     PartialActivation {
         /// The robot's cell.
-        #[serde(with = "crate::serde_cells::cell")]
         start: Cell,
     },
     /// No neuron changes by `tolerance` or more in a sweep (eq. 1.3 when 0).

@@ -23,7 +23,7 @@ pub struct QueryLine {
     /// The planner's iterations: neural-map sweeps, or node expansions.
     pub iterations: u64,
     /// The path's cells (waypoints for any-angle planners) as `[x, y]`.
-    pub path: Vec<[u32; 2]>,
+    pub path: Vec<Cell>,
     /// Wall time of the query, µs.
     pub time_us: f64,
     /// Line-of-sight checks (any-angle planners only).
@@ -32,10 +32,6 @@ pub struct QueryLine {
     /// The scenario's optimal length (scenario runs only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optimal: Option<f64>,
-}
-
-fn xy(cells: &[Cell]) -> Vec<[u32; 2]> {
-    cells.iter().map(|c| [c.x, c.y]).collect()
 }
 
 impl QueryLine {
@@ -47,7 +43,7 @@ impl QueryLine {
             steps: r.steps,
             length: r.length,
             iterations: u64::from(r.iterations),
-            path: xy(&r.path),
+            path: r.path,
             time_us: r.time_us,
             los_checks: None,
             optimal: None,
@@ -63,7 +59,7 @@ impl QueryLine {
             steps: r.steps,
             length: r.length,
             iterations: r.iterations,
-            path: xy(&r.path),
+            path: r.path,
             time_us: r.time_us,
             optimal: None,
         }
@@ -175,7 +171,7 @@ mod tests {
             steps: 3,
             length,
             iterations: 5,
-            path: vec![[0, 0], [1, 1]],
+            path: vec![Cell::new(0, 0), Cell::new(1, 1)],
             time_us: 2.0,
             optimal: Some(optimal),
         }

@@ -15,7 +15,6 @@ use crate::terrain::HazardMap;
 #[derive(Clone, PartialEq, Debug, Serialize, Deserialize)]
 pub struct Path {
     /// Start first, goal last.
-    #[serde(with = "crate::serde_cells::cells")]
     pub cells: Vec<Cell>,
     /// Sum of the Euclidean distances between consecutive cells.
     pub length: f64,

@@ -87,7 +87,6 @@ pub struct QueryResult {
     /// Node expansions.
     pub iterations: u64,
     /// Cells (A*) or waypoints (any-angle) from start to goal, empty when not found.
-    #[serde(with = "crate::serde_cells::cells")]
     pub path: Vec<Cell>,
     /// Wall time of the query in microseconds.
     pub time_us: f64,

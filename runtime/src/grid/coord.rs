@@ -109,3 +109,33 @@ mod tests {
         assert_eq!(Cell::new(2, 3).to_string(), "(2, 3)");
     }
 }
+
+/// A cell travels in JSON and other serde formats as `[x, y]`, the shape MovingAI tools and
+/// the bench's `path` field use.
+impl serde::Serialize for Cell {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        [self.x, self.y].serialize(s)
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for Cell {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Cell, D::Error> {
+        let [x, y] = <[u32; 2]>::deserialize(d)?;
+        Ok(Cell { x, y })
+    }
+}
+
+#[cfg(test)]
+mod serde_tests {
+    use super::Cell;
+
+    #[test]
+    fn cells_serialise_as_pairs() {
+        let cells = vec![Cell { x: 1, y: 2 }, Cell { x: 30, y: 4 }];
+        let text = serde_json::to_string(&cells).unwrap();
+        assert_eq!(text, "[[1,2],[30,4]]");
+        let back: Vec<Cell> = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, cells);
+        assert!(serde_json::from_str::<Cell>("[1]").is_err());
+    }
+}
