@@ -7,6 +7,7 @@
 //! |---|---|---|
 //! | [`latency`] | `hnav-bench latency [--quick] --out DIR` | one-way and round-trip latency of raw iceoryx2, the HNAV transport, a Unix domain socket and TCP loopback, in a two-thread ping-pong |
 //! | [`neural_map`] | `hnav-bench neural-map [--quick]` | neuron updates per second and time per map for 20x20 to 1024x1024, tanh against linear, and plan queries |
+//! | (`hnav_sim::bench`) | `hnav-bench sim [--robots 1,64,1024] [--seconds S] [--json]` | robot-steps per second of the physics stepper |
 //! | [`plan`] | `hnav-bench plan --planner P --map FILE (--start X,Y --goal X,Y \| --scen FILE [--first N]) [--json]` | one planning query, or every entry of a MovingAI scenario against its optimal length |
 //! | (`hnav_coordinator::experiment`) | `hnav-bench seed002 [--trials N] [--seed S]` | seed 002's obstacle-density experiment beside the thesis's Table 3.1 |
 //!

@@ -29,6 +29,9 @@ enum Command {
     /// Seed 002's experiment (50x50 m, 1 m cells, 10/20/30 % random circular obstacles):
     /// A*, Basic Theta* and Lazy Theta*, ours beside the thesis's Table 3.1.
     Seed002(Seed002Cli),
+    /// Physics stepper speed: robot-steps per second (differential drive, Hall ticks,
+    /// collision checks) for N robots on one core.
+    Sim(SimCli),
     /// Neural-map speed: updates per second and time per map, 20x20 to 1024x1024, tanh
     /// against linear, and plan queries corner to corner.
     NeuralMap {
@@ -36,6 +39,40 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+}
+
+#[derive(Debug, Args)]
+struct SimCli {
+    /// Robots in the world (each size given is measured in turn).
+    #[arg(long, value_delimiter = ',', default_values_t = [1usize, 64, 1024])]
+    robots: Vec<usize>,
+    /// Wall-clock seconds of stepping per size.
+    #[arg(long, default_value_t = 2.0)]
+    seconds: f64,
+    /// One JSON object per size instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+fn sim(args: SimCli) -> Result<()> {
+    if !args.json {
+        println!(
+            "{:>8} {:>14} {:>10} {:>18}",
+            "robots", "steps", "seconds", "robot-steps/s"
+        );
+    }
+    for robots in args.robots {
+        let r = hnav_sim::bench::robot_steps_per_second(robots, args.seconds)?;
+        if args.json {
+            println!("{}", serde_json::to_string(&r)?);
+        } else {
+            println!(
+                "{:>8} {:>14} {:>10.2} {:>18.3e}",
+                r.robots, r.steps, r.elapsed_s, r.robot_steps_per_s
+            );
+        }
+    }
+    Ok(())
 }
 
 #[derive(Debug, Args)]
@@ -176,6 +213,7 @@ fn main() -> std::process::ExitCode {
         Command::Latency(args) => latency(args),
         Command::Plan(args) => plan_cmd(args),
         Command::Seed002(args) => seed002(args),
+        Command::Sim(args) => sim(args),
         Command::NeuralMap { quick } => {
             hnav_bench::neural_map::run(quick);
             Ok(())

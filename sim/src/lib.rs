@@ -1,6 +1,48 @@
 //! # hnav-sim
 //!
-//! The physics stepper of an HNAV run: differential-drive robots, Hall-sensor odometry and
-//! collision checks on ground truth. Its modules arrive with the sim issue; until then the
-//! crate is an empty member of the workspace so that its place in the dependency graph
-//! (`runtime` <- `sim`) is fixed.
+//! The physics stepper of an HNAV run: differential-drive robots (the s-bot-like robots of
+//! §3.1: two motors, one Hall sensor per wheel), Hall-sensor odometry and collision checks on
+//! ground truth. Every parameter comes from the scenario's `[robot]` and `[sim]` sections
+//! ([`hnav_runtime::scenario::params`]).
+//!
+//! | module | what |
+//! |---|---|
+//! | [`robot`] | [`RobotModel`]: validated parameters; motor lag, speed and acceleration limits, braking |
+//! | [`kinematics`] | §D.2 wheel increments and the exact-arc pose update |
+//! | [`hall`] | tick quantisation and seeded wheel-slip noise (ChaCha) |
+//! | [`collision`] | disc–disc and disc–blocked-cell contacts, recorded when they begin |
+//! | [`watchdog`] | stale commands are replaced by braking |
+//! | [`world`] | [`World`]: N robots, struct-of-arrays, fixed step, odometry and Truth |
+//! | [`process`] | the `hnav-sim` process: [`process::SimProcess`], topics, lockstep and realtime |
+//! | [`bench`] | [`bench::robot_steps_per_second`] for `hnav-bench sim` |
+//! | [`error`] | [`SimError`]: bad parameters and inputs, never a panic |
+//!
+//! ```
+//! use hnav_runtime::grid::{Cell, Grid};
+//! use hnav_runtime::scenario::params::{RobotParams, SimParams};
+//! use hnav_sim::World;
+//!
+//! let robot = RobotParams::default();
+//! let start = World::cell_centre(robot.cell_size_m, Cell::new(2, 2), 0.0);
+//! let mut w = World::new(&robot, &SimParams::default(), Grid::new(20, 5).unwrap(), &[start]).unwrap();
+//! w.apply_command(0, 0, 10.0, 10.0, 0).unwrap();
+//! for _ in 0..100 {
+//!     w.step();
+//! }
+//! assert!(w.pose(0).unwrap().x_m > start.x_m);
+//! ```
+
+pub mod bench;
+pub mod collision;
+pub mod error;
+pub mod hall;
+pub mod kinematics;
+pub mod process;
+pub mod robot;
+pub mod watchdog;
+pub mod world;
+
+pub use collision::{Collision, Hit};
+pub use error::SimError;
+pub use robot::RobotModel;
+pub use world::World;

@@ -1,0 +1,310 @@
+//! Collisions on ground truth: robot against robot (discs) and robot against blocked cells
+//! (squares; cells outside the grid count as blocked). A collision is recorded when a contact
+//! begins, not on every step it lasts.
+
+use hnav_runtime::grid::Grid;
+
+/// What a robot hit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Hit {
+    /// Another robot (index).
+    Robot(u32),
+    /// A blocked cell `(x, y)` (column, row; may lie outside the grid).
+    Cell(i64, i64),
+}
+
+/// One recorded collision.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Collision {
+    /// Sim time of the step that began the contact, ns.
+    pub time_ns: u64,
+    /// The robot (the lower index for robot pairs).
+    pub robot: u32,
+    /// What it hit.
+    pub hit: Hit,
+    /// The robot's centre, m.
+    pub position: (f64, f64),
+    /// The other robot's centre, or the hit cell's centre, m.
+    pub other_position: (f64, f64),
+}
+
+/// Whether two discs overlap (touching counts as no contact).
+#[inline]
+pub fn discs_overlap(a: (f64, f64), b: (f64, f64), ra: f64, rb: f64) -> bool {
+    let (dx, dy) = (a.0 - b.0, a.1 - b.1);
+    let r = ra + rb;
+    dx * dx + dy * dy < r * r
+}
+
+/// Whether a disc overlaps the square of cell `(cx, cy)` of edge `cell`.
+#[inline]
+pub fn disc_overlaps_cell(p: (f64, f64), r: f64, cx: i64, cy: i64, cell: f64) -> bool {
+    let (x0, y0) = (cx as f64 * cell, cy as f64 * cell);
+    let nx = p.0.clamp(x0, x0 + cell);
+    let ny = p.1.clamp(y0, y0 + cell);
+    let (dx, dy) = (p.0 - nx, p.1 - ny);
+    dx * dx + dy * dy < r * r
+}
+
+/// `floor(v)` as an integer without the libm call `f64::floor` becomes on targets without
+/// SSE4.1.
+#[inline]
+fn floor_i64(v: f64) -> i64 {
+    let t = v as i64;
+    if (t as f64) > v {
+        t - 1
+    } else {
+        t
+    }
+}
+
+/// Whether cell `(x, y)` is blocked; outside the grid is blocked.
+#[inline]
+fn blocked(grid: &Grid, x: i64, y: i64) -> bool {
+    let (w, h) = (i64::from(grid.width()), i64::from(grid.height()));
+    x < 0 || y < 0 || x >= w || y >= h || grid.blocked()[(y * w + x) as usize]
+}
+
+/// The first blocked cell a disc of radius `r` overlaps, if any. Only cells meeting the
+/// disc's bounding box are examined (one to four when the disc is no wider than a cell).
+pub fn wall_contact(grid: &Grid, p: (f64, f64), r: f64, cell: f64) -> Option<(i64, i64)> {
+    let inv = 1.0 / cell;
+    let (x0, x1) = (floor_i64((p.0 - r) * inv), floor_i64((p.0 + r) * inv));
+    let (y0, y1) = (floor_i64((p.1 - r) * inv), floor_i64((p.1 + r) * inv));
+    for y in y0..=y1 {
+        for x in x0..=x1 {
+            if blocked(grid, x, y) && disc_overlaps_cell(p, r, x, y, cell) {
+                return Some((x, y));
+            }
+        }
+    }
+    None
+}
+
+/// Contact detection for a whole world, with reusable buffers (no allocation per step once
+/// warm). Robot pairs use a sorted cell hash: robots ordered by cell key, each checked
+/// against its own and the neighbouring cells only.
+#[derive(Debug, Clone, Default)]
+pub struct Detector {
+    order: Vec<u32>,
+    keys: Vec<i64>,
+    sorted: Vec<i64>,
+    touching: Vec<(u32, u32)>,
+    touching_next: Vec<(u32, u32)>,
+    on_wall: Vec<bool>,
+    /// Per cell of the grid it was built for: the cell and its 8 neighbours are free and
+    /// inside the grid, so a disc centred in it (no wider than a cell) touches no wall.
+    open: Vec<bool>,
+    open_w: u32,
+    cell: f64,
+    radius: f64,
+}
+
+impl Detector {
+    /// A detector for `n` robots of body radius `radius` (at most `cell / 2`) on `grid`, whose
+    /// cells have edge `cell` (m).
+    pub fn new(n: usize, grid: &Grid, cell: f64, radius: f64) -> Detector {
+        let (w, h) = (i64::from(grid.width()), i64::from(grid.height()));
+        let mut open = vec![false; grid.len()];
+        for y in 0..h {
+            for x in 0..w {
+                open[(y * w + x) as usize] =
+                    (-1..=1).all(|dy| (-1..=1).all(|dx| !blocked(grid, x + dx, y + dy)));
+            }
+        }
+        Detector {
+            open,
+            open_w: grid.width(),
+            cell,
+            radius,
+            order: (0..n as u32).collect(),
+            keys: vec![0; n],
+            sorted: Vec::with_capacity(n),
+            touching: Vec::new(),
+            touching_next: Vec::new(),
+            on_wall: vec![false; n],
+        }
+    }
+
+    /// Whether centre `p` lies in an open cell (see `open`).
+    #[inline]
+    fn in_open_cell(&self, p: (f64, f64)) -> bool {
+        if !(p.0 >= 0.0 && p.1 >= 0.0) {
+            return false;
+        }
+        let inv = 1.0 / self.cell;
+        // Non-negative, so truncation is floor; far-off values saturate and fail the bounds.
+        let (cx, cy) = ((p.0 * inv) as u64, (p.1 * inv) as u64);
+        let w = u64::from(self.open_w);
+        cx < w
+            && self
+                .open
+                .get((cy.saturating_mul(w).saturating_add(cx)) as usize)
+                == Some(&true)
+    }
+
+    /// Checks all contacts of the robot centres `xs`, `ys` and appends the
+    /// contacts that began this step to `out`. Returns how many were appended.
+    pub fn check(
+        &mut self,
+        grid: &Grid,
+        xs: &[f64],
+        ys: &[f64],
+        time_ns: u64,
+        out: &mut Vec<Collision>,
+    ) -> usize {
+        let before = out.len();
+        let (cell, r) = (self.cell, self.radius);
+        for i in 0..xs.len() {
+            let p = (xs[i], ys[i]);
+            let hit = if self.in_open_cell(p) {
+                None
+            } else {
+                wall_contact(grid, p, r, cell)
+            };
+            match hit {
+                Some((cx, cy)) if !self.on_wall[i] => out.push(Collision {
+                    time_ns,
+                    robot: i as u32,
+                    hit: Hit::Cell(cx, cy),
+                    position: p,
+                    other_position: ((cx as f64 + 0.5) * cell, (cy as f64 + 0.5) * cell),
+                }),
+                _ => {}
+            }
+            self.on_wall[i] = hit.is_some();
+        }
+        if xs.len() < 2 {
+            return out.len() - before;
+        }
+        // Broad phase: robots sorted by the key of their (clamped) cell. A disc is no wider
+        // than a cell, so a robot can only touch robots in its own cell and the 8 around it;
+        // each pair is found once, from the robot whose cell comes first in key order.
+        let (kw, kh) = (i64::from(grid.width()) + 2, i64::from(grid.height()) + 2);
+        let inv = 1.0 / cell;
+        for (k, (&x, &y)) in self.keys.iter_mut().zip(xs.iter().zip(ys)) {
+            let cx = (floor_i64(x * inv) + 1).clamp(0, kw - 1);
+            let cy = (floor_i64(y * inv) + 1).clamp(0, kh - 1);
+            *k = cy * kw + cx;
+        }
+        // Insertion sort (stable, deterministic, ~O(n): last step's order is nearly sorted).
+        let (order, keys) = (&mut self.order, &self.keys);
+        for k in 1..order.len() {
+            let v = order[k];
+            let mut j = k;
+            while j > 0 && keys[order[j - 1] as usize] > keys[v as usize] {
+                order[j] = order[j - 1];
+                j -= 1;
+            }
+            order[j] = v;
+        }
+        self.sorted.clear();
+        self.sorted.extend(order.iter().map(|&i| keys[i as usize]));
+        let (sorted, n) = (&self.sorted, order.len());
+        self.touching_next.clear();
+        let mut below = 0; // first index whose key may lie in the next row's window
+        for a in 0..n {
+            let (i, k) = (order[a] as usize, sorted[a]);
+            let mut test = |b: usize| {
+                let j = order[b] as usize;
+                if discs_overlap((xs[i], ys[i]), (xs[j], ys[j]), r, r) {
+                    self.touching_next.push((i.min(j) as u32, i.max(j) as u32));
+                }
+            };
+            // Own cell (later robots) and the cell to the right.
+            let mut b = a + 1;
+            while b < n && sorted[b] <= k + 1 {
+                test(b);
+                b += 1;
+            }
+            // The three cells of the next row; their window only moves forward with `a`.
+            let lo = k + kw - 1;
+            while below < n && sorted[below] < lo {
+                below += 1;
+            }
+            let mut b = below;
+            while b < n && sorted[b] <= k + kw + 1 {
+                test(b);
+                b += 1;
+            }
+        }
+        self.touching_next.sort_unstable();
+        for &(i, j) in &self.touching_next {
+            if self.touching.binary_search(&(i, j)).is_err() {
+                out.push(Collision {
+                    time_ns,
+                    robot: i,
+                    hit: Hit::Robot(j),
+                    position: (xs[i as usize], ys[i as usize]),
+                    other_position: (xs[j as usize], ys[j as usize]),
+                });
+            }
+        }
+        std::mem::swap(&mut self.touching, &mut self.touching_next);
+        out.len() - before
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn disc_and_cell_geometry() {
+        assert!(discs_overlap((0.0, 0.0), (0.1, 0.0), 0.058, 0.058));
+        assert!(!discs_overlap((0.0, 0.0), (0.12, 0.0), 0.058, 0.058));
+        // Cell (1, 0) spans x in [0.12, 0.24).
+        assert!(disc_overlaps_cell((0.07, 0.06), 0.058, 1, 0, 0.12));
+        assert!(!disc_overlaps_cell((0.06, 0.06), 0.058, 1, 0, 0.12));
+    }
+
+    #[test]
+    fn contact_is_recorded_once_when_it_begins() {
+        let grid = Grid::new(10, 10).unwrap();
+        let mut d = Detector::new(2, &grid, 0.12, 0.058);
+        let mut out = Vec::new();
+        let (xs, ys) = ([0.5, 0.6], [0.5, 0.5]);
+        assert_eq!(d.check(&grid, &xs, &ys, 1, &mut out), 1);
+        assert_eq!(d.check(&grid, &xs, &ys, 2, &mut out), 0);
+        assert_eq!(out[0].hit, Hit::Robot(1));
+        // Outside the grid counts as blocked.
+        let (xs, ys) = ([0.03, 0.6], [0.54, 0.54]);
+        let n = d.check(&grid, &xs, &ys, 3, &mut out);
+        assert_eq!(n, 1);
+        assert_eq!(out[1].hit, Hit::Cell(-1, 4));
+    }
+
+    #[test]
+    fn broad_phase_finds_exactly_the_brute_force_pairs() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let grid = Grid::new(12, 9).unwrap();
+        let (cell, r) = (0.12, 0.058);
+        for round in 0..50 {
+            let n = 60;
+            // Some robots off the grid too, where cells clamp.
+            let xs: Vec<f64> = (0..n).map(|_| rng.gen_range(-0.3..1.7)).collect();
+            let ys: Vec<f64> = (0..n).map(|_| rng.gen_range(-0.3..1.3)).collect();
+            let mut d = Detector::new(n, &grid, cell, r);
+            let mut out = Vec::new();
+            d.check(&grid, &xs, &ys, 0, &mut out);
+            let mut got: Vec<_> = out
+                .iter()
+                .filter_map(|c| match c.hit {
+                    Hit::Robot(j) => Some((c.robot, j)),
+                    Hit::Cell(..) => None,
+                })
+                .collect();
+            got.sort_unstable();
+            let mut want = Vec::new();
+            for i in 0..n {
+                for j in i + 1..n {
+                    if discs_overlap((xs[i], ys[i]), (xs[j], ys[j]), r, r) {
+                        want.push((i as u32, j as u32));
+                    }
+                }
+            }
+            assert_eq!(got, want, "round {round}");
+        }
+    }
+}

@@ -1,0 +1,331 @@
+//! The world: N robots stepped together, stored as struct-of-arrays, with no allocation per
+//! step (collision records aside, which grow only when a contact begins).
+
+use crate::collision::{Collision, Detector};
+use crate::error::SimError;
+use crate::hall::{self, SlipNoise};
+use crate::kinematics::{arc_update_vec, wrap_angle};
+use crate::robot::{RobotModel, SLIP_HOLD_S};
+use crate::watchdog::Watchdog;
+use hnav_runtime::grid::{Cell, Grid};
+use hnav_runtime::msg::{Odometry, Pose, Truth, MAX_AGENTS};
+use hnav_runtime::scenario::params::{RobotParams, SimParams};
+
+/// Steps between re-derivations of the heading vectors from the heading angles.
+const RESYNC_STEPS: u64 = 256;
+
+/// Every robot of a run, its motors, wheels, Hall counters and ground truth.
+#[derive(Debug, Clone)]
+pub struct World {
+    model: RobotModel,
+    grid: Grid,
+    watchdog: Watchdog,
+    step_ns: u64,
+    steps_per_slip: u64,
+    steps_per_odometry: u64,
+    steps: u64,
+    // Ground truth, per robot.
+    x: Vec<f64>,
+    y: Vec<f64>,
+    theta: Vec<f64>,
+    // The heading's unit vector, carried along so a step needs no library trigonometry.
+    cos_t: Vec<f64>,
+    sin_t: Vec<f64>,
+    // Actual and commanded wheel speeds, rad/s.
+    wl: Vec<f64>,
+    wr: Vec<f64>,
+    cmd_l: Vec<f64>,
+    cmd_r: Vec<f64>,
+    cmd_at: Vec<Option<u64>>,
+    cmd_period: Vec<Option<u64>>,
+    // Wheel angles since the start (what the Hall sensors see), rad.
+    phil: Vec<f64>,
+    phir: Vec<f64>,
+    // Current slip factors and their generators.
+    slip_l: Vec<f64>,
+    slip_r: Vec<f64>,
+    noise: Vec<SlipNoise>,
+    slip_on: bool,
+    detector: Detector,
+    collisions: Vec<Collision>,
+}
+
+impl World {
+    /// A world of robots at `starts` on `grid`, with the scenario's robot and sim parameters.
+    pub fn new(
+        robot: &RobotParams,
+        sim: &SimParams,
+        grid: Grid,
+        starts: &[Pose],
+    ) -> Result<World, SimError> {
+        let model = RobotModel::new(robot, sim)?;
+        if sim.odometry_hz == 0 {
+            return Err(SimError::BadParam {
+                name: "sim.odometry_hz",
+                value: 0.0,
+                why: "must be > 0",
+            });
+        }
+        if let Some(i) = starts
+            .iter()
+            .position(|p| !(p.x_m.is_finite() && p.y_m.is_finite() && p.theta_rad.is_finite()))
+        {
+            return Err(SimError::NonFinitePose { robot: i });
+        }
+        let n = starts.len();
+        let step_ns = u64::from(sim.step_ms) * 1_000_000;
+        let per = |period_s: f64| ((period_s / model.dt).round() as u64).max(1);
+        Ok(World {
+            steps_per_slip: per(SLIP_HOLD_S),
+            steps_per_odometry: per(1.0 / f64::from(sim.odometry_hz)),
+            watchdog: Watchdog::from_ms(sim.watchdog_ms),
+            step_ns,
+            steps: 0,
+            x: starts.iter().map(|p| p.x_m).collect(),
+            y: starts.iter().map(|p| p.y_m).collect(),
+            theta: starts.iter().map(|p| wrap_angle(p.theta_rad)).collect(),
+            cos_t: starts.iter().map(|p| p.theta_rad.cos()).collect(),
+            sin_t: starts.iter().map(|p| p.theta_rad.sin()).collect(),
+            wl: vec![0.0; n],
+            wr: vec![0.0; n],
+            cmd_l: vec![0.0; n],
+            cmd_r: vec![0.0; n],
+            cmd_at: vec![None; n],
+            cmd_period: vec![None; n],
+            phil: vec![0.0; n],
+            phir: vec![0.0; n],
+            slip_l: vec![0.0; n],
+            slip_r: vec![0.0; n],
+            noise: (0..n as u64)
+                .map(|i| SlipNoise::new(sim.seed, i, sim.slip_std))
+                .collect(),
+            slip_on: sim.slip_std > 0.0,
+            detector: Detector::new(n, &grid, model.cell_size_m, model.body_radius_m),
+            collisions: Vec::new(),
+            model,
+            grid,
+        })
+    }
+
+    /// The pose at the centre of `cell` with heading `theta_rad`.
+    pub fn cell_centre(cell_size_m: f64, cell: Cell, theta_rad: f64) -> Pose {
+        Pose {
+            x_m: (f64::from(cell.x) + 0.5) * cell_size_m,
+            y_m: (f64::from(cell.y) + 0.5) * cell_size_m,
+            theta_rad,
+        }
+    }
+
+    /// Number of robots.
+    pub fn robots(&self) -> usize {
+        self.x.len()
+    }
+
+    /// The validated robot model.
+    pub fn model(&self) -> &RobotModel {
+        &self.model
+    }
+
+    /// The map.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// Sim time, ns since the start.
+    pub fn time_ns(&self) -> u64 {
+        self.steps * self.step_ns
+    }
+
+    /// Physics steps taken.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// Physics steps per odometry reading (from `sim.odometry_hz`, at least 1).
+    pub fn steps_per_odometry(&self) -> u64 {
+        self.steps_per_odometry
+    }
+
+    /// Whether the last step closed an odometry period (a reading is due).
+    pub fn odometry_due(&self) -> bool {
+        self.steps > 0 && self.steps.is_multiple_of(self.steps_per_odometry)
+    }
+
+    fn check(&self, agent: u32) -> Result<usize, SimError> {
+        let i = agent as usize;
+        if i < self.robots() {
+            Ok(i)
+        } else {
+            Err(SimError::UnknownAgent {
+                agent,
+                robots: self.robots(),
+            })
+        }
+    }
+
+    /// Sets robot `agent`'s wheel speed set-points (rad/s) for control period `period`,
+    /// received at sim time `now_ns` (the watchdog measures from there).
+    pub fn apply_command(
+        &mut self,
+        agent: u32,
+        period: u64,
+        left: f64,
+        right: f64,
+        now_ns: u64,
+    ) -> Result<(), SimError> {
+        let i = self.check(agent)?;
+        if !(left.is_finite() && right.is_finite()) {
+            return Err(SimError::NonFiniteCommand { agent, left, right });
+        }
+        self.cmd_l[i] = left;
+        self.cmd_r[i] = right;
+        self.cmd_at[i] = Some(now_ns);
+        self.cmd_period[i] = Some(period);
+        Ok(())
+    }
+
+    /// Drops robot `agent`'s command so that it brakes from now on (its agent is down).
+    /// Unknown agents are ignored.
+    pub fn brake(&mut self, agent: u32) {
+        if let Some(t) = self.cmd_at.get_mut(agent as usize) {
+            *t = None;
+        }
+    }
+
+    /// The control period of robot `agent`'s last command, if any.
+    pub fn command_period(&self, agent: u32) -> Option<u64> {
+        self.cmd_period.get(agent as usize).copied().flatten()
+    }
+
+    /// Sets robot `agent`'s actual wheel speeds (rad/s) directly, bypassing the motor model:
+    /// for initial conditions and tests that start a robot already at speed.
+    pub fn set_wheel_speeds(&mut self, agent: u32, left: f64, right: f64) -> Result<(), SimError> {
+        let i = self.check(agent)?;
+        if !(left.is_finite() && right.is_finite()) {
+            return Err(SimError::NonFiniteCommand { agent, left, right });
+        }
+        self.wl[i] = left;
+        self.wr[i] = right;
+        Ok(())
+    }
+
+    /// Robot `agent`'s actual wheel speeds `(left, right)`, rad/s.
+    pub fn wheel_speeds(&self, agent: u32) -> Option<(f64, f64)> {
+        let i = agent as usize;
+        (i < self.robots()).then(|| (self.wl[i], self.wr[i]))
+    }
+
+    /// Whether robot `agent`'s watchdog is braking it now.
+    pub fn braking(&self, agent: u32) -> bool {
+        let i = agent as usize;
+        i < self.robots() && self.watchdog.expired(self.cmd_at[i], self.time_ns())
+    }
+
+    /// Advances the world by one physics step and returns how many collisions began in it.
+    pub fn step(&mut self) -> usize {
+        let now = self.time_ns();
+        let m = &self.model;
+        let (dt, r, inv_b) = (m.dt, m.wheel_radius_m, 1.0 / m.axle_track_m);
+        // Re-derive the heading vectors from the angles now and then (cost amortised to
+        // nothing) so that rounding in the rotations cannot accumulate.
+        let resync = self.steps.is_multiple_of(RESYNC_STEPS);
+        let redraw = self.slip_on && self.steps.is_multiple_of(self.steps_per_slip);
+        for i in 0..self.x.len() {
+            let (l0, r0) = (self.wl[i], self.wr[i]);
+            let (l1, r1) = if self.watchdog.expired(self.cmd_at[i], now) {
+                (m.brake_step(l0), m.brake_step(r0))
+            } else {
+                (
+                    m.motor_step(l0, self.cmd_l[i]),
+                    m.motor_step(r0, self.cmd_r[i]),
+                )
+            };
+            self.wl[i] = l1;
+            self.wr[i] = r1;
+            // Trapezoidal wheel angle: exact for the acceleration-limited (linear) ramp.
+            let (dphl, dphr) = (0.5 * (l0 + l1) * dt, 0.5 * (r0 + r1) * dt);
+            self.phil[i] += dphl;
+            self.phir[i] += dphr;
+            let (mut dsl, mut dsr) = (r * dphl, r * dphr);
+            if self.slip_on {
+                if redraw {
+                    (self.slip_l[i], self.slip_r[i]) = self.noise[i].draw();
+                }
+                dsl *= 1.0 + self.slip_l[i];
+                dsr *= 1.0 + self.slip_r[i];
+            }
+            let (ds, dth) = (0.5 * (dsr + dsl), (dsr - dsl) * inv_b);
+            let (x, y, c, s) =
+                arc_update_vec(self.x[i], self.y[i], self.cos_t[i], self.sin_t[i], ds, dth);
+            self.x[i] = x;
+            self.y[i] = y;
+            self.theta[i] = wrap_angle(self.theta[i] + dth);
+            if resync {
+                (self.sin_t[i], self.cos_t[i]) = self.theta[i].sin_cos();
+            } else {
+                (self.cos_t[i], self.sin_t[i]) = (c, s);
+            }
+        }
+        self.steps += 1;
+        let t = self.time_ns();
+        self.detector
+            .check(&self.grid, &self.x, &self.y, t, &mut self.collisions)
+    }
+
+    /// Robot `agent`'s ground-truth pose.
+    pub fn pose(&self, agent: u32) -> Option<Pose> {
+        let i = agent as usize;
+        (i < self.robots()).then(|| Pose {
+            x_m: self.x[i],
+            y_m: self.y[i],
+            theta_rad: self.theta[i],
+        })
+    }
+
+    /// Robot `agent`'s cumulative Hall ticks `(left, right)`.
+    pub fn ticks(&self, agent: u32) -> Option<(i64, i64)> {
+        let i = agent as usize;
+        let n = self.model.ticks_per_rev;
+        (i < self.robots()).then(|| (hall::ticks(self.phil[i], n), hall::ticks(self.phir[i], n)))
+    }
+
+    /// Robot `agent`'s odometry message for control period `period`.
+    pub fn odometry(&self, agent: u32, period: u64) -> Option<Odometry> {
+        let (ticks_left, ticks_right) = self.ticks(agent)?;
+        Some(Odometry {
+            sim_time_ns: self.time_ns(),
+            period,
+            agent,
+            reserved: 0,
+            ticks_left,
+            ticks_right,
+        })
+    }
+
+    /// Fills `truth` for control period `period`: time, collision count and the poses of the
+    /// first [`MAX_AGENTS`] robots (the message holds no more). Unused pose slots are zeroed so
+    /// the sample's bytes are fully defined.
+    pub fn fill_truth(&self, period: u64, truth: &mut Truth) {
+        let n = self.robots().min(MAX_AGENTS);
+        truth.sim_time_ns = self.time_ns();
+        truth.period = period;
+        truth.robots = n as u32;
+        truth.collisions = u32::try_from(self.collisions.len()).unwrap_or(u32::MAX);
+        for (i, p) in truth.poses.iter_mut().enumerate() {
+            *p = if i < n {
+                Pose {
+                    x_m: self.x[i],
+                    y_m: self.y[i],
+                    theta_rad: self.theta[i],
+                }
+            } else {
+                Pose::default()
+            };
+        }
+    }
+
+    /// Every collision recorded so far, in order.
+    pub fn collisions(&self) -> &[Collision] {
+        &self.collisions
+    }
+}

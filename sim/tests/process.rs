@@ -1,0 +1,197 @@
+//! The `hnav-sim` process in lockstep: this test plays two agents over the transport (wheel
+//! commands in, odometry and truth out) and checks that two runs with one seed give identical
+//! Truth streams, and that a robot whose agent never sends is braked rather than waited for.
+
+use hnav_runtime::msg::{Odometry, Truth, WheelCommand};
+use hnav_runtime::transport::{purge_run, RunId, Transport};
+use hnav_sim::process::{odometry_topic, topic_qos, wheels_topic, TRUTH_TOPIC};
+use iceoryx2::prelude::CallbackProgression;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const SIM: &str = env!("CARGO_BIN_EXE_hnav-sim");
+const PERIODS: u64 = 40;
+
+const SCENARIO: &str = r#"
+name = "sim-process-test"
+[map]
+rows = [
+  "..........",
+  "..........",
+  "..........",
+  "..........",
+]
+[sim]
+clock = "lockstep"
+seed = 9
+slip_std = 0.02
+[[agents]]
+start = [1, 1]
+goal = [8, 1]
+[[agents]]
+start = [1, 2]
+goal = [8, 2]
+"#;
+
+fn hash(h: &mut u64, t: &Truth) {
+    let mut eat = |v: u64| {
+        for b in v.to_le_bytes() {
+            *h ^= u64::from(b);
+            *h = h.wrapping_mul(0x100_0000_01b3);
+        }
+    };
+    eat(t.sim_time_ns);
+    eat(t.period);
+    eat(u64::from(t.robots) << 32 | u64::from(t.collisions));
+    for p in t.poses() {
+        eat(p.x_m.to_bits());
+        eat(p.y_m.to_bits());
+        eat(p.theta_rad.to_bits());
+    }
+}
+
+/// One lockstep run; `agents` of the two robots are driven by this test. Returns the hash
+/// of the Truth stream and the last truth.
+fn run_once(tag: &str, agents: usize, scenario: &str) -> (u64, Truth) {
+    let dir = std::env::temp_dir().join(format!("hnav-sim-test-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("scenario.toml");
+    std::fs::write(&file, scenario).unwrap();
+    let guard = RunGuard {
+        run: RunId::unique(tag),
+        dir,
+        child: None,
+    };
+    drive(guard, &file, agents)
+}
+
+/// Kills the sim if it still runs and removes the run's shared memory and files, also when
+/// the test fails half-way.
+struct RunGuard {
+    run: RunId,
+    dir: std::path::PathBuf,
+    child: Option<std::process::Child>,
+}
+
+impl Drop for RunGuard {
+    fn drop(&mut self) {
+        if let Some(child) = &mut self.child {
+            if child.try_wait().ok().flatten().is_none() {
+                let _ = child.kill();
+                let _ = child.wait();
+            }
+        }
+        let _ = purge_run(&self.run);
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
+/// Plays `agents` agents against a spawned `hnav-sim` for [`PERIODS`] periods.
+fn drive(mut guard: RunGuard, file: &std::path::Path, agents: usize) -> (u64, Truth) {
+    let run = guard.run.clone();
+    let t = Transport::builder(&run)
+        .node_name("agents")
+        .create()
+        .unwrap();
+    let q = topic_qos();
+    let wheels: Vec<_> = (0..agents)
+        .map(|i| t.sender::<WheelCommand>(&wheels_topic(i), q).unwrap())
+        .collect();
+    let odom: Vec<_> = (0..2)
+        .map(|i| t.receiver::<Odometry>(&odometry_topic(i), q).unwrap())
+        .collect();
+    let truth = t.receiver::<Truth>(TRUTH_TOPIC, q).unwrap();
+    let send = |period: u64| {
+        for (i, tx) in wheels.iter().enumerate() {
+            let k = i as f64;
+            tx.send(WheelCommand {
+                period,
+                agent: i as u32,
+                flags: 0,
+                left_rad_s: 8.0 + k,
+                right_rad_s: 10.0 - k,
+            })
+            .unwrap();
+        }
+    };
+    // Period 0's commands are kept as history for the sim's late-joining subscribers.
+    send(0);
+    let child = Command::new(SIM)
+        .args(["--run", run.as_str(), "--scenario"])
+        .arg(file)
+        .args(["--periods", &PERIODS.to_string()])
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    let child = guard.child.insert(child);
+    let ws = t.waitset().unwrap();
+    let _g = ws.attach_notification(truth.listener()).unwrap();
+    let (mut h, mut last, mut next) = (0xcbf2_9ce4_8422_2325u64, Truth::default(), 0u64);
+    let started = Instant::now();
+    while next < PERIODS {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "sim stalled at {next}"
+        );
+        ws.wait_and_process_once_with_timeout(
+            |_| CallbackProgression::Continue,
+            Duration::from_secs(1),
+        )
+        .unwrap();
+        truth.take_wakeup().unwrap();
+        truth
+            .drain(|s| {
+                // In order; realtime may overwrite an unread sample (latest-only QoS), lockstep
+                // cannot (the sim waits for the commands this loop sends).
+                assert!(s.period >= next, "truth periods arrive in order");
+                hash(&mut h, s);
+                last = *s;
+                next = s.period + 1;
+            })
+            .unwrap();
+        for rx in &odom {
+            rx.take_wakeup().unwrap();
+            rx.drain(|_| {}).unwrap();
+        }
+        if next < PERIODS {
+            send(next);
+        }
+    }
+    assert!(child.wait().unwrap().success());
+    // `guard`, a parameter, is dropped after every port of this function: purge then finds
+    // no live node of the run.
+    (h, last)
+}
+
+#[test]
+fn lockstep_runs_with_one_seed_give_identical_truth_streams() {
+    let (a, ta) = run_once("lockstep-a", 2, SCENARIO);
+    let (b, _) = run_once("lockstep-b", 2, SCENARIO);
+    assert_eq!(a, b);
+    assert_eq!(ta.robots, 2);
+    assert!(
+        ta.poses()[0].x_m > 0.18,
+        "robot 0 drove: {:?}",
+        ta.poses()[0]
+    );
+}
+
+#[test]
+fn a_robot_without_an_agent_brakes_and_does_not_stall_the_run() {
+    let (_, t) = run_once("lockstep-down", 1, SCENARIO);
+    // Robot 1 never got a command: it stands at its start cell's centre.
+    assert_eq!((t.poses()[1].x_m, t.poses()[1].y_m), (0.18, 0.30));
+    assert!(t.poses()[0].x_m > 0.18);
+}
+
+#[test]
+fn realtime_follows_the_wall_clock() {
+    let scenario = SCENARIO.replace("clock = \"lockstep\"", "clock = \"realtime\"");
+    let started = Instant::now();
+    let (_, t) = run_once("realtime", 2, &scenario);
+    let wall = started.elapsed();
+    // 40 periods of 10 ms: at least 0.4 s of wall time, and the robots moved.
+    assert!(wall >= Duration::from_millis(390), "{wall:?}");
+    assert_eq!(t.sim_time_ns, 400_000_000);
+    assert!(t.poses()[0].x_m > 0.18 && t.poses()[1].x_m > 0.18);
+}
