@@ -15,7 +15,7 @@
 
 use hnav_runtime::grid::{octile, Cell, Grid};
 
-use super::search::Search;
+use super::search::{planner_options, Search};
 use super::space::Space;
 use super::{Path, PlanStats, Planner, PlannerConfig};
 use crate::error::PlanError;
@@ -27,25 +27,7 @@ pub struct AStar {
     search: Search,
 }
 
-impl AStar {
-    /// A planner with the given options.
-    pub fn new(config: PlannerConfig) -> Self {
-        AStar {
-            config,
-            search: Search::default(),
-        }
-    }
-
-    /// The options in use.
-    pub fn config(&self) -> &PlannerConfig {
-        &self.config
-    }
-
-    /// Replaces the options (the buffers are kept).
-    pub fn set_config(&mut self, config: PlannerConfig) {
-        self.config = config;
-    }
-}
+planner_options!(AStar);
 
 impl Planner for AStar {
     fn name(&self) -> &'static str {

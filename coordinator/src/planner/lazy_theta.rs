@@ -26,7 +26,7 @@
 use hnav_runtime::grid::{Cell, Grid};
 
 use super::line_of_sight::euclid;
-use super::search::Search;
+use super::search::{planner_options, Search};
 use super::space::Space;
 use super::{Path, PlanStats, Planner, PlannerConfig};
 use crate::error::PlanError;
@@ -38,25 +38,7 @@ pub struct LazyTheta {
     search: Search,
 }
 
-impl LazyTheta {
-    /// A planner with the given options.
-    pub fn new(config: PlannerConfig) -> Self {
-        LazyTheta {
-            config,
-            search: Search::default(),
-        }
-    }
-
-    /// The options in use.
-    pub fn config(&self) -> &PlannerConfig {
-        &self.config
-    }
-
-    /// Replaces the options (the buffers are kept).
-    pub fn set_config(&mut self, config: PlannerConfig) {
-        self.config = config;
-    }
-}
+planner_options!(LazyTheta);
 
 /// `SetVertex(s)`: verifies the assumed segment `parent(s) -> s` and repairs `g(s)` and the
 /// parent if needed.

@@ -184,3 +184,29 @@ mod tests {
         assert!(s.generation < 3, "wrapped and restarted");
     }
 }
+
+/// The constructor and option accessors every planner (`config` + `search` fields) shares.
+macro_rules! planner_options {
+    ($planner:ident) => {
+        impl $planner {
+            /// A planner with the given options.
+            pub fn new(config: PlannerConfig) -> Self {
+                $planner {
+                    config,
+                    search: Search::default(),
+                }
+            }
+
+            /// The options in use.
+            pub fn config(&self) -> &PlannerConfig {
+                &self.config
+            }
+
+            /// Replaces the options (the buffers are kept).
+            pub fn set_config(&mut self, config: PlannerConfig) {
+                self.config = config;
+            }
+        }
+    };
+}
+pub(crate) use planner_options;

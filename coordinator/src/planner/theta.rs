@@ -18,7 +18,7 @@
 use hnav_runtime::grid::{Cell, Grid};
 
 use super::line_of_sight::euclid;
-use super::search::Search;
+use super::search::{planner_options, Search};
 use super::space::Space;
 use super::{Path, PlanStats, Planner, PlannerConfig};
 use crate::error::PlanError;
@@ -30,25 +30,7 @@ pub struct BasicTheta {
     search: Search,
 }
 
-impl BasicTheta {
-    /// A planner with the given options.
-    pub fn new(config: PlannerConfig) -> Self {
-        BasicTheta {
-            config,
-            search: Search::default(),
-        }
-    }
-
-    /// The options in use.
-    pub fn config(&self) -> &PlannerConfig {
-        &self.config
-    }
-
-    /// Replaces the options (the buffers are kept).
-    pub fn set_config(&mut self, config: PlannerConfig) {
-        self.config = config;
-    }
-}
+planner_options!(BasicTheta);
 
 impl Planner for BasicTheta {
     fn name(&self) -> &'static str {

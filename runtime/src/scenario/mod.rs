@@ -269,6 +269,8 @@ impl Scenario {
 }
 
 #[cfg(test)]
+mod test_support;
+#[cfg(test)]
 mod tests;
 #[cfg(test)]
 mod tests_generate;

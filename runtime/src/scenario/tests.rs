@@ -1,28 +1,9 @@
 //! Unit tests of scenario parsing and validation errors.
 
 use super::*;
+use super::test_support::{parse, BASE};
 use crate::grid::{Endpoint, GridError};
 
-const BASE: &str = r#"name = "t"
-[map]
-rows = [
-  "......",
-  ".@@...",
-  "......",
-  "...@..",
-]
-[[agents]]
-start = [0, 0]
-goal = [5, 3]
-[[agents]]
-start = [5, 0]
-goal = [0, 3]
-speed = 2.0
-"#;
-
-fn parse(text: &str) -> Result<Scenario, ScenarioError> {
-    Scenario::from_str(text, "t.toml", Path::new("."))
-}
 
 #[test]
 fn defaults_apply() {

@@ -1,28 +1,9 @@
 //! Unit tests of the scenario hash, agent generation, re-validation and the report.
 
 use super::*;
+use super::test_support::{parse, BASE};
 use crate::grid::octile_shortest_path_len;
 
-const BASE: &str = r#"name = "t"
-[map]
-rows = [
-  "......",
-  ".@@...",
-  "......",
-  "...@..",
-]
-[[agents]]
-start = [0, 0]
-goal = [5, 3]
-[[agents]]
-start = [5, 0]
-goal = [0, 3]
-speed = 2.0
-"#;
-
-fn parse(text: &str) -> Result<Scenario, ScenarioError> {
-    Scenario::from_str(text, "t.toml", Path::new("."))
-}
 
 #[test]
 fn hash_is_canonical() {
