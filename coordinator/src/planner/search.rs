@@ -160,31 +160,6 @@ impl Search {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_new_query_forgets_the_last_even_across_the_stamp_wrap() {
-        let mut s = Search::default();
-        s.begin(4);
-        s.open(2, 1.5, 0.0, 2);
-        assert_eq!(s.pop(), Some(2));
-        assert!(s.is_closed(2) && s.g(2) == 1.5);
-        s.generation = u32::MAX - 1;
-        for _ in 0..3 {
-            s.begin(6);
-            assert!(!s.is_closed(2) && s.g(2).is_infinite() && !s.is_verified(2));
-            s.open(2, 0.5, 1.0, 2);
-            s.open(2, 0.25, 1.0, 2); // improvement: the first entry goes stale
-            assert_eq!(s.pop(), Some(2));
-            assert_eq!(s.g(2), 0.25);
-            assert_eq!(s.pop(), None);
-        }
-        assert!(s.generation < 3, "wrapped and restarted");
-    }
-}
-
 /// The constructor and option accessors every planner (`config` + `search` fields) shares.
 macro_rules! planner_options {
     ($planner:ident) => {
@@ -210,3 +185,28 @@ macro_rules! planner_options {
     };
 }
 pub(crate) use planner_options;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_new_query_forgets_the_last_even_across_the_stamp_wrap() {
+        let mut s = Search::default();
+        s.begin(4);
+        s.open(2, 1.5, 0.0, 2);
+        assert_eq!(s.pop(), Some(2));
+        assert!(s.is_closed(2) && s.g(2) == 1.5);
+        s.generation = u32::MAX - 1;
+        for _ in 0..3 {
+            s.begin(6);
+            assert!(!s.is_closed(2) && s.g(2).is_infinite() && !s.is_verified(2));
+            s.open(2, 0.5, 1.0, 2);
+            s.open(2, 0.25, 1.0, 2); // improvement: the first entry goes stale
+            assert_eq!(s.pop(), Some(2));
+            assert_eq!(s.g(2), 0.25);
+            assert_eq!(s.pop(), None);
+        }
+        assert!(s.generation < 3, "wrapped and restarted");
+    }
+}

@@ -1,9 +1,8 @@
 //! Unit tests of scenario parsing and validation errors.
 
-use super::*;
 use super::test_support::{parse, BASE};
+use super::*;
 use crate::grid::{Endpoint, GridError};
-
 
 #[test]
 fn defaults_apply() {

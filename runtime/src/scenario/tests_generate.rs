@@ -1,9 +1,8 @@
 //! Unit tests of the scenario hash, agent generation, re-validation and the report.
 
-use super::*;
 use super::test_support::{parse, BASE};
+use super::*;
 use crate::grid::octile_shortest_path_len;
-
 
 #[test]
 fn hash_is_canonical() {
