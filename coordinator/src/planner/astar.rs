@@ -72,10 +72,10 @@ impl Planner for AStar {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hnav_runtime::grid::{octile_shortest_path_len, read_map_rows, CornerCutting, Endpoint};
+    use hnav_runtime::grid::{octile_shortest_path_len, CornerCutting, Endpoint};
 
     fn grid(rows: &[&str]) -> Grid {
-        read_map_rows(rows.iter().enumerate().map(|(i, r)| (i + 1, *r)), "<test>").unwrap()
+        Grid::from_rows(rows).unwrap()
     }
 
     #[test]

@@ -128,10 +128,10 @@ impl Planner for LazyTheta {
 mod tests {
     use super::*;
     use crate::planner::{check_path, BasicTheta};
-    use hnav_runtime::grid::{read_map_rows, CornerCutting};
+    use hnav_runtime::grid::CornerCutting;
 
     fn grid(rows: &[&str]) -> Grid {
-        read_map_rows(rows.iter().enumerate().map(|(i, r)| (i + 1, *r)), "<test>").unwrap()
+        Grid::from_rows(rows).unwrap()
     }
 
     #[test]

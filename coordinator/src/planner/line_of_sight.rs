@@ -183,10 +183,9 @@ pub fn euclid(a: Cell, b: Cell) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hnav_runtime::grid::read_map_rows;
 
     fn grid(rows: &[&str]) -> Grid {
-        read_map_rows(rows.iter().enumerate().map(|(i, r)| (i + 1, *r)), "<test>").unwrap()
+        Grid::from_rows(rows).unwrap()
     }
 
     fn los(g: &Grid, a: (u32, u32), b: (u32, u32), rule: CornerCutting) -> bool {

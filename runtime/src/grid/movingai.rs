@@ -132,6 +132,14 @@ pub fn read_map_file(path: impl AsRef<Path>) -> Result<Grid, GridError> {
     read_map(&text, &name)
 }
 
+impl Grid {
+    /// Builds a grid from bare MovingAI rows given in code (row `i` is reported as line
+    /// `i + 1` of `<rows>`), e.g. `Grid::from_rows(&["..@", "..."])`.
+    pub fn from_rows(rows: &[&str]) -> Result<Grid, GridError> {
+        read_map_rows(rows.iter().enumerate().map(|(i, r)| (i + 1, *r)), "<rows>")
+    }
+}
+
 /// Builds a grid from bare MovingAI rows (no header), e.g. the inline `rows = [...]` of a
 /// scenario. Each row comes with the line number to report for it; the first row sets the
 /// width. An empty list is a [`GridError::BadShape`] at line 0 (the caller knows better).

@@ -211,10 +211,9 @@ impl Iterator for Neighbours<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::read_map_rows;
 
     fn grid(rows: &[&str]) -> Grid {
-        read_map_rows(rows.iter().enumerate().map(|(i, r)| (i + 1, *r)), "<test>").unwrap()
+        Grid::from_rows(rows).unwrap()
     }
 
     #[test]

@@ -146,10 +146,10 @@ pub fn reachable_from(grid: &Grid, start: Cell, rule: CornerCutting) -> Vec<bool
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::{read_map_rows, Direction};
+    use crate::grid::Direction;
 
     fn grid(rows: &[&str]) -> Grid {
-        read_map_rows(rows.iter().enumerate().map(|(i, r)| (i + 1, *r)), "<test>").unwrap()
+        Grid::from_rows(rows).unwrap()
     }
 
     #[test]
