@@ -10,7 +10,9 @@
 //! |---|---|
 //! | [`planner`] | the [`Planner`](planner::Planner) trait; A*, Basic Theta*, Lazy Theta*; line of sight; single queries for the bench |
 //! | [`terrain`] | slope, roughness and relief from a height map; the hazard index `R`; route hazard `c = sum alpha R` |
+//! | [`conflict`] | one decision round of `shared_paths`: the conflict types (a)–(d), corners, reservations; the [`Resolver`](conflict::Resolver) |
 //! | [`experiment`] | seed 002's §4 experiment (random circular obstacles on a 50 x 50 m field) beside its Table 3.1 |
+//! | [`consensus_log`] | [`LogWriter`](consensus_log::LogWriter): appends the run's consensus log durably, recovers it after a restart |
 //! | [`error`] | [`PlanError`], every way a caller's input can be unusable |
 //!
 //! Conflict resolution and the consensus-log writer join this crate with the coordinator
@@ -30,9 +32,13 @@
 
 #![warn(missing_docs)]
 
+pub mod consensus_log;
+pub mod conflict;
 pub mod error;
 pub mod experiment;
 pub mod planner;
+pub mod process;
+pub mod round;
 pub mod terrain;
 
 pub use error::PlanError;

@@ -12,11 +12,19 @@
 //! | [`grid`] | occupancy grids, terrain, coordinates, octile neighbours, MovingAI `.map`/`.scen` files |
 //! | [`scenario`] | the TOML description of a run, validated with file/line errors |
 //! | [`msg`] | `#[repr(C)]` zero-copy payloads (Candidate, Commit, WheelCommand, ...) and their layouts |
+//! | [`topics`] | the run's service names and their QoS, defined once for every process |
+//! | [`launch`] | the command line every process of a run shares, and the start-up handshake with the supervisor |
 //! | [`transport`] | run-scoped iceoryx2 services: publisher+notifier, subscriber+listener, WaitSets |
+//! | [`supervisor`] | starting, watching, restarting and stopping a run's processes; the registry behind `hnav ps` |
+//! | [`consensus_log`] | the durable consensus log: record types, segment format, reader, verifier |
 //! | [`logging`] | `tracing` set-up shared by the binaries, with iceoryx2's own logs routed into it |
 
+pub mod consensus_log;
 pub mod grid;
+pub mod launch;
 pub mod logging;
 pub mod msg;
 pub mod scenario;
+pub mod supervisor;
+pub mod topics;
 pub mod transport;

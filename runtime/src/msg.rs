@@ -18,13 +18,14 @@
 //! | type | size | align | fields (offset: name type) |
 //! |---|---|---|---|
 //! | [`Candidate`] | 40 | 8 | 0 round u64, 8 agent u32, 12 current u32, 16 next u32, 20 probable u32, 24 priority f32, 28 speed f32, 32 flags u32, 36 reserved u32 |
-//! | [`Decision`] | 16 | 4 | 0 agent u32, 4 verdict u8, 5 refused u8, 6 reserved u16, 8 cell u32, 12 waypoint u32 |
+//! | [`Decision`] | 16 | 4 | 0 agent u32, 4 verdict u8, 5 refused u8, 6 kind u8, 7 reserved u8, 8 cell u32, 12 waypoint u32 |
 //! | [`Commit`] | 16 + 16·[`MAX_AGENTS`] = 4112 | 8 | 0 round u64, 8 count u32, 12 reserved u32, 16 decisions [Decision; 256] |
 //! | [`WheelCommand`] | 32 | 8 | 0 period u64, 8 agent u32, 12 flags u32, 16 left_rad_s f64, 24 right_rad_s f64 |
 //! | [`Odometry`] | 40 | 8 | 0 sim_time_ns u64, 8 period u64, 16 agent u32, 20 reserved u32, 24 ticks_left i64, 32 ticks_right i64 |
 //! | [`Pose`] | 24 | 8 | 0 x_m f64, 8 y_m f64, 16 theta_rad f64 |
 //! | [`Truth`] | 24 + 24·[`MAX_AGENTS`] = 6168 | 8 | 0 sim_time_ns u64, 8 period u64, 16 robots u32, 20 collisions u32, 24 poses [Pose; 256] |
 //! | [`Lifecycle`] | 24 | 8 | 0 time_ns u64, 8 pid u32, 12 index u32, 16 role u8, 17 event u8, 18 reserved u16, 20 restarts u32 |
+//! | [`Progress`] | 32 | 8 | 0 round u64, 8 agents u32, 12 at_goal u32, 16 conflicts u32, 20 replans u32, 24 done u8, 25 reserved [u8; 7] |
 //! | [`MapHeader`] | 32 | 8 | 0 round u64, 8 agent u32, 12 width u32, 16 height u32, 20 iterations u32, 24 target u32, 28 activation u8, 29 reserved [u8; 3] |
 //!
 //! The neural-map snapshot is a slice service of `f32` (one activation per cell, row-major) whose
@@ -123,6 +124,60 @@ impl Verdict {
     }
 }
 
+/// Why the coordinator refused or held a move (the dissertation's conflict types, Fig. 3-6,
+/// plus the checks a physical swarm needs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum ConflictKind {
+    /// No conflict (accepted, or nothing asked).
+    None = 0,
+    /// (a) crossing: two moves claim the same cell or sweep the same corner.
+    Crossing = 1,
+    /// (b) head-on: two agents ask for each other's cells.
+    HeadOn = 2,
+    /// (c) combined: a move that is both crossing and head-on at once.
+    Combined = 3,
+    /// (d) the cell of a standing or finished agent, refused whatever the priority.
+    StableCell = 4,
+    /// A diagonal past a blocked or occupied corner cell.
+    CornerCut = 5,
+    /// A cell still held (current or next) by an agent that is moving out of it.
+    Reserved = 6,
+    /// Not a legal move at all: not a neighbour, off the grid, or a blocked cell.
+    Invalid = 7,
+}
+
+impl ConflictKind {
+    /// Decodes a kind byte received from another process.
+    pub fn from_u8(v: u8) -> Option<Self> {
+        match v {
+            0 => Some(Self::None),
+            1 => Some(Self::Crossing),
+            2 => Some(Self::HeadOn),
+            3 => Some(Self::Combined),
+            4 => Some(Self::StableCell),
+            5 => Some(Self::CornerCut),
+            6 => Some(Self::Reserved),
+            7 => Some(Self::Invalid),
+            _ => None,
+        }
+    }
+
+    /// Short lower-case name, as in logs and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::None => "none",
+            Self::Crossing => "crossing",
+            Self::HeadOn => "head-on",
+            Self::Combined => "combined",
+            Self::StableCell => "stable-cell",
+            Self::CornerCut => "corner-cut",
+            Self::Reserved => "reserved",
+            Self::Invalid => "invalid",
+        }
+    }
+}
+
 /// One agent's entry in a [`Commit`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
 #[repr(C)]
@@ -134,8 +189,10 @@ pub struct Decision {
     pub verdict: u8,
     /// Refused directions, bit `d` for direction index `d` (0 = N, clockwise to 7 = NW).
     pub refused: u8,
+    /// Why a move was refused or held: a [`ConflictKind`] as `u8` (0 when accepted).
+    pub kind: u8,
     /// Zero.
-    pub reserved: u16,
+    pub reserved: u8,
     /// The committed cell (the accepted `probable`), or [`NO_CELL`].
     pub cell: u32,
     /// The next waypoint of a global replan, or [`NO_CELL`].
@@ -148,6 +205,7 @@ impl Default for Decision {
             agent: 0,
             verdict: Verdict::Hold as u8,
             refused: 0,
+            kind: ConflictKind::None as u8,
             reserved: 0,
             cell: NO_CELL,
             waypoint: NO_CELL,
@@ -308,6 +366,10 @@ pub enum LifecycleEvent {
     Down = 2,
     /// Started again by the supervisor after a `Down`.
     Restarted = 3,
+    /// Supervisor to all: every process is up, begin the run.
+    Start = 4,
+    /// Supervisor to all: finish cleanly and exit.
+    Stop = 5,
 }
 
 impl LifecycleEvent {
@@ -317,6 +379,8 @@ impl LifecycleEvent {
             1 => Some(Self::Up),
             2 => Some(Self::Down),
             3 => Some(Self::Restarted),
+            4 => Some(Self::Start),
+            5 => Some(Self::Stop),
             _ => None,
         }
     }
@@ -341,6 +405,28 @@ pub struct Lifecycle {
     pub reserved: u16,
     /// Restarts of this process so far.
     pub restarts: u32,
+}
+
+/// The coordinator's running tally, published after every round (latest value only) for the
+/// supervisor's progress bar and for viewers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend)]
+#[repr(C)]
+#[type_name("hnav::Progress")]
+pub struct Progress {
+    /// Last committed round.
+    pub round: u64,
+    /// Agents in the run.
+    pub agents: u32,
+    /// Agents standing on their goal.
+    pub at_goal: u32,
+    /// Refused or held moves so far.
+    pub conflicts: u32,
+    /// Global replans so far.
+    pub replans: u32,
+    /// 1 once every agent is at its goal, else 0.
+    pub done: u8,
+    /// Zero.
+    pub reserved: [u8; 7],
 }
 
 /// How a neural map's neurons saturate.
@@ -414,7 +500,8 @@ mod tests {
         assert_eq!(offset_of!(Decision, agent), 0);
         assert_eq!(offset_of!(Decision, verdict), 4);
         assert_eq!(offset_of!(Decision, refused), 5);
-        assert_eq!(offset_of!(Decision, reserved), 6);
+        assert_eq!(offset_of!(Decision, kind), 6);
+        assert_eq!(offset_of!(Decision, reserved), 7);
         assert_eq!(offset_of!(Decision, cell), 8);
         assert_eq!(offset_of!(Decision, waypoint), 12);
         assert_eq!(size_of::<Commit>(), 16 + 16 * MAX_AGENTS);
@@ -462,6 +549,19 @@ mod tests {
     }
 
     #[test]
+    fn progress_layout() {
+        assert_eq!(size_of::<Progress>(), 32);
+        assert_eq!(align_of::<Progress>(), 8);
+        assert_eq!(offset_of!(Progress, round), 0);
+        assert_eq!(offset_of!(Progress, agents), 8);
+        assert_eq!(offset_of!(Progress, at_goal), 12);
+        assert_eq!(offset_of!(Progress, conflicts), 16);
+        assert_eq!(offset_of!(Progress, replans), 20);
+        assert_eq!(offset_of!(Progress, done), 24);
+        assert_eq!(offset_of!(Progress, reserved), 25);
+    }
+
+    #[test]
     fn lifecycle_and_map_header_layout() {
         assert_eq!(size_of::<Lifecycle>(), 24);
         assert_eq!(align_of::<Lifecycle>(), 8);
@@ -501,16 +601,23 @@ mod tests {
             LifecycleEvent::Up,
             LifecycleEvent::Down,
             LifecycleEvent::Restarted,
+            LifecycleEvent::Start,
+            LifecycleEvent::Stop,
         ] {
             assert_eq!(LifecycleEvent::from_u8(e as u8), Some(e));
         }
         for a in [ActivationKind::Linear, ActivationKind::Tanh] {
             assert_eq!(ActivationKind::from_u8(a as u8), Some(a));
         }
+        for k in 0..=7u8 {
+            assert_eq!(ConflictKind::from_u8(k).map(|k| k as u8), Some(k));
+        }
+        assert_eq!(ConflictKind::from_u8(8), None);
+        assert_eq!(LifecycleEvent::from_u8(6), None);
         for bad in [0u8, 5, 200, 255] {
             assert_eq!(Verdict::from_u8(bad), None);
             assert_eq!(Role::from_u8(bad), None);
-            assert_eq!(LifecycleEvent::from_u8(bad), None);
+            assert_eq!(LifecycleEvent::from_u8(bad.max(6)), None);
             assert_eq!(ActivationKind::from_u8(bad.max(3)), None);
         }
     }

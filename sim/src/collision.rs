@@ -1,8 +1,12 @@
 //! Collisions on ground truth: robot against robot (discs) and robot against blocked cells
 //! (squares; cells outside the grid count as blocked). A collision is recorded when a contact
 //! begins, not on every step it lasts.
+//!
+//! Geometry is in nalgebra terms: robot centres are `Point2<f64>` (m), and a contact is a
+//! squared distance between points below the squared contact radius.
 
 use hnav_runtime::grid::Grid;
+use nalgebra::Point2;
 
 /// What a robot hit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -13,37 +17,41 @@ pub enum Hit {
     Cell(i64, i64),
 }
 
-/// One recorded collision.
+/// One recorded collision: when it began, who was involved and where they were.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Collision {
     /// Sim time of the step that began the contact, ns.
     pub time_ns: u64,
     /// The robot (the lower index for robot pairs).
     pub robot: u32,
-    /// What it hit.
+    /// What it hit: another robot or a blocked cell.
     pub hit: Hit,
     /// The robot's centre, m.
-    pub position: (f64, f64),
+    pub position: Point2<f64>,
     /// The other robot's centre, or the hit cell's centre, m.
-    pub other_position: (f64, f64),
+    pub other_position: Point2<f64>,
 }
 
 /// Whether two discs overlap (touching counts as no contact).
 #[inline]
-pub fn discs_overlap(a: (f64, f64), b: (f64, f64), ra: f64, rb: f64) -> bool {
-    let (dx, dy) = (a.0 - b.0, a.1 - b.1);
+pub fn discs_overlap(a: &Point2<f64>, b: &Point2<f64>, ra: f64, rb: f64) -> bool {
     let r = ra + rb;
-    dx * dx + dy * dy < r * r
+    (a - b).norm_squared() < r * r
 }
 
-/// Whether a disc overlaps the square of cell `(cx, cy)` of edge `cell`.
+/// The centre of cell `(cx, cy)` (column, row) of edge `cell`, m.
 #[inline]
-pub fn disc_overlaps_cell(p: (f64, f64), r: f64, cx: i64, cy: i64, cell: f64) -> bool {
+pub fn cell_centre(cx: i64, cy: i64, cell: f64) -> Point2<f64> {
+    Point2::new((cx as f64 + 0.5) * cell, (cy as f64 + 0.5) * cell)
+}
+
+/// Whether a disc overlaps the square of cell `(cx, cy)` of edge `cell`: the point of the
+/// square nearest to the centre lies within the radius.
+#[inline]
+pub fn disc_overlaps_cell(p: &Point2<f64>, r: f64, cx: i64, cy: i64, cell: f64) -> bool {
     let (x0, y0) = (cx as f64 * cell, cy as f64 * cell);
-    let nx = p.0.clamp(x0, x0 + cell);
-    let ny = p.1.clamp(y0, y0 + cell);
-    let (dx, dy) = (p.0 - nx, p.1 - ny);
-    dx * dx + dy * dy < r * r
+    let nearest = Point2::new(p.x.clamp(x0, x0 + cell), p.y.clamp(y0, y0 + cell));
+    (p - nearest).norm_squared() < r * r
 }
 
 /// `floor(v)` as an integer without the libm call `f64::floor` becomes on targets without
@@ -67,10 +75,10 @@ fn blocked(grid: &Grid, x: i64, y: i64) -> bool {
 
 /// The first blocked cell a disc of radius `r` overlaps, if any. Only cells meeting the
 /// disc's bounding box are examined (one to four when the disc is no wider than a cell).
-pub fn wall_contact(grid: &Grid, p: (f64, f64), r: f64, cell: f64) -> Option<(i64, i64)> {
+pub fn wall_contact(grid: &Grid, p: &Point2<f64>, r: f64, cell: f64) -> Option<(i64, i64)> {
     let inv = 1.0 / cell;
-    let (x0, x1) = (floor_i64((p.0 - r) * inv), floor_i64((p.0 + r) * inv));
-    let (y0, y1) = (floor_i64((p.1 - r) * inv), floor_i64((p.1 + r) * inv));
+    let (x0, x1) = (floor_i64((p.x - r) * inv), floor_i64((p.x + r) * inv));
+    let (y0, y1) = (floor_i64((p.y - r) * inv), floor_i64((p.y + r) * inv));
     for y in y0..=y1 {
         for x in x0..=x1 {
             if blocked(grid, x, y) && disc_overlaps_cell(p, r, x, y, cell) {
@@ -128,13 +136,13 @@ impl Detector {
 
     /// Whether centre `p` lies in an open cell (see `open`).
     #[inline]
-    fn in_open_cell(&self, p: (f64, f64)) -> bool {
-        if !(p.0 >= 0.0 && p.1 >= 0.0) {
+    fn in_open_cell(&self, p: &Point2<f64>) -> bool {
+        if !(p.x >= 0.0 && p.y >= 0.0) {
             return false;
         }
         let inv = 1.0 / self.cell;
         // Non-negative, so truncation is floor; far-off values saturate and fail the bounds.
-        let (cx, cy) = ((p.0 * inv) as u64, (p.1 * inv) as u64);
+        let (cx, cy) = ((p.x * inv) as u64, (p.y * inv) as u64);
         let w = u64::from(self.open_w);
         cx < w
             && self
@@ -143,20 +151,18 @@ impl Detector {
                 == Some(&true)
     }
 
-    /// Checks all contacts of the robot centres `xs`, `ys` and appends the
-    /// contacts that began this step to `out`. Returns how many were appended.
+    /// Checks all contacts of the robot centres `centres` and appends the contacts that
+    /// began this step to `out`. Returns how many were appended.
     pub fn check(
         &mut self,
         grid: &Grid,
-        xs: &[f64],
-        ys: &[f64],
+        centres: &[Point2<f64>],
         time_ns: u64,
         out: &mut Vec<Collision>,
     ) -> usize {
         let before = out.len();
         let (cell, r) = (self.cell, self.radius);
-        for i in 0..xs.len() {
-            let p = (xs[i], ys[i]);
+        for (i, p) in centres.iter().enumerate() {
             let hit = if self.in_open_cell(p) {
                 None
             } else {
@@ -167,14 +173,14 @@ impl Detector {
                     time_ns,
                     robot: i as u32,
                     hit: Hit::Cell(cx, cy),
-                    position: p,
-                    other_position: ((cx as f64 + 0.5) * cell, (cy as f64 + 0.5) * cell),
+                    position: *p,
+                    other_position: cell_centre(cx, cy, cell),
                 }),
                 _ => {}
             }
             self.on_wall[i] = hit.is_some();
         }
-        if xs.len() < 2 {
+        if centres.len() < 2 {
             return out.len() - before;
         }
         // Broad phase: robots sorted by the key of their (clamped) cell. A disc is no wider
@@ -182,9 +188,9 @@ impl Detector {
         // each pair is found once, from the robot whose cell comes first in key order.
         let (kw, kh) = (i64::from(grid.width()) + 2, i64::from(grid.height()) + 2);
         let inv = 1.0 / cell;
-        for (k, (&x, &y)) in self.keys.iter_mut().zip(xs.iter().zip(ys)) {
-            let cx = (floor_i64(x * inv) + 1).clamp(0, kw - 1);
-            let cy = (floor_i64(y * inv) + 1).clamp(0, kh - 1);
+        for (k, p) in self.keys.iter_mut().zip(centres) {
+            let cx = (floor_i64(p.x * inv) + 1).clamp(0, kw - 1);
+            let cy = (floor_i64(p.y * inv) + 1).clamp(0, kh - 1);
             *k = cy * kw + cx;
         }
         // Insertion sort (stable, deterministic, ~O(n): last step's order is nearly sorted).
@@ -207,7 +213,7 @@ impl Detector {
             let (i, k) = (order[a] as usize, sorted[a]);
             let mut test = |b: usize| {
                 let j = order[b] as usize;
-                if discs_overlap((xs[i], ys[i]), (xs[j], ys[j]), r, r) {
+                if discs_overlap(&centres[i], &centres[j], r, r) {
                     self.touching_next.push((i.min(j) as u32, i.max(j) as u32));
                 }
             };
@@ -235,8 +241,8 @@ impl Detector {
                     time_ns,
                     robot: i,
                     hit: Hit::Robot(j),
-                    position: (xs[i as usize], ys[i as usize]),
-                    other_position: (xs[j as usize], ys[j as usize]),
+                    position: centres[i as usize],
+                    other_position: centres[j as usize],
                 });
             }
         }
@@ -251,11 +257,13 @@ mod tests {
 
     #[test]
     fn disc_and_cell_geometry() {
-        assert!(discs_overlap((0.0, 0.0), (0.1, 0.0), 0.058, 0.058));
-        assert!(!discs_overlap((0.0, 0.0), (0.12, 0.0), 0.058, 0.058));
+        let p = Point2::new;
+        assert!(discs_overlap(&p(0.0, 0.0), &p(0.1, 0.0), 0.058, 0.058));
+        assert!(!discs_overlap(&p(0.0, 0.0), &p(0.12, 0.0), 0.058, 0.058));
         // Cell (1, 0) spans x in [0.12, 0.24).
-        assert!(disc_overlaps_cell((0.07, 0.06), 0.058, 1, 0, 0.12));
-        assert!(!disc_overlaps_cell((0.06, 0.06), 0.058, 1, 0, 0.12));
+        assert!(disc_overlaps_cell(&p(0.07, 0.06), 0.058, 1, 0, 0.12));
+        assert!(!disc_overlaps_cell(&p(0.06, 0.06), 0.058, 1, 0, 0.12));
+        assert_eq!(cell_centre(-1, 2, 0.12), p(-0.06, 0.3));
     }
 
     #[test]
@@ -263,15 +271,19 @@ mod tests {
         let grid = Grid::new(10, 10).unwrap();
         let mut d = Detector::new(2, &grid, 0.12, 0.058);
         let mut out = Vec::new();
-        let (xs, ys) = ([0.5, 0.6], [0.5, 0.5]);
-        assert_eq!(d.check(&grid, &xs, &ys, 1, &mut out), 1);
-        assert_eq!(d.check(&grid, &xs, &ys, 2, &mut out), 0);
+        let ps = [Point2::new(0.5, 0.5), Point2::new(0.6, 0.5)];
+        assert_eq!(d.check(&grid, &ps, 1, &mut out), 1);
+        assert_eq!(d.check(&grid, &ps, 2, &mut out), 0);
         assert_eq!(out[0].hit, Hit::Robot(1));
+        assert_eq!((out[0].time_ns, out[0].robot), (1, 0));
+        assert_eq!((out[0].position, out[0].other_position), (ps[0], ps[1]));
         // Outside the grid counts as blocked.
-        let (xs, ys) = ([0.03, 0.6], [0.54, 0.54]);
-        let n = d.check(&grid, &xs, &ys, 3, &mut out);
+        let ps = [Point2::new(0.03, 0.54), Point2::new(0.6, 0.54)];
+        let n = d.check(&grid, &ps, 3, &mut out);
         assert_eq!(n, 1);
         assert_eq!(out[1].hit, Hit::Cell(-1, 4));
+        assert_eq!(out[1].position, ps[0]);
+        assert_eq!(out[1].other_position, cell_centre(-1, 4, 0.12));
     }
 
     #[test]
@@ -283,11 +295,12 @@ mod tests {
         for round in 0..50 {
             let n = 60;
             // Some robots off the grid too, where cells clamp.
-            let xs: Vec<f64> = (0..n).map(|_| rng.gen_range(-0.3..1.7)).collect();
-            let ys: Vec<f64> = (0..n).map(|_| rng.gen_range(-0.3..1.3)).collect();
+            let ps: Vec<_> = (0..n)
+                .map(|_| Point2::new(rng.gen_range(-0.3..1.7), rng.gen_range(-0.3..1.3)))
+                .collect();
             let mut d = Detector::new(n, &grid, cell, r);
             let mut out = Vec::new();
-            d.check(&grid, &xs, &ys, 0, &mut out);
+            d.check(&grid, &ps, 0, &mut out);
             let mut got: Vec<_> = out
                 .iter()
                 .filter_map(|c| match c.hit {
@@ -299,7 +312,7 @@ mod tests {
             let mut want = Vec::new();
             for i in 0..n {
                 for j in i + 1..n {
-                    if discs_overlap((xs[i], ys[i]), (xs[j], ys[j]), r, r) {
+                    if discs_overlap(&ps[i], &ps[j], r, r) {
                         want.push((i as u32, j as u32));
                     }
                 }

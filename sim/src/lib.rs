@@ -3,14 +3,16 @@
 //! The physics stepper of an HNAV run: differential-drive robots (the s-bot-like robots of
 //! §3.1: two motors, one Hall sensor per wheel), Hall-sensor odometry and collision checks on
 //! ground truth. Every parameter comes from the scenario's `[robot]` and `[sim]` sections
-//! ([`hnav_runtime::scenario::params`]).
+//! ([`hnav_runtime::scenario::params`]) and its agents' start cells and headings
+//! ([`World::from_scenario`]). Poses and geometry use nalgebra (`Point2`, `UnitComplex`,
+//! `Isometry2`); see [`world`] for why the inner loop needs no separate scalar form.
 //!
 //! | module | what |
 //! |---|---|
 //! | [`robot`] | [`RobotModel`]: validated parameters; motor lag, speed and acceleration limits, braking |
-//! | [`kinematics`] | §D.2 wheel increments and the exact-arc pose update |
+//! | [`kinematics`] | §D.2 wheel increments and the exact-arc pose update as a rigid motion (nalgebra `Isometry2`, `UnitComplex` headings) |
 //! | [`hall`] | tick quantisation and seeded wheel-slip noise (ChaCha) |
-//! | [`collision`] | disc–disc and disc–blocked-cell contacts, recorded when they begin |
+//! | [`collision`] | disc–disc and disc–blocked-cell contacts (`Point2` geometry), recorded when they begin with time, robots or cell, and positions |
 //! | [`watchdog`] | stale commands are replaced by braking |
 //! | [`world`] | [`World`]: N robots, struct-of-arrays, fixed step, odometry and Truth |
 //! | [`process`] | the `hnav-sim` process: [`process::SimProcess`], topics, lockstep and realtime |

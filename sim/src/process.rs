@@ -3,42 +3,32 @@
 //!
 //! A control period is one odometry period (`1 / sim.odometry_hz`). In lockstep a period is
 //! stepped only when every live robot's command for it is in; a robot whose publisher died or
-//! left, or that misses [`LOCKSTEP_DEADLINE`], counts as down and brakes until it sends again.
+//! left, or (if `sim.lockstep_deadline_ms` > 0) that misses that deadline, counts as down and
+//! brakes until it sends again. Joined to the run's lifecycle protocol
+//! ([`SimProcess::with_lifecycle`]), it also learns of dead agents from the supervisor at
+//! once. A robot counts as live again from its first fresh command, never from a publisher
+//! merely appearing: a restarted agent first needs this period's odometry, which the sim
+//! publishes only after stepping, so waiting for it then would stall the run.
 //! In realtime the world follows the wall clock and commands apply when they arrive. The
 //! process blocks in a WaitSet throughout (listeners on the wheel topics, plus an interval in
-//! realtime or the deadline in lockstep as a timeout).
+//! realtime or, if set, the deadline in lockstep as a timeout).
 
 use crate::error::SimError;
 use crate::world::World;
+use hnav_runtime::launch::LifecyclePorts;
+use hnav_runtime::msg::{LifecycleEvent, Role};
 use hnav_runtime::msg::{Odometry, Truth, WheelCommand};
 use hnav_runtime::scenario::params::ClockMode;
 use hnav_runtime::scenario::Scenario;
-use hnav_runtime::transport::{Qos, Receiver, Sender, Transport, TransportError};
+use hnav_runtime::topics;
+use hnav_runtime::transport::{Receiver, Sender, Transport, TransportError};
 use iceoryx2::prelude::CallbackProgression;
 use iceoryx2::waitset::WaitSetRunResult;
 use std::time::{Duration, Instant};
 
-/// How long lockstep waits for missing commands before counting their robots as down.
-/// Should move to the scenario's `[sim]` section.
-pub const LOCKSTEP_DEADLINE: Duration = Duration::from_millis(500);
-
-/// Topic of robot `i`'s wheel commands.
-pub fn wheels_topic(i: usize) -> String {
-    format!("wheels/{i}")
-}
-
-/// Topic of robot `i`'s odometry.
-pub fn odometry_topic(i: usize) -> String {
-    format!("odom/{i}")
-}
-
-/// Topic of the ground truth.
-pub const TRUTH_TOPIC: &str = "truth";
-
-/// QoS of the wheel, odometry and truth topics (superseding state, latest kept).
-pub fn topic_qos() -> Qos {
-    Qos::latest()
-}
+/// How often lockstep without a deadline (`sim.lockstep_deadline_ms = 0`) wakes while it
+/// waits for commands; nothing happens on such a wake-up but a new check.
+const LOCKSTEP_IDLE_WAIT: Duration = Duration::from_secs(1);
 
 /// What stopped or broke the process.
 #[derive(Debug, thiserror::Error)]
@@ -76,34 +66,27 @@ pub struct SimProcess<'t> {
     live: Vec<bool>,
     have: Vec<bool>,
     period: u64,
+    life: Option<LifecyclePorts>,
+    /// `sim.lockstep_deadline_ms`, `None` for 0 (wait indefinitely).
+    lockstep_deadline: Option<Duration>,
 }
 
 impl<'t> SimProcess<'t> {
-    /// Builds the world from `scenario` (robots at their start cells' centres, heading 0)
-    /// and opens the ports.
+    /// Builds the world from `scenario` (robots at their start cells' centres, facing their
+    /// `start_heading_deg`) and opens the ports.
     pub fn new(transport: &'t Transport, scenario: &Scenario) -> Result<Self, ProcessError> {
-        let cs = scenario.robot.cell_size_m;
-        let starts: Vec<_> = scenario
-            .agents
-            .iter()
-            .map(|a| World::cell_centre(cs, a.start, 0.0))
-            .collect();
-        let world = World::new(
-            &scenario.robot,
-            &scenario.sim,
-            scenario.map.grid.clone(),
-            &starts,
-        )?;
-        let n = starts.len();
-        let q = topic_qos();
+        let world = World::from_scenario(scenario)?;
+        let n = world.robots();
+        let q = topics::state_qos();
         let wheels = (0..n)
-            .map(|i| transport.receiver(&wheels_topic(i), q))
+            .map(|i| transport.receiver(&topics::wheels(i), q))
             .collect::<Result<Vec<_>, _>>()?;
         let odom = (0..n)
-            .map(|i| transport.sender(&odometry_topic(i), q))
+            .map(|i| transport.sender(&topics::odometry(i), q))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(SimProcess {
-            truth_tx: transport.sender(TRUTH_TOPIC, q)?,
+            truth_tx: transport.sender(topics::TRUTH, q)?,
+            life: None,
             transport,
             world,
             clock: scenario.sim.clock,
@@ -112,7 +95,22 @@ impl<'t> SimProcess<'t> {
             live: vec![true; n],
             have: vec![false; n],
             period: 0,
+            lockstep_deadline: (scenario.sim.lockstep_deadline_ms > 0)
+                .then(|| Duration::from_millis(scenario.sim.lockstep_deadline_ms.into())),
         })
+    }
+
+    /// Joins the run's lifecycle protocol: the process then hears the supervisor's `Stop`
+    /// and learns of agents that died (their robots brake and are not waited for) or were
+    /// restarted.
+    pub fn with_lifecycle(mut self, ports: LifecyclePorts) -> Self {
+        self.life = Some(ports);
+        self
+    }
+
+    /// The lifecycle ports, if joined.
+    pub fn lifecycle(&self) -> Option<&LifecyclePorts> {
+        self.life.as_ref()
     }
 
     /// The world.
@@ -124,10 +122,17 @@ impl<'t> SimProcess<'t> {
     pub fn run(&mut self, max_periods: Option<u64>) -> Result<Outcome, ProcessError> {
         let ws = self.transport.waitset().map_err(ProcessError::Transport)?;
         let wheels = std::mem::take(&mut self.wheels);
+        let life = self.life.take();
         let mut guards = Vec::with_capacity(wheels.len());
         for rx in &wheels {
             let g = ws
                 .attach_notification(rx.listener())
+                .map_err(|e| ProcessError::WaitSet(format!("{e:?}")))?;
+            guards.push(g);
+        }
+        if let Some(l) = &life {
+            let g = ws
+                .attach_notification(l.events().listener())
                 .map_err(|e| ProcessError::WaitSet(format!("{e:?}")))?;
             guards.push(g);
         }
@@ -138,6 +143,14 @@ impl<'t> SimProcess<'t> {
         let result = loop {
             if max_periods.is_some_and(|m| self.period >= m) {
                 break Ok(());
+            }
+            match self.on_lifecycle(life.as_ref()) {
+                Ok(true) => {
+                    signalled = true;
+                    break Ok(());
+                }
+                Ok(false) => {}
+                Err(e) => break Err(e),
             }
             if let Err(e) = self.drain(&wheels) {
                 break Err(e);
@@ -150,7 +163,7 @@ impl<'t> SimProcess<'t> {
                         }
                         continue;
                     }
-                    LOCKSTEP_DEADLINE
+                    self.lockstep_deadline.unwrap_or(LOCKSTEP_IDLE_WAIT)
                 }
                 ClockMode::Realtime => {
                     let due = period_wall.mul_f64((self.period + 1) as f64);
@@ -180,7 +193,7 @@ impl<'t> SimProcess<'t> {
                 Ok(_) => {}
                 Err(e) => break Err(ProcessError::WaitSet(format!("{e:?}"))),
             }
-            if !woke && self.clock == ClockMode::Lockstep {
+            if !woke && self.clock == ClockMode::Lockstep && self.lockstep_deadline.is_some() {
                 // Deadline passed: whoever is still missing is down and brakes.
                 for i in 0..self.live.len() {
                     if !self.have[i] {
@@ -192,11 +205,28 @@ impl<'t> SimProcess<'t> {
         };
         drop(guards);
         self.wheels = wheels;
+        self.life = life;
         result.map(|()| Outcome {
             periods: self.period,
             collisions: self.world.collisions().len(),
             signalled,
         })
+    }
+
+    /// Applies the supervisor's events; returns whether it asked to stop. A dead agent's
+    /// robot brakes and is not waited for; a restarted one counts again from its first fresh
+    /// command (it needs this period's odometry before it can send one).
+    fn on_lifecycle(&mut self, life: Option<&LifecyclePorts>) -> Result<bool, ProcessError> {
+        let Some(l) = life else { return Ok(false) };
+        let (live, world) = (&mut self.live, &mut self.world);
+        Ok(l.drain(|role, index, ev| {
+            if role == Role::Agent && ev == LifecycleEvent::Down {
+                if let Some(v) = live.get_mut(index as usize) {
+                    *v = false;
+                    world.brake(index);
+                }
+            }
+        })?)
     }
 
     /// Reads every wheel topic: liveness from the wake-up events, commands for the current
@@ -208,9 +238,6 @@ impl<'t> SimProcess<'t> {
             if w.peer_dead || w.peer_left {
                 self.live[i] = false;
                 self.world.brake(i as u32);
-            }
-            if w.peer_up {
-                self.live[i] = true;
             }
             let (world, have, live, period) =
                 (&mut self.world, &mut self.have, &mut self.live, self.period);

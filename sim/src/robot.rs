@@ -4,11 +4,6 @@
 use crate::error::SimError;
 use hnav_runtime::scenario::params::{RobotParams, SimParams};
 
-/// How long a drawn wheel-slip factor holds, in seconds. Slip is redrawn on this fixed time
-/// grid (not every physics step) so that `slip_std` means the same for any step length.
-/// Should move to the scenario's `[sim]` section.
-pub const SLIP_HOLD_S: f64 = 0.010;
-
 /// Validated robot and step parameters, with per-step constants precomputed.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RobotModel {

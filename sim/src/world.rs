@@ -1,15 +1,27 @@
 //! The world: N robots stepped together, stored as struct-of-arrays, with no allocation per
 //! step (collision records aside, which grow only when a contact begins).
+//!
+//! Ground truth is kept in nalgebra types: each robot's centre is a `Point2<f64>` and its
+//! heading a [`Heading`] (`UnitComplex<f64>`, the rotation `(cos θ, sin θ)`), next to the
+//! unwrapped-then-wrapped angle `θ` that [`Pose`] messages carry. [`World::isometry`] gives a
+//! robot's pose as an `Isometry2<f64>`. A step is [`kinematics::arc_step`], a rigid motion
+//! composed of plain `f64` operations: nalgebra's fixed-size types inline to the same
+//! arithmetic as hand-written `x`/`y`/`cos`/`sin` fields (the stepper benchmark showed no
+//! measurable difference), so the inner loop needs no separate scalar representation.
+//!
+//! [`kinematics::arc_step`]: crate::kinematics::arc_step
 
 use crate::collision::{Collision, Detector};
 use crate::error::SimError;
 use crate::hall::{self, SlipNoise};
-use crate::kinematics::{arc_update_vec, wrap_angle};
-use crate::robot::{RobotModel, SLIP_HOLD_S};
+use crate::kinematics::{arc_step, heading, wrap_angle, Heading};
+use crate::robot::RobotModel;
 use crate::watchdog::Watchdog;
 use hnav_runtime::grid::{Cell, Grid};
 use hnav_runtime::msg::{Odometry, Pose, Truth, MAX_AGENTS};
 use hnav_runtime::scenario::params::{RobotParams, SimParams};
+use hnav_runtime::scenario::Scenario;
+use nalgebra::{Isometry2, Point2, Translation2};
 
 /// Steps between re-derivations of the heading vectors from the heading angles.
 const RESYNC_STEPS: u64 = 256;
@@ -24,13 +36,11 @@ pub struct World {
     steps_per_slip: u64,
     steps_per_odometry: u64,
     steps: u64,
-    // Ground truth, per robot.
-    x: Vec<f64>,
-    y: Vec<f64>,
+    // Ground truth, per robot: centre (m) and heading angle, wrapped to (-π, π].
+    pos: Vec<Point2<f64>>,
     theta: Vec<f64>,
-    // The heading's unit vector, carried along so a step needs no library trigonometry.
-    cos_t: Vec<f64>,
-    sin_t: Vec<f64>,
+    // The heading as a rotation, carried along so a step needs no library trigonometry.
+    heading: Vec<Heading>,
     // Actual and commanded wheel speeds, rad/s.
     wl: Vec<f64>,
     wr: Vec<f64>,
@@ -66,6 +76,13 @@ impl World {
                 why: "must be > 0",
             });
         }
+        if !(sim.slip_hold_s.is_finite() && sim.slip_hold_s > 0.0) {
+            return Err(SimError::BadParam {
+                name: "sim.slip_hold_s",
+                value: sim.slip_hold_s,
+                why: "must be finite and > 0",
+            });
+        }
         if let Some(i) = starts
             .iter()
             .position(|p| !(p.x_m.is_finite() && p.y_m.is_finite() && p.theta_rad.is_finite()))
@@ -76,16 +93,14 @@ impl World {
         let step_ns = u64::from(sim.step_ms) * 1_000_000;
         let per = |period_s: f64| ((period_s / model.dt).round() as u64).max(1);
         Ok(World {
-            steps_per_slip: per(SLIP_HOLD_S),
+            steps_per_slip: per(sim.slip_hold_s),
             steps_per_odometry: per(1.0 / f64::from(sim.odometry_hz)),
             watchdog: Watchdog::from_ms(sim.watchdog_ms),
             step_ns,
             steps: 0,
-            x: starts.iter().map(|p| p.x_m).collect(),
-            y: starts.iter().map(|p| p.y_m).collect(),
+            pos: starts.iter().map(|p| Point2::new(p.x_m, p.y_m)).collect(),
             theta: starts.iter().map(|p| wrap_angle(p.theta_rad)).collect(),
-            cos_t: starts.iter().map(|p| p.theta_rad.cos()).collect(),
-            sin_t: starts.iter().map(|p| p.theta_rad.sin()).collect(),
+            heading: starts.iter().map(|p| heading(p.theta_rad)).collect(),
             wl: vec![0.0; n],
             wr: vec![0.0; n],
             cmd_l: vec![0.0; n],
@@ -107,6 +122,23 @@ impl World {
         })
     }
 
+    /// The world of a scenario: its robot and sim parameters, its map, and one robot per
+    /// agent at the centre of the agent's start cell, facing its `start_heading_deg`.
+    pub fn from_scenario(scenario: &Scenario) -> Result<World, SimError> {
+        let cs = scenario.robot.cell_size_m;
+        let starts: Vec<_> = scenario
+            .agents
+            .iter()
+            .map(|a| World::cell_centre(cs, a.start, a.start_heading_rad()))
+            .collect();
+        World::new(
+            &scenario.robot,
+            &scenario.sim,
+            scenario.map.grid.clone(),
+            &starts,
+        )
+    }
+
     /// The pose at the centre of `cell` with heading `theta_rad`.
     pub fn cell_centre(cell_size_m: f64, cell: Cell, theta_rad: f64) -> Pose {
         Pose {
@@ -118,7 +150,7 @@ impl World {
 
     /// Number of robots.
     pub fn robots(&self) -> usize {
-        self.x.len()
+        self.pos.len()
     }
 
     /// The validated robot model.
@@ -230,7 +262,7 @@ impl World {
         // nothing) so that rounding in the rotations cannot accumulate.
         let resync = self.steps.is_multiple_of(RESYNC_STEPS);
         let redraw = self.slip_on && self.steps.is_multiple_of(self.steps_per_slip);
-        for i in 0..self.x.len() {
+        for i in 0..self.pos.len() {
             let (l0, r0) = (self.wl[i], self.wr[i]);
             let (l1, r1) = if self.watchdog.expired(self.cmd_at[i], now) {
                 (m.brake_step(l0), m.brake_step(r0))
@@ -255,31 +287,45 @@ impl World {
                 dsr *= 1.0 + self.slip_r[i];
             }
             let (ds, dth) = (0.5 * (dsr + dsl), (dsr - dsl) * inv_b);
-            let (x, y, c, s) =
-                arc_update_vec(self.x[i], self.y[i], self.cos_t[i], self.sin_t[i], ds, dth);
-            self.x[i] = x;
-            self.y[i] = y;
+            let (p, q) = arc_step(&self.pos[i], &self.heading[i], ds, dth);
+            self.pos[i] = p;
             self.theta[i] = wrap_angle(self.theta[i] + dth);
-            if resync {
-                (self.sin_t[i], self.cos_t[i]) = self.theta[i].sin_cos();
-            } else {
-                (self.cos_t[i], self.sin_t[i]) = (c, s);
-            }
+            self.heading[i] = if resync { heading(self.theta[i]) } else { q };
         }
         self.steps += 1;
         let t = self.time_ns();
         self.detector
-            .check(&self.grid, &self.x, &self.y, t, &mut self.collisions)
+            .check(&self.grid, &self.pos, t, &mut self.collisions)
     }
 
     /// Robot `agent`'s ground-truth pose.
     pub fn pose(&self, agent: u32) -> Option<Pose> {
         let i = agent as usize;
-        (i < self.robots()).then(|| Pose {
-            x_m: self.x[i],
-            y_m: self.y[i],
+        (i < self.robots()).then(|| self.pose_at(i))
+    }
+
+    fn pose_at(&self, i: usize) -> Pose {
+        Pose {
+            x_m: self.pos[i].x,
+            y_m: self.pos[i].y,
             theta_rad: self.theta[i],
+        }
+    }
+
+    /// Robot `agent`'s ground-truth pose as a rigid transform (robot frame to world frame).
+    pub fn isometry(&self, agent: u32) -> Option<Isometry2<f64>> {
+        let i = agent as usize;
+        (i < self.robots()).then(|| {
+            Isometry2::from_parts(
+                Translation2::from(self.pos[i].coords),
+                heading(self.theta[i]),
+            )
         })
+    }
+
+    /// Robot `agent`'s ground-truth centre, m.
+    pub fn position(&self, agent: u32) -> Option<Point2<f64>> {
+        self.pos.get(agent as usize).copied()
     }
 
     /// Robot `agent`'s cumulative Hall ticks `(left, right)`.
@@ -313,18 +359,16 @@ impl World {
         truth.collisions = u32::try_from(self.collisions.len()).unwrap_or(u32::MAX);
         for (i, p) in truth.poses.iter_mut().enumerate() {
             *p = if i < n {
-                Pose {
-                    x_m: self.x[i],
-                    y_m: self.y[i],
-                    theta_rad: self.theta[i],
-                }
+                self.pose_at(i)
             } else {
                 Pose::default()
             };
         }
     }
 
-    /// Every collision recorded so far, in order.
+    /// Every collision recorded so far, in order of the step that began it (robot contacts
+    /// after wall contacts within one step): its time, the robot, what it hit (robot or cell)
+    /// and both positions. `Truth::collisions` is the length of this list.
     pub fn collisions(&self) -> &[Collision] {
         &self.collisions
     }

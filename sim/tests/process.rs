@@ -4,7 +4,7 @@
 
 use hnav_runtime::msg::{Odometry, Truth, WheelCommand};
 use hnav_runtime::transport::{purge_run, RunId, Transport};
-use hnav_sim::process::{odometry_topic, topic_qos, wheels_topic, TRUTH_TOPIC};
+use hnav_runtime::topics;
 use iceoryx2::prelude::CallbackProgression;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -93,14 +93,14 @@ fn drive(mut guard: RunGuard, file: &std::path::Path, agents: usize) -> (u64, Tr
         .node_name("agents")
         .create()
         .unwrap();
-    let q = topic_qos();
+    let q = topics::state_qos();
     let wheels: Vec<_> = (0..agents)
-        .map(|i| t.sender::<WheelCommand>(&wheels_topic(i), q).unwrap())
+        .map(|i| t.sender::<WheelCommand>(&topics::wheels(i), q).unwrap())
         .collect();
     let odom: Vec<_> = (0..2)
-        .map(|i| t.receiver::<Odometry>(&odometry_topic(i), q).unwrap())
+        .map(|i| t.receiver::<Odometry>(&topics::odometry(i), q).unwrap())
         .collect();
-    let truth = t.receiver::<Truth>(TRUTH_TOPIC, q).unwrap();
+    let truth = t.receiver::<Truth>(topics::TRUTH, q).unwrap();
     let send = |period: u64| {
         for (i, tx) in wheels.iter().enumerate() {
             let k = i as f64;
@@ -119,7 +119,7 @@ fn drive(mut guard: RunGuard, file: &std::path::Path, agents: usize) -> (u64, Tr
     let child = Command::new(SIM)
         .args(["--run", run.as_str(), "--scenario"])
         .arg(file)
-        .args(["--periods", &PERIODS.to_string()])
+        .args(["--periods", &PERIODS.to_string(), "--standalone"])
         .stdout(Stdio::null())
         .spawn()
         .unwrap();
@@ -178,7 +178,10 @@ fn lockstep_runs_with_one_seed_give_identical_truth_streams() {
 
 #[test]
 fn a_robot_without_an_agent_brakes_and_does_not_stall_the_run() {
-    let (_, t) = run_once("lockstep-down", 1, SCENARIO);
+    // No publisher ever appears for robot 1, so no peer event marks it down: the deadline
+    // fallback does.
+    let scenario = SCENARIO.replace("[sim]\n", "[sim]\nlockstep_deadline_ms = 500\n");
+    let (_, t) = run_once("lockstep-down", 1, &scenario);
     // Robot 1 never got a command: it stands at its start cell's centre.
     assert_eq!((t.poses()[1].x_m, t.poses()[1].y_m), (0.18, 0.30));
     assert!(t.poses()[0].x_m > 0.18);

@@ -46,7 +46,7 @@ fn head_on_robots_collide_once() {
     assert_eq!(robot_hits.len(), 1, "{:?}", w.collisions());
     let c = robot_hits[0];
     assert_eq!((c.robot, c.hit), (0, Hit::Robot(1)));
-    let d = (c.position.0 - c.other_position.0).hypot(c.position.1 - c.other_position.1);
+    let d = (c.position - c.other_position).norm();
     assert!(d < 2.0 * RobotParams::default().body_radius_m && d > 0.1);
     assert!(c.time_ns > 0);
     let mut t = Truth::default();
@@ -69,7 +69,7 @@ fn robot_driven_into_a_wall_collides() {
     let first = w.collisions().first().expect("a wall hit");
     assert_eq!((first.robot, first.hit), (0, Hit::Cell(6, 2)));
     // The disc's front reaches x = 0.72 (the cell's left edge) after ~0.46 m of travel.
-    assert!((first.position.0 + 0.058 - 0.72).abs() < 1e-3, "{first:?}");
+    assert!((first.position.x + 0.058 - 0.72).abs() < 1e-3, "{first:?}");
 }
 
 #[test]
@@ -175,4 +175,62 @@ fn one_seed_gives_identical_truth_streams() {
     let a = truth_stream_hash(42);
     assert_eq!(a, truth_stream_hash(42));
     assert_ne!(a, truth_stream_hash(43), "the seed reaches the slip noise");
+}
+
+#[test]
+fn scenario_start_headings_and_slip_hold_reach_the_world() {
+    use hnav_runtime::scenario::Scenario;
+    let text = r#"
+name = "headings"
+[map]
+rows = ["......", "......", "......"]
+[sim]
+slip_hold_s = 0.05
+[[agents]]
+start = [1, 1]
+goal = [4, 1]
+[[agents]]
+start = [2, 2]
+goal = [4, 2]
+start_heading_deg = 90
+"#;
+    let s = Scenario::from_str(text, "<t>", std::path::Path::new(".")).unwrap();
+    let mut w = World::from_scenario(&s).unwrap();
+    assert_eq!(w.pose(0).unwrap(), at(Cell::new(1, 1), 0.0));
+    let p1 = w.pose(1).unwrap();
+    assert_eq!((p1.x_m, p1.y_m), (0.30, 0.30));
+    assert!((p1.theta_rad - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    // Robot 1 drives towards +y (larger rows); its rigid transform agrees with its pose.
+    run(&mut w, &[(0.0, 0.0), (10.0, 10.0)], 200);
+    let (p1, iso) = (w.pose(1).unwrap(), w.isometry(1).unwrap());
+    assert!(p1.y_m > 0.31 && (p1.x_m - 0.30).abs() < 1e-12, "{p1:?}");
+    assert_eq!(w.position(1).unwrap(), iso.translation.vector.into());
+    assert!((iso.rotation.angle() - p1.theta_rad).abs() < 1e-15);
+
+    let bad = SimParams {
+        slip_hold_s: 0.0,
+        ..SimParams::default()
+    };
+    let starts = [at(Cell::new(1, 1), 0.0)];
+    let grid = Grid::new(5, 5).unwrap();
+    assert!(World::new(&RobotParams::default(), &bad, grid, &starts).is_err());
+}
+
+#[test]
+fn slip_hold_changes_the_noise_not_its_determinism() {
+    let truth = |hold: f64| {
+        let sim = SimParams {
+            seed: 4,
+            slip_std: 0.05,
+            slip_hold_s: hold,
+            ..SimParams::default()
+        };
+        let starts = [at(Cell::new(3, 3), 0.0)];
+        let grid = Grid::new(30, 9).unwrap();
+        let mut w = World::new(&RobotParams::default(), &sim, grid, &starts).unwrap();
+        run(&mut w, &[(10.0, 10.0)], 1000);
+        w.pose(0).unwrap()
+    };
+    assert_eq!(truth(0.01), truth(0.01));
+    assert_ne!(truth(0.01), truth(0.05));
 }

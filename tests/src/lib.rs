@@ -7,11 +7,15 @@
 //!   test leaves nothing behind in `/dev/shm`;
 //! - the `hnav-test-peer` binary (`src/bin/hnav-test-peer.rs`): small publisher and
 //!   subscriber roles the tests run as separate processes;
-//! - [`pattern`]: the deterministic payloads both sides of a test agree on.
+//! - [`pattern`]: the deterministic payloads both sides of a test agree on;
+//! - [`tick`]: a discrete-time multi-agent run (neural maps, path constructor, conflict
+//!   resolver) for the papers' conflict experiments.
 //!
 //! Tests that SIGKILL processes live in their own test binaries (`tests/*_kill.rs`).
 
 pub mod pattern;
+pub mod swarm;
+pub mod tick;
 
 use std::io::{BufRead, BufReader};
 use std::process::{Command, ExitStatus, Stdio};
@@ -92,9 +96,16 @@ impl TestRun {
 
     /// Starts `program` with `args` (the run id is passed as `--run <id>` first).
     pub fn spawn(&mut self, program: &str, args: &[&str]) -> Result<Peer, String> {
+        let mut all = vec!["--run", self.run.as_str()];
+        all.extend_from_slice(args);
+        let all: Vec<String> = all.iter().map(|s| s.to_string()).collect();
+        self.spawn_exact(program, &all)
+    }
+
+    /// Starts `program` with exactly `args` (the caller places the run id, e.g. after a
+    /// subcommand: `hnav run --run <id> ...`).
+    pub fn spawn_exact(&mut self, program: &str, args: &[String]) -> Result<Peer, String> {
         let mut child = Command::new(program)
-            .arg("--run")
-            .arg(self.run.as_str())
             .args(args)
             .stdin(Stdio::null())
             .stdout(Stdio::piped())

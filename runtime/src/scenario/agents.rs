@@ -132,6 +132,7 @@ pub(super) fn with_agent_count(
                 goal,
                 speed: AgentSpec::DEFAULT_SPEED,
                 priority: None,
+                start_heading_deg: 0.0,
             });
             placed = true;
             break;

@@ -139,6 +139,17 @@ pub(super) fn build_sim(
         seed: s.seed.unwrap_or(d.seed),
         slip_std: float(&s.slip_std, d.slip_std, "sim.slip_std", false, &none, lines)?,
         watchdog_ms: count(&s.watchdog_ms, d.watchdog_ms, "sim.watchdog_ms", lines)?,
+        slip_hold_s: float(
+            &s.slip_hold_s,
+            d.slip_hold_s,
+            "sim.slip_hold_s",
+            true,
+            &none,
+            lines,
+        )?,
+        // Any u32 (0 = no deadline); a negative or fractional value fails in serde, with its
+        // line.
+        lockstep_deadline_ms: s.lockstep_deadline_ms.unwrap_or(d.lockstep_deadline_ms),
     };
     // Odometry is sampled on physics steps, so it cannot be faster than one message per step.
     if u64::from(p.odometry_hz) * u64::from(p.step_ms) > 1000 {

@@ -7,7 +7,8 @@
 //! * the map: width, height, every cell's MovingAI character, the terrain layer if any, and
 //!   the corner-cutting rule;
 //! * `[robot]`, `[sim]` (including the seed), `[coordinator]` and `[restart]`, every field;
-//! * every agent (start, goal, speed, priority) in order, and every fault in order.
+//! * every agent (start, goal, speed, priority, start heading) in order, and every fault in
+//!   order.
 //!
 //! It does **not** cover the scenario `name`, the source file name, or the map file's path
 //! (only the map's content), so renaming or moving files keeps the hash.
@@ -122,7 +123,9 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
     });
     h.u64(sim.seed)
         .f64(sim.slip_std)
-        .u64(sim.watchdog_ms.into());
+        .u64(sim.watchdog_ms.into())
+        .f64(sim.slip_hold_s)
+        .u64(sim.lockstep_deadline_ms.into());
 
     let c = &s.coordinator;
     h.u64(c.round_deadline_ms.into());
@@ -148,6 +151,7 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
             None => h.u64(0),
             Some(p) => h.u64(1).f64(p),
         };
+        h.f64(a.start_heading_deg);
     }
     h.u64(s.faults.len() as u64);
     for f in &s.faults {

@@ -20,15 +20,20 @@
 //! pole_pairs = 7                       # ticks_per_rev = 6 * pole_pairs * gear_ratio = 42 ...
 //! gear_ratio = 1.0
 //! # ticks_per_rev = 42                 # ... or give it directly (not together with the two above)
-//! cell_size_m = 0.12
+//! cell_size_m = 0.16
 //!
 //! [sim]
 //! step_ms = 1                          # physics step
 //! odometry_hz = 100                    # Hall tick messages; at most one per step
 //! clock = "lockstep"                   # or "realtime"
 //! seed = 0
-//! slip_std = 0.0
+//! slip_std = 0.0                       # relative wheel slip, in [0, 0.5)
+//! slip_hold_s = 0.01                   # > 0; a drawn slip factor holds this long
 //! watchdog_ms = 100                    # wheels brake when commands are older
+//! lockstep_deadline_ms = 0             # lockstep: how long to wait for a missing wheel command
+//!                                      # before that robot counts as down and brakes;
+//!                                      # 0 = wait indefinitely (down only when its agent
+//!                                      # process dies or leaves), > 0 = fallback for hung agents
 //!
 //! [coordinator]
 //! round_deadline_ms = 50
@@ -46,6 +51,8 @@
 //! goal = [31, 31]
 //! speed = 1.0                          # cells/s, > 0, default 1.0, within the wheels' limit
 //! priority = 2.0                       # optional, > 0; default 1 / speed
+//! start_heading_deg = 90.0             # optional, in [-360, 360]; default 0 = facing +x (towards
+//!                                      # larger columns); 90 faces +y (towards larger rows)
 //!
 //! [[faults]]                           # optional fault plan
 //! at_round = 10
@@ -139,11 +146,23 @@ pub struct AgentSpec {
     pub speed: f64,
     /// Conflict priority if given (higher wins); see [`AgentSpec::effective_priority`].
     pub priority: Option<f64>,
+    /// Heading of the robot at its start cell's centre, degrees counter-clockwise from the
+    /// sim frame's +x axis (towards larger columns); 90 faces +y, towards larger rows (down
+    /// the map as printed, since row 0 is the top). Default 0; within [-360, 360].
+    pub start_heading_deg: f64,
 }
 
 impl AgentSpec {
     /// Speed of agents that do not give one.
     pub const DEFAULT_SPEED: f64 = 1.0;
+
+    /// Largest `|start_heading_deg|` accepted.
+    pub const MAX_START_HEADING_DEG: f64 = 360.0;
+
+    /// [`AgentSpec::start_heading_deg`] in radians, as the simulator uses it.
+    pub fn start_heading_rad(&self) -> f64 {
+        self.start_heading_deg.to_radians()
+    }
 
     /// The priority used in conflicts: the given one, else the dissertation's `P = 1 / speed`.
     pub fn effective_priority(&self) -> f64 {

@@ -1,7 +1,7 @@
 //! The validated parameter sections of a scenario, with their defaults.
 //!
 //! Defaults describe an s-bot-like robot (small differential drive, BLDC hub motors with Hall
-//! sensors) on 12 cm cells, a 1 kHz lockstep physics step and a coordinator that never
+//! sensors) on 16 cm cells, a 1 kHz lockstep physics step and a coordinator that never
 //! publishes a commit before its log record is durable.
 
 use serde::{Deserialize, Serialize};
@@ -23,7 +23,10 @@ pub struct RobotParams {
     pub motor_lag_s: f64,
     /// Hall ticks per wheel revolution: `6 * pole_pairs * gear_ratio` unless given directly.
     pub ticks_per_rev: f64,
-    /// Edge length of a grid cell in metres.
+    /// Edge length of a grid cell in metres. The default, 16 cm for a 116 mm body, leaves
+    /// 22 mm on each side of a robot at a cell's centre: two robots in neighbouring cells or a
+    /// robot beside a wall stay clear while the wheel controller settles and the odometry
+    /// drifts by a few ticks (with 12 cm cells the demo's robots grazed walls by microns).
     pub cell_size_m: f64,
 }
 
@@ -47,7 +50,7 @@ impl Default for RobotParams {
             max_wheel_accel_rad_s2: 200.0,
             motor_lag_s: 0.02,
             ticks_per_rev: 6.0 * f64::from(Self::DEFAULT_POLE_PAIRS),
-            cell_size_m: 0.12,
+            cell_size_m: 0.16,
         }
     }
 }
@@ -79,6 +82,15 @@ pub struct SimParams {
     pub slip_std: f64,
     /// Motor watchdog: wheels brake when the last command is older than this.
     pub watchdog_ms: u32,
+    /// How long a drawn wheel-slip factor holds, in seconds. Slip is redrawn on this fixed
+    /// time grid (rounded to whole steps, at least one), not every physics step, so that
+    /// `slip_std` means the same for any step length.
+    pub slip_hold_s: f64,
+    /// Lockstep only: how long the simulator waits for a live robot's missing wheel command
+    /// before counting that robot as down (it then brakes until it sends again). 0 = wait
+    /// indefinitely; a robot is then counted down only when its agent's process dies or
+    /// leaves (peer-death events), and a positive value is a fallback for agents that hang.
+    pub lockstep_deadline_ms: u32,
 }
 
 impl Default for SimParams {
@@ -90,6 +102,8 @@ impl Default for SimParams {
             seed: 0,
             slip_std: 0.0,
             watchdog_ms: 100,
+            slip_hold_s: 0.010,
+            lockstep_deadline_ms: 0,
         }
     }
 }

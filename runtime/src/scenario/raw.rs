@@ -62,6 +62,8 @@ pub(super) struct RawSim {
     pub seed: Option<u64>,
     pub slip_std: Option<Spanned<f64>>,
     pub watchdog_ms: Option<Spanned<u32>>,
+    pub slip_hold_s: Option<Spanned<f64>>,
+    pub lockstep_deadline_ms: Option<u32>,
 }
 
 /// `[coordinator]`.
@@ -100,6 +102,7 @@ pub(super) struct RawAgent {
     pub goal: Spanned<Vec<i64>>,
     pub speed: Option<Spanned<f64>>,
     pub priority: Option<Spanned<f64>>,
+    pub start_heading_deg: Option<Spanned<f64>>,
 }
 
 /// What a fault does (only killing a process so far).

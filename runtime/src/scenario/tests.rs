@@ -47,6 +47,8 @@ clock = "realtime"
 seed = 42
 slip_std = 0.01
 watchdog_ms = 200
+slip_hold_s = 0.02
+lockstep_deadline_ms = 250
 [coordinator]
 round_deadline_ms = 20
 fsync = "batched"
@@ -59,6 +61,7 @@ sim = { backoff_ms = 5 }
 start = [0, 0]
 goal = [3, 2]
 priority = 4
+start_heading_deg = -90
 [[faults]]
 at_round = 10
 action = "kill"
@@ -82,6 +85,7 @@ signal = "TERM"
     assert_eq!(s.robot.ticks_per_rev, 180.0);
     assert_eq!(s.sim.clock, ClockMode::Realtime);
     assert_eq!((s.sim.seed, s.sim.step_ms, s.sim.odometry_hz), (42, 2, 50));
+    assert_eq!((s.sim.slip_hold_s, s.sim.lockstep_deadline_ms), (0.02, 250));
     assert_eq!(s.coordinator.fsync, FsyncPolicy::Batched);
     assert_eq!(s.coordinator.time_limit_s, 30.0);
     assert_eq!(
@@ -101,6 +105,11 @@ signal = "TERM"
         }
     );
     assert_eq!(s.agents[0].priority, Some(4.0));
+    assert_eq!(s.agents[0].start_heading_deg, -90.0);
+    assert_eq!(
+        s.agents[0].start_heading_rad(),
+        -std::f64::consts::FRAC_PI_2
+    );
     assert_eq!(s.faults[0].target, FaultTarget::Agent(0));
     assert_eq!(s.faults[0].signal, FaultSignal::Kill);
     assert_eq!(s.faults[1].target, FaultTarget::Coordinator);
@@ -375,4 +384,71 @@ fn fault_errors() {
     assert!(matches!(e, ScenarioError::BadFault { .. }), "{e}");
     let e = fault("role = \"agent\"\nindex = 0\nsignal = \"HUP\"\n").unwrap_err();
     assert!(matches!(e, ScenarioError::Toml { .. }), "{e}");
+}
+
+#[test]
+fn sim_timing_keys_and_start_headings() {
+    // Defaults: slip held 10 ms, no lockstep deadline (liveness from peer events), every
+    // robot facing +x.
+    let s = parse(BASE).unwrap();
+    assert_eq!(s.sim.slip_hold_s, 0.010);
+    assert_eq!(s.sim.lockstep_deadline_ms, 0);
+    assert!(s.agents.iter().all(|a| a.start_heading_deg == 0.0));
+    let s = parse(&format!(
+        "{BASE}[sim]\nlockstep_deadline_ms = 0\nslip_hold_s = 1e-3\n"
+    ))
+    .unwrap();
+    assert_eq!((s.sim.lockstep_deadline_ms, s.sim.slip_hold_s), (0, 1e-3));
+    let turned = parse(&BASE.replacen("speed = 2.0", "speed = 2.0\nstart_heading_deg = 180", 1));
+    assert_eq!(turned.unwrap().agents[1].start_heading_deg, 180.0);
+
+    // Errors carry the key's line.
+    for bad in [
+        "slip_hold_s = 0",
+        "slip_hold_s = -0.01",
+        "slip_hold_s = nan",
+    ] {
+        let e = parse(&format!("{BASE}[sim]\n{bad}\n")).unwrap_err();
+        assert!(
+            matches!(&e, ScenarioError::InvalidParameter { key, .. } if key == "sim.slip_hold_s"),
+            "{e}"
+        );
+        assert_eq!(e.line(), Some(17), "{e}");
+    }
+    for bad in ["lockstep_deadline_ms = -1", "lockstep_deadline_ms = 0.5"] {
+        let e = parse(&format!("{BASE}[sim]\n{bad}\n")).unwrap_err();
+        assert!(matches!(e, ScenarioError::Toml { .. }), "{e}");
+        assert_eq!(e.line(), Some(17), "{e}");
+    }
+    for bad in ["start_heading_deg = 361", "start_heading_deg = inf"] {
+        let e = variant("speed = 2.0", &format!("speed = 2.0\n{bad}"));
+        assert!(
+            matches!(&e, ScenarioError::InvalidParameter { key, .. } if key == "agents[1].start_heading_deg"),
+            "{e}"
+        );
+        assert_eq!(e.line(), Some(16), "{e}");
+    }
+    let e = variant("speed = 2.0", "speed = 2.0\nstart_heading_deg = \"north\"");
+    assert!(matches!(e, ScenarioError::Toml { .. }), "{e}");
+    assert_eq!(e.line(), Some(16));
+
+    // Scenarios changed in code are re-checked too, and the hash covers the new fields.
+    let mut c = parse(BASE).unwrap();
+    let h = c.scenario_hash();
+    c.agents[0].start_heading_deg = 45.0;
+    assert!(c.validate().is_ok());
+    assert_ne!(c.scenario_hash(), h);
+    c.agents[0].start_heading_deg = f64::NAN;
+    assert!(matches!(
+        c.validate(),
+        Err(ScenarioError::InvalidParameter { .. })
+    ));
+    for change in [
+        |s: &mut Scenario| s.sim.lockstep_deadline_ms = 500,
+        |s: &mut Scenario| s.sim.slip_hold_s = 0.02,
+    ] {
+        let mut d = parse(BASE).unwrap();
+        change(&mut d);
+        assert_ne!(d.scenario_hash(), h);
+    }
 }

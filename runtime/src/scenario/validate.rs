@@ -19,6 +19,7 @@ pub(super) struct AgentLocs {
     pub goal: Loc,
     pub speed: Loc,
     pub priority: Loc,
+    pub start_heading: Loc,
 }
 
 impl AgentLocs {
@@ -28,7 +29,8 @@ impl AgentLocs {
             start: at.clone(),
             goal: at.clone(),
             speed: at.clone(),
-            priority: at,
+            priority: at.clone(),
+            start_heading: at,
         }
     }
 }
@@ -46,6 +48,7 @@ pub(super) fn build_agent(
         goal: lines.at(&a.goal),
         speed: lines.at_opt(&a.speed, &entry),
         priority: lines.at_opt(&a.priority, &entry),
+        start_heading: lines.at_opt(&a.start_heading_deg, &entry),
     };
     let start = endpoint(i, Endpoint::Start, a.start.get_ref(), grid, &at.start)?;
     let goal = endpoint(i, Endpoint::Goal, a.goal.get_ref(), grid, &at.goal)?;
@@ -54,12 +57,14 @@ pub(super) fn build_agent(
         .as_ref()
         .map_or(AgentSpec::DEFAULT_SPEED, |s| *s.get_ref());
     let priority = a.priority.as_ref().map(|p| *p.get_ref());
+    let start_heading_deg = a.start_heading_deg.as_ref().map_or(0.0, |h| *h.get_ref());
     Ok((
         AgentSpec {
             start,
             goal,
             speed,
             priority,
+            start_heading_deg,
         },
         at,
     ))
@@ -174,6 +179,17 @@ pub(super) fn check_agent(
             at: at.priority.clone(),
             agent: i,
             priority: p,
+        });
+    }
+    let h = a.start_heading_deg;
+    if !(h.is_finite() && h.abs() <= AgentSpec::MAX_START_HEADING_DEG) {
+        return Err(ScenarioError::InvalidParameter {
+            at: at.start_heading.clone(),
+            key: format!("agents[{i}].start_heading_deg"),
+            problem: format!(
+                "must be a number of degrees in [-{m}, {m}], got {h}",
+                m = AgentSpec::MAX_START_HEADING_DEG
+            ),
         });
     }
     if let Some(&other) = seen.starts.get(&a.start) {

@@ -1,23 +1,27 @@
-//! `hnav-sim --run ID --scenario FILE [--periods N]`: the physics stepper of a run.
+//! `hnav-sim --run ID --scenario FILE [--agents N] [--seed S] [--mode M] [--periods N]
+//! [--standalone]`: the physics stepper of a run. Started by `hnav run`; see
+//! `hnav_sim::process`.
+
+use std::process::ExitCode;
+use std::time::Duration;
 
 use clap::Parser;
-use hnav_runtime::scenario::Scenario;
-use hnav_runtime::transport::{RunId, Transport};
+use hnav_runtime::launch::{node_name, LifecyclePorts, ProcessArgs, StartOutcome};
+use hnav_runtime::msg::Role;
+use hnav_runtime::transport::Transport;
 use hnav_sim::process::SimProcess;
-use std::process::ExitCode;
 
 #[derive(Parser)]
 #[command(about = "HNAV physics stepper: wheel commands in, odometry and ground truth out")]
 struct Args {
-    /// Run id shared by the processes of the run.
-    #[arg(long)]
-    run: String,
-    /// Scenario file (TOML).
-    #[arg(long)]
-    scenario: std::path::PathBuf,
-    /// Stop after this many control periods (default: run until signalled).
+    #[command(flatten)]
+    common: ProcessArgs,
+    /// Stop after this many control periods (default: run until stopped).
     #[arg(long)]
     periods: Option<u64>,
+    /// Run without a supervisor: no start handshake, no lifecycle events.
+    #[arg(long)]
+    standalone: bool,
 }
 
 fn main() -> ExitCode {
@@ -33,11 +37,33 @@ fn main() -> ExitCode {
 }
 
 fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let scenario = Scenario::load(&args.scenario)?;
-    let run = RunId::new(&args.run)?;
-    let transport = Transport::builder(&run).node_name("sim").create()?;
+    let scenario = args.common.scenario()?;
+    let run = args.common.run_id()?;
+    let transport = Transport::builder(&run)
+        .node_name(&node_name(Role::Sim, 0))
+        .create()?;
     let mut sim = SimProcess::new(&transport, &scenario)?;
+    if !args.standalone {
+        let ports = LifecyclePorts::open(&transport, Role::Sim, 0, scenario.agents.len())?;
+        let started = ports.handshake(&transport, args.common.resume, Duration::from_secs(60))?;
+        if started == StartOutcome::Stopped {
+            return Ok(());
+        }
+        sim = sim.with_lifecycle(ports);
+    }
     let out = sim.run(args.periods)?;
+    for c in sim.world().collisions() {
+        tracing::warn!(
+            t_s = c.time_ns as f64 * 1e-9,
+            robot = c.robot,
+            hit = ?c.hit,
+            x = c.position.x,
+            y = c.position.y,
+            other_x = c.other_position.x,
+            other_y = c.other_position.y,
+            "collision"
+        );
+    }
     println!(
         "periods={} collisions={} signalled={}",
         out.periods, out.collisions, out.signalled

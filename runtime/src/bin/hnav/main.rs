@@ -4,6 +4,10 @@
 //! Exit codes: 0 all good, 1 checks ran and found problems (or the report could not be
 //! written), 2 the input could not be loaded or is invalid (and for usage errors, via clap).
 
+mod log_cmd;
+mod ps_cmd;
+mod run_cmd;
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -40,6 +44,15 @@ enum Command {
         #[command(subcommand)]
         command: MapCommand,
     },
+    /// Run a scenario end to end: sim, coordinator and one agent process per robot.
+    Run(run_cmd::RunArgs),
+    /// List the live runs on this machine and their processes.
+    Ps(ps_cmd::PsArgs),
+    /// Inspect a run's consensus log.
+    Log {
+        #[command(subcommand)]
+        command: log_cmd::LogCommand,
+    },
 }
 
 #[derive(Subcommand, Debug)]
@@ -65,6 +78,9 @@ fn main() -> ExitCode {
         Command::Map {
             command: MapCommand::Check { map, scen },
         } => map_check(map, scen),
+        Command::Run(args) => run_cmd::run_command(args),
+        Command::Ps(args) => ps_cmd::run(args),
+        Command::Log { command } => log_cmd::run(command),
     }
 }
 

@@ -1,0 +1,361 @@
+//! The consensus-log writer: [`LogWriter`] appends [`Record`]s to a log directory in the
+//! format of [`hnav_runtime::consensus_log`] and makes them durable as the run's
+//! [`FsyncPolicy`] asks.
+//!
+//! The coordinator appends one [`Record::Round`] per decision round and publishes the round's
+//! Commit only after [`LogWriter::append`] returned. Durability by policy:
+//!
+//! | policy | `append` returns after | after a crash |
+//! |---|---|---|
+//! | [`FsyncPolicy::EveryRecord`] | `fdatasync` of the record | every published commit is in the log |
+//! | [`FsyncPolicy::Batched`] | the write; `fdatasync` every [`BATCH_RECORDS`] records or when [`BATCH_INTERVAL`] has passed since the last one (checked on append) | the unsynced tail may be lost, although its commits may already have been published |
+//! | [`FsyncPolicy::None`] | the write; never syncs (benchmarks only) | anything not yet written back by the OS may be lost |
+//!
+//! Under `Batched` and `None` a crash can also damage several unsynced records in an order
+//! the reader cannot tell from corruption; under `EveryRecord` only the record in flight can
+//! be torn, and reopening cuts exactly that.
+//!
+//! ```no_run
+//! use hnav_coordinator::consensus_log::LogWriter;
+//! use hnav_runtime::consensus_log::{Record, RunHeader, FORMAT_VERSION};
+//! use hnav_runtime::scenario::FsyncPolicy;
+//! # fn main() -> Result<(), hnav_runtime::consensus_log::LogError> {
+//! let (mut log, recovered) = LogWriter::open("target/run/log", FsyncPolicy::EveryRecord)?;
+//! if recovered.records.is_empty() {
+//!     log.append(&Record::Header(RunHeader {
+//!         version: FORMAT_VERSION,
+//!         scenario_hash: 0,
+//!         seed: 1,
+//!         clock: "lockstep".into(),
+//!         width: 8,
+//!         height: 8,
+//!         agents: Vec::new(),
+//!     }))?;
+//! }
+//! # Ok(())
+//! # }
+//! ```
+
+use std::fs::{File, OpenOptions};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use hnav_runtime::consensus_log::{
+    encode_frame, list_segments, read_log, segment_path, LogError, Record, RecordPos, TornTail,
+    DEFAULT_SEGMENT_BYTES, FORMAT_VERSION, MAGIC,
+};
+use hnav_runtime::scenario::FsyncPolicy;
+
+/// Under [`FsyncPolicy::Batched`], sync at the latest after this many records.
+pub const BATCH_RECORDS: u32 = 32;
+
+/// Under [`FsyncPolicy::Batched`], sync on the first append this long after the last sync.
+pub const BATCH_INTERVAL: Duration = Duration::from_millis(20);
+
+const MAGIC_LEN: u64 = MAGIC.len() as u64;
+
+/// How a [`LogWriter`] writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WriterOptions {
+    /// When records are made durable.
+    pub fsync: FsyncPolicy,
+    /// Start a new segment before a record that would take the current one past this size
+    /// (a segment always takes at least one record).
+    pub segment_bytes: u64,
+}
+
+impl WriterOptions {
+    /// `fsync` with the default segment size [`DEFAULT_SEGMENT_BYTES`].
+    pub fn new(fsync: FsyncPolicy) -> Self {
+        Self {
+            fsync,
+            segment_bytes: DEFAULT_SEGMENT_BYTES,
+        }
+    }
+}
+
+/// What an existing log held when it was opened for writing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Recovered {
+    /// Every complete record, in order (empty for a new log: append a header first).
+    pub records: Vec<Record>,
+    /// Where each of `records` is.
+    pub positions: Vec<RecordPos>,
+    /// Bytes of a torn tail cut off the last segment (0 if there was none).
+    pub truncated_bytes: u64,
+    /// The torn tail that was cut off, if any.
+    pub torn: Option<TornTail>,
+}
+
+/// Appends records to a consensus log; see the [module docs](self).
+#[derive(Debug)]
+pub struct LogWriter {
+    dir: PathBuf,
+    options: WriterOptions,
+    file: File,
+    path: PathBuf,
+    segment: u32,
+    len: u64,
+    records: u64,
+    buf: Vec<u8>,
+    unsynced: u32,
+    last_sync: Instant,
+    poisoned: bool,
+}
+
+impl LogWriter {
+    /// Opens (or creates) the log in `dir` with the default segment size.
+    pub fn open(dir: impl AsRef<Path>, policy: FsyncPolicy) -> Result<(Self, Recovered), LogError> {
+        Self::open_with(dir, WriterOptions::new(policy))
+    }
+
+    /// Opens the log in `dir`, creating the directory and a first segment if needed.
+    ///
+    /// An existing log is read whole: its complete records come back in [`Recovered`], a torn
+    /// tail of the last segment is truncated (and the truncation fsynced), and corruption,
+    /// a missing header or a version mismatch is an error with nothing changed.
+    pub fn open_with(
+        dir: impl AsRef<Path>,
+        options: WriterOptions,
+    ) -> Result<(Self, Recovered), LogError> {
+        let dir = dir.as_ref().to_path_buf();
+        let syncing = options.fsync != FsyncPolicy::None;
+        if !dir.is_dir() {
+            std::fs::create_dir_all(&dir).map_err(|e| LogError::io(&dir, e))?;
+            if syncing {
+                let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
+                sync_dir(parent.unwrap_or(Path::new(".")))?;
+            }
+        }
+        let segments = list_segments(&dir)?;
+        let Some(last) = segments.len().checked_sub(1) else {
+            let path = segment_path(&dir, 0);
+            let file = create_segment(&path, &dir, syncing)?;
+            let writer = Self::new(dir, options, file, path, 0, MAGIC_LEN, 0);
+            let recovered = Recovered {
+                records: Vec::new(),
+                positions: Vec::new(),
+                truncated_bytes: 0,
+                torn: None,
+            };
+            return Ok((writer, recovered));
+        };
+        let contents = read_log(&dir)?;
+        let path = segments[last].clone();
+        let mut file = OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .map_err(|e| LogError::io(&path, e))?;
+        let mut truncated_bytes = 0;
+        if let Some(torn) = &contents.torn {
+            let io = |e| LogError::io(&path, e);
+            file.set_len(torn.offset).map_err(io)?;
+            if torn.offset < MAGIC_LEN {
+                file.write_all(&MAGIC).map_err(io)?;
+            }
+            file.sync_all().map_err(io)?;
+            truncated_bytes = torn.bytes;
+        }
+        let len = file.metadata().map_err(|e| LogError::io(&path, e))?.len();
+        let records = contents.records.len() as u64;
+        let writer = Self::new(dir, options, file, path, last as u32, len, records);
+        let recovered = Recovered {
+            records: contents.records,
+            positions: contents.positions,
+            truncated_bytes,
+            torn: contents.torn,
+        };
+        Ok((writer, recovered))
+    }
+
+    fn new(
+        dir: PathBuf,
+        options: WriterOptions,
+        file: File,
+        path: PathBuf,
+        segment: u32,
+        len: u64,
+        records: u64,
+    ) -> Self {
+        Self {
+            dir,
+            options,
+            file,
+            path,
+            segment,
+            len,
+            records,
+            buf: Vec::with_capacity(4096),
+            unsynced: 0,
+            last_sync: Instant::now(),
+            poisoned: false,
+        }
+    }
+
+    /// Appends `record` with one write call and syncs as the policy asks; returns the
+    /// record's byte offset in its segment file ([`segment`](Self::segment) tells which).
+    ///
+    /// The first record of a log must be a header of [`FORMAT_VERSION`]. After a failed
+    /// fsync (or a failed write that could not be undone) the writer is poisoned: every
+    /// further call fails with [`LogError::Poisoned`] and the log must be reopened.
+    pub fn append(&mut self, record: &Record) -> Result<u64, LogError> {
+        self.check_usable()?;
+        if self.records == 0 {
+            self.check_first(record)?;
+        }
+        self.buf.clear();
+        encode_frame(record, &mut self.buf)?;
+        let frame = self.buf.len() as u64;
+        if self.len > MAGIC_LEN && self.len + frame > self.options.segment_bytes {
+            self.roll()?;
+        }
+        let offset = self.len;
+        if let Err(e) = self.file.write_all(&self.buf) {
+            // Cut a partial write so that later records do not follow garbage.
+            if self.file.set_len(offset).is_err() {
+                self.poisoned = true;
+            }
+            return Err(LogError::io(&self.path, e));
+        }
+        self.len += frame;
+        self.records += 1;
+        self.unsynced += 1;
+        let due = match self.options.fsync {
+            FsyncPolicy::EveryRecord => true,
+            FsyncPolicy::Batched => {
+                self.unsynced >= BATCH_RECORDS || self.last_sync.elapsed() >= BATCH_INTERVAL
+            }
+            FsyncPolicy::None => false,
+        };
+        if due {
+            self.sync_file()?;
+        }
+        Ok(offset)
+    }
+
+    /// Makes every appended record durable now, whatever the policy.
+    pub fn sync(&mut self) -> Result<(), LogError> {
+        self.check_usable()?;
+        self.sync_file()
+    }
+
+    /// The log directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Number of the segment being written.
+    pub fn segment(&self) -> u32 {
+        self.segment
+    }
+
+    /// Bytes in the segment being written.
+    pub fn segment_len(&self) -> u64 {
+        self.len
+    }
+
+    /// Records in the log (recovered and appended).
+    pub fn records(&self) -> u64 {
+        self.records
+    }
+
+    /// Records appended but not yet synced.
+    pub fn unsynced(&self) -> u32 {
+        self.unsynced
+    }
+
+    /// The options the writer was opened with.
+    pub fn options(&self) -> WriterOptions {
+        self.options
+    }
+
+    fn check_usable(&self) -> Result<(), LogError> {
+        if self.poisoned {
+            return Err(LogError::Poisoned {
+                path: self.path.clone(),
+            });
+        }
+        Ok(())
+    }
+
+    fn check_first(&self, record: &Record) -> Result<(), LogError> {
+        match record {
+            Record::Header(h) if h.version == FORMAT_VERSION => Ok(()),
+            Record::Header(h) => Err(LogError::Version {
+                path: self.path.clone(),
+                offset: self.len,
+                found: h.version,
+                expected: FORMAT_VERSION,
+            }),
+            other => Err(LogError::NoHeader {
+                path: self.path.clone(),
+                offset: self.len,
+                found: other.kind(),
+            }),
+        }
+    }
+
+    fn sync_file(&mut self) -> Result<(), LogError> {
+        if self.unsynced > 0 {
+            if let Err(e) = self.file.sync_data() {
+                // After a failed fsync the kernel may have dropped the dirty pages: the
+                // durable state of the file is unknown.
+                self.poisoned = true;
+                return Err(LogError::io(&self.path, e));
+            }
+            self.unsynced = 0;
+        }
+        self.last_sync = Instant::now();
+        Ok(())
+    }
+
+    /// Closes the current segment (synced, unless the policy is `None`) and starts the next.
+    fn roll(&mut self) -> Result<(), LogError> {
+        let syncing = self.options.fsync != FsyncPolicy::None;
+        if syncing {
+            self.sync_file()?;
+        }
+        let next = self.segment + 1;
+        let path = segment_path(&self.dir, next);
+        let file = create_segment(&path, &self.dir, syncing).inspect_err(|_| {
+            self.poisoned = true;
+        })?;
+        self.file = file;
+        self.path = path;
+        self.segment = next;
+        self.len = MAGIC_LEN;
+        Ok(())
+    }
+}
+
+impl Drop for LogWriter {
+    /// Syncs the unsynced records (unless the policy is `None` or the writer is poisoned).
+    fn drop(&mut self) {
+        if self.options.fsync != FsyncPolicy::None && !self.poisoned {
+            let _ = self.sync_file();
+        }
+    }
+}
+
+/// Creates a segment holding only the magic; with `syncing`, syncs it and the directory.
+fn create_segment(path: &Path, dir: &Path, syncing: bool) -> Result<File, LogError> {
+    let io = |e| LogError::io(path, e);
+    let mut file = OpenOptions::new()
+        .append(true)
+        .create_new(true)
+        .open(path)
+        .map_err(io)?;
+    file.write_all(&MAGIC).map_err(io)?;
+    if syncing {
+        file.sync_data().map_err(io)?;
+        sync_dir(dir)?;
+    }
+    Ok(file)
+}
+
+fn sync_dir(dir: &Path) -> Result<(), LogError> {
+    File::open(dir)
+        .and_then(|d| d.sync_all())
+        .map_err(|e| LogError::io(dir, e))
+}

@@ -1,0 +1,339 @@
+//! The decision round of the central compute block, free of I/O: the round's candidates in,
+//! the decisions (and the global replans) out. The coordinator process wraps it in the
+//! WaitSet loop, the consensus log and the commit topic.
+//!
+//! The arbiter keeps each agent's last known row. An agent missing from a round (late, dead,
+//! restarting) keeps its cells and counts as standing still: a stable position (type d) for
+//! the others, as the architecture says. Priorities come from the scenario, not from the
+//! candidates, so a confused agent cannot promote itself.
+//!
+//! **Hybrid mode.** An agent that asked and was refused or held for `replan_after_rounds`
+//! rounds in a row, or that reports a local extremum of its map, is replanned globally: Lazy
+//! Theta* over the map with every other agent's held cells as obstacles (falling back to the
+//! standing agents only when that finds nothing). The answer is one waypoint, the first
+//! vertex of the any-angle path: it is in line of sight, so the agent's neural map toward it
+//! leads straight there. When that vertex is the goal itself (the goal is in sight and the
+//! agent is stuck anyway) the waypoint is A*'s cell a few steps ahead, which steers it around
+//! the agent in the way.
+
+use hnav_runtime::consensus_log::ReplanRecord;
+use hnav_runtime::grid::{Cell, Grid};
+use hnav_runtime::msg::{Candidate, CandidateFlags, Decision, Verdict, NO_CELL};
+use hnav_runtime::scenario::Scenario;
+
+use crate::conflict::{AgentMode, AgentRow, Options, Outcome, Resolver};
+use crate::planner::{AStar, LazyTheta, Planner, PlannerConfig};
+
+/// How many A* steps ahead the fallback waypoint lies.
+const FALLBACK_STEPS: usize = 4;
+
+/// Per-agent tallies, for the progress topic and the run summary.
+#[derive(Clone, Copy, PartialEq, Eq, Debug, Default)]
+pub struct AgentTally {
+    /// Accepted moves.
+    pub steps: u32,
+    /// Refused or held requests.
+    pub conflicts: u32,
+    /// Global replans.
+    pub replans: u32,
+}
+
+/// The coordinator's round logic; see the [module docs](self).
+pub struct Arbiter {
+    grid: Grid,
+    scratch: Grid,
+    resolver: Resolver,
+    rows: Vec<AgentRow>,
+    flags: Vec<u32>,
+    waiting: Vec<u32>,
+    goals: Vec<Cell>,
+    priorities: Vec<f64>,
+    replan_after: u32,
+    outcomes: Vec<Outcome>,
+    decisions: Vec<Decision>,
+    replans: Vec<ReplanRecord>,
+    tally: Vec<AgentTally>,
+    lazy: LazyTheta,
+    astar: AStar,
+}
+
+impl Arbiter {
+    /// An arbiter for the scenario's map and agents, every agent at rest on its start.
+    pub fn new(scenario: &Scenario) -> Self {
+        let grid = scenario.map.grid.clone();
+        let n = scenario.agents.len();
+        let options = Options {
+            corner_cutting: scenario.map.corner_cutting,
+            ..Options::default()
+        };
+        let config = PlannerConfig::new(scenario.map.corner_cutting);
+        Arbiter {
+            scratch: grid.clone(),
+            resolver: Resolver::new(&grid, n, options),
+            rows: scenario
+                .agents
+                .iter()
+                .map(|a| AgentRow::at_rest(a.start, None, a.effective_priority()))
+                .collect(),
+            flags: vec![0; n],
+            waiting: vec![0; n],
+            goals: scenario.agents.iter().map(|a| a.goal).collect(),
+            priorities: scenario
+                .agents
+                .iter()
+                .map(|a| a.effective_priority())
+                .collect(),
+            replan_after: scenario.coordinator.replan_after_rounds.max(1),
+            outcomes: Vec::with_capacity(n),
+            decisions: Vec::with_capacity(n),
+            replans: Vec::new(),
+            tally: vec![AgentTally::default(); n],
+            lazy: LazyTheta::new(config.clone()),
+            astar: AStar::new(config),
+            grid,
+        }
+    }
+
+    /// Agents in the run.
+    pub fn agents(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// Whether a candidate names cells of this grid (and `NO_CELL` only where allowed).
+    pub fn valid(&self, c: &Candidate) -> bool {
+        let n = self.grid.len() as u32;
+        (c.agent as usize) < self.rows.len()
+            && c.current < n
+            && c.next < n
+            && (c.probable < n || c.probable == NO_CELL)
+    }
+
+    /// Decides one round. `candidates[i]` is agent `i`'s candidate (validated with
+    /// [`Arbiter::valid`]) or `None` if it is missing. Returns the decisions for the agents that
+    /// asked for something (in agent order) and the replans made.
+    pub fn decide(
+        &mut self,
+        round: u64,
+        candidates: &[Option<Candidate>],
+    ) -> (&[Decision], &[ReplanRecord]) {
+        self.decisions.clear();
+        self.replans.clear();
+        for (i, row) in self.rows.iter_mut().enumerate() {
+            match candidates.get(i).copied().flatten() {
+                Some(c) => {
+                    let cell = |v: u32| self.grid.cell_at(v as usize);
+                    row.current = cell(c.current).unwrap_or(row.current);
+                    row.next = cell(c.next).unwrap_or(row.current);
+                    row.probable = (c.probable != NO_CELL).then(|| cell(c.probable)).flatten();
+                    row.mode = if c.flags & CandidateFlags::AT_GOAL != 0 {
+                        AgentMode::Finished
+                    } else if c.flags & (CandidateFlags::STANDING | CandidateFlags::NO_PATH) != 0 {
+                        AgentMode::Standing
+                    } else {
+                        AgentMode::Active
+                    };
+                    self.flags[i] = c.flags;
+                }
+                None => {
+                    row.probable = None;
+                    row.mode = AgentMode::Standing;
+                    self.flags[i] = 0;
+                }
+            }
+            row.priority = self.priorities[i];
+        }
+        self.resolver.resolve(&self.rows, &mut self.outcomes);
+        for i in 0..self.rows.len() {
+            let row = self.rows[i];
+            let o = self.outcomes[i];
+            let stuck = self.flags[i] & CandidateFlags::LOCAL_EXTREMUM != 0
+                && row.mode == AgentMode::Active
+                && row.is_at_rest();
+            if row.probable.is_none() && !stuck {
+                continue;
+            }
+            let mut d = o.decision(i as u32, &self.grid);
+            if row.probable.is_some() {
+                if o.accepted() {
+                    self.waiting[i] = 0;
+                    self.tally[i].steps += 1;
+                } else {
+                    self.waiting[i] += 1;
+                    self.tally[i].conflicts += 1;
+                    // The contested cell travels with a refusal: an agent blocked by a
+                    // standing one learns it as an obstacle.
+                    d.cell = o
+                        .cell
+                        .and_then(|c| self.grid.checked_index(c))
+                        .map_or(NO_CELL, |c| c as u32);
+                }
+            }
+            if stuck || self.waiting[i] >= self.replan_after {
+                if let Some(r) = self.replan(round, i) {
+                    d = Decision {
+                        agent: i as u32,
+                        verdict: Verdict::Replan as u8,
+                        waypoint: r,
+                        ..Decision::default()
+                    };
+                    self.waiting[i] = 0;
+                    self.tally[i].replans += 1;
+                }
+            }
+            self.decisions.push(d);
+        }
+        (&self.decisions, &self.replans)
+    }
+
+    /// Plans agent `i` around the others; records the replan and returns the waypoint.
+    fn replan(&mut self, round: u64, i: usize) -> Option<u32> {
+        let start = self.rows[i].current;
+        let goal = self.goals[i];
+        if start == goal {
+            return None;
+        }
+        let mut result = None;
+        for only_stable in [false, true] {
+            self.scratch.clone_from(&self.grid);
+            for (j, r) in self.rows.iter().enumerate() {
+                if j == i || (only_stable && r.mode == AgentMode::Active) {
+                    continue;
+                }
+                for c in [r.current, r.next] {
+                    if c != start && c != goal {
+                        self.scratch.set_blocked(c, true);
+                    }
+                }
+            }
+            if let Ok(Some(path)) = self.lazy.plan(&self.scratch, start, goal) {
+                let first = path.cells.get(1).copied().unwrap_or(goal);
+                if first != goal {
+                    result = Some(("lazy-theta", path.cells, first));
+                    break;
+                }
+                if let Ok(Some(p)) = self.astar.plan(&self.scratch, start, goal) {
+                    let k = FALLBACK_STEPS.min(p.cells.len() - 1);
+                    let wp = p.cells[k];
+                    result = Some(("astar", p.cells[..=k].to_vec(), wp));
+                    break;
+                }
+            }
+        }
+        let (planner, cells, wp) = result?;
+        let idx = |c: &Cell| self.grid.index(*c) as u32;
+        self.replans.push(ReplanRecord {
+            round,
+            agent: i as u32,
+            planner: planner.to_string(),
+            found: true,
+            waypoints: cells.iter().map(idx).collect(),
+        });
+        Some(idx(&wp))
+    }
+
+    /// Agents whose last candidate said they stand on their goal.
+    pub fn at_goal(&self) -> u32 {
+        self.flags
+            .iter()
+            .filter(|f| *f & CandidateFlags::AT_GOAL != 0)
+            .count() as u32
+    }
+
+    /// Per-agent tallies.
+    pub fn tally(&self) -> &[AgentTally] {
+        &self.tally
+    }
+
+    /// Restores the tallies from a log's decisions (after a coordinator restart).
+    pub fn restore_tally(&mut self, agent: usize, verdict: Verdict) {
+        let Some(t) = self.tally.get_mut(agent) else {
+            return;
+        };
+        match verdict {
+            Verdict::Accept => t.steps += 1,
+            Verdict::Block | Verdict::Hold => t.conflicts += 1,
+            Verdict::Replan => t.replans += 1,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hnav_runtime::msg::ConflictKind;
+
+    fn scenario(text: &str) -> Scenario {
+        Scenario::from_str(text, "test.toml", std::path::Path::new(".")).unwrap()
+    }
+
+    fn cand(s: &Scenario, agent: u32, cur: (u32, u32), prob: Option<(u32, u32)>) -> Candidate {
+        let g = &s.map.grid;
+        let cur = g.index(Cell::new(cur.0, cur.1)) as u32;
+        Candidate {
+            round: 1,
+            agent,
+            current: cur,
+            next: cur,
+            probable: prob.map_or(NO_CELL, |p| g.index(Cell::new(p.0, p.1)) as u32),
+            ..Candidate::default()
+        }
+    }
+
+    const TWO: &str = r#"
+        name = "t"
+        [map]
+        rows = ["........", "........", "........"]
+        [coordinator]
+        replan_after_rounds = 2
+        [[agents]]
+        start = [0, 1]
+        goal = [7, 1]
+        [[agents]]
+        start = [2, 1]
+        goal = [2, 0]
+        speed = 0.5
+    "#;
+
+    #[test]
+    fn a_missing_agent_is_a_standing_obstacle() {
+        let s = scenario(TWO);
+        let mut a = Arbiter::new(&s);
+        let c0 = cand(&s, 0, (1, 1), Some((2, 1)));
+        let (d, _) = a.decide(1, &[Some(c0), None]);
+        assert_eq!(d.len(), 1);
+        assert_eq!(d[0].verdict, Verdict::Block as u8);
+        assert_eq!(d[0].kind, ConflictKind::StableCell as u8);
+        assert_eq!(d[0].cell, s.map.grid.index(Cell::new(2, 1)) as u32);
+    }
+
+    #[test]
+    fn waiting_too_long_gives_a_waypoint_around_the_blocker() {
+        let s = scenario(TWO);
+        let mut a = Arbiter::new(&s);
+        let c0 = cand(&s, 0, (1, 1), Some((2, 1)));
+        let c1 = cand(&s, 1, (2, 1), None);
+        let (d, r) = a.decide(1, &[Some(c0), Some(c1)]);
+        assert_eq!(d[0].verdict, Verdict::Hold as u8, "{d:?}");
+        assert!(r.is_empty());
+        let (d, r) = a.decide(2, &[Some(c0), Some(c1)]);
+        assert_eq!(d[0].verdict, Verdict::Replan as u8);
+        assert_eq!(r.len(), 1);
+        let wp = s.map.grid.cell_at(d[0].waypoint as usize).unwrap();
+        assert_ne!(wp, Cell::new(2, 1));
+        assert_eq!(a.tally()[0].replans, 1);
+        assert_eq!(a.tally()[0].conflicts, 2);
+    }
+
+    #[test]
+    fn invalid_candidates_are_recognised() {
+        let s = scenario(TWO);
+        let a = Arbiter::new(&s);
+        let mut c = cand(&s, 0, (1, 1), None);
+        assert!(a.valid(&c));
+        c.agent = 5;
+        assert!(!a.valid(&c));
+        c.agent = 0;
+        c.probable = 24;
+        assert!(!a.valid(&c));
+    }
+}

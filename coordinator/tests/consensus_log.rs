@@ -1,0 +1,246 @@
+//! The consensus-log writer: round trips across reopen, torn-tail recovery at every cut,
+//! rollover, and (ignored) append latency per fsync policy.
+
+use std::fs;
+use std::path::Path;
+use std::time::Instant;
+
+use hnav_coordinator::consensus_log::{LogWriter, WriterOptions};
+use hnav_runtime::consensus_log::{
+    read_log, segment_path, verify, AgentEntry, EndReason, EndRecord, LogError, LoggedDecision,
+    Record, RoundRecord, RunHeader, VerifyStatus, FORMAT_VERSION, MAGIC,
+};
+use hnav_runtime::msg::NO_CELL;
+use hnav_runtime::scenario::FsyncPolicy;
+
+fn header(agents: usize) -> Record {
+    Record::Header(RunHeader {
+        version: FORMAT_VERSION,
+        scenario_hash: 0xfeed,
+        seed: 7,
+        clock: "lockstep".into(),
+        width: 16,
+        height: 16,
+        agents: (0..agents as u32)
+            .map(|i| AgentEntry {
+                start: i,
+                goal: 255 - i,
+                speed: 1.0,
+                priority: 1.0 + f64::from(i),
+            })
+            .collect(),
+    })
+}
+
+fn round(n: u64, agents: u32) -> Record {
+    Record::Round(RoundRecord {
+        round: n,
+        candidates: agents,
+        candidates_digest: n ^ 0xabcdef,
+        decisions: (0..agents)
+            .map(|agent| LoggedDecision {
+                agent,
+                verdict: 1,
+                refused: 0,
+                kind: 0,
+                cell: (n as u32 + agent) % 256,
+                waypoint: NO_CELL,
+            })
+            .collect(),
+    })
+}
+
+fn assert_intact(dir: &Path) {
+    let report = verify(dir);
+    assert_eq!(report.status(), VerifyStatus::Intact, "{}", report.render());
+}
+
+#[test]
+fn records_survive_reopen_and_appends_continue() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("a/b/log");
+    let mut expected = vec![header(3)];
+    {
+        let (mut log, rec) = LogWriter::open(&dir, FsyncPolicy::EveryRecord).unwrap();
+        assert_eq!(rec.records, []);
+        assert_eq!(rec.truncated_bytes, 0);
+        assert_eq!(log.append(&expected[0]).unwrap(), MAGIC.len() as u64);
+        for n in 1..=5 {
+            expected.push(round(n, 3));
+            log.append(&expected[n as usize]).unwrap();
+        }
+        assert_eq!(log.records(), 6);
+        assert_eq!(log.unsynced(), 0);
+    }
+    for policy in [FsyncPolicy::Batched, FsyncPolicy::None] {
+        let (mut log, rec) = LogWriter::open(&dir, policy).unwrap();
+        assert_eq!(rec.records, expected);
+        assert_eq!(rec.truncated_bytes, 0);
+        let n = expected.len() as u64;
+        expected.push(round(n, 3));
+        let at = log.append(expected.last().unwrap()).unwrap();
+        assert_eq!(at, rec.positions.last().unwrap().end());
+        log.sync().unwrap();
+    }
+    let (mut log, rec) = LogWriter::open(&dir, FsyncPolicy::EveryRecord).unwrap();
+    assert_eq!(rec.records, expected);
+    log.append(&Record::End(EndRecord {
+        round: 7,
+        at_goal: 3,
+        reason: EndReason::AllAtGoal,
+    }))
+    .unwrap();
+    drop(log);
+    assert_intact(&dir);
+    assert_eq!(read_log(&dir).unwrap().records.len(), expected.len() + 1);
+}
+
+#[test]
+fn the_first_record_must_be_a_header() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (mut log, _) = LogWriter::open(tmp.path(), FsyncPolicy::None).unwrap();
+    assert!(matches!(
+        log.append(&round(1, 1)),
+        Err(LogError::NoHeader { .. })
+    ));
+    let Record::Header(mut h) = header(1) else {
+        unreachable!()
+    };
+    h.version = 99;
+    assert!(matches!(
+        log.append(&Record::Header(h)),
+        Err(LogError::Version { found: 99, .. })
+    ));
+    log.append(&header(1)).unwrap();
+    log.append(&round(1, 1)).unwrap();
+}
+
+#[test]
+fn a_cut_at_every_offset_of_the_last_record_is_truncated_on_open() {
+    let tmp = tempfile::tempdir().unwrap();
+    let full = tmp.path().join("full");
+    let mut records = vec![header(4)];
+    records.extend((1..=4).map(|n| round(n, 4)));
+    {
+        let (mut log, _) = LogWriter::open(&full, FsyncPolicy::None).unwrap();
+        for r in &records {
+            log.append(r).unwrap();
+        }
+    }
+    let bytes = fs::read(segment_path(&full, 0)).unwrap();
+    let last = read_log(&full).unwrap().positions.last().unwrap().offset as usize;
+    for cut in last..bytes.len() {
+        let dir = tmp.path().join(format!("cut-{cut}"));
+        fs::create_dir(&dir).unwrap();
+        fs::write(segment_path(&dir, 0), &bytes[..cut]).unwrap();
+        {
+            let (mut log, rec) = LogWriter::open(&dir, FsyncPolicy::EveryRecord)
+                .unwrap_or_else(|e| panic!("cut at {cut}: {e}"));
+            assert_eq!(rec.records, records[..4], "cut at {cut}");
+            assert_eq!(rec.truncated_bytes, (cut - last) as u64);
+            assert_eq!(rec.torn.is_some(), cut > last);
+            assert_eq!(log.segment_len(), last as u64);
+            // The lost round is decided again, then the run goes on.
+            assert_eq!(log.append(&records[4]).unwrap(), last as u64);
+            log.append(&round(5, 4)).unwrap();
+        }
+        assert_intact(&dir);
+        let mut expected = records.clone();
+        expected.push(round(5, 4));
+        assert_eq!(read_log(&dir).unwrap().records, expected);
+        fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+#[test]
+fn a_torn_segment_magic_is_rewritten_and_corruption_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let opts = WriterOptions {
+        fsync: FsyncPolicy::EveryRecord,
+        segment_bytes: 200,
+    };
+    let mut records = vec![header(2)];
+    records.extend((1..=20).map(|n| round(n, 2)));
+    {
+        let (mut log, _) = LogWriter::open_with(tmp.path(), opts).unwrap();
+        for r in &records {
+            log.append(r).unwrap();
+        }
+        assert!(log.segment() >= 3, "rolled over: segment {}", log.segment());
+    }
+    let log = read_log(tmp.path()).unwrap();
+    assert_eq!(log.records, records);
+    assert!(log
+        .segments
+        .iter()
+        .all(|s| fs::metadata(s).unwrap().len() <= 200));
+    assert_intact(tmp.path());
+
+    // A crash right after creating the next segment leaves it (nearly) empty.
+    let next = segment_path(tmp.path(), log.segments.len() as u32);
+    fs::write(&next, &MAGIC[..5]).unwrap();
+    {
+        let (mut w, rec) = LogWriter::open_with(tmp.path(), opts).unwrap();
+        assert_eq!((rec.records.len(), rec.truncated_bytes), (records.len(), 5));
+        w.append(&round(21, 2)).unwrap();
+    }
+    assert_intact(tmp.path());
+    assert_eq!(fs::read(&next).unwrap()[..8], MAGIC);
+
+    // Damage before the last complete record: open fails and changes nothing.
+    let first = segment_path(tmp.path(), 0);
+    let mut bytes = fs::read(&first).unwrap();
+    bytes[20] ^= 1;
+    fs::write(&first, &bytes).unwrap();
+    let before: Vec<Vec<u8>> = read_segments(tmp.path());
+    let err = LogWriter::open_with(tmp.path(), opts).unwrap_err();
+    assert!(
+        matches!(err, LogError::Corrupt { ref path, .. } if *path == first),
+        "{err}"
+    );
+    assert_eq!(read_segments(tmp.path()), before);
+}
+
+fn read_segments(dir: &Path) -> Vec<Vec<u8>> {
+    let mut v: Vec<_> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    v.sort();
+    v.iter().map(|p| fs::read(p).unwrap()).collect()
+}
+
+/// `cargo test -p hnav-coordinator --release --test consensus_log -- --ignored --nocapture`
+#[test]
+#[ignore = "measurement; prints append latency per fsync policy"]
+fn append_latency_per_policy() {
+    // On the target's disk, not a tmpfs /tmp, so that fsync means something.
+    let base = env!("CARGO_TARGET_TMPDIR");
+    for (policy, n) in [
+        (FsyncPolicy::None, 20_000u64),
+        (FsyncPolicy::Batched, 20_000),
+        (FsyncPolicy::EveryRecord, 2_000),
+    ] {
+        let tmp = tempfile::tempdir_in(base).unwrap();
+        let (mut log, _) = LogWriter::open(tmp.path(), policy).unwrap();
+        log.append(&header(16)).unwrap();
+        let records: Vec<Record> = (1..=n).map(|r| round(r, 16)).collect();
+        let mut lat = Vec::with_capacity(n as usize);
+        let t0 = Instant::now();
+        for r in &records {
+            let t = Instant::now();
+            log.append(r).unwrap();
+            lat.push(t.elapsed().as_secs_f64() * 1e6);
+        }
+        let total = t0.elapsed().as_secs_f64() * 1e6 / n as f64;
+        lat.sort_by(f64::total_cmp);
+        let q = |f: f64| lat[((lat.len() - 1) as f64 * f) as usize];
+        println!(
+            "{policy:?}: {n} round records of 16 decisions ({} bytes): mean {total:.2} us/record, p50 {:.2}, p99 {:.2}, max {:.2}",
+            log.segment_len() / n,
+            q(0.5),
+            q(0.99),
+            q(1.0)
+        );
+    }
+}

@@ -1,0 +1,90 @@
+//! `hnav run SCENARIO [--agents N] [--mode lockstep|realtime] [--seed S] [--out DIR]`: the
+//! supervisor. The work is in `hnav_runtime::supervisor::run`.
+//!
+//! Exit codes: 0 every robot reached its goal without a collision, 1 the run ended otherwise
+//! (time limit, collisions, stopped), 2 the run could not happen (bad scenario, a process
+//! that would not start).
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use hnav_runtime::launch::{Mode, ProcessArgs};
+use hnav_runtime::scenario::Scenario;
+use hnav_runtime::supervisor::run::{default_run_dir, new_run_id, run, RunOptions};
+
+/// `hnav run` arguments.
+#[derive(clap::Args, Debug)]
+pub struct RunArgs {
+    /// The scenario TOML file.
+    pub scenario: PathBuf,
+    /// Use exactly N agents (the scenario's first N, or extra seeded random ones).
+    #[arg(long, value_name = "N")]
+    pub agents: Option<usize>,
+    /// Clock mode [default: the scenario's sim.clock].
+    #[arg(long, value_name = "lockstep|realtime")]
+    pub mode: Option<Mode>,
+    /// Seed of the sim's noise and of generated agents [default: the scenario's sim.seed].
+    #[arg(long, value_name = "S")]
+    pub seed: Option<u64>,
+    /// Run directory (log, summary, process logs) [default: target/hnav-out/NAME].
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Run id (letters, digits, '-', '_') [default: a fresh unique one]. Tests pass their own
+    /// so they can clean the run's shared memory up even if the supervisor dies.
+    #[arg(long, value_name = "ID")]
+    pub run: Option<String>,
+    /// Where the process binaries are [default: next to this executable].
+    #[arg(long, value_name = "DIR")]
+    pub bin_dir: Option<PathBuf>,
+}
+
+pub fn run_command(a: RunArgs) -> ExitCode {
+    hnav_runtime::logging::init();
+    let name = match Scenario::load(&a.scenario) {
+        Ok(s) => default_run_dir(&s),
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let bin_dir = a.bin_dir.or_else(|| {
+        std::env::current_exe()
+            .ok()
+            .and_then(|p| p.parent().map(PathBuf::from))
+    });
+    let Some(bin_dir) = bin_dir else {
+        eprintln!("error: cannot locate the process binaries; pass --bin-dir");
+        return ExitCode::from(2);
+    };
+    let dir = a.out.unwrap_or(name);
+    let opts = RunOptions {
+        args: ProcessArgs {
+            run: a.run.unwrap_or_else(|| new_run_id().as_str().to_string()),
+            scenario: a.scenario,
+            agents: a.agents,
+            seed: a.seed,
+            mode: a.mode,
+            dir: Some(dir.clone()),
+            resume: false,
+        },
+        bin_dir,
+        progress: std::io::stderr().is_terminal(),
+    };
+    match run(&opts) {
+        Ok(summary) => {
+            print!("{}", summary.render());
+            println!("summary   {}", dir.join("summary.json").display());
+            println!("log       {}", summary.log.display());
+            if summary.success() {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

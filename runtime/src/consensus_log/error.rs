@@ -1,0 +1,176 @@
+//! [`LogError`], every way reading or writing a consensus log can fail, and [`FrameProblem`],
+//! what is wrong with the bytes at one place of a segment.
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// What is wrong with the bytes at one offset of a segment file.
+///
+/// In the last segment's final bytes such a problem is a [torn tail](super::TornTail) (a write
+/// the crash interrupted); anywhere else it is [corruption](LogError::Corrupt).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum FrameProblem {
+    /// Fewer than 8 bytes of segment magic.
+    ShortMagic {
+        /// Bytes present.
+        have: u64,
+    },
+    /// Fewer than the 8 bytes of a record header (length and checksum).
+    ShortHeader {
+        /// Bytes present.
+        have: u64,
+    },
+    /// The record's length runs past the end of the file.
+    LengthPastEnd {
+        /// The stored payload length.
+        len: u32,
+        /// Bytes present after the record header.
+        have: u64,
+    },
+    /// A payload length of 0 or above [`MAX_RECORD_LEN`](super::MAX_RECORD_LEN).
+    BadLength {
+        /// The stored payload length.
+        len: u32,
+    },
+    /// The payload's CRC-32C differs from the stored one.
+    BadChecksum {
+        /// The stored checksum.
+        stored: u32,
+        /// The checksum of the payload as read.
+        computed: u32,
+    },
+    /// The checksum matches but the payload is not a [`Record`](super::Record).
+    Undecodable {
+        /// The decoder's message.
+        detail: String,
+    },
+    /// Only zero bytes from here to the end of the file (a file system extended the file
+    /// before the data of the last write reached the disk).
+    ZeroFill {
+        /// The zero bytes.
+        bytes: u64,
+    },
+}
+
+impl fmt::Display for FrameProblem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::ShortMagic { have } => write!(f, "only {have} of 8 segment magic bytes"),
+            Self::ShortHeader { have } => write!(f, "only {have} of 8 record header bytes"),
+            Self::LengthPastEnd { len, have } => write!(
+                f,
+                "record length {len} runs past the end of the file ({have} bytes left)"
+            ),
+            Self::BadLength { len } => write!(f, "impossible record length {len}"),
+            Self::BadChecksum { stored, computed } => write!(
+                f,
+                "checksum mismatch (stored {stored:#010x}, computed {computed:#010x})"
+            ),
+            Self::Undecodable { detail } => write!(f, "undecodable record: {detail}"),
+            Self::ZeroFill { bytes } => write!(f, "{bytes} zero bytes up to the end of the file"),
+        }
+    }
+}
+
+/// An error reading, verifying or writing a consensus log. Every variant names the file (or
+/// directory) and, where one applies, the byte offset.
+#[derive(Debug, thiserror::Error)]
+pub enum LogError {
+    /// An operating-system error on a file or directory.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file or directory.
+        path: PathBuf,
+        /// The error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The directory holds no `seg-NNNNNNNN.hlog` file.
+    #[error("{}: no consensus-log segments (seg-00000000.hlog missing)", dir.display())]
+    NoSegments {
+        /// The directory.
+        dir: PathBuf,
+    },
+    /// Segment numbers are not 0, 1, 2, ... without gaps.
+    #[error("{}: segment {} missing (found segment {found} instead)", dir.display(), super::segment_name(*expected))]
+    SegmentGap {
+        /// The directory.
+        dir: PathBuf,
+        /// The segment number that should come next.
+        expected: u32,
+        /// The number found in its place.
+        found: u32,
+    },
+    /// A segment does not start with `HNAVLOG1`.
+    #[error("{}: byte 0: not a consensus-log segment (missing or unknown magic)", path.display())]
+    BadMagic {
+        /// The segment file.
+        path: PathBuf,
+    },
+    /// Bad bytes before the last complete record (or anywhere in an earlier segment).
+    #[error("{}: byte {offset}: corrupt: {problem}", path.display())]
+    Corrupt {
+        /// The segment file.
+        path: PathBuf,
+        /// Offset of the bad record's header in the file.
+        offset: u64,
+        /// What is wrong.
+        problem: FrameProblem,
+    },
+    /// The log's first record is not a [`RunHeader`](super::RunHeader).
+    #[error("{}: byte {offset}: the first record is a {found} record, not a header", path.display())]
+    NoHeader {
+        /// The segment file.
+        path: PathBuf,
+        /// Offset of the first record.
+        offset: u64,
+        /// The kind found instead.
+        found: &'static str,
+    },
+    /// The header's format version is not [`FORMAT_VERSION`](super::FORMAT_VERSION).
+    #[error("{}: byte {offset}: log format version {found}, this build reads version {expected}", path.display())]
+    Version {
+        /// The segment file.
+        path: PathBuf,
+        /// Offset of the header record.
+        offset: u64,
+        /// The version in the header.
+        found: u32,
+        /// The version this build reads and writes.
+        expected: u32,
+    },
+    /// A record to append encodes to more than [`MAX_RECORD_LEN`](super::MAX_RECORD_LEN).
+    #[error("record of {len} bytes exceeds the maximum of {max}")]
+    TooLarge {
+        /// The encoded length.
+        len: usize,
+        /// The maximum.
+        max: u32,
+    },
+    /// A record to append could not be encoded.
+    #[error("cannot encode record: {0}")]
+    Encode(#[from] bincode::error::EncodeError),
+    /// An earlier write or fsync failed; the writer refuses further appends because the
+    /// file's durable state is unknown. Reopen the log to recover.
+    #[error("{}: an earlier write or fsync failed; reopen the log", path.display())]
+    Poisoned {
+        /// The segment file.
+        path: PathBuf,
+    },
+}
+
+impl LogError {
+    /// An [`Io`](Self::Io) error for `path`.
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Self::Io {
+            path: path.into(),
+            source,
+        }
+    }
+
+    /// Whether this error means the log could not be read at all (an I/O error, or no
+    /// segments), as opposed to a log with bad contents.
+    pub fn is_unreadable(&self) -> bool {
+        matches!(self, Self::Io { .. } | Self::NoSegments { .. })
+    }
+}

@@ -1,0 +1,126 @@
+//! Record framing: `u32 LE payload length | u32 LE crc32c(payload) | payload`, the payload
+//! being the [`Record`] in bincode 2's standard configuration (through serde).
+
+use super::error::{FrameProblem, LogError};
+use super::record::Record;
+
+/// The first 8 bytes of every segment file.
+pub const MAGIC: [u8; 8] = *b"HNAVLOG1";
+
+/// Bytes before a record's payload: its length and its checksum.
+pub const FRAME_HEADER_LEN: usize = 8;
+
+/// The largest payload a record may have (16 MiB). A stored length above it is garbage.
+pub const MAX_RECORD_LEN: u32 = 16 << 20;
+
+type Standard = bincode::config::Configuration;
+type Limited = bincode::config::Configuration<
+    bincode::config::LittleEndian,
+    bincode::config::Varint,
+    bincode::config::Limit<{ MAX_RECORD_LEN as usize }>,
+>;
+
+fn standard() -> Standard {
+    bincode::config::standard()
+}
+
+/// The standard configuration with a decode limit, so that a garbage collection length in a
+/// payload cannot make the decoder allocate more than a record may hold. Same wire format.
+fn limited() -> Limited {
+    bincode::config::standard().with_limit::<{ MAX_RECORD_LEN as usize }>()
+}
+
+/// Appends one complete frame (header and payload) for `record` to `buf`.
+///
+/// On error `buf` is left as it was. Encoding into a reused `buf` allocates nothing once the
+/// buffer has grown to the largest record.
+pub fn encode_frame(record: &Record, buf: &mut Vec<u8>) -> Result<(), LogError> {
+    let start = buf.len();
+    buf.extend_from_slice(&[0; FRAME_HEADER_LEN]);
+    if let Err(e) = bincode::serde::encode_into_std_write(record, buf, standard()) {
+        buf.truncate(start);
+        return Err(LogError::Encode(e));
+    }
+    let payload = &buf[start + FRAME_HEADER_LEN..];
+    let len = payload.len();
+    if len > MAX_RECORD_LEN as usize {
+        buf.truncate(start);
+        return Err(LogError::TooLarge {
+            len,
+            max: MAX_RECORD_LEN,
+        });
+    }
+    let crc = crc32c::crc32c(payload);
+    buf[start..start + 4].copy_from_slice(&(len as u32).to_le_bytes());
+    buf[start + 4..start + 8].copy_from_slice(&crc.to_le_bytes());
+    Ok(())
+}
+
+/// Splits a record header into (payload length, stored checksum).
+pub fn parse_frame_header(header: &[u8; FRAME_HEADER_LEN]) -> (u32, u32) {
+    let len = u32::from_le_bytes([header[0], header[1], header[2], header[3]]);
+    let crc = u32::from_le_bytes([header[4], header[5], header[6], header[7]]);
+    (len, crc)
+}
+
+/// Whether a stored payload length can be a record's.
+pub fn plausible_len(len: u32) -> bool {
+    (1..=MAX_RECORD_LEN).contains(&len)
+}
+
+/// Checks `payload` against its stored checksum and decodes it; the whole payload must be
+/// one record.
+pub fn decode_payload(payload: &[u8], stored_crc: u32) -> Result<Record, FrameProblem> {
+    let computed = crc32c::crc32c(payload);
+    if computed != stored_crc {
+        return Err(FrameProblem::BadChecksum {
+            stored: stored_crc,
+            computed,
+        });
+    }
+    match bincode::serde::decode_from_slice::<Record, _>(payload, limited()) {
+        Ok((record, used)) if used == payload.len() => Ok(record),
+        Ok((_, used)) => Err(FrameProblem::Undecodable {
+            detail: format!("{} trailing bytes", payload.len() - used),
+        }),
+        Err(e) => Err(FrameProblem::Undecodable {
+            detail: e.to_string(),
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::consensus_log::{EndReason, EndRecord};
+
+    #[test]
+    fn frame_layout_and_round_trip() {
+        let r = Record::End(EndRecord {
+            round: 7,
+            at_goal: 3,
+            reason: EndReason::TimeLimit,
+        });
+        let mut buf = vec![0xAA];
+        encode_frame(&r, &mut buf).unwrap();
+        let header: [u8; 8] = buf[1..9].try_into().unwrap();
+        let (len, crc) = parse_frame_header(&header);
+        assert_eq!(len as usize, buf.len() - 9);
+        assert_eq!(crc, crc32c::crc32c(&buf[9..]));
+        assert_eq!(decode_payload(&buf[9..], crc).unwrap(), r);
+        assert!(matches!(
+            decode_payload(&buf[9..], crc ^ 1),
+            Err(FrameProblem::BadChecksum { .. })
+        ));
+    }
+
+    #[test]
+    fn garbage_with_a_valid_checksum_is_undecodable() {
+        let payload = [0xFF; 12];
+        let crc = crc32c::crc32c(&payload);
+        assert!(matches!(
+            decode_payload(&payload, crc),
+            Err(FrameProblem::Undecodable { .. })
+        ));
+    }
+}

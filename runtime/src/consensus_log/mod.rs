@@ -1,0 +1,52 @@
+//! The durable consensus log of a run: its record types, on-disk format, reader and verifier.
+//!
+//! The coordinator appends one [`Record::Round`] per decision round and publishes the round's
+//! [`Commit`](crate::msg::Commit) only after the record is durable (the writer is
+//! `hnav_coordinator::consensus_log::LogWriter`). After a restart it rebuilds its state from
+//! the records; `hnav log verify|show DIR` inspects a log.
+//!
+//! # Format (version [`FORMAT_VERSION`])
+//!
+//! A log is a directory of segment files `seg-00000000.hlog`, `seg-00000001.hlog`, ... numbered
+//! without gaps. Each segment starts with the 8-byte [`MAGIC`] `HNAVLOG1`, followed by records:
+//!
+//! ```text
+//! u32 LE payload length | u32 LE crc32c(payload) | payload
+//! ```
+//!
+//! The payload is a [`Record`] in bincode 2's standard configuration (via serde), at most
+//! [`MAX_RECORD_LEN`] bytes. The first record of a log is a [`Record::Header`]. The writer
+//! starts a new segment before a record that would take the current one past its size limit
+//! ([`DEFAULT_SEGMENT_BYTES`]). Only the end of the last segment can be torn by a crash; see
+//! [`reader`] for what counts as torn and what as corruption.
+//!
+//! | module | what it holds |
+//! |---|---|
+//! | [`record`] | [`Record`] and its parts; conversions from `msg`; [`candidates_digest`] |
+//! | [`frame`] | encoding and checking one record's frame |
+//! | [`segment`] | segment file names and listing |
+//! | [`reader`] | [`LogReader`], [`read_log`]: records in order, torn tail vs corruption |
+//! | [`verify`](mod@verify) | [`verify()`]: a [`VerifyReport`] on whether a log is intact |
+//! | [`show`] | one-line text and JSON renderings of records |
+//! | [`error`] | [`LogError`], [`FrameProblem`] |
+
+pub mod error;
+pub mod frame;
+pub mod reader;
+pub mod record;
+pub mod segment;
+pub mod show;
+pub mod verify;
+
+pub use error::{FrameProblem, LogError};
+pub use frame::{encode_frame, FRAME_HEADER_LEN, MAGIC, MAX_RECORD_LEN};
+pub use reader::{read_log, LogContents, LogReader, RecordPos, TornTail};
+pub use record::{
+    candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision, Record,
+    ReplanRecord, RoundRecord, RunHeader,
+};
+pub use segment::{list_segments, segment_name, segment_path, DEFAULT_SEGMENT_BYTES};
+pub use verify::{verify, KindCounts, VerifyReport, VerifyStatus};
+
+/// The format version this build writes into [`RunHeader::version`] and accepts on reading.
+pub const FORMAT_VERSION: u32 = 1;

@@ -1,0 +1,268 @@
+//! The records of a consensus log and their conversions from and to the message contracts.
+//!
+//! Cells are 0-based row-major indices (`y * width + x`) as in [`msg`](crate::msg), with
+//! [`NO_CELL`](crate::msg::NO_CELL) for "none". Nothing here holds a process id or a wall-clock
+//! time, so the log of a lockstep run is byte-identical across runs of the same scenario.
+
+use serde::{Deserialize, Serialize};
+
+use crate::msg::{Candidate, Commit, Decision, Lifecycle, MAX_AGENTS};
+use crate::scenario::Fnv1a64;
+
+/// One entry of the log. A log starts with exactly one [`Header`](Record::Header).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Record {
+    /// What the run is: written once, first.
+    Header(RunHeader),
+    /// One decision round; its Commit is published only after this record is durable.
+    Round(RoundRecord),
+    /// A process came up, went down or was restarted.
+    Lifecycle(LifecycleRecord),
+    /// A global replan for one agent.
+    Replan(ReplanRecord),
+    /// The run ended.
+    End(EndRecord),
+}
+
+impl Record {
+    /// Lower-case name of the record's kind (`header`, `round`, `lifecycle`, `replan`, `end`).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Header(_) => "header",
+            Self::Round(_) => "round",
+            Self::Lifecycle(_) => "lifecycle",
+            Self::Replan(_) => "replan",
+            Self::End(_) => "end",
+        }
+    }
+
+    /// The round the record belongs to (`None` for the header).
+    pub fn round(&self) -> Option<u64> {
+        match self {
+            Self::Header(_) => None,
+            Self::Round(r) => Some(r.round),
+            Self::Lifecycle(r) => Some(r.round),
+            Self::Replan(r) => Some(r.round),
+            Self::End(r) => Some(r.round),
+        }
+    }
+}
+
+/// The run a log belongs to.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunHeader {
+    /// [`FORMAT_VERSION`](super::FORMAT_VERSION) of the writer.
+    pub version: u32,
+    /// [`Scenario::scenario_hash`](crate::scenario::Scenario::scenario_hash) of the run.
+    pub scenario_hash: u64,
+    /// The sim's seed.
+    pub seed: u64,
+    /// The clock mode: `"lockstep"` or `"realtime"`.
+    pub clock: String,
+    /// Grid width in cells.
+    pub width: u32,
+    /// Grid height in cells.
+    pub height: u32,
+    /// The agents, index = agent number.
+    pub agents: Vec<AgentEntry>,
+}
+
+/// One agent of the run.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AgentEntry {
+    /// Start cell (row-major index).
+    pub start: u32,
+    /// Goal cell (row-major index).
+    pub goal: u32,
+    /// Nominal speed in cells per second.
+    pub speed: f64,
+    /// Conflict priority (larger wins).
+    pub priority: f64,
+}
+
+/// One decision round: what was proposed (as a digest) and what was decided.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RoundRecord {
+    /// The round.
+    pub round: u64,
+    /// How many candidates the round received.
+    pub candidates: u32,
+    /// [`candidates_digest`] of them.
+    pub candidates_digest: u64,
+    /// The decisions, as published in the round's [`Commit`].
+    pub decisions: Vec<LoggedDecision>,
+}
+
+impl RoundRecord {
+    /// The record of a round that received `candidates` and decided `decisions`.
+    pub fn new(round: u64, candidates: &[Candidate], decisions: &[Decision]) -> Self {
+        Self {
+            round,
+            candidates: u32::try_from(candidates.len()).unwrap_or(u32::MAX),
+            candidates_digest: candidates_digest(candidates),
+            decisions: decisions.iter().map(LoggedDecision::from).collect(),
+        }
+    }
+
+    /// The [`Commit`] this record stands for (decisions beyond [`MAX_AGENTS`] are dropped),
+    /// for republishing after a coordinator restart.
+    pub fn commit(&self) -> Commit {
+        let mut c = Commit {
+            round: self.round,
+            ..Commit::default()
+        };
+        for (slot, d) in c.decisions.iter_mut().zip(&self.decisions) {
+            *slot = Decision::from(d);
+        }
+        c.count = self.decisions.len().min(MAX_AGENTS) as u32;
+        c
+    }
+}
+
+/// One agent's decision: [`Decision`] without its reserved byte.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct LoggedDecision {
+    /// Agent index.
+    pub agent: u32,
+    /// A [`Verdict`](crate::msg::Verdict) as `u8`.
+    pub verdict: u8,
+    /// Refused directions, bit `d` for direction `d` (0 = N, clockwise).
+    pub refused: u8,
+    /// A [`ConflictKind`](crate::msg::ConflictKind) as `u8`.
+    pub kind: u8,
+    /// The committed cell or [`NO_CELL`](crate::msg::NO_CELL).
+    pub cell: u32,
+    /// The next replan waypoint or [`NO_CELL`](crate::msg::NO_CELL).
+    pub waypoint: u32,
+}
+
+impl From<&Decision> for LoggedDecision {
+    fn from(d: &Decision) -> Self {
+        Self {
+            agent: d.agent,
+            verdict: d.verdict,
+            refused: d.refused,
+            kind: d.kind,
+            cell: d.cell,
+            waypoint: d.waypoint,
+        }
+    }
+}
+
+impl From<&LoggedDecision> for Decision {
+    fn from(d: &LoggedDecision) -> Self {
+        Self {
+            agent: d.agent,
+            verdict: d.verdict,
+            refused: d.refused,
+            kind: d.kind,
+            reserved: 0,
+            cell: d.cell,
+            waypoint: d.waypoint,
+        }
+    }
+}
+
+/// A process event, as the supervisor published it, without pid and wall time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LifecycleRecord {
+    /// The last round committed when the event was logged.
+    pub round: u64,
+    /// A [`Role`](crate::msg::Role) as `u8`.
+    pub role: u8,
+    /// Agent index for agents, else 0.
+    pub index: u32,
+    /// A [`LifecycleEvent`](crate::msg::LifecycleEvent) as `u8`.
+    pub event: u8,
+    /// Restarts of the process so far.
+    pub restarts: u32,
+}
+
+impl LifecycleRecord {
+    /// The record of `event`, logged at `round` (the event's pid and time are dropped).
+    pub fn new(round: u64, event: &Lifecycle) -> Self {
+        Self {
+            round,
+            role: event.role,
+            index: event.index,
+            event: event.event,
+            restarts: event.restarts,
+        }
+    }
+}
+
+/// A global replan for one agent.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ReplanRecord {
+    /// The round it was made in.
+    pub round: u64,
+    /// The agent.
+    pub agent: u32,
+    /// Planner name (`a-star`, `theta-star`, `lazy-theta-star`, ...).
+    pub planner: String,
+    /// Whether a path was found.
+    pub found: bool,
+    /// The path's waypoints (row-major cells), empty when none was found.
+    pub waypoints: Vec<u32>,
+}
+
+/// The end of a run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct EndRecord {
+    /// The last round committed.
+    pub round: u64,
+    /// Agents standing on their goal at the end.
+    pub at_goal: u32,
+    /// Why the run ended.
+    pub reason: EndReason,
+}
+
+/// Why a run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum EndReason {
+    /// Every agent reached its goal.
+    AllAtGoal,
+    /// The scenario's time limit passed.
+    TimeLimit,
+    /// The supervisor (or an operator) stopped the run.
+    Stopped,
+}
+
+impl EndReason {
+    /// Lower-case name (`all-at-goal`, `time-limit`, `stopped`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::AllAtGoal => "all-at-goal",
+            Self::TimeLimit => "time-limit",
+            Self::Stopped => "stopped",
+        }
+    }
+}
+
+/// FNV-1a 64 ([`Fnv1a64`]) over a round's candidates in agent order (the slice is sorted by
+/// `agent` first if it is not already).
+///
+/// Encoding: the count as `u64` LE, then per candidate `round` u64, `agent`, `current`,
+/// `next`, `probable` u32, the bits of `priority` and `speed` (f32) and `flags` u32, all
+/// little-endian; `reserved` is not hashed.
+pub fn candidates_digest(candidates: &[Candidate]) -> u64 {
+    let mut h = Fnv1a64::new();
+    h.u64(candidates.len() as u64);
+    let mut feed = |c: &Candidate| {
+        h.bytes(&c.round.to_le_bytes());
+        for v in [c.agent, c.current, c.next, c.probable] {
+            h.bytes(&v.to_le_bytes());
+        }
+        h.bytes(&c.priority.to_bits().to_le_bytes());
+        h.bytes(&c.speed.to_bits().to_le_bytes());
+        h.bytes(&c.flags.to_le_bytes());
+    };
+    if candidates.windows(2).all(|w| w[0].agent <= w[1].agent) {
+        candidates.iter().for_each(&mut feed);
+    } else {
+        let mut sorted: Vec<&Candidate> = candidates.iter().collect();
+        sorted.sort_by_key(|c| c.agent);
+        sorted.into_iter().for_each(feed);
+    }
+    h.finish()
+}

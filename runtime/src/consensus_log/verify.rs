@@ -1,0 +1,283 @@
+//! [`verify`]: read a whole log and report whether it is intact. Never modifies a file.
+//!
+//! A log is intact when it has no corruption and no torn tail, its first record is a header
+//! (of this build's [`FORMAT_VERSION`](super::FORMAT_VERSION)) and no other record is one,
+//! the rounds of its round records strictly increase, it has at most one end record, and
+//! every agent index in it is below the header's agent count and every verdict is known.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::error::LogError;
+use super::reader::{LogReader, RecordPos, TornTail};
+use super::record::{EndRecord, Record};
+use super::segment::segment_name;
+use crate::msg::Verdict;
+
+/// At most this many order problems are listed; the rest are counted.
+const MAX_LISTED: usize = 20;
+
+/// Records of each kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct KindCounts {
+    /// Header records.
+    pub header: u64,
+    /// Round records.
+    pub round: u64,
+    /// Lifecycle records.
+    pub lifecycle: u64,
+    /// Replan records.
+    pub replan: u64,
+    /// End records.
+    pub end: u64,
+}
+
+impl KindCounts {
+    /// All records.
+    pub fn total(&self) -> u64 {
+        self.header + self.round + self.lifecycle + self.replan + self.end
+    }
+}
+
+/// The verdict of [`verify`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VerifyStatus {
+    /// Intact (see the [module docs](self)).
+    Intact,
+    /// Readable, but torn, corrupt or out of order.
+    NotIntact,
+    /// The directory or a segment could not be read at all, or holds no segments.
+    Unreadable,
+}
+
+/// What [`verify`] found.
+#[derive(Debug)]
+pub struct VerifyReport {
+    /// The log directory.
+    pub dir: PathBuf,
+    /// Segment files.
+    pub segments: usize,
+    /// Bytes of all complete records, segment magics included.
+    pub bytes: u64,
+    /// Complete records read (up to the first error), by kind.
+    pub counts: KindCounts,
+    /// Round of the first round record.
+    pub first_round: Option<u64>,
+    /// Round of the last round record.
+    pub last_round: Option<u64>,
+    /// The (first) end record, if the log has one.
+    pub end: Option<EndRecord>,
+    /// The torn tail, if any.
+    pub torn: Option<TornTail>,
+    /// The error that stopped reading (corruption, header, version, gap, I/O), if any.
+    pub error: Option<LogError>,
+    /// Everything that makes the log not intact, one line each.
+    pub problems: Vec<String>,
+}
+
+impl VerifyReport {
+    /// Whether the log is intact.
+    pub fn is_intact(&self) -> bool {
+        self.problems.is_empty()
+    }
+
+    /// Intact, not intact, or unreadable.
+    pub fn status(&self) -> VerifyStatus {
+        match &self.error {
+            Some(e) if e.is_unreadable() => VerifyStatus::Unreadable,
+            _ if self.is_intact() => VerifyStatus::Intact,
+            _ => VerifyStatus::NotIntact,
+        }
+    }
+
+    /// Whether the log has an end record.
+    pub fn has_end(&self) -> bool {
+        self.end.is_some()
+    }
+
+    /// A short multi-line report.
+    pub fn render(&self) -> String {
+        let mut s = String::new();
+        let c = &self.counts;
+        let _ = writeln!(s, "log        {}", self.dir.display());
+        let _ = writeln!(s, "segments   {} ({} bytes)", self.segments, self.bytes);
+        let _ = writeln!(
+            s,
+            "records    {}: {} header, {} round, {} lifecycle, {} replan, {} end",
+            c.total(),
+            c.header,
+            c.round,
+            c.lifecycle,
+            c.replan,
+            c.end
+        );
+        match (self.first_round, self.last_round) {
+            (Some(a), Some(b)) => _ = writeln!(s, "rounds     {a}..{b}"),
+            _ => _ = writeln!(s, "rounds     none"),
+        }
+        match &self.end {
+            Some(e) => {
+                let reason = e.reason.name();
+                _ = writeln!(
+                    s,
+                    "end        round {} {reason}, {} at goal",
+                    e.round, e.at_goal
+                )
+            }
+            None => _ = writeln!(s, "end        none"),
+        }
+        match &self.torn {
+            Some(t) => _ = writeln!(s, "torn tail  {} bytes at {}", t.bytes, torn_place(t)),
+            None => _ = writeln!(s, "torn tail  none"),
+        }
+        let status = match self.status() {
+            VerifyStatus::Intact => "intact",
+            VerifyStatus::NotIntact => "NOT INTACT",
+            VerifyStatus::Unreadable => "UNREADABLE",
+        };
+        let _ = writeln!(s, "status     {status}");
+        for p in &self.problems {
+            let _ = writeln!(s, "  problem: {p}");
+        }
+        s
+    }
+}
+
+fn torn_place(t: &TornTail) -> String {
+    format!(
+        "{} byte {} ({})",
+        segment_name(t.segment),
+        t.offset,
+        t.problem
+    )
+}
+
+/// Reads the log in `dir` and reports what it holds and whether it is intact.
+pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
+    let dir = dir.as_ref();
+    let mut report = VerifyReport {
+        dir: dir.to_path_buf(),
+        segments: 0,
+        bytes: 0,
+        counts: KindCounts::default(),
+        first_round: None,
+        last_round: None,
+        end: None,
+        torn: None,
+        error: None,
+        problems: Vec::new(),
+    };
+    let mut reader = match LogReader::open(dir) {
+        Ok(r) => r,
+        Err(e) => {
+            report.problems.push(e.to_string());
+            report.error = Some(e);
+            return report;
+        }
+    };
+    report.segments = reader.segments().len();
+    let mut order = OrderCheck::default();
+    let mut last_segment = None;
+    loop {
+        match reader.next_record() {
+            Ok(Some((pos, record))) => {
+                if last_segment != Some(pos.segment) {
+                    report.bytes += pos.offset;
+                    last_segment = Some(pos.segment);
+                }
+                report.bytes += pos.len;
+                order.check(&mut report, pos, &record);
+            }
+            Ok(None) => break,
+            Err(e) => {
+                report.problems.push(e.to_string());
+                report.error = Some(e);
+                break;
+            }
+        }
+    }
+    if let Some(t) = reader.torn_tail() {
+        report
+            .problems
+            .push(format!("torn tail: {} bytes at {}", t.bytes, torn_place(t)));
+        report.torn = Some(t.clone());
+    }
+    if report.error.is_none() && report.counts.header == 0 {
+        report.problems.push("no complete header record".into());
+    }
+    if order.unlisted > 0 {
+        report
+            .problems
+            .push(format!("... and {} more order problems", order.unlisted));
+    }
+    report
+}
+
+#[derive(Default)]
+struct OrderCheck {
+    agents: Option<usize>,
+    listed: usize,
+    unlisted: usize,
+}
+
+impl OrderCheck {
+    fn problem(&mut self, report: &mut VerifyReport, pos: RecordPos, what: String) {
+        if self.listed < MAX_LISTED {
+            self.listed += 1;
+            let at = format!("{} byte {}", segment_name(pos.segment), pos.offset);
+            report.problems.push(format!("{at}: {what}"));
+        } else {
+            self.unlisted += 1;
+        }
+    }
+
+    fn agent(&mut self, report: &mut VerifyReport, pos: RecordPos, agent: u32) {
+        if let Some(n) = self.agents {
+            if agent as usize >= n {
+                self.problem(report, pos, format!("agent {agent} of a run of {n} agents"));
+            }
+        }
+    }
+
+    fn check(&mut self, report: &mut VerifyReport, pos: RecordPos, record: &Record) {
+        match record {
+            Record::Header(h) => {
+                report.counts.header += 1;
+                if report.counts.header > 1 {
+                    self.problem(report, pos, "a second header record".into());
+                } else {
+                    self.agents = Some(h.agents.len());
+                }
+            }
+            Record::Round(r) => {
+                report.counts.round += 1;
+                if let Some(prev) = report.last_round.filter(|&p| r.round <= p) {
+                    let what = format!("round {} after round {prev}", r.round);
+                    self.problem(report, pos, what);
+                }
+                report.first_round.get_or_insert(r.round);
+                report.last_round = Some(r.round);
+                for d in &r.decisions {
+                    self.agent(report, pos, d.agent);
+                    if Verdict::from_u8(d.verdict).is_none() {
+                        let what = format!("agent {}: unknown verdict {}", d.agent, d.verdict);
+                        self.problem(report, pos, what);
+                    }
+                }
+            }
+            Record::Lifecycle(_) => report.counts.lifecycle += 1,
+            Record::Replan(r) => {
+                report.counts.replan += 1;
+                self.agent(report, pos, r.agent);
+            }
+            Record::End(e) => {
+                report.counts.end += 1;
+                if report.end.is_some() {
+                    self.problem(report, pos, "a second end record".into());
+                } else {
+                    report.end = Some(*e);
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,24 @@
+//! The supervisor library behind `hnav run` and `hnav ps`: it starts the run's processes (the
+//! sim, the coordinator, one agent per robot) from binaries next to its own executable,
+//! watches them, restarts what dies under the scenario's restart policy, and stops everything
+//! cleanly.
+//!
+//! | module | what it holds |
+//! |---|---|
+//! | [`child`] | one child process: spawn in its own process group with an appended log, reap, describe its exit, signal it or its group |
+//! | [`exit_fd`] | the pidfd (or waiter-thread pipe) that makes a child's exit wake an iceoryx2 WaitSet |
+//! | [`restart`] | per-child restart decisions: policy, cap, doubling backoff |
+//! | [`stop`] | the escalating stop of a run's children: wait, SIGTERM, SIGKILL, reap |
+//! | [`registry`] | the on-disk list of live runs and their processes that `hnav ps` reads |
+//! | [`run`] | `hnav run`: spawn, start-up handshake, watch and restart, faults, stop, summary |
+//! | [`summary`] | the run summary (`summary.json`): per-agent steps, length, conflicts, replans from the consensus log; goals and collisions from ground truth |
+//! | [`ps`] | what `hnav ps` shows: each registered process as running, exited or dead, as JSON or a table |
+
+pub mod child;
+pub mod exit_fd;
+pub mod ps;
+pub mod registry;
+pub mod restart;
+pub mod run;
+pub mod stop;
+pub mod summary;

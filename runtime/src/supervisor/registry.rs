@@ -1,0 +1,320 @@
+//! The on-disk list of live runs, so that `hnav ps` (a separate, short-lived process) can
+//! find every supervisor on the machine and the processes it started.
+//!
+//! Each supervisor owns one JSON file, `<runs dir>/<run_id>.json`, holding a [`RunRecord`].
+//! It rewrites the file after every spawn and restart, and removes it when the run ends.
+//! Writes go to a temporary file that is then renamed over the old one: a reader sees
+//! either the old record or the new one, never a torn one. There is no fsync: the records
+//! describe live processes, which a crash of the machine ends anyway.
+//!
+//! A supervisor that died without cleaning up leaves its file behind. Readers notice that its
+//! `supervisor_pid` is gone and report the run as *stale*.
+//!
+//! [`RunRegistry::status`] adds each process's current state (see [`super::ps`]).
+//!
+//! The directory is `$HNAV_RUNS_DIR` if that is set, else `<temp dir>/hnav-runs`.
+//! Tests use [`RunRegistry::at`] rather than the environment, which all the tests of one
+//! binary share.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use serde::{Deserialize, Serialize};
+
+use super::ps::{PsReport, RunStatus};
+use crate::msg::Role;
+use crate::transport::RunId;
+
+/// The environment variable that overrides the registry directory.
+pub const RUNS_DIR_ENV: &str = "HNAV_RUNS_DIR";
+
+/// What went wrong reading or writing a registry file.
+#[derive(Debug, thiserror::Error)]
+pub enum RegistryError {
+    /// A file or directory operation failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file or directory.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A record is not valid JSON of the expected shape.
+    #[error("{path}: not a run record: {source}")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: serde_json::Error,
+    },
+}
+
+/// The role as written in records and node names: `sim`, `coordinator`, `agent`.
+pub fn role_name(role: Role) -> &'static str {
+    match role {
+        Role::Sim => "sim",
+        Role::Coordinator => "coordinator",
+        Role::Agent => "agent",
+    }
+}
+
+/// The inverse of [`role_name`].
+pub fn parse_role(name: &str) -> Option<Role> {
+    match name {
+        "sim" => Some(Role::Sim),
+        "coordinator" => Some(Role::Coordinator),
+        "agent" => Some(Role::Agent),
+        _ => None,
+    }
+}
+
+pub use crate::launch::node_name;
+
+mod role_serde {
+    use super::{parse_role, role_name, Role};
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(role: &Role, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(role_name(*role))
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Role, D::Error> {
+        let name = String::deserialize(d)?;
+        parse_role(&name).ok_or_else(|| serde::de::Error::custom(format!("unknown role {name:?}")))
+    }
+}
+
+/// Where run records live.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RunRegistry {
+    dir: PathBuf,
+}
+
+impl RunRegistry {
+    /// A registry in `dir` (created on the first write).
+    pub fn at(dir: impl Into<PathBuf>) -> Self {
+        Self { dir: dir.into() }
+    }
+
+    /// `$HNAV_RUNS_DIR` if set and not empty, else `<temp dir>/hnav-runs`.
+    pub fn default_location() -> Self {
+        match std::env::var_os(RUNS_DIR_ENV) {
+            Some(d) if !d.is_empty() => Self::at(d),
+            _ => Self::at(std::env::temp_dir().join("hnav-runs")),
+        }
+    }
+
+    /// The directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// A new record of `run` (output directory `dir`) for this process as its supervisor,
+    /// started now, with no processes yet. Nothing is written until [`RunRecord::write`].
+    pub fn new_record(&self, run: &RunId, dir: impl Into<PathBuf>) -> RunRecord {
+        let started_unix_ms = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_millis() as u64)
+            .unwrap_or(0);
+        RunRecord {
+            run_id: run.as_str().to_string(),
+            dir: dir.into(),
+            supervisor_pid: std::process::id(),
+            started_unix_ms,
+            processes: Vec::new(),
+            file: self.dir.join(format!("{}.json", run.as_str())),
+        }
+    }
+
+    /// Every readable record, oldest run first. Unreadable or malformed files are skipped
+    /// with a warning; a missing directory means no runs.
+    pub fn list_runs(&self) -> Vec<RunEntry> {
+        let entries = match std::fs::read_dir(&self.dir) {
+            Ok(e) => e,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Vec::new(),
+            Err(e) => {
+                tracing::warn!(dir = %self.dir.display(), error = %e, "cannot read the run registry");
+                return Vec::new();
+            }
+        };
+        let mut runs = Vec::new();
+        for entry in entries.filter_map(Result::ok) {
+            let name = entry.file_name();
+            let name = name.to_string_lossy();
+            if name.starts_with('.') || !name.ends_with(".json") {
+                continue; // temporary files of writes in flight, and strangers
+            }
+            match RunRecord::read(&entry.path()) {
+                Ok(record) => {
+                    let stale = !pid_alive(record.supervisor_pid);
+                    runs.push(RunEntry { record, stale });
+                }
+                Err(e) => tracing::warn!(error = %e, "skipping run record"),
+            }
+        }
+        runs.sort_by(|a, b| {
+            (a.record.started_unix_ms, &a.record.run_id)
+                .cmp(&(b.record.started_unix_ms, &b.record.run_id))
+        });
+        runs
+    }
+
+    /// [`RunRegistry::list_runs`] with every process's current state: what `hnav ps` shows.
+    pub fn status(&self) -> PsReport {
+        PsReport {
+            runs: self.list_runs().into_iter().map(RunStatus::of).collect(),
+        }
+    }
+}
+
+/// One process of a run, as its supervisor last recorded it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ProcessRecord {
+    /// Its role (`"sim"`, `"coordinator"`, `"agent"` in JSON).
+    #[serde(with = "role_serde")]
+    pub role: Role,
+    /// The agent index, else 0.
+    pub index: u32,
+    /// The pid of its current incarnation.
+    pub pid: u32,
+    /// Restarts so far.
+    pub restarts: u32,
+}
+
+/// The registry file of one run.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RunRecord {
+    /// The run id.
+    pub run_id: String,
+    /// The run's output directory.
+    pub dir: PathBuf,
+    /// The supervisor's pid.
+    pub supervisor_pid: u32,
+    /// When the supervisor started the run, in milliseconds since the Unix epoch.
+    pub started_unix_ms: u64,
+    /// The run's processes, one entry per role and index.
+    pub processes: Vec<ProcessRecord>,
+    #[serde(skip)]
+    file: PathBuf,
+}
+
+impl RunRecord {
+    /// Reads a record file.
+    pub fn read(path: &Path) -> Result<RunRecord, RegistryError> {
+        let text = std::fs::read(path).map_err(|source| RegistryError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let mut record: RunRecord =
+            serde_json::from_slice(&text).map_err(|source| RegistryError::Parse {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        record.file = path.to_path_buf();
+        Ok(record)
+    }
+
+    /// The file this record is written to (or was read from).
+    pub fn path(&self) -> &Path {
+        &self.file
+    }
+
+    /// Records the current incarnation of `role`/`index`, replacing an older one.
+    pub fn set_process(&mut self, role: Role, index: u32, pid: u32, restarts: u32) {
+        let new = ProcessRecord {
+            role,
+            index,
+            pid,
+            restarts,
+        };
+        match self
+            .processes
+            .iter_mut()
+            .find(|p| p.role == role && p.index == index)
+        {
+            Some(p) => *p = new,
+            None => self.processes.push(new),
+        }
+    }
+
+    /// Writes the record atomically (temporary file, then rename), creating the directory.
+    pub fn write(&self) -> Result<(), RegistryError> {
+        static SEQ: AtomicU64 = AtomicU64::new(0);
+        let io = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| RegistryError::Io { path, source }
+        };
+        let dir = self.file.parent().unwrap_or(Path::new("."));
+        std::fs::create_dir_all(dir).map_err(io(dir))?;
+        let json = serde_json::to_vec_pretty(self).map_err(|source| RegistryError::Parse {
+            path: self.file.clone(),
+            source,
+        })?;
+        let tmp = dir.join(format!(
+            ".{}.{}.{}.tmp",
+            self.run_id,
+            std::process::id(),
+            SEQ.fetch_add(1, Ordering::Relaxed)
+        ));
+        let written = std::fs::File::create(&tmp)
+            .and_then(|mut f| f.write_all(&json))
+            .and_then(|()| std::fs::rename(&tmp, &self.file));
+        if let Err(source) = written {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(RegistryError::Io {
+                path: self.file.clone(),
+                source,
+            });
+        }
+        Ok(())
+    }
+
+    /// Removes the record file; a file already gone is not an error.
+    pub fn remove(&self) -> Result<(), RegistryError> {
+        match std::fs::remove_file(&self.file) {
+            Ok(()) => Ok(()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+            Err(source) => Err(RegistryError::Io {
+                path: self.file.clone(),
+                source,
+            }),
+        }
+    }
+}
+
+/// A record found in the registry.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RunEntry {
+    /// The record.
+    pub record: RunRecord,
+    /// Its supervisor is gone: the file was left behind.
+    pub stale: bool,
+}
+
+/// Whether a pid names a live process: `kill(pid, 0)` succeeds (or is refused, which means
+/// the process exists but belongs to someone else), and it is not a zombie.
+pub fn pid_alive(pid: u32) -> bool {
+    // pid 0 and negative values address process groups, not a process.
+    let Ok(raw) = i32::try_from(pid) else {
+        return false;
+    };
+    if raw <= 0 {
+        return false;
+    }
+    match nix::sys::signal::kill(nix::unistd::Pid::from_raw(raw), None) {
+        Ok(()) | Err(nix::errno::Errno::EPERM) => !is_zombie(pid),
+        Err(_) => false,
+    }
+}
+
+/// Reads the state letter of `/proc/<pid>/stat` (after the parenthesised command name).
+fn is_zombie(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .ok()
+        .and_then(|s| {
+            s.rfind(')')
+                .map(|i| s[i + 1..].trim_start().starts_with('Z'))
+        })
+        .unwrap_or(false)
+}

@@ -1,0 +1,104 @@
+//! The services of a run, in one place: every process opens a topic by the name and with the
+//! QoS defined here, so creating and opening sides always agree.
+//!
+//! | topic | payload | publishers -> subscribers | QoS |
+//! |---|---|---|---|
+//! | `wheels/<i>` | [`WheelCommand`](crate::msg::WheelCommand) | agent i -> sim | latest |
+//! | `odom/<i>` | [`Odometry`](crate::msg::Odometry) | sim -> agent i | latest |
+//! | `truth` | [`Truth`](crate::msg::Truth) | sim -> supervisor, viewers | latest |
+//! | `candidates` | [`Candidate`](crate::msg::Candidate) | agents -> coordinator | reliable |
+//! | `commit` | [`Commit`](crate::msg::Commit) | coordinator -> agents | latest, deep buffer |
+//! | `map/<i>` | `[f32]` + [`MapHeader`](crate::msg::MapHeader) | agent i -> coordinator, viewers | latest |
+//! | `progress` | [`Progress`](crate::msg::Progress) | coordinator -> supervisor | latest |
+//! | `ready` | [`Lifecycle`](crate::msg::Lifecycle) | every process -> supervisor | latest, deep buffer |
+//! | `lifecycle` | [`Lifecycle`](crate::msg::Lifecycle) | supervisor -> every process | latest, deep buffer |
+//!
+//! Why "latest" (overwrite the oldest) for commits and lifecycle events, where every sample
+//! counts: with backpressure a dead subscriber whose buffer is full would stall the publisher
+//! until the supervisor cleans the dead node up, and a stalled coordinator stalls the swarm.
+//! The buffers are sized so that a live reader never falls that far behind: an agent reads a
+//! commit every round, and there is one round in flight at a time. History 1 hands a
+//! restarted process the last commit (or lifecycle event) at once.
+
+use crate::transport::{Delivery, Qos};
+
+/// Robot `i`'s wheel commands.
+pub fn wheels(i: usize) -> String {
+    format!("wheels/{i}")
+}
+
+/// Robot `i`'s odometry.
+pub fn odometry(i: usize) -> String {
+    format!("odom/{i}")
+}
+
+/// Agent `i`'s neural-map snapshots.
+pub fn map(i: usize) -> String {
+    format!("map/{i}")
+}
+
+/// Ground truth from the sim.
+pub const TRUTH: &str = "truth";
+/// Candidate steps from the agents.
+pub const CANDIDATES: &str = "candidates";
+/// Commits from the coordinator.
+pub const COMMIT: &str = "commit";
+/// The coordinator's running tally.
+pub const PROGRESS: &str = "progress";
+/// Processes announce they are up.
+pub const READY: &str = "ready";
+/// The supervisor's lifecycle events and requests.
+pub const LIFECYCLE: &str = "lifecycle";
+
+/// QoS of the per-robot topics and of truth and progress: superseding state.
+pub fn state_qos() -> Qos {
+    Qos::latest()
+}
+
+/// QoS of the candidate stream of a swarm of `agents`.
+pub fn candidates_qos(agents: usize) -> Qos {
+    Qos::reliable(agents)
+}
+
+/// QoS of the commit stream: one publisher (two while a restarted coordinator replaces a dead
+/// one), every agent and a few observers reading, a buffer no live reader exhausts.
+pub fn commit_qos(agents: usize) -> Qos {
+    Qos {
+        max_publishers: 2,
+        max_subscribers: agents.max(1) + Qos::EXTRA_NODES,
+        buffer: 64,
+        history: 1,
+        delivery: Delivery::LatestOnly,
+    }
+}
+
+/// QoS of the `ready` and `lifecycle` topics of a swarm of `agents`.
+pub fn lifecycle_qos(agents: usize) -> Qos {
+    let n = agents.max(1) + Qos::EXTRA_NODES;
+    Qos {
+        max_publishers: 2 * n,
+        max_subscribers: n,
+        buffer: 2 * n,
+        history: 1,
+        delivery: Delivery::LatestOnly,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn per_robot_topics_are_distinct() {
+        assert_ne!(wheels(1), wheels(2));
+        assert_ne!(wheels(1), odometry(1));
+        assert_ne!(map(3), odometry(3));
+    }
+
+    #[test]
+    fn lifecycle_admits_every_process_twice() {
+        let q = lifecycle_qos(64);
+        assert!(q.max_publishers >= 2 * (64 + 2));
+        assert!(q.buffer >= 64 + 2);
+    }
+}

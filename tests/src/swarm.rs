@@ -1,0 +1,120 @@
+//! Running whole swarms from tests: `hnav run` as a child process with a test's own run id,
+//! a run directory in a temporary directory, and the registry of live runs kept out of the
+//! machine's shared one.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitStatus;
+use std::time::Duration;
+
+use crate::{Peer, TestRun};
+
+/// A workspace binary (`hnav`, `hnav-agent`, ...) next to the test executable's directory:
+/// cargo puts test executables in `target/<profile>/deps` and binaries in `target/<profile>`.
+pub fn workspace_bin(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().expect("the test executable has a path");
+    let profile_dir = exe
+        .parent()
+        .and_then(Path::parent)
+        .expect("test executables live in target/<profile>/deps");
+    profile_dir.join(name)
+}
+
+/// The repository root (for scenarios and maps).
+pub fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("the tests crate is inside the workspace")
+        .to_path_buf()
+}
+
+/// One `hnav run` of a test.
+pub struct SwarmRun {
+    /// The supervisor process.
+    pub peer: Peer,
+    /// The run directory.
+    pub dir: PathBuf,
+}
+
+impl SwarmRun {
+    /// Starts `hnav run SCENARIO --run <id> --out DIR EXTRA...` under `run`, with the run
+    /// registry in `registry`.
+    pub fn start(
+        run: &mut TestRun,
+        scenario: &Path,
+        dir: &Path,
+        registry: &Path,
+        extra: &[&str],
+    ) -> Result<SwarmRun, String> {
+        // Every test of a binary sets the same value, so the race is harmless.
+        std::env::set_var("HNAV_RUNS_DIR", registry);
+        let mut args: Vec<String> = vec![
+            "run".into(),
+            scenario.display().to_string(),
+            "--run".into(),
+            run.run.as_str().to_string(),
+            "--out".into(),
+            dir.display().to_string(),
+        ];
+        args.extend(extra.iter().map(|s| s.to_string()));
+        let hnav = workspace_bin("hnav");
+        let peer = run.spawn_exact(&hnav.display().to_string(), &args)?;
+        Ok(SwarmRun {
+            peer,
+            dir: dir.to_path_buf(),
+        })
+    }
+
+    /// Waits up to `timeout` for the supervisor to exit; on failure the error carries the
+    /// tails of the processes' logs.
+    pub fn finish(&mut self, timeout: Duration) -> Result<ExitStatus, String> {
+        self.peer
+            .wait_exit(timeout)
+            .map_err(|e| format!("{e}\n{}", self.log_tails()))
+    }
+
+    /// The summary the supervisor wrote.
+    pub fn summary(&self) -> Result<serde_json::Value, String> {
+        let p = self.dir.join("summary.json");
+        let text = std::fs::read_to_string(&p)
+            .map_err(|e| format!("{}: {e}\n{}", p.display(), self.log_tails()))?;
+        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", p.display()))
+    }
+
+    /// The last lines of every process log of the run, for failure messages.
+    pub fn log_tails(&self) -> String {
+        let mut out = String::new();
+        let Ok(entries) = std::fs::read_dir(self.dir.join("logs")) else {
+            return out;
+        };
+        let mut paths: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
+        paths.sort();
+        for p in paths {
+            let text = std::fs::read_to_string(&p).unwrap_or_default();
+            let lines: Vec<&str> = text.lines().collect();
+            let tail = &lines[lines.len().saturating_sub(8)..];
+            if !tail.is_empty() {
+                out += &format!("--- {}\n{}\n", p.display(), tail.join("\n"));
+            }
+        }
+        out
+    }
+}
+
+/// Runs `hnav log verify DIR` and returns whether it exited 0, with its output.
+pub fn verify_log(dir: &Path) -> (bool, String) {
+    match std::process::Command::new(workspace_bin("hnav"))
+        .args(["log", "verify"])
+        .arg(dir)
+        .output()
+    {
+        Ok(o) => (
+            o.status.success(),
+            format!(
+                "{}{}",
+                String::from_utf8_lossy(&o.stdout),
+                String::from_utf8_lossy(&o.stderr)
+            ),
+        ),
+        Err(e) => (false, e.to_string()),
+    }
+}
