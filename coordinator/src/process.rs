@@ -367,7 +367,9 @@ impl State {
                 }
                 self.pending[i] = Some(c);
                 self.live[i] = true;
-            } else if c.round == self.round && c.round > 0 {
+            } else if c.round <= self.round && self.round > 0 {
+                // An agent behind (a restarted one, or one the dead coordinator never
+                // answered): the last commit brings it up to date.
                 resend = true;
             }
         }

@@ -6,9 +6,10 @@
 //! left, or (if `sim.lockstep_deadline_ms` > 0) that misses that deadline, counts as down and
 //! brakes until it sends again. Joined to the run's lifecycle protocol
 //! ([`SimProcess::with_lifecycle`]), it also learns of dead agents from the supervisor at
-//! once. A robot counts as live again from its first fresh command, never from a publisher
-//! merely appearing: a restarted agent first needs this period's odometry, which the sim
-//! publishes only after stepping, so waiting for it then would stall the run.
+//! once. A robot whose agent the supervisor restarted gets its last odometry reading again
+//! (it was published before the new agent subscribed) and is waited for from then on;
+//! without the lifecycle protocol a robot counts as live again from its first fresh command,
+//! never from a publisher merely appearing, which would stall the run.
 //! In realtime the world follows the wall clock and commands apply when they arrive. The
 //! process blocks in a WaitSet throughout (listeners on the wheel topics, plus an interval in
 //! realtime or, if set, the deadline in lockstep as a timeout).
@@ -218,15 +219,34 @@ impl<'t> SimProcess<'t> {
     /// command (it needs this period's odometry before it can send one).
     fn on_lifecycle(&mut self, life: Option<&LifecyclePorts>) -> Result<bool, ProcessError> {
         let Some(l) = life else { return Ok(false) };
+        let mut restarted = Vec::new();
         let (live, world) = (&mut self.live, &mut self.world);
-        Ok(l.drain(|role, index, ev| {
-            if role == Role::Agent && ev == LifecycleEvent::Down {
-                if let Some(v) = live.get_mut(index as usize) {
+        let stop = l.drain(|role, index, ev| {
+            let Some(v) = live.get_mut(index as usize) else {
+                return;
+            };
+            match (role, ev) {
+                (Role::Agent, LifecycleEvent::Down) => {
                     *v = false;
                     world.brake(index);
                 }
+                (Role::Agent, LifecycleEvent::Restarted) => restarted.push(index),
+                _ => {}
             }
-        })?)
+        })?;
+        // A restarted agent needs an odometry reading before it can command its wheels; the
+        // last one went out before it subscribed. Send it again and wait for the agent: in
+        // lockstep its robot counts from this period on.
+        if let Some(last) = self.period.checked_sub(1) {
+            for i in restarted {
+                if let (Some(o), Some(tx)) = (self.world.odometry(i, last), self.odom.get(i as usize)) {
+                    tx.send(o)?;
+                    self.live[i as usize] = true;
+                    self.have[i as usize] = false;
+                }
+            }
+        }
+        Ok(stop)
     }
 
     /// Reads every wheel topic: liveness from the wake-up events, commands for the current

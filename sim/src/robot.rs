@@ -122,7 +122,7 @@ mod tests {
             |r: &mut RobotParams| r.wheel_radius_m = 0.0,
             |r: &mut RobotParams| r.axle_track_m = f64::NAN,
             |r: &mut RobotParams| r.motor_lag_s = -1.0,
-            |r: &mut RobotParams| r.body_radius_m = 0.07,
+            |r: &mut RobotParams| r.body_radius_m = 0.6 * r.cell_size_m,
             |r: &mut RobotParams| r.ticks_per_rev = f64::INFINITY,
         ] {
             let mut r = RobotParams::default();

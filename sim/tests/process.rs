@@ -3,14 +3,20 @@
 //! Truth streams, and that a robot whose agent never sends is braked rather than waited for.
 
 use hnav_runtime::msg::{Odometry, Truth, WheelCommand};
-use hnav_runtime::transport::{purge_run, RunId, Transport};
+use hnav_runtime::scenario::params::RobotParams;
 use hnav_runtime::topics;
+use hnav_runtime::transport::{purge_run, RunId, Transport};
 use iceoryx2::prelude::CallbackProgression;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 const SIM: &str = env!("CARGO_BIN_EXE_hnav-sim");
 const PERIODS: u64 = 40;
+
+/// The x of the start cells' centres (column 1), m.
+fn start_x() -> f64 {
+    1.5 * RobotParams::default().cell_size_m
+}
 
 const SCENARIO: &str = r#"
 name = "sim-process-test"
@@ -170,7 +176,7 @@ fn lockstep_runs_with_one_seed_give_identical_truth_streams() {
     assert_eq!(a, b);
     assert_eq!(ta.robots, 2);
     assert!(
-        ta.poses()[0].x_m > 0.18,
+        ta.poses()[0].x_m > start_x(),
         "robot 0 drove: {:?}",
         ta.poses()[0]
     );
@@ -183,8 +189,9 @@ fn a_robot_without_an_agent_brakes_and_does_not_stall_the_run() {
     let scenario = SCENARIO.replace("[sim]\n", "[sim]\nlockstep_deadline_ms = 500\n");
     let (_, t) = run_once("lockstep-down", 1, &scenario);
     // Robot 1 never got a command: it stands at its start cell's centre.
-    assert_eq!((t.poses()[1].x_m, t.poses()[1].y_m), (0.18, 0.30));
-    assert!(t.poses()[0].x_m > 0.18);
+    let c = RobotParams::default().cell_size_m;
+    assert_eq!((t.poses()[1].x_m, t.poses()[1].y_m), (1.5 * c, 2.5 * c));
+    assert!(t.poses()[0].x_m > start_x());
 }
 
 #[test]
@@ -196,5 +203,5 @@ fn realtime_follows_the_wall_clock() {
     // 40 periods of 10 ms: at least 0.4 s of wall time, and the robots moved.
     assert!(wall >= Duration::from_millis(390), "{wall:?}");
     assert_eq!(t.sim_time_ns, 400_000_000);
-    assert!(t.poses()[0].x_m > 0.18 && t.poses()[1].x_m > 0.18);
+    assert!(t.poses()[0].x_m > start_x() && t.poses()[1].x_m > start_x());
 }

@@ -68,8 +68,13 @@ fn robot_driven_into_a_wall_collides() {
     run(&mut w, &[(10.0, 10.0)], 3000);
     let first = w.collisions().first().expect("a wall hit");
     assert_eq!((first.robot, first.hit), (0, Hit::Cell(6, 2)));
-    // The disc's front reaches x = 0.72 (the cell's left edge) after ~0.46 m of travel.
-    assert!((first.position.x + 0.058 - 0.72).abs() < 1e-3, "{first:?}");
+    // The disc's front reaches the cell's left edge (x = 6 cells).
+    let r = RobotParams::default();
+    let edge = 6.0 * r.cell_size_m;
+    assert!(
+        (first.position.x + r.body_radius_m - edge).abs() < 1e-3,
+        "{first:?}"
+    );
 }
 
 #[test]
@@ -197,13 +202,16 @@ start_heading_deg = 90
     let s = Scenario::from_str(text, "<t>", std::path::Path::new(".")).unwrap();
     let mut w = World::from_scenario(&s).unwrap();
     assert_eq!(w.pose(0).unwrap(), at(Cell::new(1, 1), 0.0));
-    let p1 = w.pose(1).unwrap();
-    assert_eq!((p1.x_m, p1.y_m), (0.30, 0.30));
+    let (p1, c1) = (w.pose(1).unwrap(), at(Cell::new(2, 2), 0.0));
+    assert_eq!((p1.x_m, p1.y_m), (c1.x_m, c1.y_m));
     assert!((p1.theta_rad - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
     // Robot 1 drives towards +y (larger rows); its rigid transform agrees with its pose.
     run(&mut w, &[(0.0, 0.0), (10.0, 10.0)], 200);
     let (p1, iso) = (w.pose(1).unwrap(), w.isometry(1).unwrap());
-    assert!(p1.y_m > 0.31 && (p1.x_m - 0.30).abs() < 1e-12, "{p1:?}");
+    assert!(
+        p1.y_m > c1.y_m + 0.01 && (p1.x_m - c1.x_m).abs() < 1e-12,
+        "{p1:?}"
+    );
     assert_eq!(w.position(1).unwrap(), iso.translation.vector.into());
     assert!((iso.rotation.angle() - p1.theta_rad).abs() < 1e-15);
 

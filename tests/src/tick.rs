@@ -21,7 +21,7 @@ use hnav_agent::neural_map::{
 };
 use hnav_agent::path_constructor::{DirectionMask, PathConstructor, PathOptions, Walker};
 use hnav_coordinator::conflict::{self, AgentMode, AgentRow, Outcome, Resolver};
-use hnav_runtime::grid::{Cell, Direction, Grid};
+use hnav_runtime::grid::{Cell, CornerCutting, Direction, Grid};
 use hnav_runtime::msg::{ConflictKind, Verdict};
 
 /// What a refused (blocked) agent does.
@@ -163,7 +163,8 @@ pub struct TickRun {
     pub agents: Vec<AgentTrace>,
     /// Every Block and Hold with a conflict kind, in order.
     pub conflicts: Vec<ConflictEvent>,
-    /// The rows at the start (index 0) and at the end of every tick.
+    /// The rows at the start (index 0) and at the end of every tick (with
+    /// [`Timing::Speeds`], one more after the last arrivals).
     pub history: Vec<Vec<AgentRow>>,
     /// Seconds per tick (1 with [`Timing::Ticks`]).
     pub dt: f64,
@@ -274,7 +275,10 @@ pub fn run(grid: &Grid, agents: &[AgentSpec], config: &TickConfig) -> Result<Tic
     let (speeds, dt) = match &config.timing {
         Timing::Ticks => (vec![f64::INFINITY; agents.len()], 1.0),
         Timing::Speeds { speeds, dt } => {
-            if speeds.len() != agents.len() || speeds.iter().any(|s| !(*s > 0.0)) || !(*dt > 0.0) {
+            if speeds.len() != agents.len()
+                || speeds.iter().any(|s| !(s.is_finite() && *s > 0.0))
+                || !(dt.is_finite() && *dt > 0.0)
+            {
                 return Err("one positive speed per agent and a positive dt".into());
             }
             (speeds.clone(), *dt)
@@ -313,6 +317,7 @@ pub fn run(grid: &Grid, agents: &[AgentSpec], config: &TickConfig) -> Result<Tic
         dt,
     };
     let mut resolver = Resolver::new(grid, agents.len(), config.resolver);
+    let corners = config.resolver.corner_cutting;
     let mut out: Vec<Outcome> = Vec::new();
     for tick in 1..=config.max_ticks {
         let now = (tick - 1) as f64 * dt;
@@ -327,13 +332,16 @@ pub fn run(grid: &Grid, agents: &[AgentSpec], config: &TickConfig) -> Result<Tic
             }
         }
         if rows.iter().all(|r| r.mode == AgentMode::Finished) {
+            if config.timing != Timing::Ticks {
+                run.history.push(rows.clone());
+            }
             break;
         }
         // Picks.
         for (i, row) in rows.iter_mut().enumerate() {
             row.probable = None;
             if row.mode == AgentMode::Active && row.is_at_rest() {
-                row.probable = pick(&pc, &state[i], grid);
+                row.probable = pick(&pc, &state[i], grid, corners);
             }
         }
         resolver.resolve(&rows, &mut out);
@@ -346,7 +354,7 @@ pub fn run(grid: &Grid, agents: &[AgentSpec], config: &TickConfig) -> Result<Tic
                     if o.verdict == Verdict::Block {
                         let s = &mut state[i];
                         s.mask = DirectionMask(s.mask.0 | o.refused);
-                        let p = pick(&pc, s, grid);
+                        let p = pick(&pc, s, grid, corners);
                         changed |= p != rows[i].probable;
                         rows[i].probable = p;
                     }
@@ -417,14 +425,29 @@ pub fn run(grid: &Grid, agents: &[AgentSpec], config: &TickConfig) -> Result<Tic
 }
 
 /// The agent's next cell by gradient ascent on its own map (with its negated cells and
-/// masked directions), or `None` when every direction is refused.
-fn pick(pc: &PathConstructor, agent: &Agent, grid: &Grid) -> Option<Cell> {
+/// masked directions), or `None` when every direction is refused. Diagonals that cut a
+/// blocked map corner under `rule` are masked first (Fig. 3-7 on the map), so that the path
+/// constructor's own corner rule can stay off for the coordinator's refusals.
+fn pick(pc: &PathConstructor, agent: &Agent, grid: &Grid, rule: CornerCutting) -> Option<Cell> {
     let field = Negated {
         map: &agent.map,
         negated: &agent.negated,
     };
-    let (d, _) = agent.walker.propose(pc, &field, agent.mask);
-    d.and_then(|d| grid.step(agent.walker.cell(), d))
+    let cell = agent.walker.cell();
+    let mut mask = agent.mask;
+    for d in Direction::ALL.into_iter().filter(|d| d.is_diagonal()) {
+        let side = |dx: i32, dy: i32| cell.offset(dx, dy).is_none_or(|c| grid.is_blocked(c));
+        let (a, b) = (side(d.dx(), 0), side(0, d.dy()));
+        let cut = match rule {
+            CornerCutting::Forbidden => a || b,
+            CornerCutting::Allowed => a && b,
+        };
+        if cut {
+            mask = mask.refuse(d);
+        }
+    }
+    let (d, _) = agent.walker.propose(pc, &field, mask);
+    d.and_then(|d| grid.step(cell, d))
 }
 
 /// Appends the outcomes with verdict `verdict` and a conflict kind to the run's log.

@@ -51,7 +51,8 @@ fn config(policy: Policy, sweep: bool) -> TickConfig {
     TickConfig {
         map: NeuralMapOptions::seed_001(),
         path: PathOptions {
-            diagonal_weight: 0.7071,
+            // The papers' 0.7071, to the last bit.
+            diagonal_weight: std::f64::consts::FRAC_1_SQRT_2,
             visited: VisitedRule::Negate,
             ..PathOptions::default()
         },

@@ -105,6 +105,8 @@ struct Core {
     outstanding: Option<u64>,
     last_period: Option<u64>,
     wheel_due: Option<u64>,
+    /// A candidate is due for the last odometry reading.
+    candidate_due: bool,
     ticks: (i64, i64),
 }
 
@@ -215,6 +217,7 @@ impl<'t> AgentProcess<'t> {
                 outstanding: None,
                 last_period: None,
                 wheel_due: None,
+                candidate_due: false,
                 ticks,
             },
         })
@@ -237,7 +240,7 @@ impl<'t> AgentProcess<'t> {
             return Ok(core.outcome());
         }
         core.publish_map(p)?;
-        if core.clock == ClockMode::Lockstep {
+        if core.clock == ClockMode::Lockstep && !resume {
             // Period 0's command: the sim steps the first period once every robot has one.
             core.wheel_due = Some(core.last_period.map_or(0, |p| p + 1));
             core.send_wheels(p)?;
@@ -259,6 +262,7 @@ impl<'t> AgentProcess<'t> {
             }
             core.on_commits(p)?;
             core.on_odometry(p)?;
+            core.send_candidate(p)?;
             core.send_wheels(p)?;
             match ws.wait_and_process_once(|_| CallbackProgression::Continue) {
                 Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => break,
@@ -292,6 +296,9 @@ impl Core {
             if let Some(d) = c.decisions().iter().find(|d| d.agent == self.index) {
                 rebuilt |= self.nav.apply(d)?.map_rebuilt;
             }
+            // A later round than asked for also answers the open candidate: this agent was
+            // behind (restarted, or missed by the coordinator) and counted as standing in
+            // the rounds it missed; it goes on from the round that was decided.
             if self.outstanding.is_some_and(|r| r <= c.round) {
                 self.outstanding = None;
             }
@@ -337,13 +344,30 @@ impl Core {
                 self.publish_map(p)?;
             }
         }
-        if self.outstanding.is_none() {
-            let round = self.last_commit + 1;
-            let cand = self.nav.candidate(round);
-            p.candidates.send(cand)?;
-            self.outstanding = Some(round);
-        }
+        self.candidate_due = true;
         self.wheel_due = Some(o.period + 1);
+        Ok(())
+    }
+
+    /// Publishes the candidate for round `last commit + 1` if one is due and none is open.
+    fn send_candidate(&mut self, p: &Ports) -> Result<(), AgentError> {
+        if !self.candidate_due || self.outstanding.is_some() {
+            return Ok(());
+        }
+        self.candidate_due = false;
+        // In lockstep round r+1 is decided between period r's odometry and period r+1's wheel
+        // command, for every agent, so the period names the round; a restarted agent gets it
+        // right at once. In realtime rounds run at their own pace: ask for the next one.
+        let round = match (self.clock, self.last_period) {
+            (ClockMode::Lockstep, Some(period)) => period + 1,
+            _ => self.last_commit + 1,
+        };
+        if round <= self.last_commit {
+            return Ok(()); // decided without this agent; it stood still
+        }
+        let cand = self.nav.candidate(round);
+        p.candidates.send(cand)?;
+        self.outstanding = Some(round);
         Ok(())
     }
 

@@ -67,8 +67,9 @@
 //! # Cost
 //!
 //! [`Resolver::new`] sizes every buffer for the grid and the agent count; a round then runs in
-//! `O(n log n)` for `n` agents (one in-place sort) with generation stamps instead of clearing
-//! per-cell tables, and allocates nothing (the caller's `out` keeps its capacity).
+//! `O(n log n)` for `n` agents (one in-place sort; the type (c) check adds `O(n)` per head-on
+//! agent) with generation stamps instead of clearing per-cell tables, and allocates nothing
+//! (the caller's `out` keeps its capacity).
 
 mod resolve;
 #[cfg(test)]

@@ -166,9 +166,9 @@ impl Resolver {
             let c = self.order[k] as usize;
             self.cross(c, rows, out);
         }
-        for i in 0..n {
+        for (i, o) in out.iter_mut().enumerate() {
             if self.requests[i].stage == Stage::HeadOn && self.meets_third(i, n) {
-                out[i].kind = ConflictKind::Combined;
+                o.kind = ConflictKind::Combined;
             }
         }
     }

@@ -215,7 +215,8 @@ mod tests {
             2.0 * r.body_radius_m <= r.cell_size_m,
             "default body fits in a cell"
         );
-        assert!((r.max_speed_cells_s() - 3.5).abs() < 1e-9);
+        // 20 rad/s * 21 mm / 16 cm.
+        assert!((r.max_speed_cells_s() - 2.625).abs() < 1e-9);
         assert_eq!(RestartConfig::default().sim.policy, RestartPolicy::Never);
         assert_eq!(SimParams::default().clock, ClockMode::Lockstep);
         assert_eq!(CoordinatorParams::default().fsync, FsyncPolicy::EveryRecord);

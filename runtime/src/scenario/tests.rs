@@ -321,7 +321,7 @@ fn parameter_errors() {
         matches!(&e, ScenarioError::InvalidParameter { key, .. } if key == "robot.ticks_per_rev"),
         "{e}"
     );
-    let e = parse(&format!("{BASE}[robot]\nbody_radius_m = 0.07\n")).unwrap_err();
+    let e = parse(&format!("{BASE}[robot]\nbody_radius_m = 0.09\n")).unwrap_err();
     assert!(
         matches!(&e, ScenarioError::InvalidParameter { key, .. } if key == "robot.body_radius_m"),
         "{e}"

@@ -95,6 +95,9 @@ struct Slot {
     child: Option<Child>,
     tracker: RestartTracker,
     restart_at: Option<Instant>,
+    /// Restarted, `Restarted` not yet announced: that waits until the new process is up, so
+    /// that peers reacting to it (the sim resends odometry) find its ports.
+    announce: std::cell::Cell<bool>,
 }
 
 struct Ports {
@@ -205,6 +208,7 @@ fn specs(opts: &RunOptions, scenario: &Scenario, dir: &Path) -> Vec<Slot> {
             child: None,
             tracker: RestartTracker::new(rule),
             restart_at: None,
+            announce: std::cell::Cell::new(false),
         });
     };
     add(Role::Sim, 0, "hnav-sim");
@@ -269,7 +273,9 @@ fn supervise(
     let ws_err = |e: &dyn std::fmt::Debug| RunError::WaitSet(format!("{e:?}"));
     loop {
         let ws = transport.waitset()?;
-        let mut guards = Vec::new();
+        let mut guards = vec![ws
+            .attach_notification(ports.ready.listener())
+            .map_err(|e| ws_err(&e))?];
         for s in slots.iter() {
             if let Some(c) = &s.child {
                 guards.push(ws.attach_notification(c.exit_fd()).map_err(|e| ws_err(&e))?);
@@ -277,6 +283,7 @@ fn supervise(
         }
         let mut exited = false;
         let end = loop {
+            announce_restarts(ports, slots)?;
             let mut last = None;
             ports.progress.take_wakeup()?;
             ports.progress.drain(|p| last = Some(*p))?;
@@ -430,6 +437,23 @@ fn reap_and_restart(
             let child = Child::spawn(&spec)?;
             tracing::info!(node = node_name(spec.role, spec.index), pid = child.pid(), "restarted");
             s.child = Some(child);
+            s.announce.set(true);
+        }
+    }
+    Ok(())
+}
+
+/// Publishes `Restarted` for every restarted process that has announced itself up.
+fn announce_restarts(ports: &Ports, slots: &[Slot]) -> Result<(), RunError> {
+    ports.ready.take_wakeup()?;
+    let mut up = Vec::new();
+    ports.ready.drain(|l| up.push((l.role, l.index)))?;
+    for (role, index) in up {
+        let slot = slots
+            .iter()
+            .find(|s| s.announce.get() && s.spec.role as u8 == role && s.spec.index == index);
+        if let Some(s) = slot {
+            s.announce.set(false);
             ports.life.send(event(
                 s.spec.role,
                 s.spec.index,

@@ -1,0 +1,187 @@
+//! Fault injection on whole swarms: the supervisor SIGKILLs a process mid-run (the scenario's
+//! `[[faults]]`), restarts it, and the run still ends with every robot on its goal.
+//!
+//! In its own test binary because it SIGKILLs processes.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use hnav_runtime::consensus_log::{read_log, Record};
+use hnav_runtime::msg::Commit;
+use hnav_runtime::topics;
+use hnav_runtime::transport::{RunId, Transport};
+use hnav_tests::swarm::{repo_root, verify_log, SwarmRun};
+use hnav_tests::TestRun;
+use iceoryx2::prelude::CallbackProgression;
+
+const RUN_TIMEOUT: Duration = Duration::from_secs(600);
+
+/// The 8-agent MovingAI scenario with a fault appended (the map path made absolute, so the
+/// scenario can live in a temporary directory).
+fn scenario_with_fault(dir: &Path, fault: &str) -> std::path::PathBuf {
+    let root = repo_root();
+    let text = std::fs::read_to_string(root.join("scenarios/random-32-32-10.toml")).unwrap();
+    let map = root.join("maps/random-32-32-10.map");
+    let text = text.replace(
+        "file = \"../maps/random-32-32-10.map\"",
+        &format!("file = {:?}", map.display().to_string()),
+    );
+    let path = dir.join("scenario.toml");
+    std::fs::write(&path, format!("{text}\n{fault}\n")).unwrap();
+    path
+}
+
+/// Every commit seen on the run's commit topic, by round, recorded by a thread of the test.
+struct Observer {
+    seen: Arc<Mutex<BTreeMap<u64, Commit>>>,
+    stop: Arc<AtomicBool>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Observer {
+    fn start(run: &RunId, agents: usize) -> Observer {
+        let seen = Arc::new(Mutex::new(BTreeMap::new()));
+        let stop = Arc::new(AtomicBool::new(false));
+        let (s2, st2, run) = (seen.clone(), stop.clone(), run.clone());
+        let (ready_tx, ready_rx) = std::sync::mpsc::channel();
+        let thread = std::thread::spawn(move || {
+            let t = Transport::builder(&run)
+                .node_name("observer")
+                .create()
+                .unwrap();
+            let rx = t
+                .receiver::<Commit>(topics::COMMIT, topics::commit_qos(agents))
+                .unwrap();
+            let ws = t.waitset().unwrap();
+            let _g = ws.attach_notification(rx.listener()).unwrap();
+            ready_tx.send(()).unwrap();
+            while !st2.load(Ordering::Relaxed) {
+                let _ = rx.take_wakeup();
+                while let Ok(Some(s)) = rx.receive() {
+                    let c = *s.payload();
+                    let mut m = s2.lock().unwrap();
+                    if let Some(old) = m.insert(c.round, c) {
+                        assert_eq!(old, c, "round {} committed twice, differently", c.round);
+                    }
+                }
+                let _ = ws.wait_and_process_once_with_timeout(
+                    |_| CallbackProgression::Continue,
+                    Duration::from_millis(100),
+                );
+            }
+        });
+        ready_rx
+            .recv_timeout(Duration::from_secs(30))
+            .expect("observer up");
+        Observer {
+            seen,
+            stop,
+            thread: Some(thread),
+        }
+    }
+
+    fn finish(mut self) -> BTreeMap<u64, Commit> {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            t.join().expect("observer thread");
+        }
+        std::mem::take(&mut *self.seen.lock().unwrap())
+    }
+}
+
+fn run_with_fault(tag: &str, fault: &str) -> (SwarmRun, BTreeMap<u64, Commit>, TestRun) {
+    let tmp = tempfile::tempdir().unwrap().keep();
+    let scenario = scenario_with_fault(&tmp, fault);
+    let mut run = TestRun::new(tag);
+    // The observer joins before the supervisor starts anything, so it sees every commit.
+    let observer = Observer::start(&run.run, 8);
+    let mut swarm = SwarmRun::start(
+        &mut run,
+        &scenario,
+        &tmp.join("out"),
+        &tmp.join("runs"),
+        &["--mode", "lockstep"],
+    )
+    .expect("hnav run starts");
+    let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
+    let seen = observer.finish();
+    assert!(
+        status.success(),
+        "run failed: {status}\n{}",
+        swarm.log_tails()
+    );
+    (swarm, seen, run)
+}
+
+#[test]
+fn a_killed_coordinator_restarts_from_its_log_and_loses_no_commit() {
+    let (swarm, seen, _run) = run_with_fault(
+        "killcoord",
+        "[coordinator]\nfsync = \"every-record\"\n\n[[faults]]\nat_round = 400\naction = \"kill\"\nrole = \"coordinator\"\n",
+    );
+    let log = swarm.dir.join("log");
+    let (ok, report) = verify_log(&log);
+    assert!(ok, "log does not verify after the kill:\n{report}");
+    let records = read_log(&log).unwrap().records;
+    let logged: BTreeMap<u64, Commit> = records
+        .iter()
+        .filter_map(|r| match r {
+            Record::Round(rec) => Some((rec.round, rec.commit())),
+            _ => None,
+        })
+        .collect();
+    assert!(
+        seen.len() > 400,
+        "the observer saw only {} commits",
+        seen.len()
+    );
+    for (round, commit) in &seen {
+        assert_eq!(
+            logged.get(round),
+            Some(commit),
+            "commit of round {round} was received but is not in the log as sent"
+        );
+    }
+    let restarted = swarm.log_tails().contains("resumed from the consensus log");
+    let coord_log =
+        std::fs::read_to_string(swarm.dir.join("logs/coordinator.log")).unwrap_or_default();
+    assert!(
+        restarted || coord_log.contains("resumed from the consensus log"),
+        "the coordinator was not restarted from its log:\n{coord_log}"
+    );
+    let s = swarm.summary().unwrap();
+    for a in s["agents"].as_array().unwrap() {
+        assert_eq!(a["reached_goal"], true, "{a}");
+    }
+    assert_eq!(s["collisions"], 0, "{s}");
+    println!(
+        "{} commits observed, {} rounds logged, all present",
+        seen.len(),
+        logged.len()
+    );
+}
+
+#[test]
+fn a_killed_agent_resumes_from_its_checkpoint_and_arrives() {
+    let (swarm, _seen, _run) = run_with_fault(
+        "killagent",
+        "[[faults]]\nat_round = 300\naction = \"kill\"\nrole = \"agent\"\nindex = 1\n",
+    );
+    let s = swarm.summary().unwrap();
+    for a in s["agents"].as_array().unwrap() {
+        assert_eq!(a["reached_goal"], true, "{a}\n{}", swarm.log_tails());
+    }
+    assert_eq!(s["collisions"], 0, "{s}");
+    let records = read_log(swarm.dir.join("log")).unwrap().records;
+    let lifecycle = records
+        .iter()
+        .filter(|r| matches!(r, Record::Lifecycle(l) if l.index == 1))
+        .count();
+    assert!(
+        lifecycle >= 2,
+        "agent 1's death and restart are not in the log"
+    );
+}
