@@ -118,3 +118,52 @@ pub fn verify_log(dir: &Path) -> (bool, String) {
         Err(e) => (false, e.to_string()),
     }
 }
+
+/// A scenario of `agents` robots on the MovingAI map `map` (absolute path), each with a
+/// seeded random start and a goal whose octile shortest path (no corner cutting) is
+/// `min_len..=max_len` cells long, all starts and goals distinct, at `speed` cells/s. Written
+/// to `dir/scenario.toml`; returns its path.
+pub fn generated_scenario(
+    dir: &Path,
+    map: &Path,
+    agents: usize,
+    seed: u64,
+    (min_len, max_len): (f64, f64),
+    speed: f64,
+) -> PathBuf {
+    use hnav_runtime::grid::movingai::read_map_file;
+    use hnav_runtime::grid::shortest::octile_shortest_path_len;
+    use hnav_runtime::grid::{Cell, CornerCutting};
+    use hnav_runtime::scenario::SplitMix64;
+
+    let grid = read_map_file(map).expect("a readable map");
+    let free: Vec<Cell> = grid.passable_cells().collect();
+    let mut rng = SplitMix64::new(seed);
+    let mut pick = || free[(rng.next_u64() % free.len() as u64) as usize];
+    let mut used = std::collections::HashSet::new();
+    let mut text = format!(
+        "name = \"generated-{agents}\"\n\n[map]\nfile = {:?}\ncorner_cutting = false\n\n[sim]\nseed = {seed}\n\n[coordinator]\ntime_limit_s = 300\n",
+        map.display().to_string()
+    );
+    let mut n = 0;
+    while n < agents {
+        let (s, g) = (pick(), pick());
+        if used.contains(&s) || used.contains(&g) || s == g {
+            continue;
+        }
+        match octile_shortest_path_len(&grid, s, g, CornerCutting::Forbidden) {
+            Some(len) if (min_len..=max_len).contains(&len) => {}
+            _ => continue,
+        }
+        used.insert(s);
+        used.insert(g);
+        text += &format!(
+            "\n[[agents]]\nstart = [{}, {}]\ngoal = [{}, {}]\nspeed = {speed}\n",
+            s.x, s.y, g.x, g.y
+        );
+        n += 1;
+    }
+    let path = dir.join("scenario.toml");
+    std::fs::write(&path, text).expect("scenario written");
+    path
+}
