@@ -244,7 +244,7 @@ impl Navigator {
     /// Rebuilds the map toward `target` and forgets the visited cells (a new climb).
     fn retarget(&mut self, target: Cell) -> Result<(), Error> {
         self.target = target;
-        self.map = NeuralMap::new(&self.grid, self.map.options().clone())?;
+        self.map = NeuralMap::new(&self.grid, *self.map.options())?;
         self.report = self.map.build(target, StopRule::FullActivation)?;
         self.walker = Walker::new(self.grid.width(), self.grid.height(), self.next);
         self.mask = DirectionMask::default();

@@ -39,6 +39,9 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Decision-round latency (all candidates in -> commit at every agent) against a real
+    /// hnav-coordinator for 1..128 agents; with --faults, SIGKILL -> Down and rejoin latency.
+    Round(hnav_bench::round::RoundArgs),
 }
 
 #[derive(Debug, Args)]
@@ -218,6 +221,7 @@ fn main() -> std::process::ExitCode {
             hnav_bench::neural_map::run(quick);
             Ok(())
         }
+        Command::Round(args) => hnav_bench::round::main(args),
     };
     match outcome {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -32,8 +32,8 @@
 
 #![warn(missing_docs)]
 
-pub mod consensus_log;
 pub mod conflict;
+pub mod consensus_log;
 pub mod error;
 pub mod experiment;
 pub mod planner;

@@ -207,6 +207,9 @@ impl<'t> CoordinatorProcess<'t> {
             .handshake(self.transport, resume, START_TIMEOUT)?;
         let (p, st) = (&self.ports, &mut self.state);
         if started == StartOutcome::Stopped {
+            if !st.ended {
+                st.end(EndReason::Stopped)?;
+            }
             return Ok(st.outcome());
         }
         if let Some(rec) = &st.last_record {
@@ -323,9 +326,9 @@ impl State {
                 *l = ev == LifecycleEvent::Restarted;
             }
         }
-        if role == Role::Agent && (index as usize) < self.restarts.len() {
-            if ev == LifecycleEvent::Restarted {
-                self.restarts[index as usize] += 1;
+        if role == Role::Agent && ev == LifecycleEvent::Restarted {
+            if let Some(r) = self.restarts.get_mut(index as usize) {
+                *r += 1;
             }
         }
         if !self.ended {
@@ -357,7 +360,11 @@ impl State {
             let c = *s.payload();
             if !self.arbiter.valid(&c) {
                 self.dropped += 1;
-                tracing::warn!(agent = c.agent, round = c.round, "malformed candidate dropped");
+                tracing::warn!(
+                    agent = c.agent,
+                    round = c.round,
+                    "malformed candidate dropped"
+                );
                 continue;
             }
             let i = c.agent as usize;

@@ -72,7 +72,9 @@ impl FromStr for Mode {
         match s {
             "lockstep" => Ok(Mode(ClockMode::Lockstep)),
             "realtime" => Ok(Mode(ClockMode::Realtime)),
-            other => Err(format!("unknown mode {other:?}: expected lockstep or realtime")),
+            other => Err(format!(
+                "unknown mode {other:?}: expected lockstep or realtime"
+            )),
         }
     }
 }
@@ -134,6 +136,23 @@ impl ProcessArgs {
             a.push("--resume".into());
         }
         a
+    }
+}
+
+/// The `main` of a process binary: sets up logging, parses the command line and runs `run`;
+/// an error is printed as `NAME: error` and exits 1.
+pub fn process_main<A: clap::Parser>(
+    name: &str,
+    run: impl FnOnce(&A) -> Result<(), Box<dyn std::error::Error>>,
+) -> std::process::ExitCode {
+    crate::logging::init();
+    let args = A::parse();
+    match run(&args) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{name}: {e}");
+            std::process::ExitCode::FAILURE
+        }
     }
 }
 
@@ -216,7 +235,8 @@ impl LifecyclePorts {
         self.events.take_wakeup()?;
         let mut stop = false;
         self.events.drain(|l| {
-            if let (Some(role), Some(ev)) = (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
+            if let (Some(role), Some(ev)) =
+                (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
             {
                 stop |= ev == LifecycleEvent::Stop;
                 f(role, l.index, ev);
@@ -260,8 +280,7 @@ impl LifecyclePorts {
                     format!("no Start from the supervisor within {timeout:?}"),
                 ));
             }
-            match ws.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, left)
-            {
+            match ws.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, left) {
                 Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
                     return Ok(StartOutcome::Stopped)
                 }

@@ -43,7 +43,7 @@ fn check_demo_writes_report() {
     )
     .unwrap();
     assert_eq!(json["name"], "demo");
-    assert_eq!(json["agents"].as_array().map(Vec::len), Some(4));
+    assert_eq!(json["agents"].as_array().map(Vec::len), Some(6));
     assert!(json["agents"][0]["shortest_path_len"].as_f64().is_some());
 }
 

@@ -234,15 +234,20 @@ impl<'t> SimProcess<'t> {
                 _ => {}
             }
         })?;
-        // A restarted agent needs an odometry reading before it can command its wheels; the
-        // last one went out before it subscribed. Send it again and wait for the agent: in
-        // lockstep its robot counts from this period on.
+        // A restarted agent needs an odometry reading before it can command its wheels, and
+        // the last one may have gone out before it subscribed: send it again and wait for the
+        // agent from this period on. One that has already rejoined (its first fresh command
+        // came in before the event) needs nothing, and its command must not be forgotten.
         if let Some(last) = self.period.checked_sub(1) {
             for i in restarted {
-                if let (Some(o), Some(tx)) = (self.world.odometry(i, last), self.odom.get(i as usize)) {
+                let rejoined = self.live.get(i as usize).copied().unwrap_or(true);
+                if let (false, Some(o), Some(tx)) = (
+                    rejoined,
+                    self.world.odometry(i, last),
+                    self.odom.get(i as usize),
+                ) {
                     tx.send(o)?;
                     self.live[i as usize] = true;
-                    self.have[i as usize] = false;
                 }
             }
         }

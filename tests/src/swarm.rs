@@ -167,3 +167,35 @@ pub fn generated_scenario(
     std::fs::write(&path, text).expect("scenario written");
     path
 }
+
+/// Runs `hnav ps --json` against the registry in `registry` until `accept` likes a run of the
+/// output or `timeout` passes (the supervisor registers its run right after spawning).
+pub fn wait_for_ps(
+    registry: &Path,
+    run_id: &str,
+    timeout: Duration,
+    accept: impl Fn(&serde_json::Value) -> bool,
+) -> Result<serde_json::Value, String> {
+    let deadline = std::time::Instant::now() + timeout;
+    let mut last = String::new();
+    while std::time::Instant::now() < deadline {
+        let out = std::process::Command::new(workspace_bin("hnav"))
+            .args(["ps", "--json"])
+            .env("HNAV_RUNS_DIR", registry)
+            .output()
+            .map_err(|e| e.to_string())?;
+        last = String::from_utf8_lossy(&out.stdout).to_string();
+        if let Ok(v) = serde_json::from_str::<serde_json::Value>(&last) {
+            let found = v["runs"]
+                .as_array()
+                .and_then(|runs| runs.iter().find(|r| r["run_id"] == run_id).cloned());
+            if let Some(run) = found.filter(|r| accept(r)) {
+                return Ok(run);
+            }
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    Err(format!(
+        "run {run_id} not listed as expected within {timeout:?}; last output:\n{last}"
+    ))
+}

@@ -14,7 +14,11 @@ fn run_once(tag: &str, dir: &std::path::Path, registry: &std::path::Path) -> Swa
     let mut swarm = SwarmRun::start(&mut run, &scenario, dir, registry, &["--mode", "lockstep"])
         .expect("hnav run starts");
     let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
-    assert!(status.success(), "hnav run failed: {status}\n{}", swarm.log_tails());
+    assert!(
+        status.success(),
+        "hnav run failed: {status}\n{}",
+        swarm.log_tails()
+    );
     drop(run);
     swarm
 }
@@ -43,7 +47,16 @@ fn eight_agents_lockstep_reach_their_goals_and_replay_byte_for_byte() {
     let seg = "log/seg-00000000.hlog";
     let a = std::fs::read(first.dir.join(seg)).unwrap();
     let b = std::fs::read(second.dir.join(seg)).unwrap();
-    assert!(a.len() > 1000, "a suspiciously short log: {} bytes", a.len());
-    assert!(a == b, "the two lockstep logs differ ({} vs {} bytes)", a.len(), b.len());
+    assert!(
+        a.len() > 1000,
+        "a suspiciously short log: {} bytes",
+        a.len()
+    );
+    assert!(
+        a == b,
+        "the two lockstep logs differ ({} vs {} bytes)",
+        a.len(),
+        b.len()
+    );
     println!("log {} bytes, summary {s}", a.len());
 }

@@ -185,3 +185,46 @@ fn a_killed_agent_resumes_from_its_checkpoint_and_arrives() {
         "agent 1's death and restart are not in the log"
     );
 }
+
+#[test]
+fn sigint_stops_the_run_politely_and_leaves_nothing_behind() {
+    use hnav_tests::swarm::wait_for_ps;
+    use nix::sys::signal::Signal;
+    let tmp = tempfile::tempdir().unwrap();
+    let mut run = TestRun::new("sigint");
+    let scenario = repo_root().join("scenarios/random-32-32-10.toml");
+    let registry = tmp.path().join("runs");
+    let mut swarm = SwarmRun::start(
+        &mut run,
+        &scenario,
+        &tmp.path().join("out"),
+        &registry,
+        &["--mode", "realtime"],
+    )
+    .expect("hnav run starts");
+    let listed = wait_for_ps(&registry, run.run.as_str(), Duration::from_secs(60), |r| {
+        r["processes"].as_array().is_some_and(|p| p.len() == 10)
+    })
+    .expect("the run is listed");
+    let pids: Vec<i32> = listed["processes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["pid"].as_i64().unwrap() as i32)
+        .collect();
+    swarm.peer.signal(Signal::SIGINT).unwrap();
+    let status = swarm.finish(Duration::from_secs(60)).expect("stops");
+    assert_eq!(status.code(), Some(1), "interrupted runs exit 1: {status}");
+    let s = swarm.summary().expect("a summary is still written");
+    assert_eq!(s["end"], "stopped", "{s}");
+    for pid in pids {
+        let alive = nix::sys::signal::kill(nix::unistd::Pid::from_raw(pid), None).is_ok();
+        assert!(!alive, "process {pid} outlived the supervisor");
+    }
+    assert!(
+        hnav_runtime::transport::run_shm_files(&run.run).is_empty(),
+        "shared memory left behind"
+    );
+    let (ok, report) = verify_log(&swarm.dir.join("log"));
+    assert!(ok, "{report}");
+}

@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use hnav_tests::swarm::{generated_scenario, repo_root, verify_log, SwarmRun};
+use hnav_tests::swarm::{generated_scenario, repo_root, verify_log, wait_for_ps, SwarmRun};
 use hnav_tests::TestRun;
 
 #[test]
@@ -20,10 +20,37 @@ fn sixty_four_agents_on_a_128_map_finish_in_realtime() {
         &["--mode", "realtime"],
     )
     .expect("hnav run starts");
-    let status = swarm.finish(Duration::from_secs(600)).expect("hnav run ends");
+    // While it runs, `hnav ps` lists the run with all 66 processes running.
+    let listed = wait_for_ps(
+        &tmp.path().join("runs"),
+        run.run.as_str(),
+        Duration::from_secs(60),
+        |r| {
+            let procs = r["processes"].as_array().cloned().unwrap_or_default();
+            procs.len() == 66 && procs.iter().all(|p| p["state"] == "running")
+        },
+    )
+    .expect("hnav ps lists the run");
+    let procs = listed["processes"].as_array().unwrap();
+    for role in ["sim", "coordinator", "agent"] {
+        assert!(
+            procs.iter().any(|p| p["role"] == role),
+            "no {role} in {listed}"
+        );
+    }
+    assert!(procs
+        .iter()
+        .all(|p| p["pid"].as_u64().is_some_and(|pid| pid > 0)));
+    let status = swarm
+        .finish(Duration::from_secs(600))
+        .expect("hnav run ends");
     let s = swarm.summary().expect("a summary");
     println!("{s}");
-    assert!(status.success(), "run failed: {status}\n{s}\n{}", swarm.log_tails());
+    assert!(
+        status.success(),
+        "run failed: {status}\n{s}\n{}",
+        swarm.log_tails()
+    );
     let agents = s["agents"].as_array().unwrap();
     assert_eq!(agents.len(), 64);
     assert!(agents.iter().all(|a| a["reached_goal"] == true));

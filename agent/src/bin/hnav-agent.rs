@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use hnav_agent::process::AgentProcess;
-use hnav_runtime::launch::{node_name, ProcessArgs};
+use hnav_runtime::launch::{node_name, process_main, ProcessArgs};
 use hnav_runtime::msg::Role;
 use hnav_runtime::transport::Transport;
 
@@ -20,15 +20,7 @@ struct Args {
 }
 
 fn main() -> ExitCode {
-    hnav_runtime::logging::init();
-    let args = Args::parse();
-    match run(&args) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("hnav-agent {}: {e}", args.index);
-            ExitCode::FAILURE
-        }
-    }
+    process_main::<Args>("hnav-agent", run)
 }
 
 fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use hnav_coordinator::process::CoordinatorProcess;
-use hnav_runtime::launch::{node_name, ProcessArgs};
+use hnav_runtime::launch::{node_name, process_main, ProcessArgs};
 use hnav_runtime::msg::Role;
 use hnav_runtime::transport::Transport;
 
@@ -18,15 +18,7 @@ struct Args {
 }
 
 fn main() -> ExitCode {
-    hnav_runtime::logging::init();
-    let args = Args::parse();
-    match run(&args) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("hnav-coordinator: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    process_main::<Args>("hnav-coordinator", run)
 }
 
 fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {

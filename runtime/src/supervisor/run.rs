@@ -145,9 +145,12 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     let mut truth = None;
     ports.truth.drain(|t| truth = Some(*t))?;
     let time_limit = result.as_ref().is_ok_and(|e| *e == End::TimeLimit);
-    let _ = ports
-        .life
-        .send(event(Role::Sim, u32::from(time_limit), LifecycleEvent::Stop, 0));
+    let _ = ports.life.send(event(
+        Role::Sim,
+        u32::from(time_limit),
+        LifecycleEvent::Stop,
+        0,
+    ));
     let children: Vec<&Child> = slots.iter().filter_map(|s| s.child.as_ref()).collect();
     for s in stop_all(children, STOP_GRACE) {
         tracing::debug!(node = node_name(s.role, s.index), how = ?s.how, "stopped");
@@ -155,7 +158,10 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     drop(ports);
     drop(transport);
     if let Err(e) = purge_run(&run) {
-        tracing::warn!("shared memory of run {} not fully removed: {e}", run.as_str());
+        tracing::warn!(
+            "shared memory of run {} not fully removed: {e}",
+            run.as_str()
+        );
     }
     if let Err(e) = record.remove() {
         tracing::warn!("run registry entry not removed: {e}");
@@ -194,7 +200,9 @@ fn specs(opts: &RunOptions, scenario: &Scenario, dir: &Path) -> Vec<Slot> {
             Role::Coordinator => scenario.restart.coordinator,
             Role::Agent => scenario.restart.agent,
         };
-        let log = dir.join("logs").join(format!("{}.log", node_name(role, index)));
+        let log = dir
+            .join("logs")
+            .join(format!("{}.log", node_name(role, index)));
         let mut spec = ChildSpec::new(role, index, opts.bin_dir.join(program), log);
         let args: Vec<OsString> = opts.args.to_args();
         for a in args {
@@ -262,7 +270,9 @@ fn supervise(
         s.child = Some(Child::spawn(&s.spec)?);
     }
     update_record(record, slots);
-    wait_ready(transport, ports, slots)?;
+    if !wait_ready(transport, ports, slots)? {
+        return Ok(End::Signalled);
+    }
     ports
         .life
         .send(event(Role::Sim, 0, LifecycleEvent::Start, 0))?;
@@ -278,7 +288,10 @@ fn supervise(
             .map_err(|e| ws_err(&e))?];
         for s in slots.iter() {
             if let Some(c) = &s.child {
-                guards.push(ws.attach_notification(c.exit_fd()).map_err(|e| ws_err(&e))?);
+                guards.push(
+                    ws.attach_notification(c.exit_fd())
+                        .map_err(|e| ws_err(&e))?,
+                );
             }
         }
         let mut exited = false;
@@ -290,7 +303,10 @@ fn supervise(
             if let Some(p) = last {
                 if let Some(b) = &bar {
                     b.set_position(u64::from(p.at_goal));
-                    b.set_message(format!("round {}  conflicts {}  replans {}", p.round, p.conflicts, p.replans));
+                    b.set_message(format!(
+                        "round {}  conflicts {}  replans {}",
+                        p.round, p.conflicts, p.replans
+                    ));
                 }
                 fire_faults(scenario, slots, p.round, &mut faults_done);
                 if p.done == 1 {
@@ -339,8 +355,8 @@ fn supervise(
     }
 }
 
-/// Waits until every child has published `Up` on `ready`.
-fn wait_ready(transport: &Transport, ports: &Ports, slots: &[Slot]) -> Result<(), RunError> {
+/// Waits until every child has published `Up` on `ready`; `false` if a signal came first.
+fn wait_ready(transport: &Transport, ports: &Ports, slots: &[Slot]) -> Result<bool, RunError> {
     let mut up = vec![false; slots.len()];
     let ws = transport.waitset()?;
     let ws_err = |e: &dyn std::fmt::Debug| RunError::WaitSet(format!("{e:?}"));
@@ -361,7 +377,7 @@ fn wait_ready(transport: &Transport, ports: &Ports, slots: &[Slot]) -> Result<()
             }
         })?;
         if up.iter().all(|&u| u) {
-            return Ok(());
+            return Ok(true);
         }
         for s in slots {
             if let Some(exit) = s.child.as_ref().and_then(|c| c.try_reap()) {
@@ -390,7 +406,7 @@ fn wait_ready(transport: &Transport, ports: &Ports, slots: &[Slot]) -> Result<()
             left.min(Duration::from_millis(200)),
         ) {
             Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
-                return Err(RunError::Startup("interrupted".into()))
+                return Ok(false)
             }
             Ok(_) => {}
             Err(e) => return Err(ws_err(&e)),
@@ -413,9 +429,12 @@ fn reap_and_restart(
         s.child = None;
         let (role, index) = (s.spec.role, s.spec.index);
         tracing::warn!(node = node_name(role, index), %exit, "process exited");
-        ports
-            .life
-            .send(event(role, index, LifecycleEvent::Down, s.tracker.restarts()))?;
+        ports.life.send(event(
+            role,
+            index,
+            LifecycleEvent::Down,
+            s.tracker.restarts(),
+        ))?;
         match s.tracker.on_exit(&exit) {
             RestartDecision::Restart { after } => s.restart_at = Some(Instant::now() + after),
             RestartDecision::GiveUp(why) => {
@@ -435,7 +454,11 @@ fn reap_and_restart(
             s.restart_at = None;
             let spec = s.spec.clone().arg("--resume");
             let child = Child::spawn(&spec)?;
-            tracing::info!(node = node_name(spec.role, spec.index), pid = child.pid(), "restarted");
+            tracing::info!(
+                node = node_name(spec.role, spec.index),
+                pid = child.pid(),
+                "restarted"
+            );
             s.child = Some(child);
             s.announce.set(true);
         }
@@ -486,7 +509,12 @@ fn fire_faults(scenario: &Scenario, slots: &[Slot], round: u64, done: &mut [bool
             .find(|s| s.spec.role == role && s.spec.index == index)
             .and_then(|s| s.child.as_ref());
         if let Some(c) = target {
-            tracing::warn!(node = node_name(role, index), ?signal, round, "fault injected");
+            tracing::warn!(
+                node = node_name(role, index),
+                ?signal,
+                round,
+                "fault injected"
+            );
             if let Err(e) = c.signal(signal) {
                 tracing::warn!("fault not injected: {e}");
             }
@@ -499,9 +527,9 @@ fn progress_bar(show: bool, agents: usize) -> Option<indicatif::ProgressBar> {
         return None;
     }
     let bar = indicatif::ProgressBar::new(agents as u64);
-    if let Ok(style) =
-        indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} at goal  {msg}")
-    {
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{elapsed_precise} [{bar:30}] {pos}/{len} at goal  {msg}",
+    ) {
         bar.set_style(style.progress_chars("=> "));
     }
     Some(bar)

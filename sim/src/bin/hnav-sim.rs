@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use clap::Parser;
-use hnav_runtime::launch::{node_name, LifecyclePorts, ProcessArgs, StartOutcome};
+use hnav_runtime::launch::{node_name, process_main, LifecyclePorts, ProcessArgs, StartOutcome};
 use hnav_runtime::msg::Role;
 use hnav_runtime::transport::Transport;
 use hnav_sim::process::SimProcess;
@@ -25,15 +25,7 @@ struct Args {
 }
 
 fn main() -> ExitCode {
-    hnav_runtime::logging::init();
-    let args = Args::parse();
-    match run(&args) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("hnav-sim: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    process_main::<Args>("hnav-sim", run)
 }
 
 fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {

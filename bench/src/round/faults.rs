@@ -1,0 +1,352 @@
+//! `hnav-bench round --faults`: how fast a dead agent is noticed, and how fast a restarted
+//! one is back in the round loop.
+//!
+//! **Detection** (no coordinator process needed): a child (`sleep 60`) is spawned with the
+//! supervisor's own [`Child::spawn`] (its own process group, a pidfd exit descriptor), the
+//! descriptor is attached to a WaitSet, and the child is sent SIGKILL. Measured from just
+//! before `kill(2)`:
+//!
+//! - (a) the WaitSet wakes on the exit descriptor;
+//! - (b1) the supervisor's reaction is done: reaped (`try_reap`, as `hnav run` does) and
+//!   `Lifecycle { Down }` published on `lifecycle`;
+//! - (b2) a subscriber in another thread, blocked in its own WaitSet as the coordinator is,
+//!   has taken that `Down` sample.
+//!
+//! Not included: the dead node's iceoryx2 clean-up (`hnav run` does it after publishing
+//! `Down`; `sleep` has no node anyway) and the restart policy's backoff.
+//!
+//! **Rejoin** (c), with a real `hnav-coordinator` and 8 agents: agent 3 is reported `Down`
+//! and sits out a few rounds; then its new ports are opened (what a restarted process does
+//! before it announces itself), and the clock starts: `Restarted` is published, agent 3's
+//! candidate (flagged `RESTARTED`) is sent at once, the other 7 follow as in any round, and
+//! the clock stops when agent 3's subscriber takes the first commit with a decision for it.
+//! Not included: the restarted process's start-up (exec, opening its ports, building its
+//! neural map) and the supervisor's restart backoff.
+
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use anyhow::{anyhow, bail, Context, Result};
+use iceoryx2::prelude::CallbackProgression;
+use iceoryx2::waitset::WaitSetRunResult;
+
+use hnav_runtime::launch::now_ns;
+use hnav_runtime::msg::{Lifecycle, LifecycleEvent, Role};
+use hnav_runtime::scenario::FsyncPolicy;
+use hnav_runtime::supervisor::child::{Child, ChildSpec, ExitInfo, Signal};
+use hnav_runtime::supervisor::exit_fd::WatchMode;
+use hnav_runtime::topics;
+use hnav_runtime::transport::{purge_run, RunId, Sender, Transport};
+
+use super::report::{Dist, FaultPoint};
+use super::session::with_coordinator;
+use super::swarm::keep_going;
+
+/// Agents of the rejoin measurement.
+pub const REJOIN_AGENTS: usize = 8;
+/// The agent that dies and comes back.
+pub const VICTIM: usize = 3;
+/// Rounds played before the first rejoin trial.
+const REJOIN_WARMUP: u64 = 50;
+/// Rounds played without the victim in each trial.
+const DOWN_ROUNDS: u64 = 3;
+/// Rounds the victim may take to get a decision before the trial fails.
+const MAX_REJOIN_ROUNDS: u64 = 10;
+/// Bound on every single wait of a detection trial.
+const WAIT: Duration = Duration::from_secs(5);
+
+/// Runs every fault measurement: detection (`trials` kills), then rejoin per fsync policy.
+pub fn run(
+    program: &Path,
+    trials: usize,
+    fsync: &[FsyncPolicy],
+    mut each: impl FnMut(&FaultPoint),
+) -> Result<Vec<FaultPoint>> {
+    let mut points = Vec::new();
+    eprintln!("fault detection: {trials} SIGKILLs of `sleep 60`");
+    let (mode, det) = detection(trials)?;
+    let how = match mode {
+        WatchMode::Pidfd => "pidfd",
+        _ => "waiter thread",
+    };
+    for (measure, label, samples) in [
+        (
+            "kill_to_wake",
+            format!("(a) SIGKILL -> supervisor WaitSet wakes ({how})"),
+            &det.wake,
+        ),
+        (
+            "kill_to_down_published",
+            "(b1) SIGKILL -> reaped, Down published".to_string(),
+            &det.published,
+        ),
+        (
+            "kill_to_down_received",
+            "(b2) SIGKILL -> Down taken by the coordinator's thread".to_string(),
+            &det.received,
+        ),
+    ] {
+        let p = FaultPoint {
+            measure,
+            label,
+            coordinator: None,
+            dist: Dist::from_ns(samples)?,
+        };
+        each(&p);
+        points.push(p);
+    }
+    for &policy in fsync {
+        eprintln!(
+            "rejoin: {REJOIN_AGENTS} agents, fsync {}: {trials} Down/Restarted trials of agent \
+             {VICTIM}",
+            super::layout::fsync_name(policy)
+        );
+        let (samples, late) = rejoin(program, policy, trials)?;
+        if late > 0 {
+            eprintln!(
+                "note: in {late} of {trials} trials agent {VICTIM}'s first candidate missed \
+                 the round and its decision came a round later"
+            );
+        }
+        let p = FaultPoint {
+            measure: "restarted_to_decision",
+            label: format!(
+                "(c) Restarted -> agent {VICTIM}'s decision ({REJOIN_AGENTS} agents, {})",
+                super::layout::fsync_name(policy)
+            ),
+            coordinator: Some((REJOIN_AGENTS, policy)),
+            dist: Dist::from_ns(&samples)?,
+        };
+        each(&p);
+        points.push(p);
+    }
+    Ok(points)
+}
+
+struct Detection {
+    wake: Vec<u64>,
+    published: Vec<u64>,
+    received: Vec<u64>,
+}
+
+fn ns(d: Duration) -> u64 {
+    u64::try_from(d.as_nanos()).unwrap_or(u64::MAX)
+}
+
+fn detection(trials: usize) -> Result<(WatchMode, Detection)> {
+    let run = RunId::unique("faults");
+    let dir = std::env::temp_dir().join(format!("hnav-bench-{}", run.as_str()));
+    let stop = AtomicBool::new(false);
+    let result: Result<(WatchMode, Detection)> = std::thread::scope(|s| {
+        let (ready_tx, ready_rx) = mpsc::channel();
+        let (down_tx, down_rx) = mpsc::channel();
+        let listener = std::thread::Builder::new()
+            .name("coordinator-stand-in".into())
+            .spawn_scoped(s, || listen(&run, ready_tx, down_tx, &stop))
+            .context("start the listener thread")?;
+        let measured = match ready_rx.recv_timeout(WAIT) {
+            Ok(()) => detect(&run, &dir, trials, &down_rx),
+            Err(_) => Err(anyhow!("the listener thread did not come up")),
+        };
+        stop.store(true, Ordering::Relaxed);
+        let listened = listener
+            .join()
+            .map_err(|_| anyhow!("the listener thread panicked"))?;
+        let out = measured?;
+        listened?;
+        Ok(out)
+    });
+    let purged = purge_run(&run);
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = result?;
+    purged.context("remove the run's shared memory")?;
+    Ok(out)
+}
+
+/// The coordinator's side: a `lifecycle` subscriber in a WaitSet; reports each `Down` with
+/// the instant its sample was taken.
+fn listen(
+    run: &RunId,
+    ready: mpsc::Sender<()>,
+    downs: mpsc::Sender<(u32, Instant)>,
+    stop: &AtomicBool,
+) -> Result<()> {
+    let transport = Transport::builder(run).node_name("coordinator").create()?;
+    let rx =
+        transport.receiver::<Lifecycle>(topics::LIFECYCLE, topics::lifecycle_qos(REJOIN_AGENTS))?;
+    let ws = transport.waitset()?;
+    let _g = ws
+        .attach_notification(rx.listener())
+        .map_err(|e| anyhow!("waitset: {e:?}"))?;
+    let _ = ready.send(());
+    while !stop.load(Ordering::Relaxed) {
+        match ws.wait_and_process_once_with_timeout(
+            |_| CallbackProgression::Continue,
+            Duration::from_millis(200),
+        ) {
+            Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => return Ok(()),
+            Ok(_) => {}
+            Err(e) => bail!("waitset: {e:?}"),
+        }
+        rx.take_wakeup()?;
+        while let Some(sample) = rx.receive()? {
+            let taken = Instant::now();
+            let l = *sample.payload();
+            if l.event == LifecycleEvent::Down as u8 {
+                let _ = downs.send((l.pid, taken));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn detect(
+    run: &RunId,
+    dir: &Path,
+    trials: usize,
+    downs: &mpsc::Receiver<(u32, Instant)>,
+) -> Result<(WatchMode, Detection)> {
+    let transport = Transport::builder(run).node_name("supervisor").create()?;
+    let life = transport.sender(topics::LIFECYCLE, topics::lifecycle_qos(REJOIN_AGENTS))?;
+    let spec = ChildSpec::new(Role::Agent, VICTIM as u32, "sleep", dir.join("sleep.log")).arg("60");
+    let mut det = Detection {
+        wake: Vec::with_capacity(trials),
+        published: Vec::with_capacity(trials),
+        received: Vec::with_capacity(trials),
+    };
+    let mut mode = WatchMode::Pidfd;
+    for trial in 0..trials {
+        let child = Child::spawn(&spec).context("start `sleep 60`")?;
+        mode = child.exit_fd().mode();
+        let (wake, published, received) = kill_once(&transport, &life, &child, downs)
+            .with_context(|| format!("trial {trial}"))?;
+        det.wake.push(wake);
+        det.published.push(published);
+        det.received.push(received);
+    }
+    Ok((mode, det))
+}
+
+/// Waits (bounded) until `pid` runs `sleep`, so the kill hits the program, not a half-started
+/// fork. Set-up only, outside the measurement: a short poll of `/proc`.
+fn wait_exec(pid: u32) -> Result<()> {
+    let comm = format!("/proc/{pid}/comm");
+    let deadline = Instant::now() + WAIT;
+    while Instant::now() < deadline {
+        if std::fs::read_to_string(&comm).is_ok_and(|c| c.trim_end() == "sleep") {
+            return Ok(());
+        }
+        std::thread::sleep(Duration::from_micros(200));
+    }
+    bail!("pid {pid} did not exec `sleep` within {WAIT:?}")
+}
+
+/// One SIGKILL; returns (a), (b1), (b2) in ns.
+fn kill_once(
+    transport: &Transport,
+    life: &Sender<Lifecycle>,
+    child: &Child,
+    downs: &mpsc::Receiver<(u32, Instant)>,
+) -> Result<(u64, u64, u64)> {
+    wait_exec(child.pid())?;
+    let ws = transport.waitset()?;
+    let guard = ws
+        .attach_notification(child.exit_fd())
+        .map_err(|e| anyhow!("waitset: {e:?}"))?;
+    let mut woke = None;
+    let killed = Instant::now();
+    child.signal(Signal::SIGKILL)?;
+    match ws.wait_and_process_once_with_timeout(
+        |id| {
+            if woke.is_none() && id.has_event_from(&guard) {
+                woke = Some(Instant::now());
+            }
+            CallbackProgression::Continue
+        },
+        WAIT,
+    ) {
+        Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
+            bail!("interrupted")
+        }
+        Ok(_) => {}
+        Err(e) => bail!("waitset: {e:?}"),
+    }
+    let woke = woke.ok_or_else(|| anyhow!("no exit of pid {} within {WAIT:?}", child.pid()))?;
+    drop(guard);
+    // What `hnav run` does on the wake-up: reap, then tell the others.
+    match child.try_reap() {
+        Some(ExitInfo::Signaled(Signal::SIGKILL)) => {}
+        other => bail!("pid {}: unexpected exit {other:?}", child.pid()),
+    }
+    life.send(Lifecycle {
+        time_ns: now_ns(),
+        pid: child.pid(),
+        index: VICTIM as u32,
+        role: Role::Agent as u8,
+        event: LifecycleEvent::Down as u8,
+        reserved: 0,
+        restarts: 0,
+    })?;
+    let published = Instant::now();
+    let received = loop {
+        let (pid, at) = downs
+            .recv_timeout(WAIT)
+            .map_err(|_| anyhow!("Down not received within {WAIT:?}"))?;
+        if pid == child.pid() {
+            break at;
+        }
+    };
+    Ok((
+        ns(woke - killed),
+        ns(published - killed),
+        ns(received - killed),
+    ))
+}
+
+/// (c): `trials` Down/Restarted cycles of agent [`VICTIM`] under a real coordinator; returns
+/// the latencies and how many trials needed more than one round.
+fn rejoin(program: &Path, fsync: FsyncPolicy, trials: usize) -> Result<(Vec<u64>, usize)> {
+    with_coordinator(program, REJOIN_AGENTS, fsync, |session, swarm| {
+        let coordinator = session.child();
+        swarm.play(coordinator, REJOIN_WARMUP, |_| Ok(()), keep_going)?;
+        let mut samples = Vec::with_capacity(trials);
+        let mut late = 0;
+        for trial in 0..trials {
+            swarm.kill(VICTIM);
+            session.publish(Role::Agent, VICTIM as u32, LifecycleEvent::Down)?;
+            swarm.play(coordinator, DOWN_ROUNDS, |_| Ok(()), keep_going)?;
+            swarm.restart(VICTIM)?;
+            let mut t0 = None;
+            let mut back = None;
+            swarm.play(
+                coordinator,
+                MAX_REJOIN_ROUNDS,
+                |round| {
+                    if t0.is_none() {
+                        t0 = Some((round, Instant::now()));
+                        session.publish(Role::Agent, VICTIM as u32, LifecycleEvent::Restarted)?;
+                    }
+                    Ok(())
+                },
+                |obs| match obs.got[VICTIM] {
+                    Some((at, true)) => {
+                        back = Some((obs.round, at));
+                        std::ops::ControlFlow::Break(())
+                    }
+                    _ => std::ops::ControlFlow::Continue(()),
+                },
+            )?;
+            let (Some((first, t0)), Some((round, at))) = (t0, back) else {
+                bail!(
+                    "trial {trial}: agent {VICTIM} got no decision within {MAX_REJOIN_ROUNDS} \
+                     rounds of Restarted"
+                );
+            };
+            late += usize::from(round != first);
+            samples.push(ns(at - t0));
+        }
+        Ok((samples, late))
+    })
+}

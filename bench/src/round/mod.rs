@@ -1,0 +1,223 @@
+//! `hnav-bench round`: the decision round's latency against a real `hnav-coordinator`, and
+//! (`--faults`) fault-detection and rejoin latency.
+//!
+//! ## Round latency
+//!
+//! For each swarm size and fsync policy: a scenario (an open 32 x 32 map, the agents of
+//! [`layout`], `[coordinator] fsync`, lockstep clock) is written to a temporary directory,
+//! the real `hnav-coordinator` next to this executable is started on it, and this process
+//! plays the supervisor's start-up handshake and all N agents: one candidate publisher and
+//! one commit subscriber per agent, as each real agent has.
+//!
+//! A round: every agent's candidate is sent through its own publisher; the clock starts just
+//! before the N-th `send` (publish + notify) is called; it stops when the last of the N commit
+//! subscribers has taken commit r, all N blocking in one WaitSet (no polling, no sleeps).
+//! The time therefore includes: the last candidate's publish and notification, the
+//! coordinator's wake-up and reading of the candidates, the
+//! conflict resolution ([`layout`]'s rounds have real crossing conflicts, no global
+//! replans), encoding and appending the round to the consensus log plus its `fdatasync`
+//! under `every-record`, publishing the commit to N subscribers and notifying N listeners,
+//! and this thread's wake-up and N takes. It excludes the agents' own work (neural map,
+//! wheel control), and the N subscribers are served by one thread instead of N processes.
+//! The commit is published only after its log record is written, so fsync sits on the path.
+//!
+//! ## Faults
+//!
+//! See [`faults`]: SIGKILL -> exit-descriptor wake-up -> `Down` published -> `Down` taken by
+//! another thread; `Restarted` -> the restarted agent's first decision.
+
+mod faults;
+mod layout;
+mod report;
+mod session;
+mod swarm;
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use clap::Args;
+
+use hnav_runtime::scenario::FsyncPolicy;
+
+use report::{Dist, RoundPoint};
+use swarm::keep_going;
+
+pub use layout::MAX_AGENTS;
+
+/// Measured rounds per point by default.
+pub const ROUNDS_FULL: u64 = 2000;
+/// Measured rounds per point with `--quick`.
+pub const ROUNDS_QUICK: u64 = 300;
+
+/// The command line of `hnav-bench round`.
+#[derive(Debug, Args)]
+pub struct RoundArgs {
+    /// Swarm sizes (comma-separated, 1 to 240 agents).
+    #[arg(long, value_delimiter = ',', value_name = "N",
+          default_values_t = [1usize, 8, 32, 128], conflicts_with = "faults")]
+    pub agents: Vec<usize>,
+    /// Measured rounds per point [default: 2000, 300 with --quick].
+    #[arg(long, value_name = "N", conflicts_with = "faults")]
+    pub rounds: Option<u64>,
+    /// Warm-up rounds per point, not measured.
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 100,
+        conflicts_with = "faults"
+    )]
+    pub warmup: u64,
+    /// 300 measured rounds per point instead of 2000.
+    #[arg(long)]
+    pub quick: bool,
+    /// The coordinator's fsync policies (every-record, batched, none; comma-separated).
+    #[arg(long, value_delimiter = ',', value_name = "POLICY",
+          default_values = ["every-record", "none"], value_parser = parse_fsync)]
+    pub fsync: Vec<FsyncPolicy>,
+    /// One JSON object per line instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Also write DIR/round.csv (or DIR/faults.csv); DIR is created if missing.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Measure fault detection (SIGKILL -> Down) and rejoin (Restarted -> decision) instead.
+    #[arg(long)]
+    pub faults: bool,
+    /// Trials per fault measurement.
+    #[arg(long, value_name = "N", default_value_t = 50, requires = "faults")]
+    pub trials: usize,
+}
+
+fn parse_fsync(s: &str) -> Result<FsyncPolicy, String> {
+    match s {
+        "every-record" => Ok(FsyncPolicy::EveryRecord),
+        "batched" => Ok(FsyncPolicy::Batched),
+        "none" => Ok(FsyncPolicy::None),
+        other => Err(format!(
+            "unknown fsync policy {other:?}: expected every-record, batched or none"
+        )),
+    }
+}
+
+/// Runs `hnav-bench round` with `args`, printing as it goes.
+pub fn main(args: RoundArgs) -> Result<()> {
+    if let Some(&n) = args.agents.iter().find(|&&n| n == 0 || n > MAX_AGENTS) {
+        bail!("--agents {n}: each swarm size must be 1 to {MAX_AGENTS}");
+    }
+    if args.fsync.is_empty() {
+        bail!("--fsync needs at least one policy");
+    }
+    if args.rounds == Some(0) {
+        bail!("--rounds must be at least 1");
+    }
+    if args.trials == 0 {
+        bail!("--trials must be at least 1");
+    }
+    let program = session::coordinator_binary()?;
+    if args.faults {
+        faults_cmd(&args, &program)
+    } else {
+        round_cmd(&args, &program)
+    }
+}
+
+fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
+    let rounds = args.rounds.unwrap_or(if args.quick {
+        ROUNDS_QUICK
+    } else {
+        ROUNDS_FULL
+    });
+    if !args.json {
+        println!(
+            "decision round: last of N candidates sent -> commit taken by all N agents' \
+             subscribers"
+        );
+        println!("{}", report::round_header());
+    }
+    let mut points = Vec::new();
+    for &agents in &args.agents {
+        for &fsync in &args.fsync {
+            eprintln!(
+                "round: {agents} agents, fsync {}: {} warm-up + {rounds} measured rounds",
+                layout::fsync_name(fsync),
+                args.warmup
+            );
+            let samples = session::with_coordinator(program, agents, fsync, |session, swarm| {
+                let coordinator = session.child();
+                if args.warmup > 0 {
+                    swarm.play(coordinator, args.warmup, |_| Ok(()), keep_going)?;
+                }
+                let mut all = Vec::with_capacity(rounds as usize);
+                let mut first = Vec::with_capacity(rounds as usize);
+                let ns = |d: std::time::Duration| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX);
+                swarm.play(
+                    coordinator,
+                    rounds,
+                    |_| Ok(()),
+                    |obs| {
+                        all.push(ns(obs.all_in - obs.sent));
+                        first.push(ns(obs.first_in - obs.sent));
+                        keep_going(obs)
+                    },
+                )?;
+                Ok((all, first))
+            })?;
+            let point = RoundPoint {
+                agents,
+                fsync,
+                dist: Dist::from_ns(&samples.0)?,
+                first: Dist::from_ns(&samples.1)?,
+            };
+            if args.json {
+                println!("{}", point.json());
+            } else {
+                println!("{}", point.row());
+            }
+            points.push(point);
+        }
+    }
+    if !args.json {
+        println!(
+            "(p50/p99/max: from just before the N-th candidate's send to the N-th commit \
+             taken; 1st: to the first commit taken, i.e. without the fan-out to N subscribers; \
+             includes \
+             the coordinator's wake-up, conflict resolution, consensus-log append and its \
+             fdatasync under every-record (log in {}), the commit's publish + N notifications, \
+             one thread taking the N commits; excludes the agents' planning)",
+            std::env::temp_dir().display()
+        );
+    }
+    if let Some(dir) = &args.out {
+        let path = report::write_round_csv(dir, &points)?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+fn faults_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
+    if !args.json {
+        println!("{}", report::fault_header());
+    }
+    let points = faults::run(program, args.trials, &args.fsync, |p| {
+        if args.json {
+            println!("{}", p.json());
+        } else {
+            println!("{}", p.row());
+        }
+    })?;
+    if !args.json {
+        println!(
+            "(a)/(b) from just before kill(2) of `sleep 60` spawned by the supervisor's Child; \
+             (b1) includes waitpid and the publish; the dead node's iceoryx2 clean-up is not \
+             included. (c) from publishing Restarted (the agent's ports already open) to its \
+             subscriber taking the first commit with its decision: includes the coordinator \
+             logging the lifecycle record and the round; excludes the restarted process's \
+             start-up and the restart backoff."
+        );
+    }
+    if let Some(dir) = &args.out {
+        let path = report::write_fault_csv(dir, &points)?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}

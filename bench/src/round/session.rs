@@ -1,0 +1,229 @@
+//! A real `hnav-coordinator` under a stand-in supervisor: scenario file, spawn, start-up
+//! handshake (`Up` on `ready`, `Start` on `lifecycle`), lifecycle events, polite stop, and
+//! removal of the run's shared memory.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use anyhow::{anyhow, bail, Context, Result};
+use iceoryx2::prelude::CallbackProgression;
+use iceoryx2::waitset::WaitSetRunResult;
+
+use hnav_runtime::launch::{now_ns, ProcessArgs};
+use hnav_runtime::msg::{Lifecycle, LifecycleEvent, Role};
+use hnav_runtime::scenario::FsyncPolicy;
+use hnav_runtime::supervisor::child::{Child, ChildSpec, ExitInfo, Signal};
+use hnav_runtime::topics;
+use hnav_runtime::transport::{purge_run, Receiver, RunId, Sender, Transport};
+
+use super::layout::Layout;
+use super::swarm::Swarm;
+
+/// How long the coordinator gets to announce itself.
+const STARTUP_TIMEOUT: Duration = Duration::from_secs(30);
+/// How long it gets to exit after `Stop` (and again after SIGKILL).
+const STOP_TIMEOUT: Duration = Duration::from_secs(10);
+/// Lines of the coordinator's log quoted in an error.
+const LOG_TAIL_LINES: usize = 12;
+
+/// The `hnav-coordinator` binary next to the running benchmark executable.
+pub fn coordinator_binary() -> Result<PathBuf> {
+    let exe = std::env::current_exe().context("locate the hnav-bench executable")?;
+    let dir = exe
+        .parent()
+        .ok_or_else(|| anyhow!("{} has no parent directory", exe.display()))?;
+    let program = dir.join("hnav-coordinator");
+    if !program.is_file() {
+        bail!(
+            "{} not found: build it next to hnav-bench (cargo build --release -p \
+             hnav-coordinator -p hnav-bench)",
+            program.display()
+        );
+    }
+    Ok(program)
+}
+
+/// A running coordinator and the supervisor's ports of its run.
+pub struct Session {
+    child: Child,
+    log_file: PathBuf,
+    ready: Receiver<Lifecycle>,
+    life: Sender<Lifecycle>,
+    transport: Transport,
+}
+
+impl Session {
+    /// The coordinator process (its exit descriptor wakes a WaitSet when it dies).
+    pub fn child(&self) -> &Child {
+        &self.child
+    }
+
+    /// Publishes a supervisor event on `lifecycle`, as `hnav run` does.
+    pub fn publish(&self, role: Role, index: u32, event: LifecycleEvent) -> Result<()> {
+        self.life
+            .send(Lifecycle {
+                time_ns: now_ns(),
+                pid: 0,
+                index,
+                role: role as u8,
+                event: event as u8,
+                reserved: 0,
+                restarts: 0,
+            })
+            .context("publish on lifecycle")?;
+        Ok(())
+    }
+
+    /// Waits for the coordinator's `Up` on `ready`, then publishes `Start`.
+    fn handshake(&self) -> Result<()> {
+        let ws = self.transport.waitset()?;
+        let ws_err = |e: &dyn std::fmt::Debug| anyhow!("waitset: {e:?}");
+        let _ready = ws
+            .attach_notification(self.ready.listener())
+            .map_err(|e| ws_err(&e))?;
+        let _exit = ws
+            .attach_notification(self.child.exit_fd())
+            .map_err(|e| ws_err(&e))?;
+        let deadline = Instant::now() + STARTUP_TIMEOUT;
+        loop {
+            self.ready.take_wakeup()?;
+            let mut up = false;
+            self.ready.drain(|l| {
+                up |= l.role == Role::Coordinator as u8 && l.event == LifecycleEvent::Up as u8
+            })?;
+            if up {
+                return self.publish(Role::Sim, 0, LifecycleEvent::Start);
+            }
+            if let Some(exit) = self.child.try_reap() {
+                bail!("hnav-coordinator exited during start-up ({exit})");
+            }
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                bail!("hnav-coordinator did not announce itself within {STARTUP_TIMEOUT:?}");
+            }
+            match ws.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, left) {
+                Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
+                    bail!("interrupted")
+                }
+                Ok(_) => {}
+                Err(e) => return Err(ws_err(&e)),
+            }
+        }
+    }
+
+    /// `Stop` on `lifecycle`, then waits for the exit (bounded; SIGKILL after the bound).
+    fn stop(&self) -> Result<()> {
+        // A coordinator that already died has no subscriber left: the send still succeeds.
+        self.publish(Role::Sim, 0, LifecycleEvent::Stop)?;
+        match self.child.wait(Some(STOP_TIMEOUT)) {
+            Some(ExitInfo::Exited(0)) => Ok(()),
+            Some(exit) => bail!("hnav-coordinator ended with {exit}"),
+            None => {
+                self.child.signal_group(Signal::SIGKILL)?;
+                let exit = self.child.wait(Some(STOP_TIMEOUT));
+                bail!(
+                    "hnav-coordinator did not exit within {STOP_TIMEOUT:?} of Stop; killed ({})",
+                    exit.map_or("not reaped".to_string(), |e| e.to_string())
+                )
+            }
+        }
+    }
+}
+
+/// Starts a coordinator for `agents` agents and the given fsync policy, hands it and the
+/// agents' ports to `f`, then stops it and removes the run's shared memory. The run's files
+/// (scenario, consensus log, coordinator log) live in a temporary directory that is removed
+/// afterwards, or kept and named when something failed.
+pub fn with_coordinator<T>(
+    program: &Path,
+    agents: usize,
+    fsync: FsyncPolicy,
+    f: impl FnOnce(&Session, &mut Swarm) -> Result<T>,
+) -> Result<T> {
+    let layout = Layout::new(agents).map_err(|e| anyhow!(e))?;
+    let run = RunId::unique("round");
+    let dir = std::env::temp_dir().join(format!("hnav-bench-{}", run.as_str()));
+    std::fs::create_dir_all(&dir).with_context(|| format!("create {}", dir.display()))?;
+    let result = session(program, &run, &dir, layout, fsync, f);
+    // Every node of the run is gone now (ours dropped, the coordinator reaped or killed).
+    let purged = purge_run(&run);
+    match &result {
+        Ok(_) => {
+            let _ = std::fs::remove_dir_all(&dir);
+        }
+        Err(_) => eprintln!("kept the run's files in {}", dir.display()),
+    }
+    let out = result?;
+    purged.context("remove the run's shared memory")?;
+    Ok(out)
+}
+
+fn session<T>(
+    program: &Path,
+    run: &RunId,
+    dir: &Path,
+    layout: Layout,
+    fsync: FsyncPolicy,
+    f: impl FnOnce(&Session, &mut Swarm) -> Result<T>,
+) -> Result<T> {
+    let scenario = dir.join("scenario.toml");
+    std::fs::write(&scenario, layout.scenario_toml(fsync))
+        .with_context(|| format!("write {}", scenario.display()))?;
+    let n = layout.agents();
+    let transport = Transport::builder(run).node_name("supervisor").create()?;
+    let q = topics::lifecycle_qos(n);
+    let ready = transport.receiver(topics::READY, q)?;
+    let life = transport.sender(topics::LIFECYCLE, q)?;
+    // Every agent port exists before the coordinator starts, as after a real start-up.
+    let mut swarm = Swarm::open(run, layout)?;
+    let args = ProcessArgs {
+        run: run.as_str().to_string(),
+        scenario,
+        agents: None,
+        seed: None,
+        mode: None,
+        dir: Some(dir.to_path_buf()),
+        resume: false,
+    };
+    let log_file = dir.join("coordinator.log");
+    let spec = ChildSpec {
+        role: Role::Coordinator,
+        index: 0,
+        program: program.to_path_buf(),
+        args: args.to_args(),
+        log_file: log_file.clone(),
+        env: Vec::new(),
+    };
+    let child = Child::spawn(&spec).context("start hnav-coordinator")?;
+    let session = Session {
+        child,
+        log_file,
+        ready,
+        life,
+        transport,
+    };
+    let out = session.handshake().and_then(|()| f(&session, &mut swarm));
+    let stopped = session.stop();
+    drop(swarm);
+    match (out, stopped) {
+        (Ok(v), Ok(())) => Ok(v),
+        (Ok(_), Err(e)) => Err(anyhow!("{e:#}\n{}", log_tail(&session.log_file))),
+        (Err(e), Err(s)) => Err(anyhow!(
+            "{e:#}; then {s:#}\n{}",
+            log_tail(&session.log_file)
+        )),
+        (Err(e), Ok(())) => Err(e),
+    }
+}
+
+/// The last lines of the coordinator's log, for an error message.
+fn log_tail(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    let lines: Vec<&str> = text.lines().collect();
+    let tail = &lines[lines.len().saturating_sub(LOG_TAIL_LINES)..];
+    if tail.is_empty() {
+        format!("{} is empty", path.display())
+    } else {
+        format!("end of {}:\n{}", path.display(), tail.join("\n"))
+    }
+}

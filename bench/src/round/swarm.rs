@@ -1,0 +1,235 @@
+//! The N agents of a round benchmark, played from one process: per agent one candidate
+//! publisher and one commit subscriber (as each real `hnav-agent` has), in one iceoryx2 node.
+
+use std::collections::HashMap;
+use std::ops::ControlFlow;
+use std::time::{Duration, Instant};
+
+use anyhow::{anyhow, bail, Result};
+use iceoryx2::prelude::CallbackProgression;
+use iceoryx2::waitset::{WaitSetAttachmentId, WaitSetRunResult};
+
+use hnav_runtime::msg::{Candidate, CandidateFlags, Commit};
+use hnav_runtime::supervisor::child::Child;
+use hnav_runtime::topics;
+use hnav_runtime::transport::{Ipc, Receiver, RunId, Sender, Transport};
+
+use super::layout::Layout;
+
+/// How long one round may take before the benchmark gives up.
+const ROUND_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// What one round looked like from the agents' side.
+pub struct RoundObs<'a> {
+    /// The round.
+    pub round: u64,
+    /// When the last candidate's `send` (publish + notify) was called.
+    pub sent: Instant,
+    /// When the first of the live agents' subscribers took commit `round`.
+    pub first_in: Instant,
+    /// When the last of the live agents' subscribers took commit `round`.
+    pub all_in: Instant,
+    /// Per agent: when its subscriber took commit `round` and whether the commit carries a
+    /// decision for that agent (`None` for an agent without ports, i.e. down).
+    pub got: &'a [Option<(Instant, bool)>],
+}
+
+/// An `after` for [`Swarm::play`] that never ends early.
+pub fn keep_going(_: &RoundObs) -> ControlFlow<()> {
+    ControlFlow::Continue(())
+}
+
+/// The agents' ports.
+pub struct Swarm {
+    layout: Layout,
+    /// Agents that send candidates, in sending order.
+    order: Vec<usize>,
+    /// An agent whose next candidate carries the `RESTARTED` flag.
+    restarted: Option<usize>,
+    next_round: u64,
+    tx: Vec<Option<Sender<Candidate>>>,
+    rx: Vec<Option<Receiver<Commit>>>,
+    transport: Transport,
+}
+
+impl Swarm {
+    /// Opens every agent's ports.
+    pub fn open(run: &RunId, layout: Layout) -> Result<Self> {
+        let n = layout.agents();
+        let transport = Transport::builder(run).node_name("bench-agents").create()?;
+        let mut swarm = Swarm {
+            layout,
+            order: Vec::with_capacity(n),
+            restarted: None,
+            next_round: 1,
+            tx: (0..n).map(|_| None).collect(),
+            rx: (0..n).map(|_| None).collect(),
+            transport,
+        };
+        for i in 0..n {
+            swarm.open_agent(i)?;
+            swarm.order.push(i);
+        }
+        Ok(swarm)
+    }
+
+    fn open_agent(&mut self, i: usize) -> Result<()> {
+        let n = self.layout.agents();
+        self.tx[i] = Some(
+            self.transport
+                .sender(topics::CANDIDATES, topics::candidates_qos(n))?,
+        );
+        self.rx[i] = Some(
+            self.transport
+                .receiver(topics::COMMIT, topics::commit_qos(n))?,
+        );
+        Ok(())
+    }
+
+    /// Agent `i` dies: its ports are gone and it sends nothing.
+    pub fn kill(&mut self, i: usize) {
+        self.tx[i] = None;
+        self.rx[i] = None;
+        self.order.retain(|&j| j != i);
+    }
+
+    /// Agent `i` comes back with new ports (what a restarted process opens before it
+    /// announces itself); from the next round on it sends first, its first candidate flagged
+    /// `RESTARTED`.
+    pub fn restart(&mut self, i: usize) -> Result<()> {
+        self.open_agent(i)?;
+        self.order.retain(|&j| j != i);
+        self.order.insert(0, i);
+        self.restarted = Some(i);
+        Ok(())
+    }
+
+    /// Plays up to `rounds` rounds from the next one on: `before_send(round)`, every live
+    /// agent's candidate (one `send` per agent, through its own publisher), then a WaitSet
+    /// wait until every live agent's subscriber has taken commit `round`; `after(obs)` may end
+    /// early. Returns the rounds played. Fails if the coordinator exits or a round takes
+    /// longer than 10 s.
+    pub fn play(
+        &mut self,
+        coordinator: &Child,
+        rounds: u64,
+        mut before_send: impl FnMut(u64) -> Result<()>,
+        mut after: impl FnMut(&RoundObs) -> ControlFlow<()>,
+    ) -> Result<u64> {
+        let n = self.layout.agents();
+        let ws = self.transport.waitset()?;
+        let ws_err = |e: &dyn std::fmt::Debug| anyhow!("waitset: {e:?}");
+        let exit_guard = ws
+            .attach_notification(coordinator.exit_fd())
+            .map_err(|e| ws_err(&e))?;
+        let exit_id = WaitSetAttachmentId::from_guard(&exit_guard);
+        let mut guards = Vec::with_capacity(n);
+        let mut owner: HashMap<WaitSetAttachmentId<Ipc>, usize> = HashMap::with_capacity(n);
+        for (i, rx) in self.rx.iter().enumerate() {
+            if let Some(rx) = rx {
+                let g = ws
+                    .attach_notification(rx.listener())
+                    .map_err(|e| ws_err(&e))?;
+                owner.insert(WaitSetAttachmentId::from_guard(&g), i);
+                guards.push(g);
+            }
+        }
+        let live = guards.len();
+        let mut got: Vec<Option<(Instant, bool)>> = vec![None; n];
+        let mut fired: Vec<usize> = Vec::with_capacity(n);
+        let mut played = 0;
+        while played < rounds {
+            let round = self.next_round;
+            got.iter_mut().for_each(|g| *g = None);
+            before_send(round)?;
+            let mut sent = Instant::now();
+            for &i in &self.order {
+                let mut c = self.layout.candidate(i, round);
+                if self.restarted == Some(i) {
+                    c.flags |= CandidateFlags::RESTARTED;
+                }
+                if let Some(tx) = &self.tx[i] {
+                    // The clock starts as the last candidate goes out: before its `send`.
+                    sent = Instant::now();
+                    tx.send(c)?;
+                }
+            }
+            self.restarted = None;
+            let deadline = sent + ROUND_TIMEOUT;
+            let mut missing = live;
+            let mut first_in = None;
+            let mut all_in = sent;
+            while missing > 0 {
+                let left = deadline.saturating_duration_since(Instant::now());
+                if left.is_zero() {
+                    bail!(
+                        "round {round}: {missing} of {live} agents got no commit within \
+                         {ROUND_TIMEOUT:?}"
+                    );
+                }
+                fired.clear();
+                let mut coordinator_exited = false;
+                let r = ws.wait_and_process_once_with_timeout(
+                    |id| {
+                        if id == exit_id {
+                            coordinator_exited = true;
+                        } else if let Some(&i) = owner.get(&id) {
+                            fired.push(i);
+                        }
+                        CallbackProgression::Continue
+                    },
+                    left,
+                );
+                match r {
+                    Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
+                        bail!("interrupted")
+                    }
+                    Ok(_) => {}
+                    Err(e) => return Err(ws_err(&e)),
+                }
+                if coordinator_exited {
+                    let exit = coordinator.try_reap();
+                    bail!(
+                        "round {round}: hnav-coordinator exited ({})",
+                        exit.map_or("not reaped".to_string(), |e| e.to_string())
+                    );
+                }
+                for &i in &fired {
+                    let Some(rx) = &self.rx[i] else { continue };
+                    // Wake-up first, then the samples: nothing published before the
+                    // notification just consumed can be missed.
+                    rx.take_wakeup()?;
+                    while let Some(sample) = rx.receive()? {
+                        let c = sample.payload();
+                        if c.round == round && got[i].is_none() {
+                            let now = Instant::now();
+                            let decided = c.decisions().iter().any(|d| d.agent as usize == i);
+                            got[i] = Some((now, decided));
+                            first_in.get_or_insert(now);
+                            all_in = now;
+                            missing -= 1;
+                        } else if c.round > round {
+                            bail!(
+                                "agent {i} got commit {} while round {round} is open",
+                                c.round
+                            );
+                        }
+                    }
+                }
+            }
+            self.next_round += 1;
+            played += 1;
+            let obs = RoundObs {
+                round,
+                sent,
+                first_in: first_in.unwrap_or(all_in),
+                all_in,
+                got: &got,
+            };
+            if after(&obs).is_break() {
+                break;
+            }
+        }
+        Ok(played)
+    }
+}
