@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use hnav_runtime::consensus_log::{read_log, Record};
-use hnav_runtime::msg::Commit;
+use hnav_runtime::msg::{Commit, MapHeader};
 use hnav_runtime::topics;
 use hnav_runtime::transport::{RunId, Transport};
 use hnav_tests::swarm::{repo_root, verify_log, SwarmRun};
@@ -34,9 +34,14 @@ fn scenario_with_fault(dir: &Path, fault: &str) -> std::path::PathBuf {
     path
 }
 
-/// Every commit seen on the run's commit topic, by round, recorded by a thread of the test.
+/// The last neural-map snapshot of agent 0: its header and the value in its target cell.
+type Snapshot = Option<(MapHeader, f32, usize)>;
+
+/// Every commit seen on the run's commit topic, by round, and agent 0's last neural-map
+/// snapshot, recorded by a thread of the test.
 struct Observer {
     seen: Arc<Mutex<BTreeMap<u64, Commit>>>,
+    map: Arc<Mutex<Snapshot>>,
     stop: Arc<AtomicBool>,
     thread: Option<std::thread::JoinHandle<()>>,
 }
@@ -44,8 +49,9 @@ struct Observer {
 impl Observer {
     fn start(run: &RunId, agents: usize) -> Observer {
         let seen = Arc::new(Mutex::new(BTreeMap::new()));
+        let map: Arc<Mutex<Snapshot>> = Arc::new(Mutex::new(None));
         let stop = Arc::new(AtomicBool::new(false));
-        let (s2, st2, run) = (seen.clone(), stop.clone(), run.clone());
+        let (s2, st2, m2, run) = (seen.clone(), stop.clone(), map.clone(), run.clone());
         let (ready_tx, ready_rx) = std::sync::mpsc::channel();
         let thread = std::thread::spawn(move || {
             let t = Transport::builder(&run)
@@ -55,10 +61,24 @@ impl Observer {
             let rx = t
                 .receiver::<Commit>(topics::COMMIT, topics::commit_qos(agents))
                 .unwrap();
+            let maps = t
+                .slice_receiver::<f32, MapHeader>(&topics::map(0), topics::state_qos())
+                .unwrap();
             let ws = t.waitset().unwrap();
             let _g = ws.attach_notification(rx.listener()).unwrap();
+            let _gm = ws.attach_notification(maps.listener()).unwrap();
             ready_tx.send(()).unwrap();
             while !st2.load(Ordering::Relaxed) {
+                let _ = maps.take_wakeup();
+                while let Ok(Some(s)) = maps.receive() {
+                    let h = *s.user_header();
+                    let v = s
+                        .payload()
+                        .get(h.target as usize)
+                        .copied()
+                        .unwrap_or(f32::NAN);
+                    *m2.lock().unwrap() = Some((h, v, s.payload().len()));
+                }
                 let _ = rx.take_wakeup();
                 while let Ok(Some(s)) = rx.receive() {
                     let c = *s.payload();
@@ -78,21 +98,28 @@ impl Observer {
             .expect("observer up");
         Observer {
             seen,
+            map,
             stop,
             thread: Some(thread),
         }
     }
 
-    fn finish(mut self) -> BTreeMap<u64, Commit> {
+    fn finish(mut self) -> (BTreeMap<u64, Commit>, Snapshot) {
         self.stop.store(true, Ordering::Relaxed);
         if let Some(t) = self.thread.take() {
             t.join().expect("observer thread");
         }
-        std::mem::take(&mut *self.seen.lock().unwrap())
+        let map = *self.map.lock().unwrap();
+        (std::mem::take(&mut *self.seen.lock().unwrap()), map)
     }
 }
 
-fn run_with_fault(tag: &str, fault: &str) -> (SwarmRun, BTreeMap<u64, Commit>, TestRun) {
+/// One swarm at a time: three runs of ten processes at once on a 2-core machine would make
+/// lockstep rounds crawl, and none of these tests is about contention.
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+fn run_with_fault(tag: &str, fault: &str) -> (SwarmRun, BTreeMap<u64, Commit>, Snapshot, TestRun) {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let tmp = tempfile::tempdir().unwrap().keep();
     let scenario = scenario_with_fault(&tmp, fault);
     let mut run = TestRun::new(tag);
@@ -107,20 +134,20 @@ fn run_with_fault(tag: &str, fault: &str) -> (SwarmRun, BTreeMap<u64, Commit>, T
     )
     .expect("hnav run starts");
     let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
-    let seen = observer.finish();
+    let (seen, map) = observer.finish();
     assert!(
         status.success(),
         "run failed: {status}\n{}",
         swarm.log_tails()
     );
-    (swarm, seen, run)
+    (swarm, seen, map, run)
 }
 
 #[test]
 fn a_killed_coordinator_restarts_from_its_log_and_loses_no_commit() {
-    let (swarm, seen, _run) = run_with_fault(
+    let (swarm, seen, map, _run) = run_with_fault(
         "killcoord",
-        "[coordinator]\nfsync = \"every-record\"\n\n[[faults]]\nat_round = 400\naction = \"kill\"\nrole = \"coordinator\"\n",
+        "[coordinator]\nfsync = \"every-record\"\ntime_limit_s = 600\n\n[[faults]]\nat_round = 400\naction = \"kill\"\nrole = \"coordinator\"\n",
     );
     let log = swarm.dir.join("log");
     let (ok, report) = verify_log(&log);
@@ -157,6 +184,16 @@ fn a_killed_coordinator_restarts_from_its_log_and_loses_no_commit() {
         assert_eq!(a["reached_goal"], true, "{a}");
     }
     assert_eq!(s["collisions"], 0, "{s}");
+    // Agent 0's neural map reached the observer through shared memory: one f32 per cell,
+    // the header describing it, full activation at its target.
+    let (h, at_target, len) = map.expect("a neural-map snapshot of agent 0");
+    assert_eq!((h.agent, h.width, h.height), (0, 32, 32), "{h:?}");
+    assert_eq!(len, 32 * 32);
+    assert!(h.iterations > 0, "{h:?}");
+    assert!(
+        (at_target - 1.0).abs() < 1e-6,
+        "target activation {at_target}"
+    );
     println!(
         "{} commits observed, {} rounds logged, all present",
         seen.len(),
@@ -166,9 +203,9 @@ fn a_killed_coordinator_restarts_from_its_log_and_loses_no_commit() {
 
 #[test]
 fn a_killed_agent_resumes_from_its_checkpoint_and_arrives() {
-    let (swarm, _seen, _run) = run_with_fault(
+    let (swarm, _seen, _map, _run) = run_with_fault(
         "killagent",
-        "[[faults]]\nat_round = 300\naction = \"kill\"\nrole = \"agent\"\nindex = 1\n",
+        "[coordinator]\ntime_limit_s = 600\n\n[[faults]]\nat_round = 300\naction = \"kill\"\nrole = \"agent\"\nindex = 1\n",
     );
     let s = swarm.summary().unwrap();
     for a in s["agents"].as_array().unwrap() {
@@ -190,6 +227,7 @@ fn a_killed_agent_resumes_from_its_checkpoint_and_arrives() {
 fn sigint_stops_the_run_politely_and_leaves_nothing_behind() {
     use hnav_tests::swarm::wait_for_ps;
     use nix::sys::signal::Signal;
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let tmp = tempfile::tempdir().unwrap();
     let mut run = TestRun::new("sigint");
     let scenario = repo_root().join("scenarios/random-32-32-10.toml");

@@ -309,6 +309,12 @@ fn kill_once(
 /// the latencies and how many trials needed more than one round.
 fn rejoin(program: &Path, fsync: FsyncPolicy, trials: usize) -> Result<(Vec<u64>, usize)> {
     with_coordinator(program, REJOIN_AGENTS, fsync, |session, swarm| {
+        if let Some(t) = session.startup() {
+            eprintln!(
+                "for scale, not in (c): this hnav-coordinator took {:.1} ms from spawn to Up",
+                t.as_secs_f64() * 1e3
+            );
+        }
         let coordinator = session.child();
         swarm.play(coordinator, REJOIN_WARMUP, |_| Ok(()), keep_going)?;
         let mut samples = Vec::with_capacity(trials);

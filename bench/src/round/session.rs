@@ -46,6 +46,8 @@ pub fn coordinator_binary() -> Result<PathBuf> {
 /// A running coordinator and the supervisor's ports of its run.
 pub struct Session {
     child: Child,
+    spawned: Instant,
+    startup: std::cell::Cell<Option<Duration>>,
     log_file: PathBuf,
     ready: Receiver<Lifecycle>,
     life: Sender<Lifecycle>,
@@ -56,6 +58,12 @@ impl Session {
     /// The coordinator process (its exit descriptor wakes a WaitSet when it dies).
     pub fn child(&self) -> &Child {
         &self.child
+    }
+
+    /// How long the coordinator took from just before `spawn` to its `Up` on `ready`
+    /// (exec, scenario, ports, consensus log).
+    pub fn startup(&self) -> Option<Duration> {
+        self.startup.get()
     }
 
     /// Publishes a supervisor event on `lifecycle`, as `hnav run` does.
@@ -92,6 +100,7 @@ impl Session {
                 up |= l.role == Role::Coordinator as u8 && l.event == LifecycleEvent::Up as u8
             })?;
             if up {
+                self.startup.set(Some(self.spawned.elapsed()));
                 return self.publish(Role::Sim, 0, LifecycleEvent::Start);
             }
             if let Some(exit) = self.child.try_reap() {
@@ -194,9 +203,12 @@ fn session<T>(
         log_file: log_file.clone(),
         env: Vec::new(),
     };
+    let spawned = Instant::now();
     let child = Child::spawn(&spec).context("start hnav-coordinator")?;
     let session = Session {
         child,
+        spawned,
+        startup: std::cell::Cell::new(None),
         log_file,
         ready,
         life,
