@@ -23,8 +23,8 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use hnav_runtime::consensus_log::{
-    AgentEntry, EndReason, EndRecord, LifecycleRecord, Record, RoundRecord, RunHeader,
-    FORMAT_VERSION,
+    candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision, Record,
+    RoundRecord, RunHeader, FORMAT_VERSION,
 };
 use hnav_runtime::launch::{now_ns, LifecyclePorts, StartOutcome};
 use hnav_runtime::msg::{
@@ -94,6 +94,7 @@ struct State {
     round: u64,
     last_record: Option<RoundRecord>,
     pending: Vec<Option<Candidate>>,
+    present: Vec<Candidate>,
     live: Vec<bool>,
     opened: Option<Instant>,
     ended: bool,
@@ -165,6 +166,7 @@ impl<'t> CoordinatorProcess<'t> {
             round: 0,
             last_record: None,
             pending: vec![None; n],
+            present: Vec::with_capacity(n),
             live: vec![true; n],
             opened: None,
             ended: false,
@@ -214,8 +216,7 @@ impl<'t> CoordinatorProcess<'t> {
         }
         if let Some(rec) = &st.last_record {
             // Agents that missed the dead coordinator's last commit get it again.
-            let c = rec.commit();
-            p.commit.send_in_place(|slot| *slot = c)?;
+            p.commit.send_in_place(|slot| rec.write_commit(slot))?;
         }
         st.publish_progress(p)?;
         let ws = self.transport.waitset()?;
@@ -382,8 +383,7 @@ impl State {
         }
         if resend {
             if let Some(rec) = &self.last_record {
-                let c = rec.commit();
-                p.commit.send_in_place(|slot| *slot = c)?;
+                p.commit.send_in_place(|slot| rec.write_commit(slot))?;
             }
         }
         Ok(())
@@ -407,11 +407,25 @@ impl State {
         for r in replans {
             self.log.append(&Record::Replan(r.clone()))?;
         }
-        let present: Vec<Candidate> = self.pending.iter().flatten().copied().collect();
-        let rec = RoundRecord::new(round, &present, decisions);
-        self.log.append(&Record::Round(rec.clone()))?;
-        let commit = rec.commit();
-        p.commit.send_in_place(|slot| *slot = commit)?;
+        // The record's buffers are reused round after round: no allocation once warm.
+        self.present.clear();
+        self.present.extend(self.pending.iter().flatten());
+        let mut rec = self
+            .last_record
+            .take()
+            .unwrap_or_else(|| RoundRecord::new(0, &[], &[]));
+        rec.round = round;
+        rec.candidates = self.present.len() as u32;
+        rec.candidates_digest = candidates_digest(&self.present);
+        rec.decisions.clear();
+        rec.decisions
+            .extend(decisions.iter().map(LoggedDecision::from));
+        let record = Record::Round(rec);
+        self.log.append(&record)?;
+        let Record::Round(rec) = record else {
+            unreachable!("built as a round record above")
+        };
+        p.commit.send_in_place(|slot| rec.write_commit(slot))?;
         self.last_record = Some(rec);
         self.round = round;
         self.pending.iter_mut().for_each(|c| *c = None);

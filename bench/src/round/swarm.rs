@@ -49,6 +49,7 @@ pub struct Swarm {
     next_round: u64,
     tx: Vec<Option<Sender<Candidate>>>,
     rx: Vec<Option<Receiver<Commit>>>,
+    poke: Sender<hnav_runtime::msg::Lifecycle>,
     transport: Transport,
 }
 
@@ -64,6 +65,7 @@ impl Swarm {
             next_round: 1,
             tx: (0..n).map(|_| None).collect(),
             rx: (0..n).map(|_| None).collect(),
+            poke: transport.sender(topics::LIFECYCLE, topics::lifecycle_qos(n))?,
             transport,
         };
         for i in 0..n {
@@ -157,11 +159,17 @@ impl Swarm {
             self.restarted = None;
             let deadline = sent + ROUND_TIMEOUT;
             let mut missing = live;
+            let mut poked = false;
             let mut first_in = None;
             let mut all_in = sent;
             while missing > 0 {
-                let left = deadline.saturating_duration_since(Instant::now());
-                if left.is_zero() {
+                if missing == live && sent.elapsed() > Duration::from_secs(2) && !poked {
+                    poked = true;
+                    eprintln!("POKE at round {round}");
+                    self.poke.send(hnav_runtime::msg::Lifecycle { role: 1, event: 1, ..Default::default() })?;
+                }
+                let left = deadline.saturating_duration_since(Instant::now()).min(Duration::from_millis(500));
+                if deadline <= Instant::now() {
                     bail!(
                         "round {round}: {missing} of {live} agents got no commit within \
                          {ROUND_TIMEOUT:?}"
@@ -217,6 +225,7 @@ impl Swarm {
                     }
                 }
             }
+            if poked { eprintln!("RESCUED round {round} after {:?}", sent.elapsed()); }
             self.next_round += 1;
             played += 1;
             let obs = RoundObs {

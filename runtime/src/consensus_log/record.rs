@@ -104,17 +104,22 @@ impl RoundRecord {
         }
     }
 
-    /// The [`Commit`] this record stands for (decisions beyond [`MAX_AGENTS`] are dropped),
-    /// for republishing after a coordinator restart.
-    pub fn commit(&self) -> Commit {
-        let mut c = Commit {
-            round: self.round,
-            ..Commit::default()
-        };
+    /// Writes the commit this record describes into `c` (e.g. a loaned sample), so the
+    /// decisions reach shared memory without a copy of the whole `Commit` on the stack.
+    pub fn write_commit(&self, c: &mut Commit) {
+        c.round = self.round;
+        c.reserved = 0;
+        let n = self.decisions.len().min(MAX_AGENTS);
         for (slot, d) in c.decisions.iter_mut().zip(&self.decisions) {
             *slot = Decision::from(d);
         }
-        c.count = self.decisions.len().min(MAX_AGENTS) as u32;
+        c.count = n as u32;
+    }
+
+    /// The commit this record describes (for a resend after a restart, or a comparison).
+    pub fn commit(&self) -> Commit {
+        let mut c = Commit::default();
+        self.write_commit(&mut c);
         c
     }
 }
