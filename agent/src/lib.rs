@@ -1,11 +1,13 @@
-//! HNAV's agent library: the Hopfield "neural map" and the "path constructor" of the
-//! dissertation, plus single-query planning on top of them.
+//! HNAV's agent: the Hopfield "neural map" and the "path constructor" of the dissertation,
+//! single-query planning on top of them, and the `hnav-agent` process that drives one robot
+//! with them.
 //!
 //! A robot's agent builds a neural map of its workspace with the goal as the activation point:
 //! one neuron per cell, a wave of activation spreading from the goal through the free cells.
 //! It then climbs that map by gradient ascent, one cell at a time, and the coordinator may
-//! refuse directions to keep robots apart. Everything here is single-robot and synchronous; the
-//! processes and messages live in `hnav-runtime`.
+//! refuse directions to keep robots apart. The [`process`] module wires one agent to the run:
+//! odometry in, candidates and wheel commands out, commits applied; messages and transport
+//! live in `hnav-runtime`.
 //!
 //! | module | what |
 //! |---|---|

@@ -1,10 +1,12 @@
 //! # hnav-coordinator
 //!
-//! The central compute block of an HNAV swarm. When an agent is blocked for several rounds or
-//! stuck at a local extremum of its neural map, the coordinator replans globally over the
-//! known map (standing agents as obstacles) and answers with waypoints. This crate holds the
-//! global planners for that, and the terrain-hazard model they can plan with, after seed 002
-//! (a thesis on Lazy Theta* for s-bots on rough terrain).
+//! The central compute block of an HNAV swarm: every decision round it collects the agents'
+//! candidate steps, resolves their conflicts by priority, records the round durably in the
+//! consensus log and only then commits it. When an agent is blocked for several rounds or
+//! stuck at a local extremum of its neural map, it replans globally over the known map (other
+//! robots as obstacles) and answers with a waypoint. This crate holds all of that, the global
+//! planners, and the terrain-hazard model they can plan with, after seed 002 (a thesis on
+//! Lazy Theta* for s-bots on rough terrain).
 //!
 //! | module | concept |
 //! |---|---|
@@ -13,10 +15,9 @@
 //! | [`conflict`] | one decision round of `shared_paths`: the conflict types (a)–(d), corners, reservations; the [`Resolver`](conflict::Resolver) |
 //! | [`experiment`] | seed 002's §4 experiment (random circular obstacles on a 50 x 50 m field) beside its Table 3.1 |
 //! | [`consensus_log`] | [`LogWriter`](consensus_log::LogWriter): appends the run's consensus log durably, recovers it after a restart |
+//! | [`round`] | the decision round: [`Arbiter`](round::Arbiter) keeps the rows, runs the resolver, counts refusals, replans (hybrid mode) |
+//! | [`process`] | the `hnav-coordinator` process: the WaitSet loop, round deadline, log-then-commit, restart from the log |
 //! | [`error`] | [`PlanError`], every way a caller's input can be unusable |
-//!
-//! Conflict resolution and the consensus-log writer join this crate with the coordinator
-//! process.
 //!
 //! ```
 //! use hnav_coordinator::planner::{LazyTheta, Planner, PlannerConfig};

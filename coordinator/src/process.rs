@@ -26,7 +26,7 @@ use hnav_runtime::consensus_log::{
     candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision, Record,
     RoundRecord, RunHeader, FORMAT_VERSION,
 };
-use hnav_runtime::launch::{now_ns, LifecyclePorts, StartOutcome};
+use hnav_runtime::launch::{now_ns, LifecyclePorts, StartOutcome, LOST_WAKEUP_RECHECK};
 use hnav_runtime::msg::{
     Candidate, Commit, Lifecycle, LifecycleEvent, Progress, Role, Verdict, MAX_AGENTS,
 };
@@ -261,7 +261,10 @@ impl<'t> CoordinatorProcess<'t> {
                 Some(t) => {
                     ws.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, t)
                 }
-                None => ws.wait_and_process_once(|_| CallbackProgression::Continue),
+                None => ws.wait_and_process_once_with_timeout(
+                    |_| CallbackProgression::Continue,
+                    LOST_WAKEUP_RECHECK,
+                ),
             };
             match r {
                 Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {

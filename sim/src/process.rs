@@ -16,7 +16,7 @@
 
 use crate::error::SimError;
 use crate::world::World;
-use hnav_runtime::launch::LifecyclePorts;
+use hnav_runtime::launch::{LifecyclePorts, LOST_WAKEUP_RECHECK};
 use hnav_runtime::msg::{LifecycleEvent, Role};
 use hnav_runtime::msg::{Odometry, Truth, WheelCommand};
 use hnav_runtime::scenario::params::ClockMode;
@@ -26,10 +26,6 @@ use hnav_runtime::transport::{Receiver, Sender, Transport, TransportError};
 use iceoryx2::prelude::CallbackProgression;
 use iceoryx2::waitset::WaitSetRunResult;
 use std::time::{Duration, Instant};
-
-/// How often lockstep without a deadline (`sim.lockstep_deadline_ms = 0`) wakes while it
-/// waits for commands; nothing happens on such a wake-up but a new check.
-const LOCKSTEP_IDLE_WAIT: Duration = Duration::from_secs(1);
 
 /// What stopped or broke the process.
 #[derive(Debug, thiserror::Error)]
@@ -164,7 +160,7 @@ impl<'t> SimProcess<'t> {
                         }
                         continue;
                     }
-                    self.lockstep_deadline.unwrap_or(LOCKSTEP_IDLE_WAIT)
+                    self.lockstep_deadline.unwrap_or(LOST_WAKEUP_RECHECK)
                 }
                 ClockMode::Realtime => {
                     let due = period_wall.mul_f64((self.period + 1) as f64);

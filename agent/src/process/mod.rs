@@ -22,7 +22,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use hnav_runtime::grid::{Cell, Grid};
-use hnav_runtime::launch::{LifecyclePorts, ProcessArgs, StartOutcome};
+use hnav_runtime::launch::{LifecyclePorts, ProcessArgs, StartOutcome, LOST_WAKEUP_RECHECK};
 use hnav_runtime::msg::{Commit, MapHeader, Odometry, Pose, Role, WheelCommand};
 use hnav_runtime::scenario::{ClockMode, Scenario};
 use hnav_runtime::topics;
@@ -264,7 +264,10 @@ impl<'t> AgentProcess<'t> {
             core.on_odometry(p)?;
             core.send_candidate(p)?;
             core.send_wheels(p)?;
-            match ws.wait_and_process_once(|_| CallbackProgression::Continue) {
+            match ws.wait_and_process_once_with_timeout(
+                |_| CallbackProgression::Continue,
+                LOST_WAKEUP_RECHECK,
+            ) {
                 Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => break,
                 Ok(_) => {}
                 Err(e) => return Err(ws_err(&e)),

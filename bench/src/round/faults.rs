@@ -93,6 +93,7 @@ pub fn run(
             label,
             coordinator: None,
             dist: Dist::from_ns(samples)?,
+            stalled: 0,
         };
         each(&p);
         points.push(p);
@@ -103,7 +104,7 @@ pub fn run(
              {VICTIM}",
             super::layout::fsync_name(policy)
         );
-        let (samples, late) = rejoin(program, policy, trials)?;
+        let (samples, late, stalled) = rejoin(program, policy, trials)?;
         if late > 0 {
             eprintln!(
                 "note: in {late} of {trials} trials agent {VICTIM}'s first candidate missed \
@@ -118,6 +119,7 @@ pub fn run(
             ),
             coordinator: Some((REJOIN_AGENTS, policy)),
             dist: Dist::from_ns(&samples)?,
+            stalled,
         };
         each(&p);
         points.push(p);
@@ -306,8 +308,9 @@ fn kill_once(
 }
 
 /// (c): `trials` Down/Restarted cycles of agent [`VICTIM`] under a real coordinator; returns
-/// the latencies and how many trials needed more than one round.
-fn rejoin(program: &Path, fsync: FsyncPolicy, trials: usize) -> Result<(Vec<u64>, usize)> {
+/// the latencies, how many trials needed more than one round, and how many were left out
+/// because a round stalled.
+fn rejoin(program: &Path, fsync: FsyncPolicy, trials: usize) -> Result<(Vec<u64>, usize, usize)> {
     with_coordinator(program, REJOIN_AGENTS, fsync, |session, swarm| {
         if let Some(t) = session.startup() {
             eprintln!(
@@ -315,19 +318,20 @@ fn rejoin(program: &Path, fsync: FsyncPolicy, trials: usize) -> Result<(Vec<u64>
                 t.as_secs_f64() * 1e3
             );
         }
-        let coordinator = session.child();
-        swarm.play(coordinator, REJOIN_WARMUP, |_| Ok(()), keep_going)?;
+        swarm.play(session, REJOIN_WARMUP, |_| Ok(()), keep_going)?;
         let mut samples = Vec::with_capacity(trials);
         let mut late = 0;
+        let mut stalled = 0;
         for trial in 0..trials {
             swarm.kill(VICTIM);
             session.publish(Role::Agent, VICTIM as u32, LifecycleEvent::Down)?;
-            swarm.play(coordinator, DOWN_ROUNDS, |_| Ok(()), keep_going)?;
+            swarm.play(session, DOWN_ROUNDS, |_| Ok(()), keep_going)?;
             swarm.restart(VICTIM)?;
             let mut t0 = None;
             let mut back = None;
+            let mut stall = false;
             swarm.play(
-                coordinator,
+                session,
                 MAX_REJOIN_ROUNDS,
                 |round| {
                     if t0.is_none() {
@@ -336,12 +340,15 @@ fn rejoin(program: &Path, fsync: FsyncPolicy, trials: usize) -> Result<(Vec<u64>
                     }
                     Ok(())
                 },
-                |obs| match obs.got[VICTIM] {
-                    Some((at, true)) => {
-                        back = Some((obs.round, at));
-                        std::ops::ControlFlow::Break(())
+                |obs| {
+                    stall |= obs.stalled;
+                    match obs.got[VICTIM] {
+                        Some((at, true)) => {
+                            back = Some((obs.round, at));
+                            std::ops::ControlFlow::Break(())
+                        }
+                        _ => std::ops::ControlFlow::Continue(()),
                     }
-                    _ => std::ops::ControlFlow::Continue(()),
                 },
             )?;
             let (Some((first, t0)), Some((round, at))) = (t0, back) else {
@@ -350,9 +357,17 @@ fn rejoin(program: &Path, fsync: FsyncPolicy, trials: usize) -> Result<(Vec<u64>
                      rounds of Restarted"
                 );
             };
+            if stall {
+                eprintln!(
+                    "warning: trial {trial} stalled (lost wake-up of the coordinator, see \
+                     `hnav-bench round`); left out"
+                );
+                stalled += 1;
+                continue;
+            }
             late += usize::from(round != first);
             samples.push(ns(at - t0));
         }
-        Ok((samples, late))
+        Ok((samples, late, stalled))
     })
 }

@@ -21,6 +21,12 @@
 //! wheel control), and the N subscribers are served by one thread instead of N processes.
 //! The commit is published only after its log record is written, so fsync sits on the path.
 //!
+//! **Stalls.** A round without any commit for 1 s is poked: a lifecycle event the coordinator
+//! ignores wakes it, and the round then completes at once: every candidate had arrived but
+//! the coordinator had not been woken (a lost wake-up on the candidates topic's event
+//! service). Such rounds are counted in the `stalled` column and left out of the percentiles;
+//! in a real lockstep run nothing would wake the coordinator and the swarm would hang.
+//!
 //! ## Faults
 //!
 //! See [`faults`]: SIGKILL -> exit-descriptor wake-up -> `Down` published -> `Down` taken by
@@ -34,7 +40,7 @@ mod swarm;
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 
 use hnav_runtime::scenario::FsyncPolicy;
@@ -127,6 +133,34 @@ fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
     } else {
         ROUNDS_FULL
     });
+    if args.fsync.iter().any(|&f| f != FsyncPolicy::None) {
+        // The floor of every-record: what one append + fdatasync costs on the log's disk.
+        let d = fdatasync_baseline()?;
+        let dir = std::env::temp_dir();
+        if args.json {
+            println!(
+                "{}",
+                serde_json::json!({
+                    "bench": "fdatasync",
+                    "dir": dir.display().to_string(),
+                    "p50_us": report::us1(d.p50_ns),
+                    "p99_us": report::us1(d.p99_ns),
+                    "max_us": report::us1(d.max_ns),
+                    "n": d.n,
+                })
+            );
+        } else {
+            println!(
+                "raw 1 KiB append + fdatasync in {}: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs \
+                 ({} samples)",
+                dir.display(),
+                d.p50_ns as f64 / 1e3,
+                d.p99_ns as f64 / 1e3,
+                d.max_ns as f64 / 1e3,
+                d.n
+            );
+        }
+    }
     if !args.json {
         println!(
             "decision round: last of N candidates sent -> commit taken by all N agents' \
@@ -142,32 +176,7 @@ fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
                 layout::fsync_name(fsync),
                 args.warmup
             );
-            let samples = session::with_coordinator(program, agents, fsync, |session, swarm| {
-                let coordinator = session.child();
-                if args.warmup > 0 {
-                    swarm.play(coordinator, args.warmup, |_| Ok(()), keep_going)?;
-                }
-                let mut all = Vec::with_capacity(rounds as usize);
-                let mut first = Vec::with_capacity(rounds as usize);
-                let ns = |d: std::time::Duration| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX);
-                swarm.play(
-                    coordinator,
-                    rounds,
-                    |_| Ok(()),
-                    |obs| {
-                        all.push(ns(obs.all_in - obs.sent));
-                        first.push(ns(obs.first_in - obs.sent));
-                        keep_going(obs)
-                    },
-                )?;
-                Ok((all, first))
-            })?;
-            let point = RoundPoint {
-                agents,
-                fsync,
-                dist: Dist::from_ns(&samples.0)?,
-                first: Dist::from_ns(&samples.1)?,
-            };
+            let point = measure_point(program, agents, fsync, args.warmup, rounds)?;
             if args.json {
                 println!("{}", point.json());
             } else {
@@ -183,7 +192,9 @@ fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
              includes \
              the coordinator's wake-up, conflict resolution, consensus-log append and its \
              fdatasync under every-record (log in {}), the commit's publish + N notifications, \
-             one thread taking the N commits; excludes the agents' planning)",
+             one thread taking the N commits; excludes the agents' planning. stalled: rounds \
+             with no commit for 1 s that completed only when an unrelated lifecycle event woke \
+             the coordinator (lost wake-up); left out of the percentiles)",
             std::env::temp_dir().display()
         );
     }
@@ -192,6 +203,73 @@ fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
         eprintln!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// 200 appends of 1 KiB, each followed by `fdatasync`, in a file of the temporary directory
+/// (where the benchmark's consensus logs live).
+fn fdatasync_baseline() -> Result<Dist> {
+    use std::io::Write;
+    let path = std::env::temp_dir().join(format!(
+        "hnav-bench-fdatasync-{}",
+        hnav_runtime::transport::RunId::unique("f").as_str()
+    ));
+    let measured = (|| -> Result<Vec<u64>> {
+        let mut f = std::fs::File::create(&path)?;
+        let block = [0x5au8; 1024];
+        let mut ns = Vec::with_capacity(200);
+        for _ in 0..200 {
+            f.write_all(&block)?;
+            let t = std::time::Instant::now();
+            f.sync_data()?;
+            ns.push(u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX));
+        }
+        Ok(ns)
+    })();
+    let _ = std::fs::remove_file(&path);
+    let ns = measured.with_context(|| format!("fdatasync baseline in {}", path.display()))?;
+    Dist::from_ns(&ns)
+}
+
+/// Runs one coordinator for `agents` agents and `fsync`, plays `warmup` + `rounds` rounds.
+fn measure_point(
+    program: &std::path::Path,
+    agents: usize,
+    fsync: FsyncPolicy,
+    warmup: u64,
+    rounds: u64,
+) -> Result<RoundPoint> {
+    let ns = |d: std::time::Duration| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX);
+    let (all, first, stalled) =
+        session::with_coordinator(program, agents, fsync, |session, swarm| {
+            if warmup > 0 {
+                swarm.play(session, warmup, |_| Ok(()), keep_going)?;
+            }
+            let mut all = Vec::with_capacity(rounds as usize);
+            let mut first = Vec::with_capacity(rounds as usize);
+            let mut stalled = 0;
+            swarm.play(
+                session,
+                rounds,
+                |_| Ok(()),
+                |obs| {
+                    if obs.stalled {
+                        stalled += 1;
+                    } else {
+                        all.push(ns(obs.all_in - obs.sent));
+                        first.push(ns(obs.first_in - obs.sent));
+                    }
+                    keep_going(obs)
+                },
+            )?;
+            Ok((all, first, stalled))
+        })?;
+    Ok(RoundPoint {
+        agents,
+        fsync,
+        dist: Dist::from_ns(&all)?,
+        first: Dist::from_ns(&first)?,
+        stalled,
+    })
 }
 
 fn faults_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {

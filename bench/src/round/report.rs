@@ -56,7 +56,7 @@ fn us(ns: u64) -> f64 {
 }
 
 /// `round` with 1 decimal, for JSON.
-fn us1(ns: u64) -> f64 {
+pub(crate) fn us1(ns: u64) -> f64 {
     (ns as f64 / 100.0).round() / 10.0
 }
 
@@ -71,13 +71,15 @@ pub struct RoundPoint {
     pub dist: Dist,
     /// Latencies to the first agent's commit.
     pub first: Dist,
+    /// Measured rounds that stalled (lost wake-up) and are not in the distributions.
+    pub stalled: usize,
 }
 
 /// The table header of the round benchmark.
 pub fn round_header() -> String {
     format!(
-        "{:>7}  {:<13} {:>7} {:>10} {:>10} {:>10} | {:>10} {:>10}",
-        "agents", "fsync", "rounds", "p50 µs", "p99 µs", "max µs", "1st p50", "1st p99"
+        "{:>7}  {:<13} {:>7} {:>10} {:>10} {:>10} | {:>10} {:>10} | {:>7}",
+        "agents", "fsync", "rounds", "p50 µs", "p99 µs", "max µs", "1st p50", "1st p99", "stalled"
     )
 }
 
@@ -86,7 +88,7 @@ impl RoundPoint {
     pub fn row(&self) -> String {
         let d = &self.dist;
         format!(
-            "{:>7}  {:<13} {:>7} {:>10.1} {:>10.1} {:>10.1} | {:>10.1} {:>10.1}",
+            "{:>7}  {:<13} {:>7} {:>10.1} {:>10.1} {:>10.1} | {:>10.1} {:>10.1} | {:>7}",
             self.agents,
             fsync_name(self.fsync),
             d.n,
@@ -94,7 +96,8 @@ impl RoundPoint {
             us(d.p99_ns),
             us(d.max_ns),
             us(self.first.p50_ns),
-            us(self.first.p99_ns)
+            us(self.first.p99_ns),
+            self.stalled
         )
     }
 
@@ -111,6 +114,7 @@ impl RoundPoint {
             "rounds": d.n,
             "first_p50_us": us1(self.first.p50_ns),
             "first_p99_us": us1(self.first.p99_ns),
+            "stalled": self.stalled,
         })
         .to_string()
     }
@@ -128,6 +132,8 @@ pub struct FaultPoint {
     pub coordinator: Option<(usize, FsyncPolicy)>,
     /// The latencies.
     pub dist: Dist,
+    /// Trials left out because a round stalled (lost wake-up, see `Swarm::play`).
+    pub stalled: usize,
 }
 
 /// The table header of the fault measurements.
@@ -162,6 +168,7 @@ impl FaultPoint {
             "p99_us": us1(d.p99_ns),
             "max_us": us1(d.max_ns),
             "trials": d.n,
+            "stalled": self.stalled,
         });
         if let Some((agents, fsync)) = self.coordinator {
             v["agents"] = json!(agents);
@@ -173,7 +180,7 @@ impl FaultPoint {
 
 /// The CSV header of `round.csv` and `faults.csv`.
 pub const CSV_HEADER: &str =
-    "date,platform,bench,measure,agents,fsync,n,mean_us,p50_us,p90_us,p99_us,max_us";
+    "date,platform,bench,measure,agents,fsync,n,mean_us,p50_us,p90_us,p99_us,max_us,stalled";
 
 fn csv_row(
     info: &crate::latency::RunInfo,
@@ -181,11 +188,12 @@ fn csv_row(
     measure: &str,
     coordinator: Option<(usize, FsyncPolicy)>,
     d: &Dist,
+    stalled: usize,
 ) -> String {
     let (agents, fsync) =
         coordinator.map_or((String::new(), ""), |(a, f)| (a.to_string(), fsync_name(f)));
     format!(
-        "{},{},{bench},{measure},{agents},{fsync},{},{:.3},{:.3},{:.3},{:.3},{:.3}",
+        "{},{},{bench},{measure},{agents},{fsync},{},{:.3},{:.3},{:.3},{:.3},{:.3},{stalled}",
         info.date,
         info.platform,
         d.n,
@@ -203,13 +211,21 @@ pub fn write_round_csv(dir: &Path, points: &[RoundPoint]) -> Result<std::path::P
     let rows = points.iter().flat_map(|p| {
         let c = Some((p.agents, p.fsync));
         [
-            csv_row(&info, "round", "last_candidate_to_all_commits", c, &p.dist),
+            csv_row(
+                &info,
+                "round",
+                "last_candidate_to_all_commits",
+                c,
+                &p.dist,
+                p.stalled,
+            ),
             csv_row(
                 &info,
                 "round",
                 "last_candidate_to_first_commit",
                 c,
                 &p.first,
+                p.stalled,
             ),
         ]
     });
@@ -219,9 +235,16 @@ pub fn write_round_csv(dir: &Path, points: &[RoundPoint]) -> Result<std::path::P
 /// Writes `DIR/faults.csv`.
 pub fn write_fault_csv(dir: &Path, points: &[FaultPoint]) -> Result<std::path::PathBuf> {
     let info = crate::latency::RunInfo::now();
-    let rows = points
-        .iter()
-        .map(|p| csv_row(&info, "faults", p.measure, p.coordinator, &p.dist));
+    let rows = points.iter().map(|p| {
+        csv_row(
+            &info,
+            "faults",
+            p.measure,
+            p.coordinator,
+            &p.dist,
+            p.stalled,
+        )
+    });
     write_csv(&dir.join("faults.csv"), rows)
 }
 
@@ -264,6 +287,7 @@ mod tests {
             fsync: FsyncPolicy::None,
             dist: d,
             first: d,
+            stalled: 0,
         };
         let v: serde_json::Value = serde_json::from_str(&p.json()).unwrap();
         assert_eq!(v["bench"], "round");
