@@ -20,6 +20,8 @@ pub struct Summary {
     pub p90_ns: u64,
     /// 99th percentile.
     pub p99_ns: u64,
+    /// Exact maximum.
+    pub max_ns: u64,
 }
 
 impl Summary {
@@ -40,6 +42,7 @@ impl Summary {
             p50_ns: hist.value_at_quantile(0.50),
             p90_ns: hist.value_at_quantile(0.90),
             p99_ns: hist.value_at_quantile(0.99),
+            max_ns: samples.iter().copied().max().unwrap_or(0),
         })
     }
 

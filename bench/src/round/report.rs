@@ -3,53 +3,15 @@
 use std::io::Write;
 use std::path::Path;
 
-use anyhow::{ensure, Context, Result};
-use hdrhistogram::Histogram;
+use anyhow::{Context, Result};
 use hnav_runtime::scenario::FsyncPolicy;
 use serde_json::json;
 
 use super::layout::fsync_name;
 
-/// Percentiles kept to 3 significant digits (0.1 %), as in `hnav-bench latency`.
-const SIGNIFICANT_DIGITS: u8 = 3;
-
-/// The distribution of one series of latencies, in nanoseconds.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Dist {
-    /// Samples.
-    pub n: usize,
-    /// Exact mean.
-    pub mean_ns: f64,
-    /// Median.
-    pub p50_ns: u64,
-    /// 90th percentile.
-    pub p90_ns: u64,
-    /// 99th percentile.
-    pub p99_ns: u64,
-    /// Exact maximum.
-    pub max_ns: u64,
-}
-
-impl Dist {
-    /// Summarises `samples` (ns); nothing is trimmed.
-    pub fn from_ns(samples: &[u64]) -> Result<Self> {
-        ensure!(!samples.is_empty(), "no samples to summarise");
-        let mut hist = Histogram::<u64>::new(SIGNIFICANT_DIGITS).context("create histogram")?;
-        let mut sum: u128 = 0;
-        for &v in samples {
-            hist.record(v).context("record sample")?;
-            sum += u128::from(v);
-        }
-        Ok(Self {
-            n: samples.len(),
-            mean_ns: sum as f64 / samples.len() as f64,
-            p50_ns: hist.value_at_quantile(0.50),
-            p90_ns: hist.value_at_quantile(0.90),
-            p99_ns: hist.value_at_quantile(0.99),
-            max_ns: samples.iter().copied().max().unwrap_or(0),
-        })
-    }
-}
+/// The distribution of one series of latencies (ns): the same summary `hnav-bench latency`
+/// reports.
+pub use crate::latency::Summary as Dist;
 
 fn us(ns: u64) -> f64 {
     ns as f64 / 1e3
