@@ -250,6 +250,17 @@ fn sigint_stops_the_run_politely_and_leaves_nothing_behind() {
         .iter()
         .map(|p| p["pid"].as_i64().unwrap() as i32)
         .collect();
+    // Interrupt a run under way: wait (bounded) until rounds are being logged.
+    let seg = swarm.dir.join("log/seg-00000000.hlog");
+    let deadline = std::time::Instant::now() + Duration::from_secs(60);
+    while std::fs::metadata(&seg).map_or(0, |m| m.len()) < 4096 {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "no rounds logged within 60 s\n{}",
+            swarm.log_tails()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
     swarm.peer.signal(Signal::SIGINT).unwrap();
     let status = swarm.finish(Duration::from_secs(60)).expect("stops");
     assert_eq!(status.code(), Some(1), "interrupted runs exit 1: {status}");
