@@ -60,3 +60,49 @@ fn eight_agents_lockstep_reach_their_goals_and_replay_byte_for_byte() {
     );
     println!("log {} bytes, summary {s}", a.len());
 }
+
+/// The sha256 of the lockstep consensus logs as commit f7d1d19 (before the process refactor
+/// of issue 10) wrote them. A lockstep run's log is a pure function of the scenario and the
+/// code's decisions, so any change here is a change of behaviour: update these only together
+/// with a change that means to decide differently, and say so in its commit.
+const GOLDEN_LOGS: [(&str, &str); 2] = [
+    (
+        "scenarios/demo.toml",
+        "dba4bdeb12a858c988d0f39f8c67c6c623c37d956c9e0010fc959e072af3732b",
+    ),
+    (
+        "scenarios/random-32-32-10.toml",
+        "33b75e9275cefd29465178441d307b75f4f8bdc115d8dcd1c17a1c4b5ce9d7ed",
+    ),
+];
+
+#[test]
+fn lockstep_logs_match_the_golden_sums() {
+    use sha2::{Digest, Sha256};
+    let tmp = tempfile::tempdir().unwrap();
+    let registry = tmp.path().join("runs");
+    for (i, (scenario, want)) in GOLDEN_LOGS.iter().enumerate() {
+        let mut run = TestRun::new(&format!("gold{i}"));
+        let dir = tmp.path().join(format!("g{i}"));
+        let mut swarm = SwarmRun::start(
+            &mut run,
+            &repo_root().join(scenario),
+            &dir,
+            &registry,
+            &["--mode", "lockstep"],
+        )
+        .expect("hnav run starts");
+        let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
+        assert!(
+            status.success(),
+            "{scenario}: {status}\n{}",
+            swarm.log_tails()
+        );
+        let log = std::fs::read(dir.join("log/seg-00000000.hlog")).unwrap();
+        let got: String = Sha256::digest(&log)
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        assert_eq!(&got, want, "{scenario}: the lockstep log changed");
+    }
+}
