@@ -22,6 +22,10 @@
 //! | [`reference`](mod@reference) | [`ReferenceMap`]: the plain `f64` reference implementation (exact where `f64` does not underflow) |
 //! | [`weights`] | [`Weights`] and the dense [`WeightMatrix`] builder (Table 2-2) |
 //! | [`repair`] | §2.10: partial correction and rebuild with partial activation |
+//! | `topology` (private) | which neurons are linked and each denominator: the one network definition both implementations build from |
+//! | `driver` (private) | the stop rules ([`StopRule`]), written once for both implementations |
+//! | `kernel` (private) | the fast path's vectorisable sweep over a rectangle of the padded grid |
+//! | `xfloat` (private) | the fast path's number format: `f32` mantissa with an `i32` exponent |
 //!
 //! # Which variant reproduces what
 //!
