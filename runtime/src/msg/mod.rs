@@ -24,7 +24,7 @@
 //! | [`Odometry`] | 40 | 8 | 0 sim_time_ns u64, 8 period u64, 16 agent u32, 20 reserved u32, 24 ticks_left i64, 32 ticks_right i64 |
 //! | [`Pose`] | 24 | 8 | 0 x_m f64, 8 y_m f64, 16 theta_rad f64 |
 //! | [`Truth`] | 24 + 24·[`MAX_AGENTS`] = 6168 | 8 | 0 sim_time_ns u64, 8 period u64, 16 robots u32, 20 collisions u32, 24 poses [Pose; 256] |
-//! | [`Lifecycle`] | 24 | 8 | 0 time_ns u64, 8 pid u32, 12 index u32, 16 role u8, 17 event u8, 18 reserved u16, 20 restarts u32 |
+//! | [`Lifecycle`] | 24 | 8 | 0 time_ns u64, 8 pid u32, 12 index u32, 16 role u8, 17 event u8, 18 reason u8, 19 reserved u8, 20 restarts u32 |
 //! | [`Progress`] | 32 | 8 | 0 round u64, 8 agents u32, 12 at_goal u32, 16 conflicts u32, 20 replans u32, 24 done u8, 25 reserved [u8; 7] |
 //! | [`MapHeader`] | 32 | 8 | 0 round u64, 8 agent u32, 12 width u32, 16 height u32, 20 iterations u32, 24 target u32, 28 activation u8, 29 reserved [u8; 3] |
 //!
@@ -35,7 +35,7 @@
 //! |---|---|
 //! | `round` | the decision round: [`Candidate`], [`Decision`], [`Commit`], [`Progress`] |
 //! | `motion` | wheels and ground truth: [`WheelCommand`], [`Odometry`], [`Pose`], [`Truth`] |
-//! | `lifecycle` | the supervisor's protocol: [`Role`], [`LifecycleEvent`], [`Lifecycle`] |
+//! | `lifecycle` | the supervisor's protocol: [`Role`] and its names, [`LifecycleEvent`], [`StopReason`], [`Lifecycle`] and its constructors |
 //! | `map` | the neural-map snapshot: [`MapHeader`], [`ActivationKind`] |
 
 mod lifecycle;
@@ -43,7 +43,7 @@ mod map;
 mod motion;
 mod round;
 
-pub use lifecycle::{Lifecycle, LifecycleEvent, Role};
+pub use lifecycle::{Lifecycle, LifecycleEvent, Role, StopReason};
 pub use map::{ActivationKind, MapHeader};
 pub use motion::{Odometry, Pose, Truth, WheelCommand};
 pub use round::{Candidate, CandidateFlags, Commit, ConflictKind, Decision, Progress, Verdict};
