@@ -311,6 +311,43 @@ mod tests {
     }
 
     #[test]
+    fn drain_reports_the_stop_reason_and_drops_what_it_cannot_decode() {
+        let run = RunId::unique("drain");
+        {
+            let transport = Transport::builder(&run).create().unwrap();
+            let ports = LifecyclePorts::open(&transport, Role::Agent, 0, 1).unwrap();
+            let life = transport
+                .sender(topics::LIFECYCLE, topics::lifecycle_qos(1))
+                .unwrap();
+            let mut seen = Vec::new();
+            life.send(Lifecycle::down(Role::Agent, 0, 0)).unwrap();
+            assert_eq!(ports.drain(|r, i, e| seen.push((r, i, e))).unwrap(), None);
+            life.send(Lifecycle::stop(StopReason::TimeLimit)).unwrap();
+            let stop = ports.drain(|r, i, e| seen.push((r, i, e))).unwrap();
+            assert_eq!(stop, Some(StopReason::TimeLimit));
+            let unknown_reason = Lifecycle {
+                reason: 0,
+                ..Lifecycle::stop(StopReason::Requested)
+            };
+            let unknown_role = Lifecycle {
+                role: 0,
+                ..Lifecycle::start()
+            };
+            life.send(unknown_reason).unwrap();
+            life.send(unknown_role).unwrap();
+            assert_eq!(ports.drain(|r, i, e| seen.push((r, i, e))).unwrap(), None);
+            assert_eq!(
+                seen,
+                [
+                    (Role::Agent, 0, LifecycleEvent::Down),
+                    (Role::Sim, 0, LifecycleEvent::Stop)
+                ]
+            );
+        }
+        crate::transport::purge_run(&run).unwrap();
+    }
+
+    #[test]
     fn bad_mode_is_refused() {
         assert!("fast".parse::<Mode>().is_err());
         assert_eq!(

@@ -186,3 +186,85 @@ fn wait(ws: &WaitSet<Ipc>, timeout: Duration) -> Result<Wake, StartupError> {
         Err(e) => Err(StartupError::WaitSet(format!("{e:?}"))),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::supervisor::child::{ChildSpec, Signal};
+    use crate::transport::{purge_run, RunId};
+
+    /// A supervisor's transport and ports on a fresh run, a stand-in child (`sh -c SCRIPT`),
+    /// and a sender on `ready` that plays the child's side of the handshake.
+    fn with_run(
+        script: &str,
+        f: impl FnOnce(&Transport, &SupervisorPorts, &Child, &Sender<Lifecycle>),
+    ) {
+        let dir = tempfile::tempdir().unwrap();
+        let run = RunId::unique("startup");
+        {
+            let transport = Transport::builder(&run)
+                .node_name("supervisor")
+                .create()
+                .unwrap();
+            let ports = SupervisorPorts::open(&transport, 1).unwrap();
+            let ready = transport
+                .sender(topics::READY, topics::lifecycle_qos(1))
+                .unwrap();
+            let spec = ChildSpec::new(Role::Agent, 0, "/bin/sh", dir.path().join("agent-0.log"))
+                .arg("-c")
+                .arg(script);
+            let child = Child::spawn(&spec).unwrap();
+            f(&transport, &ports, &child, &ready);
+            child.signal_group(Signal::SIGKILL).unwrap();
+            child.wait(Some(Duration::from_secs(10))).unwrap();
+        }
+        purge_run(&run).unwrap();
+    }
+
+    #[test]
+    fn start_is_published_once_every_child_is_up() {
+        with_run("sleep 30", |transport, ports, child, ready| {
+            let events = transport
+                .receiver::<Lifecycle>(topics::LIFECYCLE, topics::lifecycle_qos(1))
+                .unwrap();
+            ready.send(Lifecycle::up(Role::Sim, 0)).unwrap();
+            ready.send(Lifecycle::up(Role::Agent, 0)).unwrap();
+            let out = ports
+                .start(transport, &[child], Duration::from_secs(10))
+                .unwrap();
+            assert!(matches!(out, Startup::Started { .. }), "{out:?}");
+            let mut got = Vec::new();
+            events.drain(|l| got.push(l.event)).unwrap();
+            assert_eq!(got, [LifecycleEvent::Start as u8]);
+        });
+    }
+
+    #[test]
+    fn a_child_that_exits_fails_the_start_up() {
+        with_run("exit 3", |transport, ports, child, _| {
+            let err = ports
+                .start(transport, &[child], Duration::from_secs(10))
+                .unwrap_err();
+            assert!(
+                matches!(&err, StartupError::Exited { node, exit, .. }
+                    if node == "agent-0" && *exit == ExitInfo::Exited(3)),
+                "{err}"
+            );
+            assert!(err.to_string().contains("agent-0.log"), "{err}");
+        });
+    }
+
+    #[test]
+    fn a_child_that_never_announces_itself_times_out() {
+        with_run("sleep 30", |transport, ports, child, ready| {
+            ready.send(Lifecycle::down(Role::Agent, 0, 0)).unwrap();
+            let err = ports
+                .start(transport, &[child], Duration::from_millis(300))
+                .unwrap_err();
+            assert!(
+                matches!(&err, StartupError::NotUp { missing, .. } if missing == &["agent-0"]),
+                "{err}"
+            );
+        });
+    }
+}
