@@ -1,8 +1,8 @@
 //! Message contracts: the payloads that cross process boundaries.
 //!
-//! Every type here is `#[repr(C)]`, [`ZeroCopySend`] and carries a `#[type_name("hnav::...")]`
-//! so that two separately built binaries (or a foreign client using the iceoryx2 C++ or Python
-//! bindings) agree on its identity. Layouts contain no implicit padding: every gap is an explicit
+//! Every type here is `#[repr(C)]`, [`ZeroCopySend`](iceoryx2::prelude::ZeroCopySend) and
+//! carries a `#[type_name("hnav::...")]` so that two separately built binaries (or a foreign
+//! client using the iceoryx2 C++ or Python bindings) agree on its identity. Layouts contain no implicit padding: every gap is an explicit
 //! `reserved` field that senders set to zero, so a sample's bytes are fully defined and can be
 //! hashed or checksummed as they are.
 //!

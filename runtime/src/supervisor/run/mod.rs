@@ -11,13 +11,13 @@
 //!    at once) with a short tick for the progress bar and the fault schedule. A dead child is
 //!    reaped, its stale iceoryx2 resources removed (which wakes its peers with a "peer dead"
 //!    event), the others told on the lifecycle topic, and it is restarted under its role's
-//!    policy with `--resume` ([`slots`]). The progress bar ([`progress`]) and the scenario's
-//!    planned faults ([`faults`]) follow the coordinator's progress topic.
+//!    policy with `--resume` (module `slots`). The progress bar (`progress`) and the
+//!    scenario's planned faults (`faults`) follow the coordinator's progress topic.
 //! 4. End when the coordinator reports every agent at its goal, the time limit passes, or
 //!    the supervisor is asked to stop (SIGINT/SIGTERM): publish `Stop` with its
-//!    [`StopReason`], give the children a
-//!    grace period, then SIGTERM and SIGKILL their process groups; remove the run's shared
-//!    memory; write `DIR/summary.json` from the consensus log and the last ground truth.
+//!    [`StopReason`], give the children a grace period, then SIGTERM and SIGKILL their
+//!    process groups; remove the run's shared memory; write `DIR/summary.json` from the
+//!    consensus log and the last ground truth.
 
 mod error;
 mod faults;
