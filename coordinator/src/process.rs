@@ -26,9 +26,9 @@ use hnav_runtime::consensus_log::{
     candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision, Record,
     RoundRecord, RunHeader, FORMAT_VERSION,
 };
-use hnav_runtime::launch::{now_ns, LifecyclePorts, StartOutcome, LOST_WAKEUP_RECHECK};
+use hnav_runtime::launch::{LifecyclePorts, StartOutcome, LOST_WAKEUP_RECHECK};
 use hnav_runtime::msg::{
-    Candidate, Commit, Lifecycle, LifecycleEvent, Progress, Role, Verdict, MAX_AGENTS,
+    Candidate, Commit, Lifecycle, LifecycleEvent, Progress, Role, StopReason, Verdict, MAX_AGENTS,
 };
 use hnav_runtime::scenario::{ClockMode, Scenario};
 use hnav_runtime::topics;
@@ -227,22 +227,17 @@ impl<'t> CoordinatorProcess<'t> {
         let _g2 = ws
             .attach_notification(p.life.events().listener())
             .map_err(|e| ws_err(&e))?;
-        let mut stop_reason = None;
-        loop {
+        let reason = loop {
             let mut events: Vec<(Role, u32, LifecycleEvent)> = Vec::new();
             let stop = p.life.drain(|r, i, e| events.push((r, i, e)))?;
             for (role, index, ev) in events {
                 st.on_lifecycle(role, index, ev)?;
-                if ev == LifecycleEvent::Stop {
-                    stop_reason = Some(if index == 1 {
-                        EndReason::TimeLimit
-                    } else {
-                        EndReason::Stopped
-                    });
-                }
             }
-            if stop {
-                break;
+            if let Some(reason) = stop {
+                break match reason {
+                    StopReason::TimeLimit => EndReason::TimeLimit,
+                    StopReason::Requested => EndReason::Stopped,
+                };
             }
             st.collect(p)?;
             if st.ready() {
@@ -268,15 +263,13 @@ impl<'t> CoordinatorProcess<'t> {
             };
             match r {
                 Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
-                    stop_reason = Some(EndReason::Stopped);
-                    break;
+                    break EndReason::Stopped;
                 }
                 Ok(_) => {}
                 Err(e) => return Err(ws_err(&e)),
             }
-        }
+        };
         if !st.ended {
-            let reason = stop_reason.unwrap_or(EndReason::Stopped);
             st.end(reason)?;
         }
         st.log.sync()?;
@@ -336,18 +329,14 @@ impl State {
             }
         }
         if !self.ended {
-            let event = Lifecycle {
-                time_ns: now_ns(),
-                pid: 0,
-                index,
-                role: role as u8,
-                event: ev as u8,
-                reserved: 0,
-                restarts: self
-                    .restarts
-                    .get(index as usize)
-                    .copied()
-                    .unwrap_or_default(),
+            let restarts = self
+                .restarts
+                .get(index as usize)
+                .copied()
+                .unwrap_or_default();
+            let event = match ev {
+                LifecycleEvent::Restarted => Lifecycle::restarted(role, index, restarts),
+                _ => Lifecycle::down(role, index, restarts),
             };
             self.log
                 .append(&Record::Lifecycle(LifecycleRecord::new(self.round, &event)))?;

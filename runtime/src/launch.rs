@@ -20,18 +20,19 @@
 //! A process the supervisor restarts (`--resume`) skips step 3: its peers are already
 //! running, and a new publisher connects to existing subscribers on its first send. During
 //! the run the supervisor publishes `Down` and `Restarted` for processes that die and come
-//! back, and `Stop` to end the run politely.
+//! back, and `Stop` (with a [`StopReason`]) to end the run politely. The supervisor's half of
+//! steps 1 and 2 is `supervisor::startup`.
 
 use std::ffi::OsString;
 use std::fmt;
 use std::path::PathBuf;
 use std::str::FromStr;
-use std::time::{Duration, SystemTime, UNIX_EPOCH};
+use std::time::Duration;
 
 use iceoryx2::prelude::CallbackProgression;
 use iceoryx2::waitset::WaitSetRunResult;
 
-use crate::msg::{Lifecycle, LifecycleEvent, Role};
+use crate::msg::{Lifecycle, LifecycleEvent, Role, StopReason};
 use crate::scenario::{ClockMode, Scenario, ScenarioError};
 use crate::topics;
 use crate::transport::{Receiver, RunId, Sender, Transport, TransportError};
@@ -166,22 +167,6 @@ pub fn process_main<A: clap::Parser>(
     }
 }
 
-/// The node name of a process: `sim`, `coordinator` or `agent-<i>` (what `hnav ps` matches).
-pub fn node_name(role: Role, index: u32) -> String {
-    match role {
-        Role::Agent => format!("agent-{index}"),
-        other => crate::supervisor::registry::role_name(other).to_string(),
-    }
-}
-
-/// Wall-clock nanoseconds since the Unix epoch (for lifecycle events, never for decisions).
-pub fn now_ns() -> u64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map(|d| d.as_nanos() as u64)
-        .unwrap_or(0)
-}
-
 /// How waiting for the supervisor's `Start` ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StartOutcome {
@@ -219,15 +204,7 @@ impl LifecyclePorts {
 
     /// Publishes `Up` for this process (call once every other port is open).
     pub fn announce(&self) -> Result<(), TransportError> {
-        self.ready.send(Lifecycle {
-            time_ns: now_ns(),
-            pid: std::process::id(),
-            index: self.index,
-            role: self.role as u8,
-            event: LifecycleEvent::Up as u8,
-            reserved: 0,
-            restarts: 0,
-        })?;
+        self.ready.send(Lifecycle::up(self.role, self.index))?;
         Ok(())
     }
 
@@ -236,21 +213,26 @@ impl LifecyclePorts {
         &self.events
     }
 
-    /// Hands every pending supervisor event with a known role and event to `f`; returns
-    /// whether a `Stop` was among them.
+    /// Hands every pending supervisor event with a known role and event (and, for `Stop`, a
+    /// known reason) to `f`; returns the reason of the last `Stop` among them, if any.
     pub fn drain(
         &self,
         mut f: impl FnMut(Role, u32, LifecycleEvent),
-    ) -> Result<bool, TransportError> {
+    ) -> Result<Option<StopReason>, TransportError> {
         self.events.take_wakeup()?;
-        let mut stop = false;
+        let mut stop = None;
         self.events.drain(|l| {
-            if let (Some(role), Some(ev)) =
-                (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
-            {
-                stop |= ev == LifecycleEvent::Stop;
-                f(role, l.index, ev);
+            let (Some(role), Some(ev)) = (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
+            else {
+                return;
+            };
+            if ev == LifecycleEvent::Stop {
+                match StopReason::from_u8(l.reason) {
+                    Some(reason) => stop = Some(reason),
+                    None => return,
+                }
             }
+            f(role, l.index, ev);
         })?;
         Ok(stop)
     }
@@ -276,7 +258,7 @@ impl LifecyclePorts {
         loop {
             let mut started = false;
             let stop = self.drain(|_, _, ev| started |= ev == LifecycleEvent::Start)?;
-            if stop {
+            if stop.is_some() {
                 return Ok(StartOutcome::Stopped);
             }
             if started {
@@ -329,17 +311,48 @@ mod tests {
     }
 
     #[test]
+    fn drain_reports_the_stop_reason_and_drops_what_it_cannot_decode() {
+        let run = RunId::unique("drain");
+        {
+            let transport = Transport::builder(&run).create().unwrap();
+            let ports = LifecyclePorts::open(&transport, Role::Agent, 0, 1).unwrap();
+            let life = transport
+                .sender(topics::LIFECYCLE, topics::lifecycle_qos(1))
+                .unwrap();
+            let mut seen = Vec::new();
+            life.send(Lifecycle::down(Role::Agent, 0, 0)).unwrap();
+            assert_eq!(ports.drain(|r, i, e| seen.push((r, i, e))).unwrap(), None);
+            life.send(Lifecycle::stop(StopReason::TimeLimit)).unwrap();
+            let stop = ports.drain(|r, i, e| seen.push((r, i, e))).unwrap();
+            assert_eq!(stop, Some(StopReason::TimeLimit));
+            let unknown_reason = Lifecycle {
+                reason: 0,
+                ..Lifecycle::stop(StopReason::Requested)
+            };
+            let unknown_role = Lifecycle {
+                role: 0,
+                ..Lifecycle::start()
+            };
+            life.send(unknown_reason).unwrap();
+            life.send(unknown_role).unwrap();
+            assert_eq!(ports.drain(|r, i, e| seen.push((r, i, e))).unwrap(), None);
+            assert_eq!(
+                seen,
+                [
+                    (Role::Agent, 0, LifecycleEvent::Down),
+                    (Role::Sim, 0, LifecycleEvent::Stop)
+                ]
+            );
+        }
+        crate::transport::purge_run(&run).unwrap();
+    }
+
+    #[test]
     fn bad_mode_is_refused() {
         assert!("fast".parse::<Mode>().is_err());
         assert_eq!(
             "lockstep".parse::<Mode>().unwrap(),
             Mode(ClockMode::Lockstep)
         );
-    }
-
-    #[test]
-    fn node_names_match_roles() {
-        assert_eq!(node_name(Role::Agent, 7), "agent-7");
-        assert_eq!(node_name(Role::Sim, 0), "sim");
     }
 }

@@ -15,7 +15,7 @@
 //! | [`topics`] | the run's service names and their QoS, defined once for every process |
 //! | [`launch`] | the command line every process of a run shares, and the start-up handshake with the supervisor |
 //! | [`transport`] | run-scoped iceoryx2 services: publisher+notifier, subscriber+listener, WaitSets |
-//! | [`supervisor`] | starting, watching, restarting and stopping a run's processes; the registry behind `hnav ps` |
+//! | [`supervisor`] | starting, watching, restarting and stopping a run's processes; the registry behind `hnav ps`. It sits on top: no other module uses it |
 //! | [`consensus_log`] | the durable consensus log: record types, segment format, reader, verifier |
 //! | [`logging`] | `tracing` set-up shared by the binaries, with iceoryx2's own logs routed into it |
 

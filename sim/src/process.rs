@@ -247,7 +247,7 @@ impl<'t> SimProcess<'t> {
                 }
             }
         }
-        Ok(stop)
+        Ok(stop.is_some())
     }
 
     /// Reads every wheel topic: liveness from the wake-up events, commands for the current

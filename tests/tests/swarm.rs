@@ -2,7 +2,7 @@
 
 use std::time::Duration;
 
-use hnav_tests::swarm::{repo_root, verify_log, SwarmRun};
+use hnav_tests::swarm::{generated_scenario, repo_root, verify_log, SwarmRun};
 use hnav_tests::TestRun;
 
 /// Generous: a debug build of 10 processes on a 2-core machine.
@@ -105,4 +105,43 @@ fn lockstep_logs_match_the_golden_sums() {
             .collect();
         assert_eq!(&got, want, "{scenario}: the lockstep log changed");
     }
+}
+
+/// The supervisor's `Stop` says why: at the time limit the coordinator logs the run's end as
+/// `time-limit`, not as stopped. Four slow robots with long paths are far from their goals
+/// after two seconds.
+#[test]
+fn a_run_at_its_time_limit_ends_as_time_limit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let map = repo_root().join("maps/random-32-32-10.map");
+    let scenario = generated_scenario(tmp.path(), &map, 4, 3, (25.0, 40.0), 0.25);
+    let text = std::fs::read_to_string(&scenario).unwrap();
+    let limited = text.replace("time_limit_s = 300", "time_limit_s = 2");
+    assert_ne!(text, limited, "the generated scenario sets a time limit");
+    std::fs::write(&scenario, limited).unwrap();
+    let mut run = TestRun::new("limit");
+    let mut swarm = SwarmRun::start(
+        &mut run,
+        &scenario,
+        &tmp.path().join("out"),
+        &tmp.path().join("runs"),
+        &["--mode", "lockstep"],
+    )
+    .expect("hnav run starts");
+    let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
+    assert_eq!(status.code(), Some(1), "{}", swarm.log_tails());
+    let s = swarm.summary().unwrap();
+    assert_eq!(
+        s["end"],
+        "time-limit",
+        "{s}
+{}",
+        swarm.log_tails()
+    );
+    let (ok, report) = verify_log(&swarm.dir.join("log"));
+    assert!(
+        ok,
+        "log does not verify:
+{report}"
+    );
 }

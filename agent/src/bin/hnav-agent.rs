@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use hnav_agent::process::AgentProcess;
-use hnav_runtime::launch::{node_name, process_main, ProcessArgs};
+use hnav_runtime::launch::{process_main, ProcessArgs};
 use hnav_runtime::msg::Role;
 use hnav_runtime::transport::Transport;
 
@@ -27,7 +27,7 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let scenario = args.common.scenario()?;
     let run = args.common.run_id()?;
     let transport = Transport::builder(&run)
-        .node_name(&node_name(Role::Agent, args.index))
+        .node_name(&Role::Agent.node_name(args.index))
         .create()?;
     let mut agent = AgentProcess::new(&transport, &args.common, &scenario, args.index)?;
     let out = agent.run(args.common.resume)?;

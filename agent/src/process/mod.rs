@@ -257,7 +257,7 @@ impl<'t> AgentProcess<'t> {
             .attach_notification(p.life.events().listener())
             .map_err(|e| ws_err(&e))?;
         loop {
-            if p.life.drain(|_, _, _| {})? {
+            if p.life.drain(|_, _, _| {})?.is_some() {
                 break;
             }
             core.on_commits(p)?;

@@ -8,7 +8,7 @@
 //!
 //! - (a) the WaitSet wakes on the exit descriptor;
 //! - (b1) the supervisor's reaction is done: reaped (`try_reap`, as `hnav run` does) and
-//!   `Lifecycle { Down }` published on `lifecycle`;
+//!   `Lifecycle::down` published on `lifecycle`;
 //! - (b2) a subscriber in another thread, blocked in its own WaitSet as the coordinator is,
 //!   has taken that `Down` sample.
 //!
@@ -32,7 +32,6 @@ use anyhow::{anyhow, bail, Context, Result};
 use iceoryx2::prelude::CallbackProgression;
 use iceoryx2::waitset::WaitSetRunResult;
 
-use hnav_runtime::launch::now_ns;
 use hnav_runtime::msg::{Lifecycle, LifecycleEvent, Role};
 use hnav_runtime::scenario::FsyncPolicy;
 use hnav_runtime::supervisor::child::{Child, ChildSpec, ExitInfo, Signal};
@@ -175,7 +174,9 @@ fn listen(
     downs: mpsc::Sender<(u32, Instant)>,
     stop: &AtomicBool,
 ) -> Result<()> {
-    let transport = Transport::builder(run).node_name("coordinator").create()?;
+    let transport = Transport::builder(run)
+        .node_name(&Role::Coordinator.node_name(0))
+        .create()?;
     let rx =
         transport.receiver::<Lifecycle>(topics::LIFECYCLE, topics::lifecycle_qos(REJOIN_AGENTS))?;
     let ws = transport.waitset()?;
@@ -282,15 +283,7 @@ fn kill_once(
         Some(ExitInfo::Signaled(Signal::SIGKILL)) => {}
         other => bail!("pid {}: unexpected exit {other:?}", child.pid()),
     }
-    life.send(Lifecycle {
-        time_ns: now_ns(),
-        pid: child.pid(),
-        index: VICTIM as u32,
-        role: Role::Agent as u8,
-        event: LifecycleEvent::Down as u8,
-        reserved: 0,
-        restarts: 0,
-    })?;
+    life.send(Lifecycle::down(Role::Agent, VICTIM as u32, 0).with_pid(child.pid()))?;
     let published = Instant::now();
     let received = loop {
         let (pid, at) = downs
@@ -318,25 +311,27 @@ fn rejoin(program: &Path, fsync: FsyncPolicy, trials: usize) -> Result<(Vec<u64>
                 t.as_secs_f64() * 1e3
             );
         }
-        swarm.play(session, REJOIN_WARMUP, |_| Ok(()), keep_going)?;
+        let (coordinator, life) = (session.child(), session.lifecycle());
+        swarm.play(coordinator, life, REJOIN_WARMUP, |_| Ok(()), keep_going)?;
         let mut samples = Vec::with_capacity(trials);
         let mut late = 0;
         let mut stalled = 0;
         for trial in 0..trials {
             swarm.kill(VICTIM);
-            session.publish(Role::Agent, VICTIM as u32, LifecycleEvent::Down)?;
-            swarm.play(session, DOWN_ROUNDS, |_| Ok(()), keep_going)?;
+            life.publish(Lifecycle::down(Role::Agent, VICTIM as u32, 0))?;
+            swarm.play(coordinator, life, DOWN_ROUNDS, |_| Ok(()), keep_going)?;
             swarm.restart(VICTIM)?;
             let mut t0 = None;
             let mut back = None;
             let mut stall = false;
             swarm.play(
-                session,
+                coordinator,
+                life,
                 MAX_REJOIN_ROUNDS,
                 |round| {
                     if t0.is_none() {
                         t0 = Some((round, Instant::now()));
-                        session.publish(Role::Agent, VICTIM as u32, LifecycleEvent::Restarted)?;
+                        life.publish(Lifecycle::restarted(Role::Agent, VICTIM as u32, 0))?;
                     }
                     Ok(())
                 },

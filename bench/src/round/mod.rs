@@ -241,14 +241,16 @@ fn measure_point(
     let ns = |d: std::time::Duration| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX);
     let (all, first, stalled) =
         session::with_coordinator(program, agents, fsync, |session, swarm| {
+            let (coordinator, life) = (session.child(), session.lifecycle());
             if warmup > 0 {
-                swarm.play(session, warmup, |_| Ok(()), keep_going)?;
+                swarm.play(coordinator, life, warmup, |_| Ok(()), keep_going)?;
             }
             let mut all = Vec::with_capacity(rounds as usize);
             let mut first = Vec::with_capacity(rounds as usize);
             let mut stalled = 0;
             swarm.play(
-                session,
+                coordinator,
+                life,
                 rounds,
                 |_| Ok(()),
                 |obs| {

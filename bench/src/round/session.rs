@@ -6,15 +6,13 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Context, Result};
-use iceoryx2::prelude::CallbackProgression;
-use iceoryx2::waitset::WaitSetRunResult;
 
-use hnav_runtime::launch::{now_ns, ProcessArgs};
-use hnav_runtime::msg::{Lifecycle, LifecycleEvent, Role};
+use hnav_runtime::launch::ProcessArgs;
+use hnav_runtime::msg::{Lifecycle, Role, StopReason};
 use hnav_runtime::scenario::FsyncPolicy;
 use hnav_runtime::supervisor::child::{Child, ChildSpec, ExitInfo, Signal};
-use hnav_runtime::topics;
-use hnav_runtime::transport::{purge_run, Receiver, RunId, Sender, Transport};
+use hnav_runtime::supervisor::startup::{Startup, SupervisorPorts};
+use hnav_runtime::transport::{purge_run, RunId, Transport};
 
 use super::layout::Layout;
 use super::swarm::Swarm;
@@ -49,8 +47,7 @@ pub struct Session {
     spawned: Instant,
     startup: std::cell::Cell<Option<Duration>>,
     log_file: PathBuf,
-    ready: Receiver<Lifecycle>,
-    life: Sender<Lifecycle>,
+    life: SupervisorPorts,
     transport: Transport,
 }
 
@@ -66,64 +63,31 @@ impl Session {
         self.startup.get()
     }
 
-    /// Publishes a supervisor event on `lifecycle`, as `hnav run` does.
-    pub fn publish(&self, role: Role, index: u32, event: LifecycleEvent) -> Result<()> {
-        self.life
-            .send(Lifecycle {
-                time_ns: now_ns(),
-                pid: 0,
-                index,
-                role: role as u8,
-                event: event as u8,
-                reserved: 0,
-                restarts: 0,
-            })
-            .context("publish on lifecycle")?;
-        Ok(())
+    /// The supervisor's lifecycle ports: events published there reach the coordinator as
+    /// they would from `hnav run`.
+    pub fn lifecycle(&self) -> &SupervisorPorts {
+        &self.life
     }
 
-    /// Waits for the coordinator's `Up` on `ready`, then publishes `Start`.
+    /// The supervisor's start-up handshake with the coordinator, as `hnav run` does it.
     fn handshake(&self) -> Result<()> {
-        let ws = self.transport.waitset()?;
-        let ws_err = |e: &dyn std::fmt::Debug| anyhow!("waitset: {e:?}");
-        let _ready = ws
-            .attach_notification(self.ready.listener())
-            .map_err(|e| ws_err(&e))?;
-        let _exit = ws
-            .attach_notification(self.child.exit_fd())
-            .map_err(|e| ws_err(&e))?;
-        let deadline = Instant::now() + STARTUP_TIMEOUT;
-        loop {
-            self.ready.take_wakeup()?;
-            let mut up = false;
-            self.ready.drain(|l| {
-                up |= l.role == Role::Coordinator as u8 && l.event == LifecycleEvent::Up as u8
-            })?;
-            if up {
-                self.startup.set(Some(self.spawned.elapsed()));
-                return self.publish(Role::Sim, 0, LifecycleEvent::Start);
+        match self
+            .life
+            .start(&self.transport, &[&self.child], STARTUP_TIMEOUT)?
+        {
+            Startup::Started { all_up } => {
+                self.startup.set(Some(all_up - self.spawned));
+                Ok(())
             }
-            if let Some(exit) = self.child.try_reap() {
-                bail!("hnav-coordinator exited during start-up ({exit})");
-            }
-            let left = deadline.saturating_duration_since(Instant::now());
-            if left.is_zero() {
-                bail!("hnav-coordinator did not announce itself within {STARTUP_TIMEOUT:?}");
-            }
-            match ws.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, left) {
-                Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
-                    bail!("interrupted")
-                }
-                Ok(_) => {}
-                Err(e) => return Err(ws_err(&e)),
-            }
+            Startup::Interrupted => bail!("interrupted"),
         }
     }
 
     /// `Stop` on `lifecycle`, then waits for the exit (bounded; SIGKILL after the bound).
     fn stop(&self) -> Result<()> {
-        // A coordinator that already died has no subscriber left: the send still succeeds.
-        self.publish(Role::Sim, 0, LifecycleEvent::Stop)?;
+        self.life
+            .publish(Lifecycle::stop(StopReason::Requested))
+            .context("publish Stop on lifecycle")?;
         match self.child.wait(Some(STOP_TIMEOUT)) {
             Some(ExitInfo::Exited(0)) => Ok(()),
             Some(exit) => bail!("hnav-coordinator ended with {exit}"),
@@ -180,9 +144,7 @@ fn session<T>(
         .with_context(|| format!("write {}", scenario.display()))?;
     let n = layout.agents();
     let transport = Transport::builder(run).node_name("supervisor").create()?;
-    let q = topics::lifecycle_qos(n);
-    let ready = transport.receiver(topics::READY, q)?;
-    let life = transport.sender(topics::LIFECYCLE, q)?;
+    let life = SupervisorPorts::open(&transport, n)?;
     // Every agent port exists before the coordinator starts, as after a real start-up.
     let mut swarm = Swarm::open(run, layout)?;
     let args = ProcessArgs {
@@ -210,7 +172,6 @@ fn session<T>(
         spawned,
         startup: std::cell::Cell::new(None),
         log_file,
-        ready,
         life,
         transport,
     };

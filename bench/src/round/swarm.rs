@@ -9,12 +9,13 @@ use anyhow::{anyhow, bail, Result};
 use iceoryx2::prelude::CallbackProgression;
 use iceoryx2::waitset::{WaitSetAttachmentId, WaitSetRunResult};
 
-use hnav_runtime::msg::{Candidate, CandidateFlags, Commit, LifecycleEvent, Role};
+use hnav_runtime::msg::{Candidate, CandidateFlags, Commit, Lifecycle, Role};
+use hnav_runtime::supervisor::child::Child;
+use hnav_runtime::supervisor::startup::SupervisorPorts;
 use hnav_runtime::topics;
 use hnav_runtime::transport::{Ipc, Receiver, RunId, Sender, Transport};
 
 use super::layout::Layout;
-use super::session::Session;
 
 /// How long one round may take before the benchmark gives up.
 const ROUND_TIMEOUT: Duration = Duration::from_secs(10);
@@ -119,26 +120,27 @@ impl Swarm {
         Ok(())
     }
 
-    /// Plays up to `rounds` rounds from the next one on: `before_send(round)`, every live
-    /// agent's candidate (one `send` per agent, through its own publisher), then a WaitSet
-    /// wait until every live agent's subscriber has taken commit `round`; `after(obs)` may end
-    /// early. Returns the rounds played. Fails if the coordinator exits or a round takes
-    /// longer than 10 s.
+    /// Plays up to `rounds` rounds from the next one on against the `coordinator` process:
+    /// `before_send(round)`, every live agent's candidate (one `send` per agent, through its
+    /// own publisher), then a WaitSet wait until every live agent's subscriber has taken
+    /// commit `round`; `after(obs)` may end early. Returns the rounds played. Fails if the
+    /// coordinator exits or a round takes longer than 10 s.
     ///
-    /// **Stalls.** If no commit comes for [`STALL_AFTER`], the coordinator is poked once with
-    /// a lifecycle event it ignores (`Up` of the sim); the round is reported `stalled`. Seen
+    /// **Stalls.** If no commit comes for [`STALL_AFTER`], the coordinator is poked once
+    /// through the supervisor's `life` ports with a lifecycle event it ignores (`Up` of the
+    /// sim); the round is reported `stalled`. Seen
     /// under load at 128 agents: every candidate was in, yet the coordinator slept until the
     /// poke, i.e. a notification on the candidates topic was lost (a lost wake-up in the
     /// notifier/listener hand-over of iceoryx2's event service).
     pub fn play(
         &mut self,
-        session: &Session,
+        coordinator: &Child,
+        life: &SupervisorPorts,
         rounds: u64,
         mut before_send: impl FnMut(u64) -> Result<()>,
         mut after: impl FnMut(&RoundObs) -> ControlFlow<()>,
     ) -> Result<u64> {
         let n = self.layout.agents();
-        let coordinator = session.child();
         let ws = self.transport.waitset()?;
         let ws_err = |e: &dyn std::fmt::Debug| anyhow!("waitset: {e:?}");
         let exit_guard = ws
@@ -186,7 +188,7 @@ impl Swarm {
                 let now = Instant::now();
                 if !stalled && missing == live && now >= sent + STALL_AFTER {
                     stalled = true;
-                    session.publish(Role::Sim, 0, LifecycleEvent::Up)?;
+                    life.publish(Lifecycle::up(Role::Sim, 0))?;
                 }
                 let left = deadline.saturating_duration_since(now);
                 if left.is_zero() {

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use hnav_coordinator::process::CoordinatorProcess;
-use hnav_runtime::launch::{node_name, process_main, ProcessArgs};
+use hnav_runtime::launch::{process_main, ProcessArgs};
 use hnav_runtime::msg::Role;
 use hnav_runtime::transport::Transport;
 
@@ -30,7 +30,7 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         .clone()
         .ok_or("--dir is required: the consensus log lives in DIR/log")?;
     let transport = Transport::builder(&run)
-        .node_name(&node_name(Role::Coordinator, 0))
+        .node_name(&Role::Coordinator.node_name(0))
         .create()?;
     let mut coordinator = CoordinatorProcess::new(&transport, &scenario, &dir)?;
     let out = coordinator.run(args.common.resume)?;

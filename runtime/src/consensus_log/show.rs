@@ -65,17 +65,12 @@ pub fn describe(record: &Record, width: u32) -> String {
         Record::Lifecycle(l) => {
             let _ = write!(s, "lifecycle round {}  ", l.round);
             match Role::from_u8(l.role) {
-                Some(Role::Agent) => _ = write!(s, "agent {}", l.index),
-                Some(Role::Sim) => s.push_str("sim"),
-                Some(Role::Coordinator) => s.push_str("coordinator"),
+                Some(Role::Agent) => _ = write!(s, "{} {}", Role::Agent.name(), l.index),
+                Some(r) => s.push_str(r.name()),
                 None => _ = write!(s, "role{} {}", l.role, l.index),
             }
             let event = match LifecycleEvent::from_u8(l.event) {
-                Some(LifecycleEvent::Up) => "up".to_string(),
-                Some(LifecycleEvent::Down) => "down".into(),
-                Some(LifecycleEvent::Restarted) => "restarted".into(),
-                Some(LifecycleEvent::Start) => "start".into(),
-                Some(LifecycleEvent::Stop) => "stop".into(),
+                Some(e) => e.name().to_string(),
                 None => format!("event{}", l.event),
             };
             let _ = write!(s, " {event} restarts {}", l.restarts);

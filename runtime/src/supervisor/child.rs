@@ -122,7 +122,7 @@ impl ChildSpec {
 
     /// The iceoryx2 node name the process uses: `sim`, `coordinator` or `agent-<index>`.
     pub fn node_name(&self) -> String {
-        super::registry::node_name(self.role, self.index)
+        self.role.node_name(self.index)
     }
 }
 

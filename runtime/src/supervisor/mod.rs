@@ -3,6 +3,10 @@
 //! watches them, restarts what dies under the scenario's restart policy, and stops everything
 //! cleanly.
 //!
+//! It builds on the rest of the crate (launch, msg, topics, transport, scenario,
+//! consensus_log) and nothing outside `supervisor` uses it: the processes of a run never
+//! link the supervisor's code, and `hnav-bench round` borrows its pieces to stand in for it.
+//!
 //! | module | what it holds |
 //! |---|---|
 //! | [`child`] | one child process: spawn in its own process group with an appended log, reap, describe its exit, signal it or its group |
@@ -10,6 +14,7 @@
 //! | [`restart`] | per-child restart decisions: policy, cap, doubling backoff |
 //! | [`stop`] | the escalating stop of a run's children: wait, SIGTERM, SIGKILL, reap |
 //! | [`registry`] | the on-disk list of live runs and their processes that `hnav ps` reads |
+//! | [`startup`] | the supervisor's half of the lifecycle protocol: the start-up handshake and the events it publishes |
 //! | [`run`] | `hnav run`: spawn, start-up handshake, watch and restart, faults, stop, summary |
 //! | [`summary`] | the run summary (`summary.json`): per-agent steps, length, conflicts, replans from the consensus log; goals and collisions from ground truth |
 //! | [`ps`] | what `hnav ps` shows: each registered process as running, exited or dead, as JSON or a table |
@@ -20,5 +25,6 @@ pub mod ps;
 pub mod registry;
 pub mod restart;
 pub mod run;
+pub mod startup;
 pub mod stop;
 pub mod summary;

@@ -9,13 +9,9 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use super::registry::{pid_alive, role_name, RunEntry};
+use super::registry::{pid_alive, RunEntry, RunRegistry};
 use crate::msg::Role;
 use crate::transport::{NodeLiveness, RunId, Transport};
-
-fn serialize_role<S: serde::Serializer>(role: &Role, s: S) -> Result<S::Ok, S::Error> {
-    s.serialize_str(role_name(*role))
-}
 
 /// A process's state as `hnav ps` shows it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -43,8 +39,7 @@ impl ProcessState {
 /// One process in `hnav ps`.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct ProcessStatus {
-    /// Its role.
-    #[serde(serialize_with = "serialize_role")]
+    /// Its role ([`Role::name`] in JSON).
     pub role: Role,
     /// Its index.
     pub index: u32,
@@ -154,6 +149,18 @@ pub struct PsReport {
 }
 
 impl PsReport {
+    /// Every run of `registry` ([`RunRegistry::list_runs`]) with each process's current
+    /// state.
+    pub fn of(registry: &RunRegistry) -> PsReport {
+        PsReport {
+            runs: registry
+                .list_runs()
+                .into_iter()
+                .map(RunStatus::of)
+                .collect(),
+        }
+    }
+
     /// `{"runs": [...]}`, pretty-printed.
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).unwrap_or_else(|_| r#"{"runs": []}"#.to_string())
@@ -190,7 +197,7 @@ impl PsReport {
                 rows.push([
                     id.clone(),
                     dir.clone(),
-                    role_name(p.role).into(),
+                    p.role.name().into(),
                     p.index.to_string(),
                     p.pid.to_string(),
                     state,

@@ -10,8 +10,6 @@
 //! A supervisor that died without cleaning up leaves its file behind. Readers notice that its
 //! `supervisor_pid` is gone and report the run as *stale*.
 //!
-//! [`RunRegistry::status`] adds each process's current state (see [`super::ps`]).
-//!
 //! The directory is `$HNAV_RUNS_DIR` if that is set, else `<temp dir>/hnav-runs`.
 //! Tests use [`RunRegistry::at`] rather than the environment, which all the tests of one
 //! binary share.
@@ -22,7 +20,6 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use serde::{Deserialize, Serialize};
 
-use super::ps::{PsReport, RunStatus};
 use crate::msg::Role;
 use crate::transport::RunId;
 
@@ -48,41 +45,6 @@ pub enum RegistryError {
         /// The cause.
         source: serde_json::Error,
     },
-}
-
-/// The role as written in records and node names: `sim`, `coordinator`, `agent`.
-pub fn role_name(role: Role) -> &'static str {
-    match role {
-        Role::Sim => "sim",
-        Role::Coordinator => "coordinator",
-        Role::Agent => "agent",
-    }
-}
-
-/// The inverse of [`role_name`].
-pub fn parse_role(name: &str) -> Option<Role> {
-    match name {
-        "sim" => Some(Role::Sim),
-        "coordinator" => Some(Role::Coordinator),
-        "agent" => Some(Role::Agent),
-        _ => None,
-    }
-}
-
-pub use crate::launch::node_name;
-
-mod role_serde {
-    use super::{parse_role, role_name, Role};
-    use serde::{Deserialize, Deserializer, Serializer};
-
-    pub fn serialize<S: Serializer>(role: &Role, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(role_name(*role))
-    }
-
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Role, D::Error> {
-        let name = String::deserialize(d)?;
-        parse_role(&name).ok_or_else(|| serde::de::Error::custom(format!("unknown role {name:?}")))
-    }
 }
 
 /// Where run records live.
@@ -159,20 +121,12 @@ impl RunRegistry {
         });
         runs
     }
-
-    /// [`RunRegistry::list_runs`] with every process's current state: what `hnav ps` shows.
-    pub fn status(&self) -> PsReport {
-        PsReport {
-            runs: self.list_runs().into_iter().map(RunStatus::of).collect(),
-        }
-    }
 }
 
 /// One process of a run, as its supervisor last recorded it.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ProcessRecord {
-    /// Its role (`"sim"`, `"coordinator"`, `"agent"` in JSON).
-    #[serde(with = "role_serde")]
+    /// Its role ([`Role::name`] in JSON).
     pub role: Role,
     /// The agent index, else 0.
     pub index: u32,

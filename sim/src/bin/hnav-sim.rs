@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use clap::Parser;
-use hnav_runtime::launch::{node_name, process_main, LifecyclePorts, ProcessArgs, StartOutcome};
+use hnav_runtime::launch::{process_main, LifecyclePorts, ProcessArgs, StartOutcome};
 use hnav_runtime::msg::Role;
 use hnav_runtime::transport::Transport;
 use hnav_sim::process::SimProcess;
@@ -32,7 +32,7 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let scenario = args.common.scenario()?;
     let run = args.common.run_id()?;
     let transport = Transport::builder(&run)
-        .node_name(&node_name(Role::Sim, 0))
+        .node_name(&Role::Sim.node_name(0))
         .create()?;
     let mut sim = SimProcess::new(&transport, &scenario)?;
     if !args.standalone {

@@ -1,8 +1,10 @@
 //! `hnav ps`: the live runs on this machine and the state of their processes. A thin
-//! front end; the registry and the state lookup live in `hnav_runtime::supervisor::registry`.
+//! front end; the registry lives in `hnav_runtime::supervisor::registry`, the state lookup
+//! in `hnav_runtime::supervisor::ps`.
 
 use std::process::ExitCode;
 
+use hnav_runtime::supervisor::ps::PsReport;
 use hnav_runtime::supervisor::registry::RunRegistry;
 
 /// `hnav ps` arguments.
@@ -17,7 +19,7 @@ pub struct PsArgs {
 /// there are none.
 pub fn run(args: PsArgs) -> ExitCode {
     hnav_runtime::logging::init();
-    let report = RunRegistry::default_location().status();
+    let report = PsReport::of(&RunRegistry::default_location());
     if args.json {
         println!("{}", report.to_json());
     } else {

@@ -1,0 +1,319 @@
+//! The lifecycle protocol's payload and its vocabulary: which process ([`Role`], with the one
+//! spelling of its name), what happened to it ([`LifecycleEvent`]), why a run is stopped
+//! ([`StopReason`]), and the [`Lifecycle`] sample built by its constructors.
+
+use std::time::{SystemTime, UNIX_EPOCH};
+
+use iceoryx2::prelude::ZeroCopySend;
+
+/// Which kind of process a [`Lifecycle`] event is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Role {
+    /// The physics stepper `hnav-sim`.
+    Sim = 1,
+    /// The central compute block `hnav-coordinator`.
+    Coordinator = 2,
+    /// One robot's `hnav-agent`.
+    Agent = 3,
+}
+
+impl Role {
+    /// Decodes a role byte received from another process.
+    pub fn from_u8(v: u8) -> Option<Self> {
+        match v {
+            1 => Some(Self::Sim),
+            2 => Some(Self::Coordinator),
+            3 => Some(Self::Agent),
+            _ => None,
+        }
+    }
+
+    /// The role's name: `sim`, `coordinator` or `agent`, the one spelling used by node names,
+    /// the run registry, `hnav ps` and `hnav log show`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Sim => "sim",
+            Self::Coordinator => "coordinator",
+            Self::Agent => "agent",
+        }
+    }
+
+    /// The inverse of [`Role::name`].
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "sim" => Some(Self::Sim),
+            "coordinator" => Some(Self::Coordinator),
+            "agent" => Some(Self::Agent),
+            _ => None,
+        }
+    }
+
+    /// The iceoryx2 node name of the process: `sim`, `coordinator` or `agent-<index>` (what
+    /// `hnav ps` matches dead nodes against).
+    pub fn node_name(self, index: u32) -> String {
+        match self {
+            Self::Agent => format!("{}-{index}", self.name()),
+            other => other.name().to_string(),
+        }
+    }
+}
+
+/// In JSON (run records, `hnav ps --json`) a role is its [`Role::name`].
+impl serde::Serialize for Role {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for Role {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        Role::from_name(&name)
+            .ok_or_else(|| serde::de::Error::custom(format!("unknown role {name:?}")))
+    }
+}
+
+/// What happened to a process.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum LifecycleEvent {
+    /// Started and attached to the run.
+    Up = 1,
+    /// Exited or was killed.
+    Down = 2,
+    /// Started again by the supervisor after a `Down`.
+    Restarted = 3,
+    /// Supervisor to all: every process is up, begin the run.
+    Start = 4,
+    /// Supervisor to all: finish cleanly and exit; [`Lifecycle::reason`] says why.
+    Stop = 5,
+}
+
+impl LifecycleEvent {
+    /// Decodes an event byte received from another process.
+    pub fn from_u8(v: u8) -> Option<Self> {
+        match v {
+            1 => Some(Self::Up),
+            2 => Some(Self::Down),
+            3 => Some(Self::Restarted),
+            4 => Some(Self::Start),
+            5 => Some(Self::Stop),
+            _ => None,
+        }
+    }
+
+    /// Lower-case name (`up`, `down`, `restarted`, `start`, `stop`), as in `hnav log show`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Up => "up",
+            Self::Down => "down",
+            Self::Restarted => "restarted",
+            Self::Start => "start",
+            Self::Stop => "stop",
+        }
+    }
+}
+
+/// Why the supervisor sends `Stop`: the coordinator logs it as the end of the run.
+///
+/// There is no "all at goal": the coordinator ends such a run itself, before the supervisor
+/// learns of it from the progress topic.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum StopReason {
+    /// Asked to stop: the run is complete, or the supervisor was signalled.
+    Requested = 1,
+    /// The scenario's time limit passed.
+    TimeLimit = 2,
+}
+
+impl StopReason {
+    /// Decodes a reason byte received from another process.
+    pub fn from_u8(v: u8) -> Option<Self> {
+        match v {
+            1 => Some(Self::Requested),
+            2 => Some(Self::TimeLimit),
+            _ => None,
+        }
+    }
+}
+
+/// A process came up, went down or was restarted, or the supervisor starts or stops the run.
+///
+/// Built by the constructors ([`Lifecycle::up`], [`Lifecycle::down`],
+/// [`Lifecycle::restarted`], [`Lifecycle::start`], [`Lifecycle::stop`]), which stamp the
+/// wall-clock time and leave every byte they do not set zero.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend)]
+#[repr(C)]
+#[type_name("hnav::Lifecycle")]
+pub struct Lifecycle {
+    /// Wall-clock time of the event, ns since the Unix epoch (never used for decisions).
+    pub time_ns: u64,
+    /// OS process id of the process the event is about; 0 when the sender does not say.
+    pub pid: u32,
+    /// Agent index for [`Role::Agent`], else 0.
+    pub index: u32,
+    /// A [`Role`] as `u8`. `Start` and `Stop` are addressed to every process and carry
+    /// [`Role::Sim`] and index 0 as placeholders, since a receiver drops unknown roles.
+    pub role: u8,
+    /// A [`LifecycleEvent`] as `u8`.
+    pub event: u8,
+    /// For `Stop`, a [`StopReason`] as `u8`; zero for every other event.
+    pub reason: u8,
+    /// Zero.
+    pub reserved: u8,
+    /// Restarts of this process so far.
+    pub restarts: u32,
+}
+
+impl Lifecycle {
+    /// `Up` of the calling process (with its own pid): its ports are open.
+    pub fn up(role: Role, index: u32) -> Self {
+        Self::about(role, index, LifecycleEvent::Up, 0).with_pid(std::process::id())
+    }
+
+    /// `Down`: the process exited or was killed, after `restarts` restarts.
+    pub fn down(role: Role, index: u32, restarts: u32) -> Self {
+        Self::about(role, index, LifecycleEvent::Down, restarts)
+    }
+
+    /// `Restarted`: the process runs again, its `restarts`-th incarnation after the first.
+    pub fn restarted(role: Role, index: u32, restarts: u32) -> Self {
+        Self::about(role, index, LifecycleEvent::Restarted, restarts)
+    }
+
+    /// `Start`: every process is up, begin the run.
+    pub fn start() -> Self {
+        Self::about(Role::Sim, 0, LifecycleEvent::Start, 0)
+    }
+
+    /// `Stop`: finish cleanly and exit, for `reason`.
+    pub fn stop(reason: StopReason) -> Self {
+        Self {
+            reason: reason as u8,
+            ..Self::about(Role::Sim, 0, LifecycleEvent::Stop, 0)
+        }
+    }
+
+    /// The same event about the process with id `pid`.
+    pub fn with_pid(self, pid: u32) -> Self {
+        Self { pid, ..self }
+    }
+
+    fn about(role: Role, index: u32, event: LifecycleEvent, restarts: u32) -> Self {
+        Self {
+            time_ns: wall_clock_ns(),
+            pid: 0,
+            index,
+            role: role as u8,
+            event: event as u8,
+            reason: 0,
+            reserved: 0,
+            restarts,
+        }
+    }
+}
+
+/// Nanoseconds since the Unix epoch; 0 if the clock is set before it.
+fn wall_clock_ns() -> u64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map(|d| d.as_nanos() as u64)
+        .unwrap_or(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::mem::{align_of, offset_of, size_of};
+
+    const ROLES: [Role; 3] = [Role::Sim, Role::Coordinator, Role::Agent];
+
+    #[test]
+    fn lifecycle_layout() {
+        assert_eq!(size_of::<Lifecycle>(), 24);
+        assert_eq!(align_of::<Lifecycle>(), 8);
+        assert_eq!(offset_of!(Lifecycle, time_ns), 0);
+        assert_eq!(offset_of!(Lifecycle, pid), 8);
+        assert_eq!(offset_of!(Lifecycle, index), 12);
+        assert_eq!(offset_of!(Lifecycle, role), 16);
+        assert_eq!(offset_of!(Lifecycle, event), 17);
+        assert_eq!(offset_of!(Lifecycle, reason), 18);
+        assert_eq!(offset_of!(Lifecycle, reserved), 19);
+        assert_eq!(offset_of!(Lifecycle, restarts), 20);
+    }
+
+    #[test]
+    fn enums_round_trip_and_reject_unknown_bytes() {
+        for r in ROLES {
+            assert_eq!(Role::from_u8(r as u8), Some(r));
+        }
+        for e in [
+            LifecycleEvent::Up,
+            LifecycleEvent::Down,
+            LifecycleEvent::Restarted,
+            LifecycleEvent::Start,
+            LifecycleEvent::Stop,
+        ] {
+            assert_eq!(LifecycleEvent::from_u8(e as u8), Some(e));
+        }
+        for s in [StopReason::Requested, StopReason::TimeLimit] {
+            assert_eq!(StopReason::from_u8(s as u8), Some(s));
+        }
+        assert_eq!(LifecycleEvent::from_u8(6), None);
+        for bad in [0u8, 5, 200, 255] {
+            assert_eq!(Role::from_u8(bad), None);
+            assert_eq!(LifecycleEvent::from_u8(bad.max(6)), None);
+            assert_eq!(StopReason::from_u8(bad.max(3)), None);
+        }
+        assert_eq!(StopReason::from_u8(0), None);
+    }
+
+    #[test]
+    fn role_names_have_one_spelling() {
+        for r in ROLES {
+            assert_eq!(Role::from_name(r.name()), Some(r));
+            let json = serde_json::to_string(&r).unwrap();
+            assert_eq!(json, format!("\"{}\"", r.name()));
+            assert_eq!(serde_json::from_str::<Role>(&json).unwrap(), r);
+        }
+        assert_eq!(Role::from_name("robot"), None);
+        assert!(serde_json::from_str::<Role>("\"robot\"").is_err());
+        assert_eq!(Role::Agent.node_name(7), "agent-7");
+        assert_eq!(Role::Sim.node_name(0), "sim");
+        assert_eq!(Role::Coordinator.node_name(0), "coordinator");
+    }
+
+    /// The fields a lifecycle record copies (role, index, event, restarts) are what the
+    /// supervisor and the coordinator sent before the constructors existed.
+    #[test]
+    fn constructors_fill_the_fields_the_protocol_reads() {
+        let fields = |l: Lifecycle| (l.role, l.index, l.event, l.reason, l.reserved, l.restarts);
+        let (sim, agent) = (Role::Sim as u8, Role::Agent as u8);
+        let up = Lifecycle::up(Role::Agent, 4);
+        assert_eq!(up.pid, std::process::id());
+        assert_eq!(fields(up), (agent, 4, LifecycleEvent::Up as u8, 0, 0, 0));
+        let down = Lifecycle::down(Role::Agent, 4, 2);
+        assert_eq!(down.pid, 0);
+        assert_eq!(
+            fields(down),
+            (agent, 4, LifecycleEvent::Down as u8, 0, 0, 2)
+        );
+        assert_eq!(down.with_pid(77).pid, 77);
+        let back = Lifecycle::restarted(Role::Agent, 4, 3);
+        assert_eq!(
+            fields(back),
+            (agent, 4, LifecycleEvent::Restarted as u8, 0, 0, 3)
+        );
+        let start = Lifecycle::start();
+        assert_eq!(
+            fields(start),
+            (sim, 0, LifecycleEvent::Start as u8, 0, 0, 0)
+        );
+        let stop = Lifecycle::stop(StopReason::TimeLimit);
+        assert_eq!(fields(stop), (sim, 0, LifecycleEvent::Stop as u8, 2, 0, 0));
+        assert_eq!(Lifecycle::stop(StopReason::Requested).reason, 1);
+        assert!(start.time_ns > 0);
+    }
+}

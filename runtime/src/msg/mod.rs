@@ -1,0 +1,55 @@
+//! Message contracts: the payloads that cross process boundaries.
+//!
+//! Every type here is `#[repr(C)]`, [`ZeroCopySend`](iceoryx2::prelude::ZeroCopySend) and
+//! carries a `#[type_name("hnav::...")]` so that two separately built binaries (or a foreign
+//! client using the iceoryx2 C++ or Python bindings) agree on its identity. Layouts contain no implicit padding: every gap is an explicit
+//! `reserved` field that senders set to zero, so a sample's bytes are fully defined and can be
+//! hashed or checksummed as they are.
+//!
+//! Cells travel as 0-based row-major indices (`y * width + x`, MovingAI `x` = column, `y` = row)
+//! in a `u32`; [`NO_CELL`] marks "none". Enumerations travel as plain integers with associated
+//! constants instead of Rust enums, because reading an out-of-range discriminant out of shared
+//! memory would be undefined behaviour: a receiver validates with `from_u8` and drops what it
+//! does not understand.
+//!
+//! All sizes and offsets below are for a 64-bit little-endian target and are asserted by the
+//! layout tests of each submodule, so this table cannot drift from the code.
+//!
+//! | type | size | align | fields (offset: name type) |
+//! |---|---|---|---|
+//! | [`Candidate`] | 40 | 8 | 0 round u64, 8 agent u32, 12 current u32, 16 next u32, 20 probable u32, 24 priority f32, 28 speed f32, 32 flags u32, 36 reserved u32 |
+//! | [`Decision`] | 16 | 4 | 0 agent u32, 4 verdict u8, 5 refused u8, 6 kind u8, 7 reserved u8, 8 cell u32, 12 waypoint u32 |
+//! | [`Commit`] | 16 + 16·[`MAX_AGENTS`] = 4112 | 8 | 0 round u64, 8 count u32, 12 reserved u32, 16 decisions [Decision; 256] |
+//! | [`WheelCommand`] | 32 | 8 | 0 period u64, 8 agent u32, 12 flags u32, 16 left_rad_s f64, 24 right_rad_s f64 |
+//! | [`Odometry`] | 40 | 8 | 0 sim_time_ns u64, 8 period u64, 16 agent u32, 20 reserved u32, 24 ticks_left i64, 32 ticks_right i64 |
+//! | [`Pose`] | 24 | 8 | 0 x_m f64, 8 y_m f64, 16 theta_rad f64 |
+//! | [`Truth`] | 24 + 24·[`MAX_AGENTS`] = 6168 | 8 | 0 sim_time_ns u64, 8 period u64, 16 robots u32, 20 collisions u32, 24 poses [Pose; 256] |
+//! | [`Lifecycle`] | 24 | 8 | 0 time_ns u64, 8 pid u32, 12 index u32, 16 role u8, 17 event u8, 18 reason u8, 19 reserved u8, 20 restarts u32 |
+//! | [`Progress`] | 32 | 8 | 0 round u64, 8 agents u32, 12 at_goal u32, 16 conflicts u32, 20 replans u32, 24 done u8, 25 reserved [u8; 7] |
+//! | [`MapHeader`] | 32 | 8 | 0 round u64, 8 agent u32, 12 width u32, 16 height u32, 20 iterations u32, 24 target u32, 28 activation u8, 29 reserved [u8; 3] |
+//!
+//! The neural-map snapshot is a slice service of `f32` (one activation per cell, row-major) whose
+//! user header is a [`MapHeader`].
+//!
+//! | module | payloads |
+//! |---|---|
+//! | `round` | the decision round: [`Candidate`], [`Decision`], [`Commit`], [`Progress`] |
+//! | `motion` | wheels and ground truth: [`WheelCommand`], [`Odometry`], [`Pose`], [`Truth`] |
+//! | `lifecycle` | the supervisor's protocol: [`Role`] and its names, [`LifecycleEvent`], [`StopReason`], [`Lifecycle`] and its constructors |
+//! | `map` | the neural-map snapshot: [`MapHeader`], [`ActivationKind`] |
+
+mod lifecycle;
+mod map;
+mod motion;
+mod round;
+
+pub use lifecycle::{Lifecycle, LifecycleEvent, Role, StopReason};
+pub use map::{ActivationKind, MapHeader};
+pub use motion::{Odometry, Pose, Truth, WheelCommand};
+pub use round::{Candidate, CandidateFlags, Commit, ConflictKind, Decision, Progress, Verdict};
+
+/// The largest swarm one [`Commit`] or [`Truth`] sample can describe.
+pub const MAX_AGENTS: usize = 256;
+
+/// Marks "no cell" in a cell field.
+pub const NO_CELL: u32 = u32::MAX;

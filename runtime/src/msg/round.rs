@@ -1,0 +1,317 @@
+//! The decision round's payloads: agents' candidates, the coordinator's commit, its tally.
+
+use iceoryx2::prelude::ZeroCopySend;
+
+use super::{MAX_AGENTS, NO_CELL};
+
+/// One agent's row of the dissertation's `shared_paths` table, proposed for a decision round.
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("hnav::Candidate")]
+pub struct Candidate {
+    /// Decision round this candidate is for.
+    pub round: u64,
+    /// Agent index (0-based, < the run's agent count).
+    pub agent: u32,
+    /// Cell the robot is in.
+    pub current: u32,
+    /// Cell already committed for the robot (it will not change), or [`NO_CELL`].
+    pub next: u32,
+    /// Cell the agent proposes to enter after `next`, or [`NO_CELL`] when it stands still.
+    pub probable: u32,
+    /// Conflict priority; larger wins. `1 / speed` unless the scenario gives one.
+    pub priority: f32,
+    /// Nominal speed in cells per second.
+    pub speed: f32,
+    /// Bit set of [`CandidateFlags`] values.
+    pub flags: u32,
+    /// Zero.
+    pub reserved: u32,
+}
+
+impl Default for Candidate {
+    fn default() -> Self {
+        Self {
+            round: 0,
+            agent: 0,
+            current: NO_CELL,
+            next: NO_CELL,
+            probable: NO_CELL,
+            priority: 0.0,
+            speed: 0.0,
+            flags: 0,
+            reserved: 0,
+        }
+    }
+}
+
+/// Bits of [`Candidate::flags`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CandidateFlags;
+
+impl CandidateFlags {
+    /// The robot is at its goal and stays there.
+    pub const AT_GOAL: u32 = 1 << 0;
+    /// The agent proposes no move this round.
+    pub const STANDING: u32 = 1 << 1;
+    /// The ascent found no neighbour better than the current cell (local extremum).
+    pub const LOCAL_EXTREMUM: u32 = 1 << 2;
+    /// The agent process was restarted and resumes from the committed state.
+    pub const RESTARTED: u32 = 1 << 3;
+    /// The neural map reports the goal unreachable.
+    pub const NO_PATH: u32 = 1 << 4;
+}
+
+/// What the coordinator decided for one agent in a round.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Verdict {
+    /// The probable cell is accepted: `next <- probable`.
+    Accept = 1,
+    /// The move is refused; [`Decision::refused`] names the refused directions.
+    Block = 2,
+    /// No move asked or possible (standing, finished, missing in the round).
+    Hold = 3,
+    /// A global replan was made; [`Decision::waypoint`] is the next intermediate target.
+    Replan = 4,
+}
+
+impl Verdict {
+    /// Decodes a verdict byte received from another process.
+    pub fn from_u8(v: u8) -> Option<Self> {
+        match v {
+            1 => Some(Self::Accept),
+            2 => Some(Self::Block),
+            3 => Some(Self::Hold),
+            4 => Some(Self::Replan),
+            _ => None,
+        }
+    }
+}
+
+/// Why the coordinator refused or held a move (the dissertation's conflict types, Fig. 3-6,
+/// plus the checks a physical swarm needs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum ConflictKind {
+    /// No conflict (accepted, or nothing asked).
+    None = 0,
+    /// (a) crossing: two moves claim the same cell or sweep the same corner.
+    Crossing = 1,
+    /// (b) head-on: two agents ask for each other's cells.
+    HeadOn = 2,
+    /// (c) combined: a move that is both crossing and head-on at once.
+    Combined = 3,
+    /// (d) the cell of a standing or finished agent, refused whatever the priority.
+    StableCell = 4,
+    /// A diagonal past a blocked or occupied corner cell.
+    CornerCut = 5,
+    /// A cell still held (current or next) by an agent that is moving out of it.
+    Reserved = 6,
+    /// Not a legal move at all: not a neighbour, off the grid, or a blocked cell.
+    Invalid = 7,
+}
+
+impl ConflictKind {
+    /// Decodes a kind byte received from another process.
+    pub fn from_u8(v: u8) -> Option<Self> {
+        match v {
+            0 => Some(Self::None),
+            1 => Some(Self::Crossing),
+            2 => Some(Self::HeadOn),
+            3 => Some(Self::Combined),
+            4 => Some(Self::StableCell),
+            5 => Some(Self::CornerCut),
+            6 => Some(Self::Reserved),
+            7 => Some(Self::Invalid),
+            _ => None,
+        }
+    }
+
+    /// Short lower-case name, as in logs and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::None => "none",
+            Self::Crossing => "crossing",
+            Self::HeadOn => "head-on",
+            Self::Combined => "combined",
+            Self::StableCell => "stable-cell",
+            Self::CornerCut => "corner-cut",
+            Self::Reserved => "reserved",
+            Self::Invalid => "invalid",
+        }
+    }
+}
+
+/// One agent's entry in a [`Commit`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("hnav::Decision")]
+pub struct Decision {
+    /// Agent index.
+    pub agent: u32,
+    /// A [`Verdict`] as `u8`.
+    pub verdict: u8,
+    /// Refused directions, bit `d` for direction index `d` (0 = N, clockwise to 7 = NW).
+    pub refused: u8,
+    /// Why a move was refused or held: a [`ConflictKind`] as `u8` (0 when accepted).
+    pub kind: u8,
+    /// Zero.
+    pub reserved: u8,
+    /// The committed cell (the accepted `probable`), or [`NO_CELL`].
+    pub cell: u32,
+    /// The next waypoint of a global replan, or [`NO_CELL`].
+    pub waypoint: u32,
+}
+
+impl Default for Decision {
+    fn default() -> Self {
+        Self {
+            agent: 0,
+            verdict: Verdict::Hold as u8,
+            refused: 0,
+            kind: ConflictKind::None as u8,
+            reserved: 0,
+            cell: NO_CELL,
+            waypoint: NO_CELL,
+        }
+    }
+}
+
+/// One decision round's outcome, published only after it is durable in the consensus log.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("hnav::Commit")]
+pub struct Commit {
+    /// The round decided.
+    pub round: u64,
+    /// How many entries of `decisions` are valid.
+    pub count: u32,
+    /// Zero.
+    pub reserved: u32,
+    /// The decisions, `decisions[..count]`.
+    pub decisions: [Decision; MAX_AGENTS],
+}
+
+impl Default for Commit {
+    fn default() -> Self {
+        Self {
+            round: 0,
+            count: 0,
+            reserved: 0,
+            decisions: [Decision::default(); MAX_AGENTS],
+        }
+    }
+}
+
+impl Commit {
+    /// The valid decisions (`count` clamped to [`MAX_AGENTS`], so a corrupt count cannot
+    /// index out of bounds).
+    pub fn decisions(&self) -> &[Decision] {
+        &self.decisions[..(self.count as usize).min(MAX_AGENTS)]
+    }
+}
+
+/// The coordinator's running tally, published after every round (latest value only) for the
+/// supervisor's progress bar and for viewers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend)]
+#[repr(C)]
+#[type_name("hnav::Progress")]
+pub struct Progress {
+    /// Last committed round.
+    pub round: u64,
+    /// Agents in the run.
+    pub agents: u32,
+    /// Agents standing on their goal.
+    pub at_goal: u32,
+    /// Refused or held moves so far.
+    pub conflicts: u32,
+    /// Global replans so far.
+    pub replans: u32,
+    /// 1 once every agent is at its goal, else 0.
+    pub done: u8,
+    /// Zero.
+    pub reserved: [u8; 7],
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::mem::{align_of, offset_of, size_of};
+
+    #[test]
+    fn candidate_layout() {
+        assert_eq!(size_of::<Candidate>(), 40);
+        assert_eq!(align_of::<Candidate>(), 8);
+        assert_eq!(offset_of!(Candidate, round), 0);
+        assert_eq!(offset_of!(Candidate, agent), 8);
+        assert_eq!(offset_of!(Candidate, current), 12);
+        assert_eq!(offset_of!(Candidate, next), 16);
+        assert_eq!(offset_of!(Candidate, probable), 20);
+        assert_eq!(offset_of!(Candidate, priority), 24);
+        assert_eq!(offset_of!(Candidate, speed), 28);
+        assert_eq!(offset_of!(Candidate, flags), 32);
+        assert_eq!(offset_of!(Candidate, reserved), 36);
+    }
+
+    #[test]
+    fn commit_layout() {
+        assert_eq!(size_of::<Decision>(), 16);
+        assert_eq!(align_of::<Decision>(), 4);
+        assert_eq!(offset_of!(Decision, agent), 0);
+        assert_eq!(offset_of!(Decision, verdict), 4);
+        assert_eq!(offset_of!(Decision, refused), 5);
+        assert_eq!(offset_of!(Decision, kind), 6);
+        assert_eq!(offset_of!(Decision, reserved), 7);
+        assert_eq!(offset_of!(Decision, cell), 8);
+        assert_eq!(offset_of!(Decision, waypoint), 12);
+        assert_eq!(size_of::<Commit>(), 16 + 16 * MAX_AGENTS);
+        assert_eq!(size_of::<Commit>(), 4112);
+        assert_eq!(align_of::<Commit>(), 8);
+        assert_eq!(offset_of!(Commit, round), 0);
+        assert_eq!(offset_of!(Commit, count), 8);
+        assert_eq!(offset_of!(Commit, reserved), 12);
+        assert_eq!(offset_of!(Commit, decisions), 16);
+    }
+
+    #[test]
+    fn progress_layout() {
+        assert_eq!(size_of::<Progress>(), 32);
+        assert_eq!(align_of::<Progress>(), 8);
+        assert_eq!(offset_of!(Progress, round), 0);
+        assert_eq!(offset_of!(Progress, agents), 8);
+        assert_eq!(offset_of!(Progress, at_goal), 12);
+        assert_eq!(offset_of!(Progress, conflicts), 16);
+        assert_eq!(offset_of!(Progress, replans), 20);
+        assert_eq!(offset_of!(Progress, done), 24);
+        assert_eq!(offset_of!(Progress, reserved), 25);
+    }
+
+    #[test]
+    fn enums_round_trip_and_reject_unknown_bytes() {
+        for v in [
+            Verdict::Accept,
+            Verdict::Block,
+            Verdict::Hold,
+            Verdict::Replan,
+        ] {
+            assert_eq!(Verdict::from_u8(v as u8), Some(v));
+        }
+        for k in 0..=7u8 {
+            assert_eq!(ConflictKind::from_u8(k).map(|k| k as u8), Some(k));
+        }
+        assert_eq!(ConflictKind::from_u8(8), None);
+        for bad in [0u8, 5, 200, 255] {
+            assert_eq!(Verdict::from_u8(bad), None);
+        }
+    }
+
+    #[test]
+    fn a_corrupt_count_does_not_index_out_of_bounds() {
+        let c = Commit {
+            count: u32::MAX,
+            ..Commit::default()
+        };
+        assert_eq!(c.decisions().len(), MAX_AGENTS);
+    }
+}

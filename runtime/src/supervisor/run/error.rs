@@ -1,0 +1,51 @@
+//! What can stop `hnav run` from happening at all.
+
+use std::path::{Path, PathBuf};
+
+use crate::consensus_log::LogError;
+use crate::scenario::ScenarioError;
+use crate::supervisor::child::ChildError;
+use crate::supervisor::startup::StartupError;
+use crate::transport::TransportError;
+
+/// What can stop a run from happening at all.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The scenario is unusable.
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    /// The transport failed.
+    #[error(transparent)]
+    Transport(#[from] TransportError),
+    /// A process could not be started.
+    #[error(transparent)]
+    Child(#[from] ChildError),
+    /// The run directory could not be prepared or the summary written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The path.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// The options name no run directory.
+    #[error("start-up failed: no run directory")]
+    NoRunDir,
+    /// A process did not come up.
+    #[error("start-up failed: {0}")]
+    Startup(#[from] StartupError),
+    /// The consensus log could not be read for the summary.
+    #[error(transparent)]
+    Log(#[from] LogError),
+    /// The WaitSet failed.
+    #[error("waitset: {0}")]
+    WaitSet(String),
+}
+
+/// Maps an I/O error on `path` to [`RunError::Io`].
+pub(super) fn io(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
+    move |source| RunError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}

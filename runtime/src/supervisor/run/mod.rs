@@ -1,0 +1,298 @@
+//! `hnav run`: one run of a scenario, end to end.
+//!
+//! 1. Prepare the run directory (a previous run's log and checkpoints are removed: a log
+//!    left there would make the new coordinator resume the old run) and register the run for
+//!    `hnav ps`.
+//! 2. Spawn `hnav-sim`, `hnav-coordinator` and one `hnav-agent` per robot, each in its own
+//!    process group with its output in `DIR/logs/<node>.log`, and wait until every one has
+//!    announced itself on `ready`; then publish `Start` (see [`crate::launch`] and
+//!    [`super::startup`]).
+//! 3. Watch: block in a WaitSet on the children's exit descriptors (a child's death wakes it
+//!    at once) with a short tick for the progress bar and the fault schedule. A dead child is
+//!    reaped, its stale iceoryx2 resources removed (which wakes its peers with a "peer dead"
+//!    event), the others told on the lifecycle topic, and it is restarted under its role's
+//!    policy with `--resume` (module `slots`). The progress bar (`progress`) and the
+//!    scenario's planned faults (`faults`) follow the coordinator's progress topic.
+//! 4. End when the coordinator reports every agent at its goal, the time limit passes, or
+//!    the supervisor is asked to stop (SIGINT/SIGTERM): publish `Stop` with its
+//!    [`StopReason`], give the children a grace period, then SIGTERM and SIGKILL their
+//!    process groups; remove the run's shared memory; write `DIR/summary.json` from the
+//!    consensus log and the last ground truth.
+
+mod error;
+mod faults;
+mod progress;
+mod slots;
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use iceoryx2::prelude::CallbackProgression;
+use iceoryx2::waitset::{WaitSet, WaitSetRunResult};
+
+use super::child::Child;
+use super::registry::{RunRecord, RunRegistry};
+use super::startup::{Startup, SupervisorPorts};
+use super::stop::stop_all;
+use super::summary::RunSummary;
+use crate::launch::ProcessArgs;
+use crate::msg::{Lifecycle, Progress, StopReason, Truth};
+use crate::scenario::Scenario;
+use crate::topics;
+use crate::transport::{purge_run, Ipc, Receiver, RunId, Transport};
+use error::io;
+use faults::FaultSchedule;
+use progress::ProgressView;
+use slots::Slots;
+
+pub use error::RunError;
+
+/// How long the processes get to come up.
+pub const STARTUP_TIMEOUT: Duration = Duration::from_secs(60);
+/// How long a child gets after `Stop`, and again after SIGTERM.
+pub const STOP_GRACE: Duration = Duration::from_secs(3);
+/// Refresh period of the progress bar and the fault schedule.
+const TICK: Duration = Duration::from_millis(50);
+
+/// What `hnav run` needs.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// The processes' shared arguments (run id, scenario, overrides, run directory).
+    pub args: ProcessArgs,
+    /// Where `hnav-sim`, `hnav-coordinator` and `hnav-agent` are.
+    pub bin_dir: PathBuf,
+    /// Show a progress bar (on a terminal).
+    pub progress: bool,
+}
+
+struct Ports {
+    life: SupervisorPorts,
+    progress: Receiver<Progress>,
+    truth: Receiver<Truth>,
+}
+
+/// Runs the scenario to its end and returns the summary (also written to `DIR/summary.json`).
+pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
+    let scenario = opts.args.scenario()?;
+    let run = opts.args.run_id()?;
+    let dir = opts.args.dir.clone().ok_or(RunError::NoRunDir)?;
+    prepare_dir(&dir)?;
+    let transport = Transport::builder(&run)
+        .node_name("supervisor")
+        .handle_signals(true)
+        .create()?;
+    let n = scenario.agents.len();
+    let ports = Ports {
+        life: SupervisorPorts::open(&transport, n)?,
+        progress: transport.receiver(topics::PROGRESS, topics::state_qos())?,
+        truth: transport.receiver(topics::TRUTH, topics::state_qos())?,
+    };
+    let registry = RunRegistry::default_location();
+    let mut record = registry.new_record(&run, &dir);
+    let started = Instant::now();
+    let mut slots = Slots::new(&opts.args, &opts.bin_dir, &scenario, &dir);
+    let result = supervise(
+        &transport,
+        &ports,
+        &scenario,
+        &mut slots,
+        &mut record,
+        opts.progress,
+    );
+    // The last ground truth, taken while the sim still runs (a sample does not outlive its
+    // publisher). After the end of the run nothing moves any more in lockstep.
+    let mut truth = None;
+    ports.truth.drain(|t| truth = Some(*t))?;
+    let reason = match result {
+        Ok(End::TimeLimit) => StopReason::TimeLimit,
+        _ => StopReason::Requested,
+    };
+    let _ = ports.life.publish(Lifecycle::stop(reason));
+    for s in stop_all(slots.children(), STOP_GRACE) {
+        tracing::debug!(node = s.role.node_name(s.index), how = ?s.how, "stopped");
+    }
+    drop(ports);
+    drop(transport);
+    if let Err(e) = purge_run(&run) {
+        tracing::warn!(
+            "shared memory of run {} not fully removed: {e}",
+            run.as_str()
+        );
+    }
+    if let Err(e) = record.remove() {
+        tracing::warn!("run registry entry not removed: {e}");
+    }
+    result?;
+    let summary = RunSummary::from_log(
+        run.as_str(),
+        &dir.join("log"),
+        truth.as_ref(),
+        scenario.robot.cell_size_m,
+        started.elapsed().as_secs_f64(),
+    )?;
+    summary.write_json(&dir).map_err(io(&dir))?;
+    Ok(summary)
+}
+
+/// Removes what a previous run left in `dir` that a new one would mistake for its own.
+fn prepare_dir(dir: &Path) -> Result<(), RunError> {
+    for sub in ["log", "agents", "logs"] {
+        let p = dir.join(sub);
+        if p.exists() {
+            std::fs::remove_dir_all(&p).map_err(io(&p))?;
+        }
+    }
+    let logs = dir.join("logs");
+    std::fs::create_dir_all(&logs).map_err(io(&logs))?;
+    let _ = std::fs::remove_file(dir.join("summary.json"));
+    Ok(())
+}
+
+/// How the watched part of a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum End {
+    AllAtGoal,
+    TimeLimit,
+    Signalled,
+}
+
+/// Spawns the processes, runs the start-up handshake, then watches until the run ends,
+/// reaping and restarting whatever dies.
+fn supervise(
+    transport: &Transport,
+    ports: &Ports,
+    scenario: &Scenario,
+    slots: &mut Slots,
+    record: &mut RunRecord,
+    show_progress: bool,
+) -> Result<End, RunError> {
+    slots.spawn_all()?;
+    slots.write_record(record);
+    let children: Vec<&Child> = slots.children().collect();
+    if ports.life.start(transport, &children, STARTUP_TIMEOUT)? == Startup::Interrupted {
+        return Ok(End::Signalled);
+    }
+    let mut watch = Watch {
+        view: ProgressView::new(show_progress, scenario.agents.len()),
+        faults: FaultSchedule::new(&scenario.faults),
+        t0: Instant::now(),
+        limit: Duration::from_secs_f64(scenario.coordinator.time_limit_s.max(0.0)),
+    };
+    loop {
+        if let Some(end) = watch.until_change(transport, ports, slots)? {
+            watch.view.finish();
+            return Ok(end);
+        }
+        slots.reap_and_restart(transport, &ports.life)?;
+        slots.write_record(record);
+    }
+}
+
+/// The state of the watch between two changes of the set of running processes.
+struct Watch<'s> {
+    view: ProgressView,
+    faults: FaultSchedule<'s>,
+    t0: Instant,
+    limit: Duration,
+}
+
+impl Watch<'_> {
+    /// Follows the run until it ends (`Some`) or until a child exits, a restart is due or a
+    /// process announces itself (`None`: reap, restart, and watch the new set of children).
+    fn until_change(
+        &mut self,
+        transport: &Transport,
+        ports: &Ports,
+        slots: &Slots,
+    ) -> Result<Option<End>, RunError> {
+        let ws = transport.waitset()?;
+        let ws_err = |e: &dyn std::fmt::Debug| RunError::WaitSet(format!("{e:?}"));
+        let mut guards = vec![ws
+            .attach_notification(ports.life.ready().listener())
+            .map_err(|e| ws_err(&e))?];
+        for c in slots.children() {
+            guards.push(
+                ws.attach_notification(c.exit_fd())
+                    .map_err(|e| ws_err(&e))?,
+            );
+        }
+        loop {
+            slots.announce_restarts(&ports.life)?;
+            if let Some(end) = self.on_progress(ports, slots)? {
+                return Ok(Some(end));
+            }
+            if self.t0.elapsed() >= self.limit {
+                return Ok(Some(End::TimeLimit));
+            }
+            let now = Instant::now();
+            let due = slots.next_restart();
+            if due.is_some_and(|d| d <= now) {
+                return Ok(None);
+            }
+            let mut timeout = TICK.min(self.limit.saturating_sub(self.t0.elapsed()));
+            if let Some(d) = due {
+                timeout = timeout.min(d - now);
+            }
+            match wait(&ws, timeout)? {
+                Wake::Signalled => return Ok(Some(End::Signalled)),
+                Wake::Attachment => return Ok(None),
+                Wake::Timeout => {}
+            }
+        }
+    }
+
+    /// Shows the coordinator's latest progress and fires the faults due by its round;
+    /// `AllAtGoal` once it reports every agent at its goal.
+    fn on_progress(&mut self, ports: &Ports, slots: &Slots) -> Result<Option<End>, RunError> {
+        let mut last = None;
+        ports.progress.take_wakeup()?;
+        ports.progress.drain(|p| last = Some(*p))?;
+        let Some(p) = last else {
+            return Ok(None);
+        };
+        self.view.show(&p);
+        self.faults.fire(slots, p.round);
+        Ok((p.done == 1).then_some(End::AllAtGoal))
+    }
+}
+
+/// What ended one wait of the watch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Wake {
+    /// A child's exit descriptor or the `ready` topic.
+    Attachment,
+    /// Nothing within the timeout.
+    Timeout,
+    /// A termination signal.
+    Signalled,
+}
+
+/// One bounded wait on the watch's WaitSet.
+fn wait(ws: &WaitSet<Ipc>, timeout: Duration) -> Result<Wake, RunError> {
+    let mut fired = false;
+    let r = ws.wait_and_process_once_with_timeout(
+        |_| {
+            fired = true;
+            CallbackProgression::Continue
+        },
+        timeout,
+    );
+    match r {
+        Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
+            Ok(Wake::Signalled)
+        }
+        Ok(_) if fired => Ok(Wake::Attachment),
+        Ok(_) => Ok(Wake::Timeout),
+        Err(e) => Err(RunError::WaitSet(format!("{e:?}"))),
+    }
+}
+
+/// The run directory `hnav run` uses when none is given: `target/hnav-out/<scenario name>`.
+pub fn default_run_dir(scenario: &Scenario) -> PathBuf {
+    crate::scenario::default_out_dir(&scenario.name)
+}
+
+/// A fresh run id for `hnav run`.
+pub fn new_run_id() -> RunId {
+    RunId::unique("run")
+}

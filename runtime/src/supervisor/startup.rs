@@ -1,0 +1,270 @@
+//! The supervisor's half of the lifecycle protocol (the processes' half is
+//! [`crate::launch::LifecyclePorts`]): it hears each process's `Up` on `ready` and publishes
+//! `Start`, `Down`, `Restarted` and `Stop` on `lifecycle`.
+//!
+//! [`SupervisorPorts::start`] is the start-up handshake, once for `hnav run` and for the
+//! stand-in supervisor of `hnav-bench round`: wait (bounded) until every expected process has
+//! announced itself, fail at once if one of them exits, then publish `Start`.
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use iceoryx2::prelude::CallbackProgression;
+use iceoryx2::waitset::{WaitSet, WaitSetRunResult};
+
+use super::child::{Child, ExitInfo};
+use crate::msg::{Lifecycle, LifecycleEvent, Role};
+use crate::topics;
+use crate::transport::{Ipc, Receiver, Sender, Transport, TransportError};
+
+/// The longest one wait of the handshake sleeps before it looks at the children and the
+/// `ready` topic again, in case a wake-up was lost (see [`crate::launch::LOST_WAKEUP_RECHECK`]).
+const RECHECK: Duration = Duration::from_millis(200);
+
+/// Why the processes of a run did not all come up.
+#[derive(Debug, thiserror::Error)]
+pub enum StartupError {
+    /// An expected process exited before it announced itself.
+    #[error("{node} exited during start-up ({exit}); see {}", log.display())]
+    Exited {
+        /// Its node name.
+        node: String,
+        /// How it ended.
+        exit: ExitInfo,
+        /// Its log file.
+        log: PathBuf,
+    },
+    /// Some processes had not announced themselves when the time was up.
+    #[error("not up within {timeout:?}: {}", missing.join(", "))]
+    NotUp {
+        /// The bound.
+        timeout: Duration,
+        /// Node names of the processes still missing.
+        missing: Vec<String>,
+    },
+    /// The transport failed.
+    #[error(transparent)]
+    Transport(#[from] TransportError),
+    /// The WaitSet failed.
+    #[error("waitset: {0}")]
+    WaitSet(String),
+}
+
+/// How the start-up handshake ended, when it did not fail.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Startup {
+    /// Every process was up at `all_up`; `Start` has been published.
+    Started {
+        /// When the last `Up` was taken.
+        all_up: Instant,
+    },
+    /// A termination signal came first; `Start` was not published.
+    Interrupted,
+}
+
+/// The supervisor's ports of the lifecycle protocol.
+pub struct SupervisorPorts {
+    ready: Receiver<Lifecycle>,
+    events: Sender<Lifecycle>,
+}
+
+impl SupervisorPorts {
+    /// Opens `ready` and `lifecycle` for a run of `agents` agents. Open them before spawning
+    /// anything: an `Up` sent before the subscriber exists is lost.
+    pub fn open(transport: &Transport, agents: usize) -> Result<Self, TransportError> {
+        let q = topics::lifecycle_qos(agents);
+        Ok(Self {
+            ready: transport.receiver(topics::READY, q)?,
+            events: transport.sender(topics::LIFECYCLE, q)?,
+        })
+    }
+
+    /// The `ready` topic, on which restarted processes announce themselves too.
+    pub fn ready(&self) -> &Receiver<Lifecycle> {
+        &self.ready
+    }
+
+    /// Publishes `event` on `lifecycle`. A process that already died has no subscriber left;
+    /// the send still succeeds.
+    pub fn publish(&self, event: Lifecycle) -> Result<(), TransportError> {
+        self.events.send(event)?;
+        Ok(())
+    }
+
+    /// The start-up handshake: waits until each of `children` has announced `Up` on `ready`
+    /// (matched by its spec's role and index), then publishes `Start`. Fails when one of them
+    /// exits first, or when `timeout` passes with some still missing.
+    pub fn start(
+        &self,
+        transport: &Transport,
+        children: &[&Child],
+        timeout: Duration,
+    ) -> Result<Startup, StartupError> {
+        let ws = transport.waitset()?;
+        let ws_err = |e: &dyn std::fmt::Debug| StartupError::WaitSet(format!("{e:?}"));
+        let mut guards = vec![ws
+            .attach_notification(self.ready.listener())
+            .map_err(|e| ws_err(&e))?];
+        for c in children {
+            guards.push(
+                ws.attach_notification(c.exit_fd())
+                    .map_err(|e| ws_err(&e))?,
+            );
+        }
+        let mut up = vec![false; children.len()];
+        let deadline = Instant::now() + timeout;
+        loop {
+            self.take_ups(children, &mut up)?;
+            if up.iter().all(|&u| u) {
+                let all_up = Instant::now();
+                self.publish(Lifecycle::start())?;
+                return Ok(Startup::Started { all_up });
+            }
+            for c in children {
+                if let Some(exit) = c.try_reap() {
+                    let spec = c.spec();
+                    return Err(StartupError::Exited {
+                        node: spec.role.node_name(spec.index),
+                        exit,
+                        log: spec.log_file.clone(),
+                    });
+                }
+            }
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                let missing = children
+                    .iter()
+                    .zip(&up)
+                    .filter(|(_, &u)| !u)
+                    .map(|(c, _)| c.spec().role.node_name(c.spec().index))
+                    .collect();
+                return Err(StartupError::NotUp { timeout, missing });
+            }
+            if wait(&ws, left.min(RECHECK))? == Wake::Signalled {
+                return Ok(Startup::Interrupted);
+            }
+        }
+    }
+
+    /// Marks in `up` every child whose `Up` is pending on `ready`.
+    fn take_ups(&self, children: &[&Child], up: &mut [bool]) -> Result<(), TransportError> {
+        self.ready.take_wakeup()?;
+        self.ready.drain(|l| {
+            if l.event != LifecycleEvent::Up as u8 {
+                return;
+            }
+            let Some(role) = Role::from_u8(l.role) else {
+                return;
+            };
+            let found = children
+                .iter()
+                .position(|c| c.spec().role == role && c.spec().index == l.index);
+            if let Some(i) = found {
+                up[i] = true;
+            }
+        })?;
+        Ok(())
+    }
+}
+
+/// What ended one wait of the handshake.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Wake {
+    /// An `Up`, an exit, or the timeout: look again.
+    Look,
+    /// A termination signal.
+    Signalled,
+}
+
+/// One bounded wait on the handshake's WaitSet.
+fn wait(ws: &WaitSet<Ipc>, timeout: Duration) -> Result<Wake, StartupError> {
+    match ws.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, timeout) {
+        Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
+            Ok(Wake::Signalled)
+        }
+        Ok(_) => Ok(Wake::Look),
+        Err(e) => Err(StartupError::WaitSet(format!("{e:?}"))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::supervisor::child::{ChildSpec, Signal};
+    use crate::transport::{purge_run, RunId};
+
+    /// A supervisor's transport and ports on a fresh run, a stand-in child (`sh -c SCRIPT`),
+    /// and a sender on `ready` that plays the child's side of the handshake.
+    fn with_run(
+        script: &str,
+        f: impl FnOnce(&Transport, &SupervisorPorts, &Child, &Sender<Lifecycle>),
+    ) {
+        let dir = tempfile::tempdir().unwrap();
+        let run = RunId::unique("startup");
+        {
+            let transport = Transport::builder(&run)
+                .node_name("supervisor")
+                .create()
+                .unwrap();
+            let ports = SupervisorPorts::open(&transport, 1).unwrap();
+            let ready = transport
+                .sender(topics::READY, topics::lifecycle_qos(1))
+                .unwrap();
+            let spec = ChildSpec::new(Role::Agent, 0, "/bin/sh", dir.path().join("agent-0.log"))
+                .arg("-c")
+                .arg(script);
+            let child = Child::spawn(&spec).unwrap();
+            f(&transport, &ports, &child, &ready);
+            child.signal_group(Signal::SIGKILL).unwrap();
+            child.wait(Some(Duration::from_secs(10))).unwrap();
+        }
+        purge_run(&run).unwrap();
+    }
+
+    #[test]
+    fn start_is_published_once_every_child_is_up() {
+        with_run("sleep 30", |transport, ports, child, ready| {
+            let events = transport
+                .receiver::<Lifecycle>(topics::LIFECYCLE, topics::lifecycle_qos(1))
+                .unwrap();
+            ready.send(Lifecycle::up(Role::Sim, 0)).unwrap();
+            ready.send(Lifecycle::up(Role::Agent, 0)).unwrap();
+            let out = ports
+                .start(transport, &[child], Duration::from_secs(10))
+                .unwrap();
+            assert!(matches!(out, Startup::Started { .. }), "{out:?}");
+            let mut got = Vec::new();
+            events.drain(|l| got.push(l.event)).unwrap();
+            assert_eq!(got, [LifecycleEvent::Start as u8]);
+        });
+    }
+
+    #[test]
+    fn a_child_that_exits_fails_the_start_up() {
+        with_run("exit 3", |transport, ports, child, _| {
+            let err = ports
+                .start(transport, &[child], Duration::from_secs(10))
+                .unwrap_err();
+            assert!(
+                matches!(&err, StartupError::Exited { node, exit, .. }
+                    if node == "agent-0" && *exit == ExitInfo::Exited(3)),
+                "{err}"
+            );
+            assert!(err.to_string().contains("agent-0.log"), "{err}");
+        });
+    }
+
+    #[test]
+    fn a_child_that_never_announces_itself_times_out() {
+        with_run("sleep 30", |transport, ports, child, ready| {
+            ready.send(Lifecycle::down(Role::Agent, 0, 0)).unwrap();
+            let err = ports
+                .start(transport, &[child], Duration::from_millis(300))
+                .unwrap_err();
+            assert!(
+                matches!(&err, StartupError::NotUp { missing, .. } if missing == &["agent-0"]),
+                "{err}"
+            );
+        });
+    }
+}
