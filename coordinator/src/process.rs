@@ -23,8 +23,8 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use hnav_runtime::consensus_log::{
-    candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision, Record,
-    RoundRecord, RunHeader, FORMAT_VERSION,
+    candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LogError, LogWriter,
+    LoggedDecision, Record, RoundRecord, RunHeader, FORMAT_VERSION,
 };
 use hnav_runtime::launch::{now_ns, LifecyclePorts, StartOutcome, LOST_WAKEUP_RECHECK};
 use hnav_runtime::msg::{
@@ -36,9 +36,7 @@ use hnav_runtime::transport::{Receiver, Sender, Transport, TransportError};
 use iceoryx2::prelude::CallbackProgression;
 use iceoryx2::waitset::WaitSetRunResult;
 
-use crate::consensus_log::LogWriter;
 use crate::round::Arbiter;
-use hnav_runtime::consensus_log::LogError;
 
 /// How long the coordinator waits for the supervisor's start signal.
 pub const START_TIMEOUT: Duration = Duration::from_secs(60);
