@@ -27,9 +27,7 @@ use hnav_runtime::consensus_log::{
     LoggedDecision, Record, RoundRecord, RunHeader, FORMAT_VERSION,
 };
 use hnav_runtime::launch::{now_ns, LifecyclePorts, StartOutcome, LOST_WAKEUP_RECHECK};
-use hnav_runtime::msg::{
-    Candidate, Commit, Lifecycle, LifecycleEvent, Progress, Role, Verdict, MAX_AGENTS,
-};
+use hnav_runtime::msg::{Candidate, Commit, Lifecycle, LifecycleEvent, Progress, Role, MAX_AGENTS};
 use hnav_runtime::scenario::{ClockMode, Scenario};
 use hnav_runtime::topics;
 use hnav_runtime::transport::{Receiver, Sender, Transport, TransportError};
@@ -296,11 +294,7 @@ impl State {
         match r {
             Record::Round(rec) => {
                 self.round = self.round.max(rec.round);
-                for d in &rec.decisions {
-                    if let Some(v) = Verdict::from_u8(d.verdict) {
-                        self.arbiter.restore_tally(d.agent as usize, v);
-                    }
-                }
+                self.arbiter.replay(rec);
                 self.last_record = Some(rec.clone());
             }
             Record::End(_) => self.ended = true,
@@ -454,9 +448,9 @@ impl State {
             round: self.round,
             agents: self.arbiter.agents() as u32,
             at_goal: self.arbiter.at_goal(),
-            conflicts: t.iter().map(|a| a.conflicts).sum(),
-            replans: t.iter().map(|a| a.replans).sum(),
-            done: u8::from(self.ended && self.arbiter.at_goal() as usize == t.len()),
+            conflicts: t.conflicts(),
+            replans: t.replans(),
+            done: u8::from(self.ended && self.arbiter.at_goal() as usize == t.agents().len()),
             reserved: [0; 7],
         })?;
         Ok(())

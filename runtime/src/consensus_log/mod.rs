@@ -1,10 +1,10 @@
-//! The durable consensus log of a run: its record types, on-disk format, writer, reader and
-//! verifier.
+//! The durable consensus log of a run: its record types, on-disk format, writer, reader,
+//! verifier, and the [`Tally`] its decisions add up to.
 //!
 //! The coordinator appends one [`Record::Round`] per decision round with a [`LogWriter`] and
 //! publishes the round's [`Commit`](crate::msg::Commit) only after the record is durable.
 //! After a restart it rebuilds its state from the records; `hnav log verify|show DIR` inspects
-//! a log.
+//! a log, and the run summary is read from it.
 //!
 //! # Format (version [`FORMAT_VERSION`])
 //!
@@ -30,6 +30,7 @@
 //! | [`reader`] | [`LogReader`], [`read_log`]: records in order, torn tail vs corruption |
 //! | [`verify`](mod@verify) | [`verify()`]: a [`VerifyReport`] on whether a log is intact |
 //! | [`show`] | one-line text and JSON renderings of records |
+//! | [`tally`] | [`Tally`]: per-agent steps, octile length, conflicts and replans of the decisions |
 //! | [`error`] | [`LogError`], [`FrameProblem`] |
 
 pub mod error;
@@ -38,6 +39,7 @@ pub mod reader;
 pub mod record;
 pub mod segment;
 pub mod show;
+pub mod tally;
 pub mod verify;
 pub mod writer;
 
@@ -49,6 +51,7 @@ pub use record::{
     ReplanRecord, RoundRecord, RunHeader,
 };
 pub use segment::{list_segments, segment_name, segment_path, DEFAULT_SEGMENT_BYTES};
+pub use tally::{AgentTally, Tally};
 pub use verify::{verify, KindCounts, VerifyReport, VerifyStatus};
 pub use writer::{LogWriter, Recovered, WriterOptions, BATCH_INTERVAL, BATCH_RECORDS};
 
