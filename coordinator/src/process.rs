@@ -23,12 +23,12 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use hnav_runtime::consensus_log::{
-    candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision, Record,
-    RoundRecord, RunHeader, FORMAT_VERSION,
+    candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LogError, LogWriter,
+    LoggedDecision, Record, RoundRecord, RunHeader, FORMAT_VERSION,
 };
 use hnav_runtime::launch::{LifecyclePorts, StartOutcome, LOST_WAKEUP_RECHECK};
 use hnav_runtime::msg::{
-    Candidate, Commit, Lifecycle, LifecycleEvent, Progress, Role, StopReason, Verdict, MAX_AGENTS,
+    Candidate, Commit, Lifecycle, LifecycleEvent, Progress, Role, StopReason, MAX_AGENTS,
 };
 use hnav_runtime::scenario::{ClockMode, Scenario};
 use hnav_runtime::topics;
@@ -36,9 +36,7 @@ use hnav_runtime::transport::{Receiver, Sender, Transport, TransportError};
 use iceoryx2::prelude::CallbackProgression;
 use iceoryx2::waitset::WaitSetRunResult;
 
-use crate::consensus_log::LogWriter;
 use crate::round::Arbiter;
-use hnav_runtime::consensus_log::LogError;
 
 /// How long the coordinator waits for the supervisor's start signal.
 pub const START_TIMEOUT: Duration = Duration::from_secs(60);
@@ -291,11 +289,7 @@ impl State {
         match r {
             Record::Round(rec) => {
                 self.round = self.round.max(rec.round);
-                for d in &rec.decisions {
-                    if let Some(v) = Verdict::from_u8(d.verdict) {
-                        self.arbiter.restore_tally(d.agent as usize, v);
-                    }
-                }
+                self.arbiter.replay(rec);
                 self.last_record = Some(rec.clone());
             }
             Record::End(_) => self.ended = true,
@@ -445,9 +439,9 @@ impl State {
             round: self.round,
             agents: self.arbiter.agents() as u32,
             at_goal: self.arbiter.at_goal(),
-            conflicts: t.iter().map(|a| a.conflicts).sum(),
-            replans: t.iter().map(|a| a.replans).sum(),
-            done: u8::from(self.ended && self.arbiter.at_goal() as usize == t.len()),
+            conflicts: t.conflicts(),
+            replans: t.replans(),
+            done: u8::from(self.ended && self.arbiter.at_goal() as usize == t.agents().len()),
             reserved: [0; 7],
         })?;
         Ok(())

@@ -16,7 +16,7 @@
 //! agent is stuck anyway) the waypoint is A*'s cell a few steps ahead, which steers it around
 //! the agent in the way.
 
-use hnav_runtime::consensus_log::ReplanRecord;
+use hnav_runtime::consensus_log::{LoggedDecision, ReplanRecord, RoundRecord, Tally};
 use hnav_runtime::grid::{Cell, Grid};
 use hnav_runtime::msg::{Candidate, CandidateFlags, Decision, Verdict, NO_CELL};
 use hnav_runtime::scenario::Scenario;
@@ -26,17 +26,6 @@ use crate::planner::{AStar, LazyTheta, Planner, PlannerConfig};
 
 /// How many A* steps ahead the fallback waypoint lies.
 const FALLBACK_STEPS: usize = 4;
-
-/// Per-agent tallies, for the progress topic and the run summary.
-#[derive(Clone, Copy, PartialEq, Eq, Debug, Default)]
-pub struct AgentTally {
-    /// Accepted moves.
-    pub steps: u32,
-    /// Refused or held requests.
-    pub conflicts: u32,
-    /// Global replans.
-    pub replans: u32,
-}
 
 /// The coordinator's round logic; see the [module docs](self).
 pub struct Arbiter {
@@ -52,7 +41,7 @@ pub struct Arbiter {
     outcomes: Vec<Outcome>,
     decisions: Vec<Decision>,
     replans: Vec<ReplanRecord>,
-    tally: Vec<AgentTally>,
+    tally: Tally,
     lazy: LazyTheta,
     astar: AStar,
 }
@@ -87,7 +76,10 @@ impl Arbiter {
             outcomes: Vec::with_capacity(n),
             decisions: Vec::with_capacity(n),
             replans: Vec::new(),
-            tally: vec![AgentTally::default(); n],
+            tally: Tally::new(
+                scenario.agents.iter().map(|a| grid.index(a.start) as u32),
+                grid.width(),
+            ),
             lazy: LazyTheta::new(config.clone()),
             astar: AStar::new(config),
             grid,
@@ -156,10 +148,8 @@ impl Arbiter {
             if row.probable.is_some() {
                 if o.accepted() {
                     self.waiting[i] = 0;
-                    self.tally[i].steps += 1;
                 } else {
                     self.waiting[i] += 1;
-                    self.tally[i].conflicts += 1;
                     // The contested cell travels with a refusal: an agent blocked by a
                     // standing one learns it as an obstacle.
                     d.cell = o
@@ -177,9 +167,11 @@ impl Arbiter {
                         ..Decision::default()
                     };
                     self.waiting[i] = 0;
-                    self.tally[i].replans += 1;
                 }
             }
+            // The tally counts what is published (and logged), so that a replay of the log
+            // after a restart and the run summary arrive at the same numbers.
+            self.tally.fold(&LoggedDecision::from(&d));
             self.decisions.push(d);
         }
         (&self.decisions, &self.replans)
@@ -239,21 +231,15 @@ impl Arbiter {
             .count() as u32
     }
 
-    /// Per-agent tallies.
-    pub fn tally(&self) -> &[AgentTally] {
+    /// The tally of every decision made (and replayed) so far.
+    pub fn tally(&self) -> &Tally {
         &self.tally
     }
 
-    /// Restores the tallies from a log's decisions (after a coordinator restart).
-    pub fn restore_tally(&mut self, agent: usize, verdict: Verdict) {
-        let Some(t) = self.tally.get_mut(agent) else {
-            return;
-        };
-        match verdict {
-            Verdict::Accept => t.steps += 1,
-            Verdict::Block | Verdict::Hold => t.conflicts += 1,
-            Verdict::Replan => t.replans += 1,
-        }
+    /// Adds a logged round's decisions to the tally, as if this arbiter had made them (after
+    /// a coordinator restart).
+    pub fn replay(&mut self, round: &RoundRecord) {
+        self.tally.fold_round(round);
     }
 }
 
@@ -320,8 +306,28 @@ mod tests {
         assert_eq!(r.len(), 1);
         let wp = s.map.grid.cell_at(d[0].waypoint as usize).unwrap();
         assert_ne!(wp, Cell::new(2, 1));
-        assert_eq!(a.tally()[0].replans, 1);
-        assert_eq!(a.tally()[0].conflicts, 2);
+        // Round 1 held, round 2 replanned (as published, not also counted as held).
+        assert_eq!(a.tally().agents()[0].replans, 1);
+        assert_eq!(a.tally().agents()[0].conflicts, 1);
+    }
+
+    #[test]
+    fn the_tally_of_the_published_decisions_is_the_tally_of_their_replay() {
+        let s = scenario(TWO);
+        let mut live = Arbiter::new(&s);
+        let mut replayed = Arbiter::new(&s);
+        let c0 = cand(&s, 0, (1, 1), Some((2, 1)));
+        let c1 = cand(&s, 1, (2, 1), Some((2, 0)));
+        let c1_standing = cand(&s, 1, (2, 1), None);
+        for (round, c1) in (1..).zip([c1_standing, c1_standing, c1, c1_standing]) {
+            let (d, _) = live.decide(round, &[Some(c0), Some(c1)]);
+            replayed.replay(&RoundRecord::new(round, &[], d));
+        }
+        let t = live.tally();
+        assert_eq!(t, replayed.tally());
+        // Agent 0: held, replanned, held (agent 1 leaving its cell), replanned.
+        assert_eq!((t.conflicts(), t.replans()), (2, 2), "{t:?}");
+        assert_eq!(t.agents()[1].steps, 1, "{t:?}");
     }
 
     #[test]

@@ -226,7 +226,7 @@ mod tests {
             // Two conflict rounds in four, one loser per pair: the left agent.
             assert_eq!(blocked, 20 * (n / 2), "{n} agents");
             assert_eq!(
-                arbiter.tally()[0].conflicts as usize,
+                arbiter.tally().agents()[0].conflicts as usize,
                 20 * usize::from(n > 1)
             );
         }

@@ -1,9 +1,10 @@
-//! The durable consensus log of a run: its record types, on-disk format, reader and verifier.
+//! The durable consensus log of a run: its record types, on-disk format, writer, reader,
+//! verifier, and the [`Tally`] its decisions add up to.
 //!
-//! The coordinator appends one [`Record::Round`] per decision round and publishes the round's
-//! [`Commit`](crate::msg::Commit) only after the record is durable (the writer is
-//! `hnav_coordinator::consensus_log::LogWriter`). After a restart it rebuilds its state from
-//! the records; `hnav log verify|show DIR` inspects a log.
+//! The coordinator appends one [`Record::Round`] per decision round with a [`LogWriter`] and
+//! publishes the round's [`Commit`](crate::msg::Commit) only after the record is durable.
+//! After a restart it rebuilds its state from the records; `hnav log verify|show DIR` inspects
+//! a log, and the run summary is read from it.
 //!
 //! # Format (version [`FORMAT_VERSION`])
 //!
@@ -25,9 +26,11 @@
 //! | [`record`] | [`Record`] and its parts; conversions from `msg`; [`candidates_digest`] |
 //! | [`frame`] | encoding and checking one record's frame |
 //! | [`segment`] | segment file names and listing |
+//! | [`writer`] | [`LogWriter`]: appends durably by [`FsyncPolicy`](crate::scenario::FsyncPolicy), cuts a torn tail on open, poisons itself after a failed fsync |
 //! | [`reader`] | [`LogReader`], [`read_log`]: records in order, torn tail vs corruption |
 //! | [`verify`](mod@verify) | [`verify()`]: a [`VerifyReport`] on whether a log is intact |
 //! | [`show`] | one-line text and JSON renderings of records |
+//! | [`tally`] | [`Tally`]: per-agent steps, octile length, conflicts and replans of the decisions |
 //! | [`error`] | [`LogError`], [`FrameProblem`] |
 
 pub mod error;
@@ -36,7 +39,9 @@ pub mod reader;
 pub mod record;
 pub mod segment;
 pub mod show;
+pub mod tally;
 pub mod verify;
+pub mod writer;
 
 pub use error::{FrameProblem, LogError};
 pub use frame::{encode_frame, FRAME_HEADER_LEN, MAGIC, MAX_RECORD_LEN};
@@ -46,7 +51,9 @@ pub use record::{
     ReplanRecord, RoundRecord, RunHeader,
 };
 pub use segment::{list_segments, segment_name, segment_path, DEFAULT_SEGMENT_BYTES};
+pub use tally::{AgentTally, Tally};
 pub use verify::{verify, KindCounts, VerifyReport, VerifyStatus};
+pub use writer::{LogWriter, Recovered, WriterOptions, BATCH_INTERVAL, BATCH_RECORDS};
 
 /// The format version this build writes into [`RunHeader::version`] and accepts on reading.
 pub const FORMAT_VERSION: u32 = 1;

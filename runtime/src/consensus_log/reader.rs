@@ -200,7 +200,10 @@ impl Iterator for LogReader {
     }
 }
 
-fn check_header(path: &Path, offset: u64, record: &Record) -> Result<(), LogError> {
+/// Checks that `record`, the first of a log (at `offset` of `path`), is a header of this
+/// build's [`FORMAT_VERSION`]: the reader's rule for what it reads, the writer's for what it
+/// writes.
+pub(super) fn check_header(path: &Path, offset: u64, record: &Record) -> Result<(), LogError> {
     match record {
         Record::Header(h) if h.version == FORMAT_VERSION => Ok(()),
         Record::Header(h) => Err(LogError::Version {

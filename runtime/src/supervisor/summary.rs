@@ -1,8 +1,8 @@
 //! The run summary `hnav run` writes to `DIR/summary.json` and prints as a table.
 //!
-//! Per-agent numbers come from the consensus log, the durable record of what was decided:
-//! accepted moves (steps and their octile length from the start in the log's header),
-//! refused or held requests (conflicts) and global replans. Whether a robot reached its goal
+//! Per-agent numbers are the [`Tally`] of the consensus log, the durable record of what was
+//! decided: accepted moves (steps and their octile length from the start in the log's
+//! header), refused or held requests (conflicts) and global replans. Whether a robot reached its goal
 //! comes from the sim's ground truth — its true pose lies in its goal cell — not from what the
 //! agents believed.
 
@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::consensus_log::{read_log, LogError, Record};
-use crate::msg::{Truth, Verdict};
+use crate::consensus_log::{read_log, LogError, Record, Tally};
+use crate::msg::Truth;
 
 /// One agent's line of the summary.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -68,57 +68,38 @@ impl RunSummary {
     ) -> Result<RunSummary, LogError> {
         let contents = read_log(log_dir)?;
         let mut header = None;
-        let mut agents: Vec<AgentSummary> = Vec::new();
-        let mut pos: Vec<u32> = Vec::new();
-        let mut goals: Vec<u32> = Vec::new();
+        let mut tally = Tally::default();
         let mut rounds = 0;
         let mut end = "incomplete".to_string();
-        let mut width = 1u32;
         for r in &contents.records {
             match r {
                 Record::Header(h) => {
-                    width = h.width.max(1);
-                    agents = (0..h.agents.len() as u32)
-                        .map(|id| AgentSummary {
-                            id,
-                            reached_goal: false,
-                            steps: 0,
-                            length: 0.0,
-                            conflicts: 0,
-                            replans: 0,
-                        })
-                        .collect();
-                    pos = h.agents.iter().map(|a| a.start).collect();
-                    goals = h.agents.iter().map(|a| a.goal).collect();
-                    header = Some(h.clone());
+                    tally = Tally::from_header(h);
+                    header = Some(h);
                 }
                 Record::Round(rec) => {
                     rounds = rounds.max(rec.round);
-                    for d in &rec.decisions {
-                        let i = d.agent as usize;
-                        let (Some(a), Some(p)) = (agents.get_mut(i), pos.get_mut(i)) else {
-                            continue;
-                        };
-                        match Verdict::from_u8(d.verdict) {
-                            Some(Verdict::Accept) => {
-                                a.steps += 1;
-                                a.length += step_length(*p, d.cell, width);
-                                *p = d.cell;
-                            }
-                            Some(Verdict::Block | Verdict::Hold) => a.conflicts += 1,
-                            Some(Verdict::Replan) => a.replans += 1,
-                            None => {}
-                        }
-                    }
+                    tally.fold_round(rec);
                 }
                 Record::End(e) => end = e.reason.name().to_string(),
                 Record::Lifecycle(_) | Record::Replan(_) => {}
             }
         }
-        if let Some(t) = truth {
-            for (a, pose) in agents.iter_mut().zip(t.poses()) {
-                let g = goals[a.id as usize];
-                let (gx, gy) = (g % width, g / width);
+        let mut agents: Vec<AgentSummary> = (0u32..)
+            .zip(tally.agents())
+            .map(|(id, t)| AgentSummary {
+                id,
+                reached_goal: false,
+                steps: t.steps,
+                length: t.length,
+                conflicts: t.conflicts,
+                replans: t.replans,
+            })
+            .collect();
+        if let (Some(t), Some(h)) = (truth, header) {
+            let width = h.width.max(1);
+            for ((a, pose), entry) in agents.iter_mut().zip(t.poses()).zip(&h.agents) {
+                let (gx, gy) = (entry.goal % width, entry.goal / width);
                 let cx = (pose.x_m / cell_size_m).floor();
                 let cy = (pose.y_m / cell_size_m).floor();
                 a.reached_goal = cx == f64::from(gx) && cy == f64::from(gy);
@@ -126,7 +107,7 @@ impl RunSummary {
         }
         Ok(RunSummary {
             run_id: run_id.to_string(),
-            mode: header.map(|h| h.clock).unwrap_or_default(),
+            mode: header.map(|h| h.clock.clone()).unwrap_or_default(),
             agents,
             collisions: truth.map_or(0, |t| t.collisions),
             rounds,
@@ -170,30 +151,5 @@ impl RunSummary {
             self.end
         );
         s
-    }
-}
-
-/// Octile length of one move between row-major cell indices (0 when not a single move).
-fn step_length(from: u32, to: u32, width: u32) -> f64 {
-    let (fx, fy) = (i64::from(from % width), i64::from(from / width));
-    let (tx, ty) = (i64::from(to % width), i64::from(to / width));
-    match ((tx - fx).abs(), (ty - fy).abs()) {
-        (1, 1) => std::f64::consts::SQRT_2,
-        (1, 0) | (0, 1) => 1.0,
-        _ => 0.0,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn step_lengths_are_octile() {
-        assert_eq!(step_length(0, 1, 10), 1.0);
-        assert_eq!(step_length(0, 10, 10), 1.0);
-        assert_eq!(step_length(0, 11, 10), std::f64::consts::SQRT_2);
-        assert_eq!(step_length(0, 22, 10), 0.0);
-        assert_eq!(step_length(9, 10, 10), 0.0, "no wrap across rows");
     }
 }

@@ -1,6 +1,6 @@
 //! The consensus-log writer: [`LogWriter`] appends [`Record`]s to a log directory in the
-//! format of [`hnav_runtime::consensus_log`] and makes them durable as the run's
-//! [`FsyncPolicy`] asks.
+//! format of the [module docs](super) and makes them durable as the run's [`FsyncPolicy`]
+//! asks.
 //!
 //! The coordinator appends one [`Record::Round`] per decision round and publishes the round's
 //! Commit only after [`LogWriter::append`] returned. Durability by policy:
@@ -16,8 +16,7 @@
 //! be torn, and reopening cuts exactly that.
 //!
 //! ```no_run
-//! use hnav_coordinator::consensus_log::LogWriter;
-//! use hnav_runtime::consensus_log::{Record, RunHeader, FORMAT_VERSION};
+//! use hnav_runtime::consensus_log::{LogWriter, Record, RunHeader, FORMAT_VERSION};
 //! use hnav_runtime::scenario::FsyncPolicy;
 //! # fn main() -> Result<(), hnav_runtime::consensus_log::LogError> {
 //! let (mut log, recovered) = LogWriter::open("target/run/log", FsyncPolicy::EveryRecord)?;
@@ -41,11 +40,12 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use hnav_runtime::consensus_log::{
-    encode_frame, list_segments, read_log, segment_path, LogError, Record, RecordPos, TornTail,
-    DEFAULT_SEGMENT_BYTES, FORMAT_VERSION, MAGIC,
-};
-use hnav_runtime::scenario::FsyncPolicy;
+use super::error::LogError;
+use super::frame::{encode_frame, MAGIC};
+use super::reader::{check_header, read_log, RecordPos, TornTail};
+use super::record::Record;
+use super::segment::{list_segments, segment_path, DEFAULT_SEGMENT_BYTES};
+use crate::scenario::FsyncPolicy;
 
 /// Under [`FsyncPolicy::Batched`], sync at the latest after this many records.
 pub const BATCH_RECORDS: u32 = 32;
@@ -196,13 +196,14 @@ impl LogWriter {
     /// Appends `record` with one write call and syncs as the policy asks; returns the
     /// record's byte offset in its segment file ([`segment`](Self::segment) tells which).
     ///
-    /// The first record of a log must be a header of [`FORMAT_VERSION`]. After a failed
-    /// fsync (or a failed write that could not be undone) the writer is poisoned: every
-    /// further call fails with [`LogError::Poisoned`] and the log must be reopened.
+    /// The first record of a log must be a header of
+    /// [`FORMAT_VERSION`](super::FORMAT_VERSION). After a failed fsync (or a failed write
+    /// that could not be undone) the writer is poisoned: every further call fails with
+    /// [`LogError::Poisoned`] and the log must be reopened.
     pub fn append(&mut self, record: &Record) -> Result<u64, LogError> {
         self.check_usable()?;
         if self.records == 0 {
-            self.check_first(record)?;
+            check_header(&self.path, self.len, record)?;
         }
         self.buf.clear();
         encode_frame(record, &mut self.buf)?;
@@ -277,23 +278,6 @@ impl LogWriter {
             });
         }
         Ok(())
-    }
-
-    fn check_first(&self, record: &Record) -> Result<(), LogError> {
-        match record {
-            Record::Header(h) if h.version == FORMAT_VERSION => Ok(()),
-            Record::Header(h) => Err(LogError::Version {
-                path: self.path.clone(),
-                offset: self.len,
-                found: h.version,
-                expected: FORMAT_VERSION,
-            }),
-            other => Err(LogError::NoHeader {
-                path: self.path.clone(),
-                offset: self.len,
-                found: other.kind(),
-            }),
-        }
     }
 
     fn sync_file(&mut self) -> Result<(), LogError> {

@@ -1,135 +1,19 @@
-//! The consensus-log format: records, framing, torn tails vs corruption, segments, verify and
-//! the `hnav log` command. Logs are written here frame by frame with `encode_frame` (the
-//! writer itself lives in hnav-coordinator).
+//! The format as the reader and the verifier see it: records round-trip, a cut or damaged
+//! last record is a torn tail (and the writer cuts exactly it on open), damage anywhere else
+//! is corruption at its offset, segments and header rules.
 
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use hnav_runtime::consensus_log::{
-    candidates_digest, encode_frame, read_log, segment_path, verify, AgentEntry, EndReason,
-    EndRecord, FrameProblem, LifecycleRecord, LogError, LoggedDecision, Record, ReplanRecord,
-    RoundRecord, RunHeader, VerifyStatus, FORMAT_VERSION, MAGIC,
+    candidates_digest, encode_frame, read_log, segment_path, verify, EndReason, EndRecord,
+    FrameProblem, LogError, LogWriter, LoggedDecision, Record, RoundRecord, VerifyStatus,
+    FORMAT_VERSION, MAGIC,
 };
-use hnav_runtime::msg::{Candidate, Decision, NO_CELL};
+use hnav_runtime::msg::{Candidate, Decision};
+use hnav_runtime::scenario::FsyncPolicy;
 
-fn header() -> Record {
-    Record::Header(RunHeader {
-        version: FORMAT_VERSION,
-        scenario_hash: 0x0123_4567_89ab_cdef,
-        seed: 42,
-        clock: "lockstep".into(),
-        width: 10,
-        height: 8,
-        agents: vec![
-            AgentEntry {
-                start: 11,
-                goal: 55,
-                speed: 1.0,
-                priority: 1.0,
-            },
-            AgentEntry {
-                start: 12,
-                goal: 3,
-                speed: 0.5,
-                priority: 2.0,
-            },
-        ],
-    })
-}
-
-fn round(n: u64) -> Record {
-    Record::Round(RoundRecord {
-        round: n,
-        candidates: 2,
-        candidates_digest: n.wrapping_mul(0x9E37_79B9_7F4A_7C15),
-        decisions: vec![
-            LoggedDecision {
-                agent: 0,
-                verdict: 1,
-                refused: 0,
-                kind: 0,
-                cell: 22,
-                waypoint: NO_CELL,
-            },
-            LoggedDecision {
-                agent: 1,
-                verdict: 2,
-                refused: 0b11,
-                kind: 1,
-                cell: NO_CELL,
-                waypoint: NO_CELL,
-            },
-        ],
-    })
-}
-
-fn every_kind() -> Vec<Record> {
-    let mut v = vec![header(), round(1), round(2)];
-    v.push(Record::Lifecycle(LifecycleRecord {
-        round: 2,
-        role: 3,
-        index: 1,
-        event: 3,
-        restarts: 1,
-    }));
-    v.push(Record::Replan(ReplanRecord {
-        round: 3,
-        agent: 1,
-        planner: "lazy-theta-star".into(),
-        found: true,
-        waypoints: vec![12, 14, 34, 3],
-    }));
-    v.push(round(3));
-    v.push(round(4));
-    v.push(Record::End(EndRecord {
-        round: 4,
-        at_goal: 2,
-        reason: EndReason::AllAtGoal,
-    }));
-    v
-}
-
-/// Writes `records` as a log, starting a new segment before a record that would take the
-/// current one past `segment_bytes` (as the writer does). Returns (segment, offset) of each.
-fn write_log(dir: &Path, records: &[Record], segment_bytes: usize) -> Vec<(u32, usize)> {
-    let mut segments = vec![MAGIC.to_vec()];
-    let mut at = Vec::new();
-    for r in records {
-        let mut frame = Vec::new();
-        encode_frame(r, &mut frame).unwrap();
-        let cur = segments.last().unwrap();
-        if cur.len() > MAGIC.len() && cur.len() + frame.len() > segment_bytes {
-            segments.push(MAGIC.to_vec());
-        }
-        let n = segments.len() as u32 - 1;
-        let cur = segments.last_mut().unwrap();
-        at.push((n, cur.len()));
-        cur.extend_from_slice(&frame);
-    }
-    fs::create_dir_all(dir).unwrap();
-    for (n, bytes) in segments.iter().enumerate() {
-        fs::write(segment_path(dir, n as u32), bytes).unwrap();
-    }
-    at
-}
-
-fn hnav(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_hnav"))
-        .args(args)
-        .output()
-        .unwrap();
-    let text = |b: Vec<u8>| String::from_utf8_lossy(&b).into_owned();
-    (
-        out.status.code().unwrap_or(-1),
-        text(out.stdout),
-        text(out.stderr),
-    )
-}
-
-fn p(dir: &Path) -> &str {
-    dir.to_str().unwrap()
-}
+use super::fixtures::{assert_intact, every_kind, header, round, write_log, ONE_SEGMENT};
 
 #[test]
 fn every_record_kind_round_trips() {
@@ -142,7 +26,7 @@ fn every_record_kind_round_trips() {
             reason,
         }));
     }
-    let at = write_log(tmp.path(), &records, 1 << 20);
+    let at = write_log(tmp.path(), &records, ONE_SEGMENT);
     let log = read_log(tmp.path()).unwrap();
     assert_eq!(log.records, records);
     assert_eq!(log.torn, None);
@@ -193,20 +77,21 @@ fn decisions_convert_both_ways_and_the_digest_hashes_fields_in_agent_order() {
     assert_eq!((commit.round, commit.decisions()), (5, &[d][..]));
 }
 
-#[test]
-fn a_cut_at_every_offset_of_the_last_record_is_a_torn_tail() {
-    let tmp = tempfile::tempdir().unwrap();
-    let full = tmp.path().join("full");
-    let records = every_kind();
-    let at = write_log(&full, &records, 1 << 20);
+/// Cuts the log of `records` at every offset of its last record. Each cut is a torn tail the
+/// reader reports without changing a byte; opening the log for writing cuts exactly it,
+/// the lost record is written again, then `then`, and the log is intact.
+fn cut_at_every_offset_of_the_last_record(tmp: &Path, records: &[Record], then: &[Record]) {
+    let full = tmp.join("full");
+    let at = write_log(&full, records, ONE_SEGMENT);
     let bytes = fs::read(segment_path(&full, 0)).unwrap();
     let last = at.last().unwrap().1;
+    let (lost, kept) = records.split_last().unwrap();
     for cut in last..bytes.len() {
-        let dir = tmp.path().join(format!("cut-{cut}"));
+        let dir = tmp.join(format!("cut-{cut}"));
         fs::create_dir(&dir).unwrap();
         fs::write(segment_path(&dir, 0), &bytes[..cut]).unwrap();
         let log = read_log(&dir).unwrap_or_else(|e| panic!("cut at {cut}: {e}"));
-        assert_eq!(log.records, records[..records.len() - 1], "cut at {cut}");
+        assert_eq!(log.records, kept, "cut at {cut}");
         let report = verify(&dir);
         if cut == last {
             assert_eq!(log.torn, None);
@@ -224,15 +109,46 @@ fn a_cut_at_every_offset_of_the_last_record_is_a_torn_tail() {
         }
         // Reading changed nothing.
         assert_eq!(fs::read(segment_path(&dir, 0)).unwrap(), &bytes[..cut]);
+        {
+            let (mut log, rec) = LogWriter::open(&dir, FsyncPolicy::EveryRecord)
+                .unwrap_or_else(|e| panic!("cut at {cut}: {e}"));
+            assert_eq!(rec.records, kept, "cut at {cut}");
+            assert_eq!(rec.truncated_bytes, (cut - last) as u64);
+            assert_eq!(rec.torn.is_some(), cut > last);
+            assert_eq!(log.segment_len(), last as u64);
+            // The lost record is decided again, then the run goes on.
+            assert_eq!(log.append(lost).unwrap(), last as u64);
+            for r in then {
+                log.append(r).unwrap();
+            }
+        }
+        assert_intact(&dir);
+        let mut expected = records.to_vec();
+        expected.extend_from_slice(then);
+        assert_eq!(read_log(&dir).unwrap().records, expected);
         fs::remove_dir_all(&dir).unwrap();
     }
+}
+
+#[test]
+fn a_cut_at_every_offset_of_a_final_end_record_is_a_torn_tail_cut_on_open() {
+    let tmp = tempfile::tempdir().unwrap();
+    cut_at_every_offset_of_the_last_record(tmp.path(), &every_kind(), &[]);
+}
+
+#[test]
+fn a_cut_at_every_offset_of_a_final_round_record_is_a_torn_tail_cut_on_open() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut records = vec![header(4)];
+    records.extend((1..=4).map(|n| round(n, 4)));
+    cut_at_every_offset_of_the_last_record(tmp.path(), &records, &[round(5, 4)]);
 }
 
 #[test]
 fn a_damaged_final_record_and_a_zero_filled_tail_are_torn() {
     let tmp = tempfile::tempdir().unwrap();
     let records = every_kind();
-    let at = write_log(tmp.path(), &records, 1 << 20);
+    let at = write_log(tmp.path(), &records, ONE_SEGMENT);
     let path = segment_path(tmp.path(), 0);
     let good = fs::read(&path).unwrap();
     let last = at.last().unwrap().1;
@@ -259,7 +175,7 @@ fn a_damaged_final_record_and_a_zero_filled_tail_are_torn() {
 fn a_flipped_byte_in_a_middle_record_is_corruption_at_its_offset() {
     let tmp = tempfile::tempdir().unwrap();
     let records = every_kind();
-    let at = write_log(tmp.path(), &records, 1 << 20);
+    let at = write_log(tmp.path(), &records, ONE_SEGMENT);
     let path = segment_path(tmp.path(), 0);
     let good = fs::read(&path).unwrap();
     let (start, end) = (at[3].1, at[4].1);
@@ -290,8 +206,8 @@ fn a_flipped_byte_in_a_middle_record_is_corruption_at_its_offset() {
 #[test]
 fn segments_roll_over_and_damage_in_an_earlier_one_is_corruption() {
     let tmp = tempfile::tempdir().unwrap();
-    let mut records = vec![header()];
-    records.extend((1..=40).map(round));
+    let mut records = vec![header(2)];
+    records.extend((1..=40).map(|n| round(n, 2)));
     let at = write_log(tmp.path(), &records, 300);
     let segments = at.last().unwrap().0 + 1;
     assert!(segments >= 5, "{segments} segments");
@@ -334,24 +250,47 @@ fn header_rules_and_order_problems() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = |name: &str| -> PathBuf { tmp.path().join(name) };
 
-    write_log(&dir("no-header"), &[round(1), round(2)], 1 << 20);
+    // The writer refuses both logs; they are its output with the header frame removed, or
+    // swapped for one of another version.
+    let at = write_log(
+        &dir("no-header"),
+        &[header(2), round(1, 2), round(2, 2)],
+        ONE_SEGMENT,
+    );
+    let seg = segment_path(&dir("no-header"), 0);
+    let mut bytes = fs::read(&seg).unwrap();
+    bytes.drain(at[0].1..at[1].1);
+    fs::write(&seg, bytes).unwrap();
     assert!(matches!(
         read_log(dir("no-header")),
         Err(LogError::NoHeader { found: "round", .. })
     ));
 
-    let Record::Header(mut h) = header() else {
+    write_log(&dir("version"), &[header(2)], ONE_SEGMENT);
+    let Record::Header(mut h) = header(2) else {
         unreachable!()
     };
     h.version = FORMAT_VERSION + 1;
-    write_log(&dir("version"), &[Record::Header(h)], 1 << 20);
+    let seg = segment_path(&dir("version"), 0);
+    let mut bytes = fs::read(&seg).unwrap();
+    bytes.truncate(MAGIC.len());
+    encode_frame(&Record::Header(h), &mut bytes).unwrap();
+    fs::write(&seg, bytes).unwrap();
     assert!(matches!(
         read_log(dir("version")),
         Err(LogError::Version { found: 2, .. })
     ));
 
-    let unordered = [header(), round(1), round(3), round(3), round(2), header()];
-    write_log(&dir("order"), &unordered, 1 << 20);
+    // The writer checks only the first record; order is the verifier's business.
+    let unordered = [
+        header(2),
+        round(1, 2),
+        round(3, 2),
+        round(3, 2),
+        round(2, 2),
+        header(2),
+    ];
+    write_log(&dir("order"), &unordered, ONE_SEGMENT);
     let report = verify(dir("order"));
     assert_eq!(report.status(), VerifyStatus::NotIntact);
     assert_eq!(report.problems.len(), 3, "{:?}", report.problems);
@@ -365,95 +304,16 @@ fn header_rules_and_order_problems() {
     assert_eq!(verify(dir("missing")).status(), VerifyStatus::Unreadable);
 
     // A last segment with only part of its magic (a crash while creating it) is torn.
-    fs::create_dir(dir("new-segment")).unwrap();
-    fs::write(segment_path(&dir("new-segment"), 0), &MAGIC[..3]).unwrap();
-    let log = read_log(dir("new-segment")).unwrap();
-    assert_eq!(log.records, []);
-    assert_eq!(log.torn.map(|t| (t.offset, t.bytes)), Some((0, 3)));
-}
-
-#[test]
-fn hnav_log_verify_and_show_exit_codes() {
-    let tmp = tempfile::tempdir().unwrap();
-    let good = tmp.path().join("good");
-    let records = every_kind();
-    let at = write_log(&good, &records, 1 << 20);
-
-    let (code, out, _) = hnav(&["log", "verify", p(&good)]);
-    assert_eq!(code, 0, "{out}");
-    assert!(out.contains("intact"), "{out}");
-
-    let (code, out, _) = hnav(&["log", "show", p(&good)]);
-    assert_eq!(code, 0);
-    assert_eq!(out.lines().count(), records.len());
-    assert!(
-        out.contains("accept a0->[2,2] block a1 crossing (N,NE)"),
-        "{out}"
-    );
-    assert!(out.lines().last().unwrap().contains("all-at-goal"), "{out}");
-
-    let (code, out, _) = hnav(&["log", "show", "--json", p(&good)]);
-    assert_eq!(code, 0);
-    let lines: Vec<serde_json::Value> = out
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    assert_eq!(lines.len(), records.len());
-    assert_eq!(lines[1]["kind"], "round");
-    assert_eq!(lines[1]["round"], 1);
-    assert_eq!(lines[1]["offset"], at[1].1);
-
-    // Torn: verify 1, show 0 with a note.
-    let torn = tmp.path().join("torn");
-    write_log(&torn, &records, 1 << 20);
-    let seg = segment_path(&torn, 0);
-    let len = fs::metadata(&seg).unwrap().len();
+    write_log(&dir("new-segment"), &[], ONE_SEGMENT);
+    let seg = segment_path(&dir("new-segment"), 0);
+    assert_eq!(fs::read(&seg).unwrap(), MAGIC, "a new log is its magic");
     fs::OpenOptions::new()
         .write(true)
         .open(&seg)
         .unwrap()
-        .set_len(len - 2)
+        .set_len(3)
         .unwrap();
-    assert_eq!(hnav(&["log", "verify", p(&torn)]).0, 1);
-    let (code, out, err) = hnav(&["log", "show", p(&torn)]);
-    assert_eq!((code, out.lines().count()), (0, records.len() - 1));
-    assert!(err.contains("torn tail"), "{err}");
-
-    // Corrupt: both 1.
-    let corrupt = tmp.path().join("corrupt");
-    write_log(&corrupt, &records, 1 << 20);
-    let seg = segment_path(&corrupt, 0);
-    let mut bytes = fs::read(&seg).unwrap();
-    bytes[at[2].1 + 9] ^= 0xFF;
-    fs::write(&seg, bytes).unwrap();
-    let (code, out, _) = hnav(&["log", "verify", p(&corrupt)]);
-    assert_eq!(code, 1);
-    assert!(out.contains(&format!("byte {}", at[2].1)), "{out}");
-    let (code, out, err) = hnav(&["log", "show", p(&corrupt)]);
-    assert_eq!((code, out.lines().count()), (1, 2));
-    assert!(err.contains("corrupt"), "{err}");
-
-    // Unreadable: 2.
-    let missing = tmp.path().join("missing");
-    assert_eq!(hnav(&["log", "verify", p(&missing)]).0, 2);
-    assert_eq!(hnav(&["log", "show", p(&missing)]).0, 2);
-    assert_eq!(hnav(&["log", "verify", p(tmp.path())]).0, 2);
-
-    // Garbage in a segment never panics.
-    let garbage = tmp.path().join("garbage");
-    fs::create_dir(&garbage).unwrap();
-    let mut junk = MAGIC.to_vec();
-    junk.extend((0..4000u32).map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8));
-    fs::write(segment_path(&garbage, 0), junk).unwrap();
-    for args in [
-        &["log", "verify"][..],
-        &["log", "show"],
-        &["log", "show", "--json"],
-    ] {
-        let mut args = args.to_vec();
-        args.push(p(&garbage));
-        let (code, _, err) = hnav(&args);
-        assert!(code == 1 || code == 0, "{args:?}: {code} {err}");
-        assert!(!err.contains("panicked"), "{err}");
-    }
+    let log = read_log(dir("new-segment")).unwrap();
+    assert_eq!(log.records, []);
+    assert_eq!(log.torn.map(|t| (t.offset, t.bytes)), Some((0, 3)));
 }

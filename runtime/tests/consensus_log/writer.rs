@@ -1,59 +1,17 @@
-//! The consensus-log writer: round trips across reopen, torn-tail recovery at every cut,
-//! rollover, and (ignored) append latency per fsync policy.
+//! The writer: round trips across reopen under every fsync policy, the header rule, rollover,
+//! a torn segment magic rewritten, corruption refused unchanged, and (ignored) append latency
+//! per fsync policy. Its recovery of a cut last record is tested with the reader's view of
+//! the same cuts in `format`.
 
 use std::fs;
-use std::path::Path;
 use std::time::Instant;
 
-use hnav_coordinator::consensus_log::{LogWriter, WriterOptions};
 use hnav_runtime::consensus_log::{
-    read_log, segment_path, verify, AgentEntry, EndReason, EndRecord, LogError, LoggedDecision,
-    Record, RoundRecord, RunHeader, VerifyStatus, FORMAT_VERSION, MAGIC,
+    read_log, segment_path, EndReason, EndRecord, LogError, LogWriter, Record, WriterOptions, MAGIC,
 };
-use hnav_runtime::msg::NO_CELL;
 use hnav_runtime::scenario::FsyncPolicy;
 
-fn header(agents: usize) -> Record {
-    Record::Header(RunHeader {
-        version: FORMAT_VERSION,
-        scenario_hash: 0xfeed,
-        seed: 7,
-        clock: "lockstep".into(),
-        width: 16,
-        height: 16,
-        agents: (0..agents as u32)
-            .map(|i| AgentEntry {
-                start: i,
-                goal: 255 - i,
-                speed: 1.0,
-                priority: 1.0 + f64::from(i),
-            })
-            .collect(),
-    })
-}
-
-fn round(n: u64, agents: u32) -> Record {
-    Record::Round(RoundRecord {
-        round: n,
-        candidates: agents,
-        candidates_digest: n ^ 0xabcdef,
-        decisions: (0..agents)
-            .map(|agent| LoggedDecision {
-                agent,
-                verdict: 1,
-                refused: 0,
-                kind: 0,
-                cell: (n as u32 + agent) % 256,
-                waypoint: NO_CELL,
-            })
-            .collect(),
-    })
-}
-
-fn assert_intact(dir: &Path) {
-    let report = verify(dir);
-    assert_eq!(report.status(), VerifyStatus::Intact, "{}", report.render());
-}
+use super::fixtures::{assert_intact, header, read_files, round};
 
 #[test]
 fn records_survive_reopen_and_appends_continue() {
@@ -116,43 +74,6 @@ fn the_first_record_must_be_a_header() {
 }
 
 #[test]
-fn a_cut_at_every_offset_of_the_last_record_is_truncated_on_open() {
-    let tmp = tempfile::tempdir().unwrap();
-    let full = tmp.path().join("full");
-    let mut records = vec![header(4)];
-    records.extend((1..=4).map(|n| round(n, 4)));
-    {
-        let (mut log, _) = LogWriter::open(&full, FsyncPolicy::None).unwrap();
-        for r in &records {
-            log.append(r).unwrap();
-        }
-    }
-    let bytes = fs::read(segment_path(&full, 0)).unwrap();
-    let last = read_log(&full).unwrap().positions.last().unwrap().offset as usize;
-    for cut in last..bytes.len() {
-        let dir = tmp.path().join(format!("cut-{cut}"));
-        fs::create_dir(&dir).unwrap();
-        fs::write(segment_path(&dir, 0), &bytes[..cut]).unwrap();
-        {
-            let (mut log, rec) = LogWriter::open(&dir, FsyncPolicy::EveryRecord)
-                .unwrap_or_else(|e| panic!("cut at {cut}: {e}"));
-            assert_eq!(rec.records, records[..4], "cut at {cut}");
-            assert_eq!(rec.truncated_bytes, (cut - last) as u64);
-            assert_eq!(rec.torn.is_some(), cut > last);
-            assert_eq!(log.segment_len(), last as u64);
-            // The lost round is decided again, then the run goes on.
-            assert_eq!(log.append(&records[4]).unwrap(), last as u64);
-            log.append(&round(5, 4)).unwrap();
-        }
-        assert_intact(&dir);
-        let mut expected = records.clone();
-        expected.push(round(5, 4));
-        assert_eq!(read_log(&dir).unwrap().records, expected);
-        fs::remove_dir_all(&dir).unwrap();
-    }
-}
-
-#[test]
 fn a_torn_segment_magic_is_rewritten_and_corruption_is_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let opts = WriterOptions {
@@ -192,25 +113,16 @@ fn a_torn_segment_magic_is_rewritten_and_corruption_is_refused() {
     let mut bytes = fs::read(&first).unwrap();
     bytes[20] ^= 1;
     fs::write(&first, &bytes).unwrap();
-    let before: Vec<Vec<u8>> = read_segments(tmp.path());
+    let before = read_files(tmp.path());
     let err = LogWriter::open_with(tmp.path(), opts).unwrap_err();
     assert!(
         matches!(err, LogError::Corrupt { ref path, .. } if *path == first),
         "{err}"
     );
-    assert_eq!(read_segments(tmp.path()), before);
+    assert_eq!(read_files(tmp.path()), before);
 }
 
-fn read_segments(dir: &Path) -> Vec<Vec<u8>> {
-    let mut v: Vec<_> = fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    v.sort();
-    v.iter().map(|p| fs::read(p).unwrap()).collect()
-}
-
-/// `cargo test -p hnav-coordinator --release --test consensus_log -- --ignored --nocapture`
+/// `cargo test -p hnav-runtime --release --test consensus_log -- --ignored --nocapture`
 #[test]
 #[ignore = "measurement; prints append latency per fsync policy"]
 fn append_latency_per_policy() {
