@@ -17,10 +17,12 @@
 //! | [`transport`] | run-scoped iceoryx2 services: publisher+notifier, subscriber+listener, WaitSets |
 //! | [`supervisor`] | starting, watching, restarting and stopping a run's processes; the registry behind `hnav ps` |
 //! | [`consensus_log`] | the durable consensus log: record types, segment format, reader, verifier |
+//! | [`hash`] | FNV-1a 64 and SplitMix64: digests and seeded random numbers, stable across platforms |
 //! | [`logging`] | `tracing` set-up shared by the binaries, with iceoryx2's own logs routed into it |
 
 pub mod consensus_log;
 pub mod grid;
+pub mod hash;
 pub mod launch;
 pub mod logging;
 pub mod msg;
