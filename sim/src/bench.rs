@@ -2,6 +2,7 @@
 
 use crate::error::SimError;
 use crate::world::World;
+use hnav_runtime::grid::geometry::cell_centre_pose;
 use hnav_runtime::grid::{Cell, Grid};
 use hnav_runtime::scenario::params::{RobotParams, SimParams};
 use serde::Serialize;
@@ -45,7 +46,7 @@ pub fn robot_steps_per_second(robots: usize, seconds: f64) -> Result<BenchResult
     let starts: Vec<_> = (0..robots as u32)
         .map(|i| {
             let c = Cell::new(1 + 2 * (i % per_row), 1 + 2 * (i / per_row));
-            World::cell_centre(robot.cell_size_m, c, f64::from(i) * 0.7)
+            cell_centre_pose(robot.cell_size_m, c, f64::from(i) * 0.7)
         })
         .collect();
     let mut world = World::new(&robot, &sim, grid, &starts)?;

@@ -1,6 +1,7 @@
 //! World-level behaviour: collisions (head-on, into a wall, a clear run), the motor watchdog,
 //! and bit-for-bit determinism of two runs with one seed.
 
+use hnav_runtime::grid::geometry::cell_centre_pose;
 use hnav_runtime::grid::{Cell, Grid};
 use hnav_runtime::hash::Fnv1a64;
 use hnav_runtime::msg::{Pose, Truth};
@@ -8,7 +9,7 @@ use hnav_runtime::scenario::params::{RobotParams, SimParams};
 use hnav_sim::{Hit, World};
 
 fn at(cell: Cell, theta: f64) -> Pose {
-    World::cell_centre(RobotParams::default().cell_size_m, cell, theta)
+    cell_centre_pose(RobotParams::default().cell_size_m, cell, theta)
 }
 
 /// Runs `steps` steps renewing each robot's command `(l, r)` every 10 steps.
