@@ -104,6 +104,7 @@ mod build;
 mod build_params;
 pub mod error;
 mod hash;
+mod lines;
 pub mod params;
 mod raw;
 pub mod report;
@@ -115,8 +116,8 @@ use serde::{Deserialize, Serialize};
 
 pub use error::{Loc, ScenarioError};
 pub use params::{
-    ClockMode, CoordinatorParams, FsyncPolicy, RestartConfig, RestartPolicy, RestartRule,
-    RobotParams, SimParams,
+    ClockMode, ClockModeError, CoordinatorParams, FsyncPolicy, RestartConfig, RestartPolicy,
+    RestartRule, RobotParams, SimParams,
 };
 pub use report::{default_out_dir, ScenarioReport};
 
