@@ -13,7 +13,6 @@
 //! | [`planner`] | the [`Planner`](planner::Planner) trait; A*, Basic Theta*, Lazy Theta*; line of sight; single queries for the bench |
 //! | [`terrain`] | slope, roughness and relief from a height map; the hazard index `R`; route hazard `c = sum alpha R` |
 //! | [`conflict`] | one decision round of `shared_paths`: the conflict types (a)–(d), corners, reservations; the [`Resolver`](conflict::Resolver) |
-//! | [`experiment`] | seed 002's §4 experiment (random circular obstacles on a 50 x 50 m field) beside its Table 3.1 |
 //! | [`consensus_log`] | [`LogWriter`](consensus_log::LogWriter): appends the run's consensus log durably, recovers it after a restart |
 //! | [`round`] | the decision round: [`Arbiter`](round::Arbiter) keeps the rows, runs the resolver, counts refusals, replans (hybrid mode) |
 //! | [`process`] | the `hnav-coordinator` process: the WaitSet loop, round deadline, log-then-commit, restart from the log |
@@ -36,7 +35,6 @@
 pub mod conflict;
 pub mod consensus_log;
 pub mod error;
-pub mod experiment;
 pub mod planner;
 pub mod process;
 pub mod round;

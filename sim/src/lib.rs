@@ -16,7 +16,6 @@
 //! | [`watchdog`] | stale commands are replaced by braking |
 //! | [`world`] | [`World`]: N robots, struct-of-arrays, fixed step, odometry and Truth |
 //! | [`process`] | the `hnav-sim` process: [`process::SimProcess`], topics, lockstep and realtime |
-//! | [`bench`] | [`bench::robot_steps_per_second`] for `hnav-bench sim` |
 //! | [`error`] | [`SimError`]: bad parameters and inputs, never a panic |
 //!
 //! ```
@@ -35,7 +34,6 @@
 //! assert!(w.pose(0).unwrap().x_m > start.x_m);
 //! ```
 
-pub mod bench;
 pub mod collision;
 pub mod error;
 pub mod hall;

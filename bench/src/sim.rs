@@ -1,12 +1,12 @@
 //! The stepper benchmark behind `hnav-bench sim`: robot-steps per second of [`World::step`].
 
-use crate::error::SimError;
-use crate::world::World;
+use std::time::Instant;
+
 use hnav_runtime::grid::geometry::cell_centre_pose;
 use hnav_runtime::grid::{Cell, Grid};
 use hnav_runtime::scenario::params::{RobotParams, SimParams};
+use hnav_sim::{SimError, World};
 use serde::Serialize;
-use std::time::Instant;
 
 /// What [`robot_steps_per_second`] measured.
 #[derive(Debug, Clone, PartialEq, Serialize)]
