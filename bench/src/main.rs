@@ -171,7 +171,7 @@ fn plan_cmd(args: PlanCli) -> Result<()> {
         if json {
             println!("{}", serde_json::to_string(line).unwrap_or_default());
         } else {
-            println!("{}", line.render());
+            println!("{}", plan::render(line));
         }
     })?;
     if let Some(s) = summary {

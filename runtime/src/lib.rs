@@ -13,6 +13,7 @@
 //! | [`scenario`] | the TOML description of a run, validated with file/line errors |
 //! | [`msg`] | `#[repr(C)]` zero-copy payloads (Candidate, Commit, WheelCommand, ...) and their layouts |
 //! | [`topics`] | the run's service names and their QoS, defined once for every process |
+//! | [`plan`] | [`PlanResult`](plan::PlanResult), the answer to one planning query, whichever planner gave it |
 //! | [`launch`] | the command line every process of a run shares, and the start-up handshake with the supervisor |
 //! | [`transport`] | run-scoped iceoryx2 services: publisher+notifier, subscriber+listener, WaitSets |
 //! | [`supervisor`] | starting, watching, restarting and stopping a run's processes; the registry behind `hnav ps` |
@@ -26,6 +27,7 @@ pub mod hash;
 pub mod launch;
 pub mod logging;
 pub mod msg;
+pub mod plan;
 pub mod scenario;
 pub mod supervisor;
 pub mod topics;
