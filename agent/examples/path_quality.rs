@@ -84,7 +84,7 @@ fn run(cases: usize, corner: CornerCutting, map: NeuralMapOptions, stop: PlanSto
         };
         let mut planner = Planner::with_options(&g, map, stop, PathOptions::default()).unwrap();
         let r = planner.query(s, t).unwrap();
-        sweeps += u64::from(r.iterations);
+        sweeps += r.iterations;
         if !r.found {
             failures += 1;
             continue;

@@ -9,6 +9,7 @@
 //! nominal speed (cells/s) and by the motors' limit; the sim adds the acceleration limit and
 //! the motor lag, which the slow-down leaves room for.
 
+use hnav_runtime::grid::geometry::wrap_angle_shifted;
 use hnav_runtime::msg::Pose;
 use hnav_runtime::scenario::RobotParams;
 
@@ -95,7 +96,7 @@ impl WheelController {
                 arrived: dist <= p.arrive_tolerance_m,
             };
         }
-        let err = wrap(dy.atan2(dx) - pose.theta_rad);
+        let err = wrap_angle_shifted(dy.atan2(dx) - pose.theta_rad);
         let omega = p.heading_gain * err;
         let v = if err.abs() > p.turn_in_place_rad {
             0.0
@@ -119,16 +120,6 @@ impl WheelController {
             right_rad_s: r,
             arrived: false,
         }
-    }
-}
-
-fn wrap(a: f64) -> f64 {
-    use std::f64::consts::{PI, TAU};
-    let w = (a + PI).rem_euclid(TAU) - PI;
-    if w <= -PI {
-        w + TAU
-    } else {
-        w
     }
 }
 

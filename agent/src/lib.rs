@@ -17,7 +17,7 @@
 //! | [`controller`] | the wheel controller that drives the robot to the centre of the committed cell |
 //! | [`odometry`] | §D.2 dead reckoning from Hall ticks: [`odometry::DeadReckoning`], a pure function of the tick stream |
 //! | [`process`] | the `hnav-agent` process: ports, the round loop in lockstep and realtime, map snapshots, the restart checkpoint |
-//! | [`plan`] | [`plan_query`]: one start-goal query with a JSON-ready [`PlanResult`] |
+//! | [`plan`] | [`plan_query`]: one start-goal query, answered with a JSON-ready [`PlanResult`](hnav_runtime::plan::PlanResult) |
 //! | [`error`] | [`Error`]: bad cells and bad options, never a panic |
 //!
 //! ```
@@ -45,4 +45,4 @@ pub use neural_map::{
     ReferenceMap, StopRule,
 };
 pub use path_constructor::{DirectionMask, Path, PathConstructor, PathOptions, Walker};
-pub use plan::{plan_query, PlanOptions, PlanResult};
+pub use plan::{plan_query, PlanOptions};

@@ -5,6 +5,7 @@
 //! `Δs = (Δs_R + Δs_L)/2` while turning `Δθ = (Δs_R − Δs_L)/b`, integrated with the exact-arc
 //! update (midpoint when `|Δθ| ≤ 1e-6`).
 
+use hnav_runtime::grid::geometry::wrap_angle;
 use hnav_runtime::msg::Pose;
 use hnav_runtime::scenario::params::RobotParams;
 
@@ -104,20 +105,7 @@ pub fn arc_update(p: Pose, ds: f64, dtheta: f64) -> Pose {
     Pose {
         x_m: x,
         y_m: y,
-        theta_rad: wrap(t2),
-    }
-}
-
-fn wrap(a: f64) -> f64 {
-    use std::f64::consts::{PI, TAU};
-    if a > -PI && a <= PI {
-        return a;
-    }
-    let w = a.rem_euclid(TAU);
-    if w > PI {
-        w - TAU
-    } else {
-        w
+        theta_rad: wrap_angle(t2),
     }
 }
 

@@ -1,6 +1,7 @@
 //! One planning query: build a neural map towards the goal and climb it from the start. This
-//! is what `hnav-bench plan` calls; [`PlanResult`] serialises to the bench's JSON line
-//! (`planner`, `found`, `steps`, `length`, `iterations`, `path` as `[x, y]` pairs, `time_us`).
+//! is what `hnav-bench plan` calls; the answer is the runtime's [`PlanResult`], the type every
+//! planner answers with, and serialises to the bench's JSON line (`planner`, `found`, `steps`,
+//! `length`, `iterations`, `path` as `[x, y]` pairs, `time_us`).
 //!
 //! The corner rule applies to both halves: with [`CornerCutting::Forbidden`] (MovingAI's rule)
 //! no diagonal link passes a blocked corner, in propagation or in the path; with
@@ -9,6 +10,7 @@
 use std::time::Instant;
 
 use hnav_runtime::grid::{Cell, CornerCutting, Grid};
+use hnav_runtime::plan::PlanResult;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{check_inside, Error, Role};
@@ -62,25 +64,6 @@ impl PlanOptions {
     }
 }
 
-/// The answer to a query.
-#[derive(Clone, PartialEq, Debug, Serialize, Deserialize)]
-pub struct PlanResult {
-    /// Always `"hnav"`.
-    pub planner: String,
-    /// Whether the path reaches the goal.
-    pub found: bool,
-    /// Moves in the path (0 when not found).
-    pub steps: usize,
-    /// Path length, straight 1 and diagonal `sqrt 2` (0 when not found).
-    pub length: f64,
-    /// Sweeps of the neural map.
-    pub iterations: u32,
-    /// Cells from start to goal (empty when not found).
-    pub path: Vec<Cell>,
-    /// Wall time of the query in microseconds.
-    pub time_us: f64,
-}
-
 /// A planner for many queries on one grid: the map's buffers are allocated once.
 #[derive(Clone, Debug)]
 pub struct Planner {
@@ -119,7 +102,8 @@ impl Planner {
         &self.map
     }
 
-    /// Plans from `start` to `goal`; `time_us` covers the map build and the path.
+    /// Plans from `start` to `goal`; `time_us` covers the map build and the path. The answer's
+    /// planner is `"hnav"` and its iterations are the map's sweeps.
     pub fn query(&mut self, start: Cell, goal: Cell) -> Result<PlanResult, Error> {
         let t0 = Instant::now();
         let (w, h) = (
@@ -143,9 +127,11 @@ impl Planner {
             found: false,
             steps: 0,
             length: 0.0,
-            iterations: report.sweeps,
+            iterations: u64::from(report.sweeps),
             path: Vec::new(),
             time_us: 0.0,
+            los_checks: None,
+            optimal: None,
         };
         if !matches!(report.outcome, Outcome::Unreachable | Outcome::SweepLimit) {
             let path = self.path.trace(&self.map, start)?;

@@ -7,9 +7,10 @@ use std::time::Instant;
 
 use hnav_agent::neural_map::{ActivationField, NeuralMap};
 use hnav_agent::path_constructor::PathConstructor;
-use hnav_agent::plan::{PlanOptions, PlanResult, PlanStop, Planner};
+use hnav_agent::plan::{PlanOptions, PlanStop, Planner};
 use hnav_agent::Activation;
 use hnav_runtime::grid::{octile_shortest_path_len, Cell, CornerCutting, Direction, Grid};
+use hnav_runtime::plan::PlanResult;
 
 /// Plans and checks the path: legal moves, no revisits, strictly rising activation.
 fn plan_and_check(g: &Grid, start: Cell, goal: Cell, options: &PlanOptions) -> PlanResult {

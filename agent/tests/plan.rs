@@ -2,9 +2,10 @@
 
 mod common;
 
-use hnav_agent::plan::{plan_query, PlanOptions, PlanResult, PlanStop};
+use hnav_agent::plan::{plan_query, PlanOptions, PlanStop};
 use hnav_agent::{Activation, Error, Role};
 use hnav_runtime::grid::{Cell, CornerCutting, Grid};
+use hnav_runtime::plan::PlanResult;
 
 #[test]
 fn json_has_exactly_the_bench_fields() {

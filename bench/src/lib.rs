@@ -7,10 +7,10 @@
 //! |---|---|---|
 //! | [`latency`] | `hnav-bench latency [--quick] --out DIR` | one-way and round-trip latency of raw iceoryx2, the HNAV transport, a Unix domain socket and TCP loopback, in a two-thread ping-pong |
 //! | [`neural_map`] | `hnav-bench neural-map [--quick]` | neuron updates per second and time per map for 20x20 to 1024x1024, tanh against linear, and plan queries |
-//! | (`hnav_sim::bench`) | `hnav-bench sim [--robots 1,64,1024] [--seconds S] [--json]` | robot-steps per second of the physics stepper |
+//! | [`sim`] | `hnav-bench sim [--robots 1,64,1024] [--seconds S] [--json]` | robot-steps per second of the physics stepper |
 //! | [`plan`] | `hnav-bench plan --planner P --map FILE (--start X,Y --goal X,Y \| --scen FILE [--first N]) [--json]` | one planning query, or every entry of a MovingAI scenario against its optimal length |
 //! | [`round`] | `hnav-bench round [--agents 1,8,32,128] [--rounds N] [--fsync every-record,none] [--json] [--out DIR]`, `hnav-bench round --faults [--trials N]` | a decision round's latency against a real `hnav-coordinator` (all candidates in -> commit at every agent); SIGKILL -> `Down` detection and restarted agent -> first decision |
-//! | (`hnav_coordinator::experiment`) | `hnav-bench seed002 [--trials N] [--seed S]` | seed 002's obstacle-density experiment beside the thesis's Table 3.1 |
+//! | [`seed002`] | `hnav-bench seed002 [--trials N] [--seed S]` | seed 002's obstacle-density experiment (A*, Basic Theta*, Lazy Theta* on random circular obstacles) beside the thesis's Table 3.1 |
 //!
 //! Results go to stdout as a table and to CSV files in dora-benchmark's schema
 //! (`date,language,platform,name,size_bytes,avg_us,p50_us,p90_us,p99_us,n`), so they can be
@@ -20,3 +20,5 @@ pub mod latency;
 pub mod neural_map;
 pub mod plan;
 pub mod round;
+pub mod seed002;
+pub mod sim;

@@ -65,7 +65,7 @@ fn sim(args: SimCli) -> Result<()> {
         );
     }
     for robots in args.robots {
-        let r = hnav_sim::bench::robot_steps_per_second(robots, args.seconds)?;
+        let r = hnav_bench::sim::robot_steps_per_second(robots, args.seconds)?;
         if args.json {
             println!("{}", serde_json::to_string(&r)?);
         } else {
@@ -92,7 +92,7 @@ struct Seed002Cli {
 }
 
 fn seed002(args: Seed002Cli) -> Result<()> {
-    use hnav_coordinator::experiment::seed002::{run, Seed002Config};
+    use hnav_bench::seed002::{run, Seed002Config};
     let config = Seed002Config {
         trials: args.trials,
         seed: args.seed,
@@ -171,7 +171,7 @@ fn plan_cmd(args: PlanCli) -> Result<()> {
         if json {
             println!("{}", serde_json::to_string(line).unwrap_or_default());
         } else {
-            println!("{}", line.render());
+            println!("{}", plan::render(line));
         }
     })?;
     if let Some(s) = summary {

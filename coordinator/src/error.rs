@@ -64,10 +64,4 @@ pub enum PlanError {
         /// The name as given.
         name: String,
     },
-    /// Parameters of the seed-002 experiment that cannot produce a map.
-    #[error("bad experiment parameters: {problem}")]
-    BadExperiment {
-        /// What is wrong, in words.
-        problem: String,
-    },
 }

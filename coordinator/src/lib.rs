@@ -13,7 +13,6 @@
 //! | [`planner`] | the [`Planner`](planner::Planner) trait; A*, Basic Theta*, Lazy Theta*; line of sight; single queries for the bench |
 //! | [`terrain`] | slope, roughness and relief from a height map; the hazard index `R`; route hazard `c = sum alpha R` |
 //! | [`conflict`] | one decision round of `shared_paths`: the conflict types (a)–(d), corners, reservations; the [`Resolver`](conflict::Resolver) |
-//! | [`experiment`] | seed 002's §4 experiment (random circular obstacles on a 50 x 50 m field) beside its Table 3.1 |
 //! | [`round`] | the decision round: [`Arbiter`](round::Arbiter) keeps the rows, runs the resolver, tallies the decisions, replans (hybrid mode) |
 //! | [`process`] | the `hnav-coordinator` process: the WaitSet loop, round deadline, log-then-commit (through [`LogWriter`](hnav_runtime::consensus_log::LogWriter)), restart from the log |
 //! | [`error`] | [`PlanError`], every way a caller's input can be unusable |
@@ -34,7 +33,6 @@
 
 pub mod conflict;
 pub mod error;
-pub mod experiment;
 pub mod planner;
 pub mod process;
 pub mod round;

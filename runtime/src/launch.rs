@@ -24,9 +24,7 @@
 //! steps 1 and 2 is `supervisor::startup`.
 
 use std::ffi::OsString;
-use std::fmt;
 use std::path::PathBuf;
-use std::str::FromStr;
 use std::time::Duration;
 
 use iceoryx2::prelude::CallbackProgression;
@@ -54,39 +52,13 @@ pub struct ProcessArgs {
     pub seed: Option<u64>,
     /// Clock mode [default: the scenario's sim.clock].
     #[arg(long, value_name = "lockstep|realtime")]
-    pub mode: Option<Mode>,
+    pub mode: Option<ClockMode>,
     /// The run's output directory (the coordinator keeps its consensus log in DIR/log).
     #[arg(long, value_name = "DIR")]
     pub dir: Option<PathBuf>,
     /// Restarted by the supervisor: the run is under way, skip the start handshake.
     #[arg(long)]
     pub resume: bool,
-}
-
-/// A clock mode on the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Mode(pub ClockMode);
-
-impl FromStr for Mode {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "lockstep" => Ok(Mode(ClockMode::Lockstep)),
-            "realtime" => Ok(Mode(ClockMode::Realtime)),
-            other => Err(format!(
-                "unknown mode {other:?}: expected lockstep or realtime"
-            )),
-        }
-    }
-}
-
-impl fmt::Display for Mode {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self.0 {
-            ClockMode::Lockstep => "lockstep",
-            ClockMode::Realtime => "realtime",
-        })
-    }
 }
 
 impl ProcessArgs {
@@ -102,7 +74,7 @@ impl ProcessArgs {
                 s = s.with_agent_count(n, s.sim.seed)?;
             }
         }
-        if let Some(Mode(m)) = self.mode {
+        if let Some(m) = self.mode {
             s.sim.clock = m;
         }
         Ok(s)
@@ -301,7 +273,7 @@ mod tests {
             scenario: "s.toml".into(),
             agents: Some(8),
             seed: Some(3),
-            mode: Some(Mode(ClockMode::Realtime)),
+            mode: Some(ClockMode::Realtime),
             dir: Some("out".into()),
             resume: true,
         };
@@ -349,10 +321,16 @@ mod tests {
 
     #[test]
     fn bad_mode_is_refused() {
-        assert!("fast".parse::<Mode>().is_err());
-        assert_eq!(
-            "lockstep".parse::<Mode>().unwrap(),
-            Mode(ClockMode::Lockstep)
+        let argv = ["x", "--run", "r", "--scenario", "s.toml", "--mode"];
+        let err = Cli::try_parse_from(argv.iter().chain(&["fast"]))
+            .err()
+            .unwrap();
+        assert!(
+            err.to_string()
+                .contains("unknown mode \"fast\": expected lockstep or realtime"),
+            "{err}"
         );
+        let ok = Cli::try_parse_from(argv.iter().chain(&["lockstep"])).unwrap();
+        assert_eq!(ok.args.mode, Some(ClockMode::Lockstep));
     }
 }

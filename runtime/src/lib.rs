@@ -13,17 +13,21 @@
 //! | [`scenario`] | the TOML description of a run, validated with file/line errors |
 //! | [`msg`] | `#[repr(C)]` zero-copy payloads (Candidate, Commit, WheelCommand, ...) and their layouts |
 //! | [`topics`] | the run's service names and their QoS, defined once for every process |
+//! | [`plan`] | [`PlanResult`](plan::PlanResult), the answer to one planning query, whichever planner gave it |
 //! | [`launch`] | the command line every process of a run shares, and the start-up handshake with the supervisor |
 //! | [`transport`] | run-scoped iceoryx2 services: publisher+notifier, subscriber+listener, WaitSets |
 //! | [`supervisor`] | starting, watching, restarting and stopping a run's processes; the registry behind `hnav ps`. It sits on top: no other module uses it |
 //! | [`consensus_log`] | the durable consensus log: record types, segment format, reader, verifier |
+//! | [`hash`] | FNV-1a 64 and SplitMix64: digests and seeded random numbers, stable across platforms |
 //! | [`logging`] | `tracing` set-up shared by the binaries, with iceoryx2's own logs routed into it |
 
 pub mod consensus_log;
 pub mod grid;
+pub mod hash;
 pub mod launch;
 pub mod logging;
 pub mod msg;
+pub mod plan;
 pub mod scenario;
 pub mod supervisor;
 pub mod topics;

@@ -5,6 +5,7 @@
 //! Geometry is in nalgebra terms: robot centres are `Point2<f64>` (m), and a contact is a
 //! squared distance between points below the squared contact radius.
 
+use hnav_runtime::grid::geometry::signed_cell_centre_m;
 use hnav_runtime::grid::Grid;
 use nalgebra::Point2;
 
@@ -39,10 +40,12 @@ pub fn discs_overlap(a: &Point2<f64>, b: &Point2<f64>, ra: f64, rb: f64) -> bool
     (a - b).norm_squared() < r * r
 }
 
-/// The centre of cell `(cx, cy)` (column, row) of edge `cell`, m.
+/// The centre of cell `(cx, cy)` (column, row; may lie outside the grid) of edge `cell`, m,
+/// as the point a wall contact records.
 #[inline]
-pub fn cell_centre(cx: i64, cy: i64, cell: f64) -> Point2<f64> {
-    Point2::new((cx as f64 + 0.5) * cell, (cy as f64 + 0.5) * cell)
+fn cell_centre_point(cx: i64, cy: i64, cell: f64) -> Point2<f64> {
+    let (x, y) = signed_cell_centre_m(cell, cx, cy);
+    Point2::new(x, y)
 }
 
 /// Whether a disc overlaps the square of cell `(cx, cy)` of edge `cell`: the point of the
@@ -69,8 +72,7 @@ fn floor_i64(v: f64) -> i64 {
 /// Whether cell `(x, y)` is blocked; outside the grid is blocked.
 #[inline]
 fn blocked(grid: &Grid, x: i64, y: i64) -> bool {
-    let (w, h) = (i64::from(grid.width()), i64::from(grid.height()));
-    x < 0 || y < 0 || x >= w || y >= h || grid.blocked()[(y * w + x) as usize]
+    grid.cell_checked(x, y).is_none_or(|c| grid.is_blocked(c))
 }
 
 /// The first blocked cell a disc of radius `r` overlaps, if any. Only cells meeting the
@@ -112,14 +114,13 @@ impl Detector {
     /// A detector for `n` robots of body radius `radius` (at most `cell / 2`) on `grid`, whose
     /// cells have edge `cell` (m).
     pub fn new(n: usize, grid: &Grid, cell: f64, radius: f64) -> Detector {
-        let (w, h) = (i64::from(grid.width()), i64::from(grid.height()));
-        let mut open = vec![false; grid.len()];
-        for y in 0..h {
-            for x in 0..w {
-                open[(y * w + x) as usize] =
-                    (-1..=1).all(|dy| (-1..=1).all(|dx| !blocked(grid, x + dx, y + dy)));
-            }
-        }
+        let open = grid
+            .cells()
+            .map(|c| {
+                let (x, y) = (i64::from(c.x), i64::from(c.y));
+                (-1..=1).all(|dy| (-1..=1).all(|dx| !blocked(grid, x + dx, y + dy)))
+            })
+            .collect();
         Detector {
             open,
             open_w: grid.width(),
@@ -174,7 +175,7 @@ impl Detector {
                     robot: i as u32,
                     hit: Hit::Cell(cx, cy),
                     position: *p,
-                    other_position: cell_centre(cx, cy, cell),
+                    other_position: cell_centre_point(cx, cy, cell),
                 }),
                 _ => {}
             }
@@ -263,7 +264,7 @@ mod tests {
         // Cell (1, 0) spans x in [0.12, 0.24).
         assert!(disc_overlaps_cell(&p(0.07, 0.06), 0.058, 1, 0, 0.12));
         assert!(!disc_overlaps_cell(&p(0.06, 0.06), 0.058, 1, 0, 0.12));
-        assert_eq!(cell_centre(-1, 2, 0.12), p(-0.06, 0.3));
+        assert_eq!(cell_centre_point(-1, 2, 0.12), p(-0.06, 0.3));
     }
 
     #[test]
@@ -283,7 +284,7 @@ mod tests {
         assert_eq!(n, 1);
         assert_eq!(out[1].hit, Hit::Cell(-1, 4));
         assert_eq!(out[1].position, ps[0]);
-        assert_eq!(out[1].other_position, cell_centre(-1, 4, 0.12));
+        assert_eq!(out[1].other_position, cell_centre_point(-1, 4, 0.12));
     }
 
     #[test]

@@ -145,21 +145,6 @@ pub fn arc_step(
     (position + chord, mid * half)
 }
 
-/// Wraps an angle into `(-π, π]`.
-#[inline]
-pub fn wrap_angle(a: f64) -> f64 {
-    use std::f64::consts::{PI, TAU};
-    if a > -PI && a <= PI {
-        return a;
-    }
-    let w = a.rem_euclid(TAU);
-    if w > PI {
-        w - TAU
-    } else {
-        w
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -215,13 +200,5 @@ mod tests {
         assert!(
             (th.cos() - h.cos_angle()).abs() < 1e-15 && (th.sin() - h.sin_angle()).abs() < 1e-15
         );
-    }
-
-    #[test]
-    fn wrap_angle_range() {
-        use std::f64::consts::PI;
-        assert_eq!(wrap_angle(0.5), 0.5);
-        assert!((wrap_angle(3.0 * PI) - PI).abs() < 1e-12);
-        assert!((wrap_angle(-3.5 * PI) - 0.5 * PI).abs() < 1e-12);
     }
 }

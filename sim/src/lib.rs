@@ -16,16 +16,16 @@
 //! | [`watchdog`] | stale commands are replaced by braking |
 //! | [`world`] | [`World`]: N robots, struct-of-arrays, fixed step, odometry and Truth |
 //! | [`process`] | the `hnav-sim` process: [`process::SimProcess`], topics, lockstep and realtime |
-//! | [`bench`] | [`bench::robot_steps_per_second`] for `hnav-bench sim` |
 //! | [`error`] | [`SimError`]: bad parameters and inputs, never a panic |
 //!
 //! ```
+//! use hnav_runtime::grid::geometry::cell_centre_pose;
 //! use hnav_runtime::grid::{Cell, Grid};
 //! use hnav_runtime::scenario::params::{RobotParams, SimParams};
 //! use hnav_sim::World;
 //!
 //! let robot = RobotParams::default();
-//! let start = World::cell_centre(robot.cell_size_m, Cell::new(2, 2), 0.0);
+//! let start = cell_centre_pose(robot.cell_size_m, Cell::new(2, 2), 0.0);
 //! let mut w = World::new(&robot, &SimParams::default(), Grid::new(20, 5).unwrap(), &[start]).unwrap();
 //! w.apply_command(0, 0, 10.0, 10.0, 0).unwrap();
 //! for _ in 0..100 {
@@ -34,7 +34,6 @@
 //! assert!(w.pose(0).unwrap().x_m > start.x_m);
 //! ```
 
-pub mod bench;
 pub mod collision;
 pub mod error;
 pub mod hall;

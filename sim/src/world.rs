@@ -16,10 +16,11 @@
 use crate::collision::{Collision, Detector};
 use crate::error::SimError;
 use crate::hall::{self, SlipNoise};
-use crate::kinematics::{arc_step, heading, wrap_angle, Heading};
+use crate::kinematics::{arc_step, heading, Heading};
 use crate::robot::RobotModel;
 use crate::watchdog::Watchdog;
-use hnav_runtime::grid::{Cell, Grid};
+use hnav_runtime::grid::geometry::{cell_centre_pose, wrap_angle};
+use hnav_runtime::grid::Grid;
 use hnav_runtime::msg::{Odometry, Pose, Truth, MAX_AGENTS};
 use hnav_runtime::scenario::params::{RobotParams, SimParams};
 use hnav_runtime::scenario::Scenario;
@@ -131,7 +132,7 @@ impl World {
         let starts: Vec<_> = scenario
             .agents
             .iter()
-            .map(|a| World::cell_centre(cs, a.start, a.start_heading_rad()))
+            .map(|a| cell_centre_pose(cs, a.start, a.start_heading_rad()))
             .collect();
         World::new(
             &scenario.robot,
@@ -139,15 +140,6 @@ impl World {
             scenario.map.grid.clone(),
             &starts,
         )
-    }
-
-    /// The pose at the centre of `cell` with heading `theta_rad`.
-    pub fn cell_centre(cell_size_m: f64, cell: Cell, theta_rad: f64) -> Pose {
-        Pose {
-            x_m: (f64::from(cell.x) + 0.5) * cell_size_m,
-            y_m: (f64::from(cell.y) + 0.5) * cell_size_m,
-            theta_rad,
-        }
     }
 
     /// Number of robots.

@@ -1,10 +1,10 @@
 //! Kinematics against closed forms (noise off, ideal motors started at speed): straight line,
 //! rotation in place and a constant arc, within 1e-9.
 
+use hnav_runtime::grid::geometry::wrap_angle;
 use hnav_runtime::grid::Grid;
 use hnav_runtime::msg::Pose;
 use hnav_runtime::scenario::params::{RobotParams, SimParams};
-use hnav_sim::kinematics::wrap_angle;
 use hnav_sim::World;
 
 const TOL: f64 = 1e-9;

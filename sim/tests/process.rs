@@ -2,6 +2,7 @@
 //! commands in, odometry and truth out) and checks that two runs with one seed give identical
 //! Truth streams, and that a robot whose agent never sends is braked rather than waited for.
 
+use hnav_runtime::hash::Fnv1a64;
 use hnav_runtime::msg::{Odometry, Truth, WheelCommand};
 use hnav_runtime::scenario::params::RobotParams;
 use hnav_runtime::topics;
@@ -39,20 +40,11 @@ start = [1, 2]
 goal = [8, 2]
 "#;
 
-fn hash(h: &mut u64, t: &Truth) {
-    let mut eat = |v: u64| {
-        for b in v.to_le_bytes() {
-            *h ^= u64::from(b);
-            *h = h.wrapping_mul(0x100_0000_01b3);
-        }
-    };
-    eat(t.sim_time_ns);
-    eat(t.period);
-    eat(u64::from(t.robots) << 32 | u64::from(t.collisions));
+fn hash(h: &mut Fnv1a64, t: &Truth) {
+    h.u64(t.sim_time_ns).u64(t.period);
+    h.u64(u64::from(t.robots) << 32 | u64::from(t.collisions));
     for p in t.poses() {
-        eat(p.x_m.to_bits());
-        eat(p.y_m.to_bits());
-        eat(p.theta_rad.to_bits());
+        h.f64(p.x_m).f64(p.y_m).f64(p.theta_rad);
     }
 }
 
@@ -132,7 +124,7 @@ fn drive(mut guard: RunGuard, file: &std::path::Path, agents: usize) -> (u64, Tr
     let child = guard.child.insert(child);
     let ws = t.waitset().unwrap();
     let _g = ws.attach_notification(truth.listener()).unwrap();
-    let (mut h, mut last, mut next) = (0xcbf2_9ce4_8422_2325u64, Truth::default(), 0u64);
+    let (mut h, mut last, mut next) = (Fnv1a64::new(), Truth::default(), 0u64);
     let started = Instant::now();
     while next < PERIODS {
         assert!(
@@ -166,7 +158,7 @@ fn drive(mut guard: RunGuard, file: &std::path::Path, agents: usize) -> (u64, Tr
     assert!(child.wait().unwrap().success());
     // `guard`, a parameter, is dropped after every port of this function: purge then finds
     // no live node of the run.
-    (h, last)
+    (h.finish(), last)
 }
 
 #[test]

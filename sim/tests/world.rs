@@ -1,13 +1,15 @@
 //! World-level behaviour: collisions (head-on, into a wall, a clear run), the motor watchdog,
 //! and bit-for-bit determinism of two runs with one seed.
 
+use hnav_runtime::grid::geometry::cell_centre_pose;
 use hnav_runtime::grid::{Cell, Grid};
+use hnav_runtime::hash::Fnv1a64;
 use hnav_runtime::msg::{Pose, Truth};
 use hnav_runtime::scenario::params::{RobotParams, SimParams};
 use hnav_sim::{Hit, World};
 
 fn at(cell: Cell, theta: f64) -> Pose {
-    World::cell_centre(RobotParams::default().cell_size_m, cell, theta)
+    cell_centre_pose(RobotParams::default().cell_size_m, cell, theta)
 }
 
 /// Runs `steps` steps renewing each robot's command `(l, r)` every 10 steps.
@@ -129,21 +131,12 @@ fn watchdog_brakes_a_robot_whose_commands_stop() {
 }
 
 /// FNV-1a over a Truth sample's bytes (fields hashed one by one; the layout has no padding).
-fn hash_truth(h: &mut u64, t: &Truth) {
-    let mut eat = |b: &[u8]| {
-        for &x in b {
-            *h ^= u64::from(x);
-            *h = h.wrapping_mul(0x100_0000_01b3);
-        }
-    };
-    eat(&t.sim_time_ns.to_le_bytes());
-    eat(&t.period.to_le_bytes());
-    eat(&t.robots.to_le_bytes());
-    eat(&t.collisions.to_le_bytes());
+fn hash_truth(h: &mut Fnv1a64, t: &Truth) {
+    h.u64(t.sim_time_ns).u64(t.period);
+    h.bytes(&t.robots.to_le_bytes())
+        .bytes(&t.collisions.to_le_bytes());
     for p in &t.poses {
-        eat(&p.x_m.to_bits().to_le_bytes());
-        eat(&p.y_m.to_bits().to_le_bytes());
-        eat(&p.theta_rad.to_bits().to_le_bytes());
+        h.f64(p.x_m).f64(p.y_m).f64(p.theta_rad);
     }
 }
 
@@ -166,13 +159,13 @@ fn truth_stream_hash(seed: u64) -> u64 {
     let cmds: Vec<_> = (0..8)
         .map(|i| (8.0 + f64::from(i), 12.0 - f64::from(i)))
         .collect();
-    let (mut h, mut t) = (0xcbf2_9ce4_8422_2325u64, Truth::default());
+    let (mut h, mut t) = (Fnv1a64::new(), Truth::default());
     for period in 0..300 {
         run(&mut w, &cmds, 10);
         w.fill_truth(period, &mut t);
         hash_truth(&mut h, &t);
     }
-    h
+    h.finish()
 }
 
 #[test]

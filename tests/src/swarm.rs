@@ -134,7 +134,7 @@ pub fn generated_scenario(
     use hnav_runtime::grid::movingai::read_map_file;
     use hnav_runtime::grid::shortest::octile_shortest_path_len;
     use hnav_runtime::grid::{Cell, CornerCutting};
-    use hnav_runtime::scenario::SplitMix64;
+    use hnav_runtime::hash::SplitMix64;
 
     let grid = read_map_file(map).expect("a readable map");
     let free: Vec<Cell> = grid.passable_cells().collect();

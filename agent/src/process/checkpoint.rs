@@ -11,8 +11,8 @@ use std::fs::File;
 use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
 
+use hnav_runtime::hash::Fnv1a64;
 use hnav_runtime::msg::Pose;
-use hnav_runtime::scenario::Fnv1a64;
 
 const MAGIC: u64 = 0x4b43_5641_4e48_0001; // "HNAVCK" v1
 const FIELDS: usize = 11;

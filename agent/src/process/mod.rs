@@ -21,6 +21,7 @@ pub mod checkpoint;
 use std::path::Path;
 use std::time::Duration;
 
+use hnav_runtime::grid::geometry::{cell_centre_m, cell_centre_pose, cell_index};
 use hnav_runtime::grid::{Cell, Grid};
 use hnav_runtime::launch::{LifecyclePorts, ProcessArgs, StartOutcome, LOST_WAKEUP_RECHECK};
 use hnav_runtime::msg::{Commit, MapHeader, Odometry, Pose, Role, WheelCommand};
@@ -110,14 +111,6 @@ struct Core {
     ticks: (i64, i64),
 }
 
-/// The centre of `cell` in metres.
-pub fn cell_centre(cell_size_m: f64, cell: Cell) -> (f64, f64) {
-    (
-        (f64::from(cell.x) + 0.5) * cell_size_m,
-        (f64::from(cell.y) + 0.5) * cell_size_m,
-    )
-}
-
 impl<'t> AgentProcess<'t> {
     /// Loads agent `index` of the run described by `args` and opens its ports. A restarted
     /// agent (`args.resume`) resumes from its checkpoint in the run directory if there is a
@@ -181,12 +174,7 @@ impl<'t> AgentProcess<'t> {
                 (nav, dr, c.last_commit, (c.ticks_left, c.ticks_right))
             }
             None => {
-                let (x, y) = cell_centre(cs, spec.start);
-                let start = Pose {
-                    x_m: x,
-                    y_m: y,
-                    theta_rad: spec.start_heading_rad(),
-                };
+                let start = cell_centre_pose(cs, spec.start, spec.start_heading_rad());
                 let mut nav = Navigator::new(
                     grid,
                     scenario.map.corner_cutting,
@@ -342,7 +330,7 @@ impl Core {
         self.ticks = (o.ticks_left, o.ticks_right);
         let pose = self.dr.update(o.ticks_left, o.ticks_right);
         if self.nav.is_moving() {
-            let (x, y) = cell_centre(self.cell_size_m, self.nav.next());
+            let (x, y) = cell_centre_m(self.cell_size_m, self.nav.next());
             if self.ctl.arrived(pose, x, y) && self.nav.arrived()? {
                 self.publish_map(p)?;
             }
@@ -384,7 +372,7 @@ impl Core {
         }
         let pose = self.dr.pose();
         let (l, r) = if self.nav.is_moving() {
-            let (x, y) = cell_centre(self.cell_size_m, self.nav.next());
+            let (x, y) = cell_centre_m(self.cell_size_m, self.nav.next());
             let w = self.ctl.command(pose, x, y);
             (w.left_rad_s, w.right_rad_s)
         } else {
@@ -415,7 +403,7 @@ impl Core {
             width: self.width,
             height: (len / self.width.max(1) as usize) as u32,
             iterations: self.nav.report().sweeps,
-            target: (self.nav.target().y * self.width + self.nav.target().x),
+            target: cell_index(self.width, self.nav.target()) as u32,
             activation: map.options().activation.to_kind() as u8,
             reserved: [0; 3],
         };
@@ -435,7 +423,7 @@ impl Core {
 
     fn store_checkpoint(&self, period: u64, pose: Pose) {
         let Some(f) = &self.checkpoint else { return };
-        let idx = |c: Cell| c.y * self.width + c.x;
+        let idx = |c: Cell| cell_index(self.width, c) as u32;
         let c = Checkpoint {
             period,
             ticks_left: self.ticks.0,

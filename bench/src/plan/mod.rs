@@ -20,8 +20,9 @@ use hnav_coordinator::planner::{
     run_query_with, Planner as GlobalPlanner, PlannerConfig, PlannerKind as GlobalKind,
 };
 use hnav_runtime::grid::{read_map_file, read_scen_file, Cell, CornerCutting, Grid};
+use hnav_runtime::plan::PlanResult;
 
-pub use output::{QueryLine, Summary};
+pub use output::{render, Summary};
 
 /// The planners `--planner` accepts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -101,22 +102,17 @@ impl Engine {
         }
     }
 
-    fn query(&mut self, grid: &Grid, start: Cell, goal: Cell) -> Result<QueryLine> {
+    fn query(&mut self, grid: &Grid, start: Cell, goal: Cell) -> Result<PlanResult> {
         match self {
-            Self::Hnav(p) => Ok(QueryLine::from_hnav(p.query(start, goal)?)),
-            Self::Global(p) => Ok(QueryLine::from_global(run_query_with(
-                p.as_mut(),
-                grid,
-                start,
-                goal,
-            )?)),
+            Self::Hnav(p) => Ok(p.query(start, goal)?),
+            Self::Global(p) => Ok(run_query_with(p.as_mut(), grid, start, goal)?),
         }
     }
 }
 
 /// Runs the queries `args` asks for and hands each line to `emit`; returns the summary
 /// (scenario runs) or `None` (a single query).
-pub fn run(args: &PlanArgs, mut emit: impl FnMut(&QueryLine)) -> Result<Option<Summary>> {
+pub fn run(args: &PlanArgs, mut emit: impl FnMut(&PlanResult)) -> Result<Option<Summary>> {
     let grid = read_map_file(&args.map).map_err(anyhow::Error::msg)?;
     let mut engine = Engine::new(args, &grid)?;
     match (&args.endpoints, &args.scen) {

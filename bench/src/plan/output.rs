@@ -1,81 +1,23 @@
-//! The JSON lines of `hnav-bench plan` and the summary of a scenario run.
+//! The lines of `hnav-bench plan` and the summary of a scenario run. With `--json` a query's
+//! line is its [`PlanResult`] as is; without, [`render`] prints it as a table row.
 
-use hnav_agent::plan::PlanResult;
-use hnav_coordinator::planner::QueryResult;
-use hnav_runtime::grid::Cell;
+use hnav_runtime::plan::PlanResult;
 use serde::Serialize;
 
 /// Lengths within this of the scenario's optimal length count as optimal (the `.scen` files
 /// print 8 decimals).
 pub const OPTIMAL_TOLERANCE: f64 = 1e-6;
 
-/// One answered query, as printed with `--json`.
-#[derive(Debug, Clone, Serialize)]
-pub struct QueryLine {
-    /// The planner's name.
-    pub planner: String,
-    /// Whether a path to the goal was found.
-    pub found: bool,
-    /// Moves in the path.
-    pub steps: usize,
-    /// Path length (straight 1, diagonal √2; any-angle planners: Euclidean).
-    pub length: f64,
-    /// The planner's iterations: neural-map sweeps, or node expansions.
-    pub iterations: u64,
-    /// The path's cells (waypoints for any-angle planners) as `[x, y]`.
-    pub path: Vec<Cell>,
-    /// Wall time of the query, µs.
-    pub time_us: f64,
-    /// Line-of-sight checks (any-angle planners only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub los_checks: Option<u64>,
-    /// The scenario's optimal length (scenario runs only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub optimal: Option<f64>,
-}
-
-impl QueryLine {
-    /// From the neural map's answer.
-    pub fn from_hnav(r: PlanResult) -> Self {
-        Self {
-            planner: "hnav".into(),
-            found: r.found,
-            steps: r.steps,
-            length: r.length,
-            iterations: u64::from(r.iterations),
-            path: r.path,
-            time_us: r.time_us,
-            los_checks: None,
-            optimal: None,
-        }
-    }
-
-    /// From a global planner's answer.
-    pub fn from_global(r: QueryResult) -> Self {
-        Self {
-            los_checks: (r.los_checks > 0).then_some(r.los_checks),
-            planner: r.planner,
-            found: r.found,
-            steps: r.steps,
-            length: r.length,
-            iterations: r.iterations,
-            path: r.path,
-            time_us: r.time_us,
-            optimal: None,
-        }
-    }
-
-    /// A one-line human rendering.
-    pub fn render(&self) -> String {
-        let optimal = self
-            .optimal
-            .map(|o| format!("  optimal {o:.4}"))
-            .unwrap_or_default();
-        format!(
-            "{:<10} found {:<5} steps {:>5}  length {:>10.4}{optimal}  iterations {:>7}  {:>10.1} us",
-            self.planner, self.found, self.steps, self.length, self.iterations, self.time_us
-        )
-    }
+/// A query's answer as one human-readable line.
+pub fn render(r: &PlanResult) -> String {
+    let optimal = r
+        .optimal
+        .map(|o| format!("  optimal {o:.4}"))
+        .unwrap_or_default();
+    format!(
+        "{:<10} found {:<5} steps {:>5}  length {:>10.4}{optimal}  iterations {:>7}  {:>10.1} us",
+        r.planner, r.found, r.steps, r.length, r.iterations, r.time_us
+    )
 }
 
 /// Totals over a scenario file.
@@ -121,7 +63,7 @@ impl Summary {
     }
 
     /// Counts one answered query.
-    pub fn add(&mut self, line: &QueryLine) {
+    pub fn add(&mut self, line: &PlanResult) {
         self.queries += 1;
         self.total_time_us += line.time_us;
         if !line.found {
@@ -162,9 +104,10 @@ impl Summary {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hnav_runtime::grid::Cell;
 
-    fn line(length: f64, optimal: f64, found: bool) -> QueryLine {
-        QueryLine {
+    fn line(length: f64, optimal: f64, found: bool) -> PlanResult {
+        PlanResult {
             planner: "hnav".into(),
             found,
             los_checks: None,
@@ -211,5 +154,15 @@ mod tests {
             .unwrap()
             .get("optimal")
             .is_none());
+    }
+
+    #[test]
+    fn json_line_keeps_its_field_order() {
+        let mut l = line(2.5, 2.0, true);
+        l.los_checks = Some(7);
+        assert_eq!(
+            serde_json::to_string(&l).unwrap(),
+            r#"{"planner":"hnav","found":true,"steps":3,"length":2.5,"iterations":5,"path":[[0,0],[1,1]],"time_us":2.0,"los_checks":7,"optimal":2.0}"#
+        );
     }
 }

@@ -8,7 +8,7 @@
 //! | [`theta`] | [`BasicTheta`]: Basic Theta* (Nash, Daniel, Koenig & Felner 2007), eager line of sight |
 //! | [`lazy_theta`] | [`LazyTheta`]: Lazy Theta* (Nash, Koenig & Tovey 2010), one line-of-sight check per expansion |
 //! | [`mod@line_of_sight`] | [`line_of_sight()`](fn@line_of_sight) and the exact cell walk behind it |
-//! | [`query`] | [`PlannerKind`], [`run_query`] and [`QueryResult`], the JSON answer of `hnav-bench plan` |
+//! | [`query`] | [`PlannerKind`] and [`run_query`], answering with the runtime's [`PlanResult`](hnav_runtime::plan::PlanResult), the JSON line of `hnav-bench plan` |
 //! | `open_list`, `search`, `space` (private) | the reusable open list, per-node buffers with generation stamps, and the grid as the planners see it |
 //!
 //! # Conventions shared by every planner
@@ -50,7 +50,7 @@ pub use astar::AStar;
 pub use lazy_theta::LazyTheta;
 pub use line_of_sight::{euclid, line_of_sight, segment_chords};
 pub use path::{check_path, heading_changes, Path, PathDefect};
-pub use query::{run_query, run_query_with, PlannerKind, QueryResult};
+pub use query::{run_query, run_query_with, PlannerKind};
 pub use theta::BasicTheta;
 
 /// A single-agent global planner over an occupancy grid.
@@ -59,7 +59,8 @@ pub use theta::BasicTheta;
 /// for that reason. The trait knows nothing about how a planner works inside, so the agent's
 /// neural map can implement it too.
 pub trait Planner {
-    /// A short stable name, e.g. `"astar"`; the `planner` field of [`QueryResult`].
+    /// A short stable name, e.g. `"astar"`; the `planner` field of a query's
+    /// [`PlanResult`](hnav_runtime::plan::PlanResult).
     fn name(&self) -> &'static str;
 
     /// A path from `start` to `goal`, `Ok(None)` if the goal is unreachable, or an error if an

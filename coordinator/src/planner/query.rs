@@ -1,15 +1,17 @@
 //! Single planning queries, the library side of `hnav-bench plan --planner astar|theta|lazy-theta`.
 //!
-//! [`QueryResult`] serialises to the bench's JSON line: `planner`, `found`, `steps`, `length`,
-//! `iterations`, `path` (a list of `[x, y]`) and `time_us`, plus `los_checks` and
-//! `generated`. The agent's neural-map query answers with the same first seven fields.
+//! A query answers with the runtime's [`PlanResult`], as the agent's neural-map query does, so
+//! the bench prints every planner the same way: `planner`, `found`, `steps`, `length`,
+//! `iterations` (node expansions), `path` (a list of `[x, y]`) and `time_us`, plus
+//! `los_checks` for a planner that made any. The open-list pushes are in
+//! [`Planner::stats`].
 
 use std::fmt;
 use std::str::FromStr;
 use std::time::Instant;
 
 use hnav_runtime::grid::{Cell, CornerCutting, Grid};
-use serde::{Deserialize, Serialize};
+use hnav_runtime::plan::PlanResult;
 
 use super::{AStar, BasicTheta, LazyTheta, Planner, PlannerConfig};
 use crate::error::PlanError;
@@ -73,29 +75,6 @@ impl FromStr for PlannerKind {
     }
 }
 
-/// The answer to one query, as the bench prints it.
-#[derive(Clone, PartialEq, Debug, Serialize, Deserialize)]
-pub struct QueryResult {
-    /// The planner's name (`"astar"`, `"theta"`, `"lazy-theta"`).
-    pub planner: String,
-    /// Whether a path was found.
-    pub found: bool,
-    /// Moves (A*) or segments (any-angle) of the path, 0 when not found.
-    pub steps: usize,
-    /// Path length in cell units, 0 when not found.
-    pub length: f64,
-    /// Node expansions.
-    pub iterations: u64,
-    /// Cells (A*) or waypoints (any-angle) from start to goal, empty when not found.
-    pub path: Vec<Cell>,
-    /// Wall time of the query in microseconds.
-    pub time_us: f64,
-    /// Line-of-sight checks (0 for A*).
-    pub los_checks: u64,
-    /// Pushes onto the open list (new nodes and improvements).
-    pub generated: u64,
-}
-
 /// Runs one query with a fresh planner of the given kind and no hazard model.
 ///
 /// ```
@@ -115,19 +94,20 @@ pub fn run_query(
     start: Cell,
     goal: Cell,
     corner_cutting: CornerCutting,
-) -> Result<QueryResult, PlanError> {
+) -> Result<PlanResult, PlanError> {
     let mut planner = kind.build(PlannerConfig::new(corner_cutting));
     run_query_with(planner.as_mut(), grid, start, goal)
 }
 
 /// Runs one query with a given planner (reusing its buffers and its configuration, hazard
-/// model included) and times it.
+/// model included) and times it. `iterations` are the node expansions; `los_checks` is `None`
+/// for a planner that made none (A*).
 pub fn run_query_with(
     planner: &mut dyn Planner,
     grid: &Grid,
     start: Cell,
     goal: Cell,
-) -> Result<QueryResult, PlanError> {
+) -> Result<PlanResult, PlanError> {
     let t0 = Instant::now();
     let path = planner.plan(grid, start, goal)?;
     let time_us = t0.elapsed().as_secs_f64() * 1e6;
@@ -136,7 +116,7 @@ pub fn run_query_with(
         Some(p) => (true, p.steps(), p.length, p.cells),
         None => (false, 0, 0.0, Vec::new()),
     };
-    Ok(QueryResult {
+    Ok(PlanResult {
         planner: planner.name().into(),
         found,
         steps,
@@ -144,8 +124,8 @@ pub fn run_query_with(
         iterations: stats.expansions,
         path,
         time_us,
-        los_checks: stats.los_checks,
-        generated: stats.generated,
+        los_checks: (stats.los_checks > 0).then_some(stats.los_checks),
+        optimal: None,
     })
 }
 

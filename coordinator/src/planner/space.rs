@@ -4,6 +4,7 @@
 //! A [`Space`] is built per query from borrowed data, after checking the endpoints and the
 //! hazard map's shape, so the search loops below can index slices without further checks.
 
+use hnav_runtime::grid::geometry::{cell_index, index_cell};
 use hnav_runtime::grid::{Cell, CornerCutting, Endpoint, Grid};
 
 use super::line_of_sight::{euclid, walk};
@@ -79,14 +80,15 @@ impl<'a> Space<'a> {
     /// Row-major index of a cell inside the grid.
     #[inline]
     pub(crate) fn index(&self, c: Cell) -> usize {
-        c.y as usize * self.width + c.x as usize
+        // The width came from the grid's u32.
+        cell_index(self.width as u32, c)
     }
 
     /// The cell at an index `< len()`.
     #[inline]
     pub(crate) fn cell(&self, i: usize) -> Cell {
-        // Both quotients are below the grid's dimensions, which are u32.
-        Cell::new((i % self.width) as u32, (i / self.width) as u32)
+        // A grid's width is at least 1 and its rows fit u32, so the conversion cannot fail.
+        index_cell(self.width as u32, i).unwrap_or_default()
     }
 
     /// Whether the cell at `i` is an obstacle: blocked, or impassable terrain.

@@ -6,8 +6,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::hash::Fnv1a64;
 use crate::msg::{Candidate, Commit, Decision, Lifecycle, MAX_AGENTS};
-use crate::scenario::Fnv1a64;
 
 /// One entry of the log. A log starts with exactly one [`Header`](Record::Header).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -4,6 +4,7 @@
 //! |---|---|
 //! | [`Grid`] (here) | width x height cells, blocked flags, original MovingAI characters, optional terrain |
 //! | [`coord`] | [`Cell`] (`x` = column, `y` = row, origin top-left) and [`octile`] distance |
+//! | [`geometry`] | row-major index <-> [`Cell`], cell centres in metres, octile step length, angle wrapping |
 //! | [`neighbours`] | the 8 [`Direction`]s in the dissertation's order and the [`CornerCutting`] rule |
 //! | [`tile`] | [`Tile`], the MovingAI characters and which of them block |
 //! | [`terrain`] | [`Terrain`], an optional elevation or cost layer |
@@ -29,6 +30,7 @@
 pub mod check;
 pub mod coord;
 pub mod error;
+pub mod geometry;
 pub mod movingai;
 pub mod neighbours;
 pub mod scen;
@@ -166,7 +168,7 @@ impl Grid {
     /// Row-major index `y * width + x`. Only meaningful for cells inside the grid (it never
     /// panics, but an outside cell maps to some unrelated number); see [`Self::checked_index`].
     pub fn index(&self, cell: Cell) -> usize {
-        cell.y as usize * self.width as usize + cell.x as usize
+        geometry::cell_index(self.width, cell)
     }
 
     /// Row-major index, or `None` for a cell outside the grid.
@@ -179,12 +181,7 @@ impl Grid {
         if index >= self.len() {
             return None;
         }
-        let w = self.width as usize;
-        // Both quotients are < 2^26, so they fit in u32.
-        Some(Cell {
-            x: (index % w) as u32,
-            y: (index / w) as u32,
-        })
+        geometry::index_cell(self.width, index)
     }
 
     /// The dissertation's 1-based row-major cell id, `y * width + x + 1`. Only meaningful for

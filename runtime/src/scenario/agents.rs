@@ -3,7 +3,7 @@
 //! Extra agents get seeded random starts and goals: free cells, every start distinct from all
 //! other starts, every goal distinct from all other goals, start != goal, and the goal
 //! reachable from the start under the map's corner-cutting rule (checked with a BFS flood).
-//! The random numbers come from a tiny SplitMix64 so that the placement is identical on every
+//! The random numbers come from [`SplitMix64`] so that the placement is identical on every
 //! platform and every version of HNAV for a given seed, without pulling in `rand`.
 
 use std::collections::HashSet;
@@ -11,44 +11,7 @@ use std::collections::HashSet;
 use super::error::{Loc, ScenarioError};
 use super::{AgentSpec, FaultTarget, Scenario};
 use crate::grid::{reachable_from, Cell, Grid};
-
-/// SplitMix64 (Steele, Lea, Flood 2014): a 64-bit state, good statistical quality for
-/// placement purposes, and trivially reproducible.
-#[derive(Clone, Debug)]
-pub struct SplitMix64 {
-    state: u64,
-}
-
-impl SplitMix64 {
-    /// A generator with the given seed.
-    pub fn new(seed: u64) -> Self {
-        SplitMix64 { state: seed }
-    }
-
-    /// The next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.state = self.state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// A uniform number in `0..n` (`n > 0`), without modulo bias (Lemire's multiply-shift
-    /// with rejection).
-    pub fn below(&mut self, n: u64) -> u64 {
-        if n == 0 {
-            return 0;
-        }
-        let threshold = n.wrapping_neg() % n;
-        loop {
-            let m = u128::from(self.next_u64()) * u128::from(n);
-            if (m as u64) >= threshold {
-                return (m >> 64) as u64;
-            }
-        }
-    }
-}
+use crate::hash::SplitMix64;
 
 /// Connected-component label of every free cell (`u32::MAX` for blocked cells).
 fn components(grid: &Grid, rule: crate::grid::CornerCutting) -> Vec<u32> {
@@ -151,27 +114,6 @@ pub(super) fn with_agent_count(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn splitmix_reference_values() {
-        // First outputs for seed 1234567 from the reference C implementation.
-        let mut r = SplitMix64::new(1_234_567);
-        assert_eq!(r.next_u64(), 6_457_827_717_110_365_317);
-        assert_eq!(r.next_u64(), 3_203_168_211_198_807_973);
-    }
-
-    #[test]
-    fn below_stays_in_range_and_covers_it() {
-        let mut r = SplitMix64::new(7);
-        let mut hit = [false; 5];
-        for _ in 0..200 {
-            let v = r.below(5);
-            assert!(v < 5);
-            hit[v as usize] = true;
-        }
-        assert!(hit.iter().all(|&h| h));
-        assert_eq!(r.below(0), 0);
-    }
 
     #[test]
     fn components_split_by_wall() {

@@ -1,6 +1,6 @@
 //! From TOML text to a validated [`Scenario`]: parse with `serde`, then check every semantic
-//! rule, turning `toml` spans into line numbers for the errors. The parameter sections are
-//! checked in `build_params`, agents and faults in `validate`.
+//! rule, turning `toml` spans into line numbers for the errors (`lines`). The parameter
+//! sections are checked in `build_params`, agents and faults in `validate`.
 
 use std::path::Path;
 
@@ -8,62 +8,11 @@ use toml::Spanned;
 
 use super::build_params::{build_coordinator, build_restart, build_robot, build_sim};
 use super::error::{Loc, ScenarioError};
+use super::lines::{toml_error, Lines};
 use super::raw::{RawMap, RawScenario};
 use super::validate::{build_agent, build_fault, check_agent, Seen};
 use super::{MapSpec, Scenario};
 use crate::grid::{read_map_file, read_map_rows, CornerCutting, GridError};
-
-/// Byte offset to 1-based line.
-pub(super) struct Lines<'a> {
-    pub(super) source_name: &'a str,
-    starts: Vec<usize>,
-}
-
-impl<'a> Lines<'a> {
-    pub(super) fn new(text: &str, source_name: &'a str) -> Self {
-        let starts = std::iter::once(0)
-            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
-            .collect();
-        Lines {
-            source_name,
-            starts,
-        }
-    }
-
-    pub(super) fn line(&self, offset: usize) -> usize {
-        self.starts.partition_point(|&s| s <= offset).max(1)
-    }
-
-    pub(super) fn at<T>(&self, s: &Spanned<T>) -> Loc {
-        Loc::new(self.source_name, self.line(s.span().start))
-    }
-
-    pub(super) fn at_opt<T>(&self, s: &Option<Spanned<T>>, fallback: &Loc) -> Loc {
-        s.as_ref().map_or_else(|| fallback.clone(), |s| self.at(s))
-    }
-}
-
-/// Converts a `toml` error, recognising serde's unknown/missing field messages so they get
-/// their own variants.
-pub(super) fn toml_error(e: &toml::de::Error, lines: &Lines<'_>) -> ScenarioError {
-    let at = Loc::new(
-        lines.source_name,
-        e.span().map_or(1, |s| lines.line(s.start)),
-    );
-    let message = e.message().trim().to_string();
-    let quoted = |rest: &str| {
-        rest.split_once('`')
-            .map(|(key, tail)| (key.to_string(), tail.to_string()))
-    };
-    if let Some((key, tail)) = message.strip_prefix("unknown field `").and_then(quoted) {
-        let expected = tail.trim_start_matches(',').trim().to_string();
-        return ScenarioError::UnknownKey { at, key, expected };
-    }
-    if let Some((key, _)) = message.strip_prefix("missing field `").and_then(quoted) {
-        return ScenarioError::MissingKey { at, key };
-    }
-    ScenarioError::Toml { at, message }
-}
 
 /// Parses and validates a scenario.
 pub(super) fn parse(

@@ -3,8 +3,8 @@
 
 use toml::Spanned;
 
-use super::build::Lines;
 use super::error::{Loc, ScenarioError};
+use super::lines::Lines;
 use super::params::{CoordinatorParams, RestartConfig, RestartRule, RobotParams, SimParams};
 use super::raw::{RawCoordinator, RawRestart, RawRestartRule, RawRobot, RawSim};
 

@@ -1,8 +1,8 @@
 //! The scenario hash written into the consensus log's run header.
 //!
-//! FNV-1a 64 over a canonical byte encoding, so the hash does not depend on TOML formatting,
-//! comments, key order, the file's location or the Rust version. It covers everything that
-//! changes what a run does:
+//! FNV-1a 64 ([`Fnv1a64`]) over a canonical byte encoding, so the hash does not depend on TOML
+//! formatting, comments, key order, the file's location or the Rust version. It covers
+//! everything that changes what a run does:
 //!
 //! * the map: width, height, every cell's MovingAI character, the terrain layer if any, and
 //!   the corner-cutting rule;
@@ -20,50 +20,7 @@
 use super::params::{ClockMode, FsyncPolicy, RestartPolicy, RestartRule};
 use super::{FaultAction, FaultSignal, FaultTarget, Scenario};
 use crate::grid::{CornerCutting, TerrainKind};
-
-/// FNV-1a 64-bit hasher.
-#[derive(Clone, Copy, Debug)]
-pub struct Fnv1a64(u64);
-
-impl Fnv1a64 {
-    const OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
-    const PRIME: u64 = 0x0000_0100_0000_01b3;
-
-    /// A fresh hasher.
-    pub fn new() -> Self {
-        Fnv1a64(Self::OFFSET)
-    }
-
-    /// Feeds bytes.
-    pub fn bytes(&mut self, bytes: &[u8]) -> &mut Self {
-        for &b in bytes {
-            self.0 ^= u64::from(b);
-            self.0 = self.0.wrapping_mul(Self::PRIME);
-        }
-        self
-    }
-
-    /// Feeds an integer (as little-endian `u64`).
-    pub fn u64(&mut self, v: u64) -> &mut Self {
-        self.bytes(&v.to_le_bytes())
-    }
-
-    /// Feeds a float (its bits, little-endian).
-    pub fn f64(&mut self, v: f64) -> &mut Self {
-        self.u64(v.to_bits())
-    }
-
-    /// The hash so far.
-    pub fn finish(&self) -> u64 {
-        self.0
-    }
-}
-
-impl Default for Fnv1a64 {
-    fn default() -> Self {
-        Self::new()
-    }
-}
+use crate::hash::Fnv1a64;
 
 fn rule(h: &mut Fnv1a64, r: &RestartRule) {
     let policy = match r.policy {
@@ -170,20 +127,4 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
         });
     }
     h.finish()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn fnv1a_known_vectors() {
-        // Published FNV-1a 64 test vectors.
-        assert_eq!(Fnv1a64::new().finish(), 0xcbf2_9ce4_8422_2325);
-        assert_eq!(Fnv1a64::new().bytes(b"a").finish(), 0xaf63_dc4c_8601_ec8c);
-        assert_eq!(
-            Fnv1a64::new().bytes(b"foobar").finish(),
-            0x8594_4171_f739_67e8
-        );
-    }
 }

@@ -104,6 +104,7 @@ mod build;
 mod build_params;
 pub mod error;
 mod hash;
+mod lines;
 pub mod params;
 mod raw;
 pub mod report;
@@ -113,12 +114,10 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-pub use agents::SplitMix64;
 pub use error::{Loc, ScenarioError};
-pub use hash::Fnv1a64;
 pub use params::{
-    ClockMode, CoordinatorParams, FsyncPolicy, RestartConfig, RestartPolicy, RestartRule,
-    RobotParams, SimParams,
+    ClockMode, ClockModeError, CoordinatorParams, FsyncPolicy, RestartConfig, RestartPolicy,
+    RestartRule, RobotParams, SimParams,
 };
 pub use report::{default_out_dir, ScenarioReport};
 
@@ -268,8 +267,8 @@ impl Scenario {
 
     /// A stable FNV-1a 64 hash of the scenario's content, for the consensus log's run header.
     /// Covers the map cells, corner cutting, every parameter section, the agents and the
-    /// faults; not the name or file paths. See [`Fnv1a64`] and the `hash` module source for
-    /// the exact encoding.
+    /// faults; not the name or file paths. See [`Fnv1a64`](crate::hash::Fnv1a64) and the
+    /// `hash` module source for the exact encoding.
     pub fn scenario_hash(&self) -> u64 {
         hash::scenario_hash(self)
     }

@@ -4,6 +4,9 @@
 //! sensors) on 16 cm cells, a 1 kHz lockstep physics step and a coordinator that never
 //! publishes a commit before its log record is durable.
 
+use std::fmt;
+use std::str::FromStr;
+
 use serde::{Deserialize, Serialize};
 
 /// Robot geometry and drive limits (`[robot]`).
@@ -65,6 +68,47 @@ pub enum ClockMode {
     Lockstep,
     /// Follow the wall clock; late commands are simply late, as on hardware.
     Realtime,
+}
+
+impl ClockMode {
+    /// The name used in scenario files, on the command line (`--mode`) and in the consensus
+    /// log's run header: `"lockstep"` or `"realtime"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ClockMode::Lockstep => "lockstep",
+            ClockMode::Realtime => "realtime",
+        }
+    }
+}
+
+impl fmt::Display for ClockMode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A clock mode that could not be parsed.
+#[derive(Clone, PartialEq, Eq, Debug, thiserror::Error)]
+pub enum ClockModeError {
+    /// Neither `lockstep` nor `realtime`.
+    #[error("unknown mode {name:?}: expected lockstep or realtime")]
+    Unknown {
+        /// The text as given.
+        name: String,
+    },
+}
+
+impl FromStr for ClockMode {
+    type Err = ClockModeError;
+
+    /// Accepts exactly the names [`ClockMode::name`] prints.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "lockstep" => Ok(ClockMode::Lockstep),
+            "realtime" => Ok(ClockMode::Realtime),
+            other => Err(ClockModeError::Unknown { name: other.into() }),
+        }
+    }
 }
 
 /// Physics stepper parameters (`[sim]`).
@@ -220,5 +264,17 @@ mod tests {
         assert_eq!(RestartConfig::default().sim.policy, RestartPolicy::Never);
         assert_eq!(SimParams::default().clock, ClockMode::Lockstep);
         assert_eq!(CoordinatorParams::default().fsync, FsyncPolicy::EveryRecord);
+    }
+
+    #[test]
+    fn clock_modes_parse_what_they_print() {
+        for m in [ClockMode::Lockstep, ClockMode::Realtime] {
+            assert_eq!(m.to_string().parse::<ClockMode>(), Ok(m));
+        }
+        let e = "fast".parse::<ClockMode>().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "unknown mode \"fast\": expected lockstep or realtime"
+        );
     }
 }

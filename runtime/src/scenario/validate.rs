@@ -5,8 +5,8 @@ use std::collections::HashMap;
 
 use toml::Spanned;
 
-use super::build::Lines;
 use super::error::{Loc, ScenarioError};
+use super::lines::Lines;
 use super::params::RobotParams;
 use super::raw::{RawAgent, RawFault, RawFaultAction, RawRole};
 use super::{AgentSpec, FaultAction, FaultSignal, FaultSpec, FaultTarget, Scenario};

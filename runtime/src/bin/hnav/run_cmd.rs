@@ -9,8 +9,8 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use hnav_runtime::launch::{Mode, ProcessArgs};
-use hnav_runtime::scenario::Scenario;
+use hnav_runtime::launch::ProcessArgs;
+use hnav_runtime::scenario::{ClockMode, Scenario};
 use hnav_runtime::supervisor::run::{default_run_dir, new_run_id, run, RunOptions};
 
 /// `hnav run` arguments.
@@ -23,7 +23,7 @@ pub struct RunArgs {
     pub agents: Option<usize>,
     /// Clock mode [default: the scenario's sim.clock].
     #[arg(long, value_name = "lockstep|realtime")]
-    pub mode: Option<Mode>,
+    pub mode: Option<ClockMode>,
     /// Seed of the sim's noise and of generated agents [default: the scenario's sim.seed].
     #[arg(long, value_name = "S")]
     pub seed: Option<u64>,

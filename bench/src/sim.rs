@@ -1,11 +1,12 @@
 //! The stepper benchmark behind `hnav-bench sim`: robot-steps per second of [`World::step`].
 
-use crate::error::SimError;
-use crate::world::World;
+use std::time::Instant;
+
+use hnav_runtime::grid::geometry::cell_centre_pose;
 use hnav_runtime::grid::{Cell, Grid};
 use hnav_runtime::scenario::params::{RobotParams, SimParams};
+use hnav_sim::{SimError, World};
 use serde::Serialize;
-use std::time::Instant;
 
 /// What [`robot_steps_per_second`] measured.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -45,7 +46,7 @@ pub fn robot_steps_per_second(robots: usize, seconds: f64) -> Result<BenchResult
     let starts: Vec<_> = (0..robots as u32)
         .map(|i| {
             let c = Cell::new(1 + 2 * (i % per_row), 1 + 2 * (i / per_row));
-            World::cell_centre(robot.cell_size_m, c, f64::from(i) * 0.7)
+            cell_centre_pose(robot.cell_size_m, c, f64::from(i) * 0.7)
         })
         .collect();
     let mut world = World::new(&robot, &sim, grid, &starts)?;

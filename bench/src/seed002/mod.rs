@@ -20,15 +20,30 @@
 //!   compare ratios, not values. Extra metrics the notes ask for: expansions, line-of-sight
 //!   checks, heading changes and total turn.
 
-use std::fmt::Write as _;
+mod render;
+
 use std::time::Instant;
 
+use hnav_coordinator::planner::{heading_changes, PlannerConfig, PlannerKind};
+use hnav_coordinator::PlanError;
+use hnav_runtime::grid::geometry::{cell_centre_m, cell_index};
 use hnav_runtime::grid::{Cell, CornerCutting, Grid};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::error::PlanError;
-use crate::planner::{heading_changes, PlannerConfig, PlannerKind};
+/// Why the experiment could not run.
+#[derive(Clone, PartialEq, Debug, thiserror::Error)]
+pub enum Seed002Error {
+    /// Parameters that cannot produce a map (a density out of range, radii out of order...).
+    #[error("bad experiment parameters: {problem}")]
+    BadParameters {
+        /// What is wrong, in words.
+        problem: String,
+    },
+    /// A planner refused a query.
+    #[error(transparent)]
+    Plan(#[from] PlanError),
+}
 
 /// Parameters of the experiment.
 #[derive(Clone, PartialEq, Debug)]
@@ -163,7 +178,7 @@ pub fn obstacle_field(
     config: &Seed002Config,
     density: f64,
     rng: &mut impl Rng,
-) -> Result<(Grid, f64), PlanError> {
+) -> Result<(Grid, f64), Seed002Error> {
     let side = config.side;
     let n = side as usize * side as usize;
     let mut covered = vec![false; n];
@@ -178,7 +193,7 @@ pub fn obstacle_field(
     while covered_count < target {
         draws += 1;
         if draws > max_draws {
-            return Err(PlanError::BadExperiment {
+            return Err(Seed002Error::BadParameters {
                 problem: format!("density {density} not reached after {max_draws} circles"),
             });
         }
@@ -198,8 +213,9 @@ pub fn obstacle_field(
         let hi = |c: f64| ((c + big + 1.0).ceil() as u32).min(side);
         for y in lo(cy)..hi(cy) {
             for x in lo(cx)..hi(cx) {
-                let d = dist((f64::from(x) + 0.5, f64::from(y) + 0.5));
-                let i = y as usize * side as usize + x as usize;
+                let cell = Cell::new(x, y);
+                let d = dist(cell_centre_m(1.0, cell));
+                let i = cell_index(side, cell);
                 if d <= r && !covered[i] {
                     covered[i] = true;
                     covered_count += 1;
@@ -210,14 +226,15 @@ pub fn obstacle_field(
             }
         }
     }
-    let grid = Grid::from_blocked(side, side, &blocked).map_err(|e| PlanError::BadExperiment {
-        problem: e.to_string(),
-    })?;
+    let grid =
+        Grid::from_blocked(side, side, &blocked).map_err(|e| Seed002Error::BadParameters {
+            problem: e.to_string(),
+        })?;
     Ok((grid, covered_count as f64 / n as f64))
 }
 
-fn validate(config: &Seed002Config) -> Result<(), PlanError> {
-    let bad = |problem: String| Err(PlanError::BadExperiment { problem });
+fn validate(config: &Seed002Config) -> Result<(), Seed002Error> {
+    let bad = |problem: String| Err(Seed002Error::BadParameters { problem });
     let (lo, hi) = config.radius;
     if !(2..=4096).contains(&config.side) {
         return bad(format!("side {} must be in 2..=4096", config.side));
@@ -240,7 +257,7 @@ fn validate(config: &Seed002Config) -> Result<(), PlanError> {
 }
 
 /// Runs the experiment: for every density, `trials` solvable maps, every planner on each.
-pub fn run(config: &Seed002Config) -> Result<Seed002Report, PlanError> {
+pub fn run(config: &Seed002Config) -> Result<Seed002Report, Seed002Error> {
     validate(config)?;
     let cfg = PlannerConfig::new(config.corner_cutting);
     let mut planners: Vec<_> = PlannerKind::ALL
@@ -258,7 +275,7 @@ pub fn run(config: &Seed002Config) -> Result<Seed002Report, PlanError> {
         };
         while result.trials.len() < config.trials {
             if result.rejected_maps > 100 * config.trials.max(1) {
-                return Err(PlanError::BadExperiment {
+                return Err(Seed002Error::BadParameters {
                     problem: format!("density {density}: almost no map is solvable"),
                 });
             }
@@ -304,149 +321,4 @@ pub fn run(config: &Seed002Config) -> Result<Seed002Report, PlanError> {
         config: config.clone(),
         densities,
     })
-}
-
-impl Seed002Report {
-    /// Our table beside the thesis's (rows matched by density), then the extra metrics.
-    pub fn render(&self) -> String {
-        let c = &self.config;
-        let mut s = String::new();
-        let _ = writeln!(
-            s,
-            "Seed 002 §4: {side} x {side} m, e = 1 m, start (0.5, 0.5) m, goal ({g}, {g}) m; \
-             {} solvable maps per density (seed {}), obstacle radius {}-{} m inflated by {} m, \
-             corners {:?}.\nThesis: MATLAB, one unspecified map per row. Ours: mean over the maps, \
-             Rust, time in µs (the thesis's in s).\n",
-            c.trials,
-            c.seed,
-            c.radius.0,
-            c.radius.1,
-            c.inflation,
-            c.corner_cutting,
-            side = c.side,
-            g = f64::from(c.side) - 0.5,
-        );
-        let _ = writeln!(
-            s,
-            "| density | A* L thesis | A* L ours | Theta* L thesis | Theta* L ours | Lazy L thesis | Lazy L ours |\n|---|---|---|---|---|---|---|"
-        );
-        for d in &self.densities {
-            let t = thesis_row(d.density);
-            let th = |f: fn(&ThesisRow) -> f64| t.map_or("-".into(), |t| format!("{:.3}", f(&t)));
-            let _ = writeln!(
-                s,
-                "| {:.0} % | {} | {:.3} | {} | {:.3} | {} | {:.3} |",
-                d.density * 100.0,
-                th(|t| t.astar.0),
-                d.mean(0, |r| r.length),
-                th(|t| t.basic_theta.0),
-                d.mean(1, |r| r.length),
-                th(|t| t.lazy_theta.0),
-                d.mean(2, |r| r.length),
-            );
-        }
-        let _ = writeln!(
-            s,
-            "\n| density | A* t thesis (s) | A* t ours (µs) | Theta* t thesis | Theta* t ours | Lazy t thesis | Lazy t ours |\n|---|---|---|---|---|---|---|"
-        );
-        for d in &self.densities {
-            let t = thesis_row(d.density);
-            let th = |f: fn(&ThesisRow) -> f64| t.map_or("-".into(), |t| format!("{:.3}", f(&t)));
-            let _ = writeln!(
-                s,
-                "| {:.0} % | {} | {:.1} | {} | {:.1} | {} | {:.1} |",
-                d.density * 100.0,
-                th(|t| t.astar.1),
-                d.mean(0, |r| r.time_us),
-                th(|t| t.basic_theta.1),
-                d.mean(1, |r| r.time_us),
-                th(|t| t.lazy_theta.1),
-                d.mean(2, |r| r.time_us),
-            );
-        }
-        let _ = writeln!(
-            s,
-            "\n| density | Lazy vs A* L thesis | ours | Lazy vs Theta* L thesis | ours | Lazy/A* t thesis | ours | Lazy/Theta* t thesis | ours |\n|---|---|---|---|---|---|---|---|---|"
-        );
-        for d in &self.densities {
-            let t = thesis_row(d.density);
-            let pct = |a: f64, b: f64| format!("{:+.2} %", 100.0 * (a / b - 1.0));
-            let ratio = |a: f64, b: f64| format!("{:.2}", a / b);
-            let th = |f: &dyn Fn(&ThesisRow) -> String| t.map_or("-".into(), |t| f(&t));
-            let l = |k: usize| d.mean(k, |r| r.length);
-            let tm = |k: usize| d.mean(k, |r| r.time_us);
-            let _ = writeln!(
-                s,
-                "| {:.0} % | {} | {} | {} | {} | {} | {} | {} | {} |",
-                d.density * 100.0,
-                th(&|t| pct(t.lazy_theta.0, t.astar.0)),
-                pct(l(2), l(0)),
-                th(&|t| pct(t.lazy_theta.0, t.basic_theta.0)),
-                pct(l(2), l(1)),
-                th(&|t| ratio(t.lazy_theta.1, t.astar.1)),
-                ratio(tm(2), tm(0)),
-                th(&|t| ratio(t.lazy_theta.1, t.basic_theta.1)),
-                ratio(tm(2), tm(1)),
-            );
-        }
-        let _ = writeln!(
-            s,
-            "\nOurs only (means per map): coverage / blocked after inflation, expansions, line-of-sight checks, heading changes, total turn.\n\
-             | density | coverage | blocked | rejected maps | planner | expansions | LOS checks | turns | turn (deg) |\n|---|---|---|---|---|---|---|---|---|"
-        );
-        for d in &self.densities {
-            let n = d.trials.len().max(1) as f64;
-            let cov = d.trials.iter().map(|t| t.coverage).sum::<f64>() / n;
-            let blk = d.trials.iter().map(|t| t.blocked).sum::<f64>() / n;
-            for (k, kind) in PlannerKind::ALL.iter().enumerate() {
-                let _ = writeln!(
-                    s,
-                    "| {:.0} % | {:.1} % | {:.1} % | {} | {} | {:.1} | {:.1} | {:.2} | {:.1} |",
-                    d.density * 100.0,
-                    cov * 100.0,
-                    blk * 100.0,
-                    d.rejected_maps,
-                    kind,
-                    d.mean(k, |r| r.expansions as f64),
-                    d.mean(k, |r| r.los_checks as f64),
-                    d.mean(k, |r| r.heading_changes as f64),
-                    d.mean(k, |r| r.turn_deg),
-                );
-            }
-        }
-        let _ = writeln!(s, "\nInvariants per map:");
-        for d in &self.densities {
-            let longer = d
-                .trials
-                .iter()
-                .filter(|t| t.runs[1].length > t.runs[0].length + 1e-9)
-                .count();
-            let worst = d
-                .trials
-                .iter()
-                .map(|t| (t.runs[2].length / t.runs[1].length - 1.0).abs())
-                .fold(0.0, f64::max);
-            let los: (u64, u64) = d.trials.iter().fold((0, 0), |a, t| {
-                (a.0 + t.runs[2].los_checks, a.1 + t.runs[1].los_checks)
-            });
-            let _ = writeln!(
-                s,
-                "  {:.0} %: Theta* longer than A* on {longer}/{} maps; |Lazy/Theta* - 1| <= {:.3} %; \
-                 LOS checks Lazy/Theta* = {:.3}",
-                d.density * 100.0,
-                d.trials.len(),
-                100.0 * worst,
-                los.0 as f64 / los.1.max(1) as f64,
-            );
-        }
-        s
-    }
-}
-
-/// The thesis's row for a density, if it has one.
-fn thesis_row(density: f64) -> Option<ThesisRow> {
-    THESIS_TABLE_3_1
-        .iter()
-        .copied()
-        .find(|t| (t.density - density).abs() < 1e-9)
 }

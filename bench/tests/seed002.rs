@@ -9,8 +9,7 @@
 //!
 //! Times are not asserted (debug build, shared machine); the example prints them.
 
-use hnav_coordinator::experiment::seed002::{obstacle_field, run, Seed002Config, THESIS_TABLE_3_1};
-use hnav_coordinator::PlanError;
+use hnav_bench::seed002::{obstacle_field, run, Seed002Config, Seed002Error, THESIS_TABLE_3_1};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -110,10 +109,10 @@ fn bad_parameters_are_errors() {
         densities: vec![0.95],
         ..small()
     };
-    assert!(matches!(run(&cfg), Err(PlanError::BadExperiment { .. })));
+    assert!(matches!(run(&cfg), Err(Seed002Error::BadParameters { .. })));
     let cfg = Seed002Config {
         radius: (2.0, 1.0),
         ..small()
     };
-    assert!(matches!(run(&cfg), Err(PlanError::BadExperiment { .. })));
+    assert!(matches!(run(&cfg), Err(Seed002Error::BadParameters { .. })));
 }
