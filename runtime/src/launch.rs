@@ -25,15 +25,12 @@
 
 use std::ffi::OsString;
 use std::path::PathBuf;
-use std::time::Duration;
-
-use iceoryx2::prelude::CallbackProgression;
-use iceoryx2::waitset::WaitSetRunResult;
+use std::time::{Duration, Instant};
 
 use crate::msg::{Lifecycle, LifecycleEvent, Role, StopReason};
 use crate::scenario::{ClockMode, Scenario, ScenarioError};
 use crate::topics;
-use crate::transport::{Receiver, RunId, Sender, Transport, TransportError};
+use crate::transport::{Receiver, RunId, Sender, Transport, TransportError, Wake};
 
 /// The command line shared by the run's processes.
 #[derive(clap::Args, Debug, Clone, PartialEq)]
@@ -112,15 +109,15 @@ impl ProcessArgs {
     }
 }
 
-/// The longest a process's WaitSet sleeps before it looks at its inputs again, even with
-/// nothing signalled.
-///
-/// A lost wake-up, not a timer: under load iceoryx2 0.10's event listener can miss a
-/// notification when a notifier fires while the listener resets its state (`hnav-bench round`
-/// saw a round's candidates all delivered and the coordinator asleep, about once in 5 000
-/// rounds at 128 agents). Lockstep waits on data, never on time, so re-checking changes no
-/// decision; it only bounds such a stall to this long.
-pub const LOST_WAKEUP_RECHECK: Duration = Duration::from_millis(50);
+/// How long a process waits for the supervisor's `Start` ([`LifecyclePorts::handshake`]):
+/// the one start-up timeout of the run's processes. A supervisor that never answers is an
+/// error, not a hang.
+pub const START_TIMEOUT: Duration = Duration::from_secs(60);
+
+/// The lost-wake-up re-check of the loops that still block in a raw WaitSet; it is
+/// [`Waiter::LOST_WAKEUP_RECHECK`](crate::transport::Waiter::LOST_WAKEUP_RECHECK), which
+/// documents the cause. Goes once every loop waits in a [`Waiter`](crate::transport::Waiter).
+pub const LOST_WAKEUP_RECHECK: Duration = crate::transport::Waiter::LOST_WAKEUP_RECHECK;
 
 /// The `main` of a process binary: sets up logging, parses the command line and runs `run`;
 /// an error is printed as `NAME: error` and exits 1.
@@ -222,11 +219,9 @@ impl LifecyclePorts {
         if resume {
             return Ok(StartOutcome::Started);
         }
-        let ws = transport.waitset()?;
-        let _guard = ws
-            .attach_notification(self.events.listener())
-            .map_err(|e| TransportError::ipc("attach listener", "lifecycle", e))?;
-        let deadline = std::time::Instant::now() + timeout;
+        let waiter = transport.waiter()?;
+        let _attached = waiter.attach(&self.events)?;
+        let deadline = Instant::now() + timeout;
         loop {
             let mut started = false;
             let stop = self.drain(|_, _, ev| started |= ev == LifecycleEvent::Start)?;
@@ -236,20 +231,16 @@ impl LifecyclePorts {
             if started {
                 return Ok(StartOutcome::Started);
             }
-            let left = deadline.saturating_duration_since(std::time::Instant::now());
-            if left.is_zero() {
-                return Err(TransportError::ipc(
-                    "wait for start",
-                    "lifecycle",
-                    format!("no Start from the supervisor within {timeout:?}"),
-                ));
-            }
-            match ws.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, left) {
-                Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
-                    return Ok(StartOutcome::Stopped)
+            match waiter.wait(Some(deadline))? {
+                Wake::Data => {}
+                Wake::Stop => return Ok(StartOutcome::Stopped),
+                Wake::TimedOut => {
+                    return Err(TransportError::ipc(
+                        "wait for start",
+                        "lifecycle",
+                        format!("no Start from the supervisor within {timeout:?}"),
+                    ))
                 }
-                Ok(_) => {}
-                Err(e) => return Err(TransportError::ipc("wait for start", "lifecycle", e)),
             }
         }
     }
