@@ -33,6 +33,7 @@ use nix::unistd::Pid;
 
 use super::exit_fd::{ExitFd, WatchMode};
 use crate::msg::Role;
+use crate::transport::{Attachment, TransportError, Waiter};
 
 /// What went wrong starting or signalling a child.
 #[derive(Debug, thiserror::Error)]
@@ -274,6 +275,13 @@ impl Child {
     /// readable).
     pub fn exit_fd(&self) -> &ExitFd {
         &self.exit_fd
+    }
+
+    /// Wakes `waiter` when the child exits (its exit descriptor becomes readable). Keep the
+    /// attachment while the exit is unhandled and drop it after: the descriptor stays
+    /// readable, and a waiter still watching it would never sleep again.
+    pub fn watch<'w>(&self, waiter: &'w Waiter) -> Result<Attachment<'w, '_>, TransportError> {
+        waiter.attach_fd(&self.exit_fd)
     }
 
     /// The exit, if [`Child::try_reap`] has reaped the child.

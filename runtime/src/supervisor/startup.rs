@@ -9,17 +9,10 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use iceoryx2::prelude::CallbackProgression;
-use iceoryx2::waitset::{WaitSet, WaitSetRunResult};
-
 use super::child::{Child, ExitInfo};
 use crate::msg::{Lifecycle, LifecycleEvent, Role};
 use crate::topics;
-use crate::transport::{Ipc, Receiver, Sender, Transport, TransportError};
-
-/// The longest one wait of the handshake sleeps before it looks at the children and the
-/// `ready` topic again, in case a wake-up was lost (see [`crate::launch::LOST_WAKEUP_RECHECK`]).
-const RECHECK: Duration = Duration::from_millis(200);
+use crate::transport::{Receiver, Sender, Transport, TransportError, Wake};
 
 /// Why the processes of a run did not all come up.
 #[derive(Debug, thiserror::Error)]
@@ -45,9 +38,6 @@ pub enum StartupError {
     /// The transport failed.
     #[error(transparent)]
     Transport(#[from] TransportError),
-    /// The WaitSet failed.
-    #[error("waitset: {0}")]
-    WaitSet(String),
 }
 
 /// How the start-up handshake ended, when it did not fail.
@@ -100,16 +90,10 @@ impl SupervisorPorts {
         children: &[&Child],
         timeout: Duration,
     ) -> Result<Startup, StartupError> {
-        let ws = transport.waitset()?;
-        let ws_err = |e: &dyn std::fmt::Debug| StartupError::WaitSet(format!("{e:?}"));
-        let mut guards = vec![ws
-            .attach_notification(self.ready.listener())
-            .map_err(|e| ws_err(&e))?];
+        let waiter = transport.waiter()?;
+        let mut attached = vec![waiter.attach(&self.ready)?];
         for c in children {
-            guards.push(
-                ws.attach_notification(c.exit_fd())
-                    .map_err(|e| ws_err(&e))?,
-            );
+            attached.push(c.watch(&waiter)?);
         }
         let mut up = vec![false; children.len()];
         let deadline = Instant::now() + timeout;
@@ -140,7 +124,7 @@ impl SupervisorPorts {
                     .collect();
                 return Err(StartupError::NotUp { timeout, missing });
             }
-            if wait(&ws, left.min(RECHECK))? == Wake::Signalled {
+            if waiter.wait(Some(deadline))? == Wake::Stop {
                 return Ok(Startup::Interrupted);
             }
         }
@@ -164,26 +148,6 @@ impl SupervisorPorts {
             }
         })?;
         Ok(())
-    }
-}
-
-/// What ended one wait of the handshake.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Wake {
-    /// An `Up`, an exit, or the timeout: look again.
-    Look,
-    /// A termination signal.
-    Signalled,
-}
-
-/// One bounded wait on the handshake's WaitSet.
-fn wait(ws: &WaitSet<Ipc>, timeout: Duration) -> Result<Wake, StartupError> {
-    match ws.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, timeout) {
-        Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
-            Ok(Wake::Signalled)
-        }
-        Ok(_) => Ok(Wake::Look),
-        Err(e) => Err(StartupError::WaitSet(format!("{e:?}"))),
     }
 }
 

@@ -253,14 +253,6 @@ impl Waiter {
     }
 
     /// Wakes the waiter when `fd` becomes readable (the supervisor's child exit descriptors).
-    #[cfg_attr(
-        not(test),
-        expect(
-            dead_code,
-            reason = "the supervisor attaches its children's exit descriptors once its loop \
-                      waits in a Waiter"
-        )
-    )]
     pub(crate) fn attach_fd<'a, T>(&self, fd: &'a T) -> Result<Attachment<'_, 'a>, TransportError>
     where
         T: SynchronousMultiplexing + Debug + ?Sized,

@@ -37,9 +37,6 @@ pub enum RunError {
     /// The consensus log could not be read for the summary.
     #[error(transparent)]
     Log(#[from] LogError),
-    /// The WaitSet failed.
-    #[error("waitset: {0}")]
-    WaitSet(String),
 }
 
 /// Maps an I/O error on `path` to [`RunError::Io`].

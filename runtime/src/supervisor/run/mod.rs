@@ -27,9 +27,6 @@ mod slots;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use iceoryx2::prelude::CallbackProgression;
-use iceoryx2::waitset::{WaitSet, WaitSetRunResult};
-
 use super::child::Child;
 use super::registry::{RunRecord, RunRegistry};
 use super::startup::{Startup, SupervisorPorts};
@@ -39,7 +36,7 @@ use crate::launch::ProcessArgs;
 use crate::msg::{Lifecycle, Progress, StopReason, Truth};
 use crate::scenario::Scenario;
 use crate::topics;
-use crate::transport::{purge_run, Ipc, Receiver, RunId, Transport};
+use crate::transport::{purge_run, Receiver, RunId, Transport, Wake};
 use error::io;
 use faults::FaultSchedule;
 use progress::ProgressView;
@@ -205,16 +202,10 @@ impl Watch<'_> {
         ports: &Ports,
         slots: &Slots,
     ) -> Result<Option<End>, RunError> {
-        let ws = transport.waitset()?;
-        let ws_err = |e: &dyn std::fmt::Debug| RunError::WaitSet(format!("{e:?}"));
-        let mut guards = vec![ws
-            .attach_notification(ports.life.ready().listener())
-            .map_err(|e| ws_err(&e))?];
+        let waiter = transport.waiter()?;
+        let mut attached = vec![waiter.attach(ports.life.ready())?];
         for c in slots.children() {
-            guards.push(
-                ws.attach_notification(c.exit_fd())
-                    .map_err(|e| ws_err(&e))?,
-            );
+            attached.push(c.watch(&waiter)?);
         }
         loop {
             slots.announce_restarts(&ports.life)?;
@@ -229,14 +220,17 @@ impl Watch<'_> {
             if due.is_some_and(|d| d <= now) {
                 return Ok(None);
             }
-            let mut timeout = TICK.min(self.limit.saturating_sub(self.t0.elapsed()));
+            // The next tick of the progress bar and the fault schedule, sooner if a restart
+            // is due, never past the time limit.
+            let mut until = now + TICK.min(self.limit.saturating_sub(self.t0.elapsed()));
             if let Some(d) = due {
-                timeout = timeout.min(d - now);
+                until = until.min(d);
             }
-            match wait(&ws, timeout)? {
-                Wake::Signalled => return Ok(Some(End::Signalled)),
-                Wake::Attachment => return Ok(None),
-                Wake::Timeout => {}
+            match waiter.wait(Some(until))? {
+                Wake::Stop => return Ok(Some(End::Signalled)),
+                // A child's exit, an `Up`, or only a re-check: reap and look again.
+                Wake::Data => return Ok(None),
+                Wake::TimedOut => {}
             }
         }
     }
@@ -253,37 +247,6 @@ impl Watch<'_> {
         self.view.show(&p);
         self.faults.fire(slots, p.round);
         Ok((p.done == 1).then_some(End::AllAtGoal))
-    }
-}
-
-/// What ended one wait of the watch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Wake {
-    /// A child's exit descriptor or the `ready` topic.
-    Attachment,
-    /// Nothing within the timeout.
-    Timeout,
-    /// A termination signal.
-    Signalled,
-}
-
-/// One bounded wait on the watch's WaitSet.
-fn wait(ws: &WaitSet<Ipc>, timeout: Duration) -> Result<Wake, RunError> {
-    let mut fired = false;
-    let r = ws.wait_and_process_once_with_timeout(
-        |_| {
-            fired = true;
-            CallbackProgression::Continue
-        },
-        timeout,
-    );
-    match r {
-        Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
-            Ok(Wake::Signalled)
-        }
-        Ok(_) if fired => Ok(Wake::Attachment),
-        Ok(_) => Ok(Wake::Timeout),
-        Err(e) => Err(RunError::WaitSet(format!("{e:?}"))),
     }
 }
 
