@@ -139,15 +139,10 @@ impl ProcessArgs {
     }
 }
 
-/// The longest a process's WaitSet sleeps before it looks at its inputs again, even with
-/// nothing signalled.
-///
-/// A lost wake-up, not a timer: under load iceoryx2 0.10's event listener can miss a
-/// notification when a notifier fires while the listener resets its state (`hnav-bench round`
-/// saw a round's candidates all delivered and the coordinator asleep, about once in 5 000
-/// rounds at 128 agents). Lockstep waits on data, never on time, so re-checking changes no
-/// decision; it only bounds such a stall to this long.
-pub const LOST_WAKEUP_RECHECK: Duration = Duration::from_millis(50);
+/// The lost-wake-up re-check of the loops that still block in a raw WaitSet; it is
+/// [`Waiter::LOST_WAKEUP_RECHECK`](crate::transport::Waiter::LOST_WAKEUP_RECHECK), which
+/// documents the cause. Goes once every loop waits in a [`Waiter`](crate::transport::Waiter).
+pub const LOST_WAKEUP_RECHECK: Duration = crate::transport::Waiter::LOST_WAKEUP_RECHECK;
 
 /// The `main` of a process binary: sets up logging, parses the command line and runs `run`;
 /// an error is printed as `NAME: error` and exits 1.

@@ -175,6 +175,15 @@ impl Wakeup {
     }
 }
 
+/// What one [`Receiver::drain_pending`] found.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Drained {
+    /// The listener's events, consumed before the samples were received.
+    pub wakeup: Wakeup,
+    /// How many samples were received.
+    pub samples: usize,
+}
+
 /// The sending half of a topic: a publisher of `P` (a fixed-size type, or `[E]` for a slice
 /// topic, see [`SliceSender`](super::SliceSender)) with user header `H`, plus a notifier that
 /// wakes receivers.
@@ -286,8 +295,9 @@ impl<T: Debug + ZeroCopySend + 'static> Sender<T> {
 /// The receiving half of a topic: a subscriber of `P` (fixed-size, or `[E]` for a slice topic,
 /// see [`SliceReceiver`](super::SliceReceiver)) with user header `H`, plus a listener to block on.
 ///
-/// Attach [`Receiver::listener`] to a [`WaitSet`](iceoryx2::prelude::WaitSet); when it fires,
-/// call [`Receiver::take_wakeup`] and then `receive` (or `drain`) until nothing is left.
+/// Attach it to a [`Waiter`](super::Waiter); when the waiter returns
+/// [`Wake::Data`](super::Wake::Data), call [`Receiver::drain_pending`] (or
+/// [`Receiver::take_wakeup`] and then `receive` until nothing is left, in that order).
 pub struct Receiver<P, H = ()>
 where
     P: Debug + IceoryxSend + ?Sized + 'static,
@@ -328,7 +338,7 @@ where
         self.name.as_str()
     }
 
-    /// The listener to attach to a WaitSet.
+    /// The listener behind the receiver (what a [`Waiter`](super::Waiter) attaches).
     pub fn listener(&self) -> &Listener<Ipc> {
         &self.listener
     }
@@ -381,5 +391,13 @@ impl<T: Debug + ZeroCopySend + 'static> Receiver<T> {
             n += 1;
         }
         Ok(n)
+    }
+
+    /// Consumes the listener's events, then hands every unread sample to `f`: the drain order
+    /// a [`Waiter`](super::Waiter) wake-up needs, in one call.
+    pub fn drain_pending(&self, f: impl FnMut(&T)) -> Result<Drained, TransportError> {
+        let wakeup = self.take_wakeup()?;
+        let samples = self.drain(f)?;
+        Ok(Drained { wakeup, samples })
     }
 }

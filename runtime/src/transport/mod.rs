@@ -8,8 +8,11 @@
 //!   parallel tests) on one machine never see each other's services or shared-memory files.
 //! - **Event-driven receive** ([`Sender`], [`Receiver`]): a publisher is paired with a notifier on
 //!   an event service of the same name, and a subscriber with a listener, so every receiving loop
-//!   blocks in a [`WaitSet`](iceoryx2::prelude::WaitSet) instead of polling. The event service also
-//!   reports publishers that appear, leave cleanly or die ([`Wakeup`]).
+//!   blocks instead of polling. The event service also reports publishers that appear, leave
+//!   cleanly or die ([`Wakeup`]).
+//! - **One wait** ([`Waiter`], [`Wake`]): the only place a process blocks, on its receivers, an
+//!   interval and a deadline; it guarantees the drain order, tells a paused process from a
+//!   stopped one and bounds iceoryx2's lost wake-up.
 //! - **In-place slices** ([`SliceSender`], [`SliceReceiver`]): the neural-map snapshot is loaned
 //!   from shared memory and written there directly; no intermediate `Vec`.
 //! - **QoS from the swarm size** ([`Qos`]): iceoryx2's defaults allow two publishers per service;
@@ -35,13 +38,15 @@ mod node;
 mod qos;
 mod run;
 mod slice;
+mod waiter;
 
-pub use channel::{Receiver, Sender, Wakeup};
+pub use channel::{Drained, Receiver, Sender, Wakeup};
 pub use error::TransportError;
 pub use node::{CleanupReport, NodeInfo, NodeLiveness, Transport, TransportBuilder};
 pub use qos::{Delivery, Qos};
 pub use run::{purge_run, run_config, run_shm_files, RunId};
 pub use slice::{SliceLoan, SliceReceiver, SliceSender};
+pub use waiter::{stop_requested, Attachment, Waiter, Wake};
 
 /// The iceoryx2 service variant HNAV uses between processes.
 pub type Ipc = iceoryx2::prelude::ipc::Service;

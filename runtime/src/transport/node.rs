@@ -13,6 +13,7 @@ use iceoryx2::service::Service as _;
 
 use super::{
     run_config, Ipc, Qos, Receiver, RunId, Sender, SliceReceiver, SliceSender, TransportError,
+    Waiter,
 };
 
 /// Builds a [`Transport`].
@@ -30,9 +31,10 @@ impl TransportBuilder {
         self
     }
 
-    /// Whether iceoryx2 turns SIGINT/SIGTERM into a termination request that
-    /// [`WaitSet::wait_and_process`] returns (default `true`). Turn it off when the process
-    /// handles signals itself.
+    /// Whether iceoryx2 turns SIGINT/SIGTERM into a termination request that the transport's
+    /// waiters return as [`Wake::Stop`](super::Wake::Stop) (default `true`). Turn it off when
+    /// the process handles signals itself: its waiters then never install a signal handler
+    /// and never stop.
     pub fn handle_signals(mut self, yes: bool) -> Self {
         self.handle_signals = yes;
         self
@@ -147,7 +149,15 @@ impl Transport {
         SliceReceiver::open_slice(&self.node, self.run.service_name(topic)?, qos)
     }
 
-    /// A WaitSet with the same signal handling as the node.
+    /// A [`Waiter`] with the same signal handling as the node: what every process loop
+    /// blocks in.
+    pub fn waiter(&self) -> Result<Waiter, TransportError> {
+        Waiter::create(self.run.as_str(), self.signals)
+    }
+
+    /// A raw iceoryx2 WaitSet with the same signal handling as the node, for code that must
+    /// tell its attachments apart (the benchmarks). Process loops use [`Transport::waiter`],
+    /// which also keeps a paused process running and bounds iceoryx2's lost wake-up.
     pub fn waitset(&self) -> Result<WaitSet<Ipc>, TransportError> {
         WaitSetBuilder::new()
             .signal_handling_mode(self.signals)

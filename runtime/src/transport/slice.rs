@@ -14,7 +14,7 @@ use iceoryx2::sample::Sample;
 use iceoryx2::sample_mut_uninit::SampleMutUninit;
 
 use super::channel::{backpressure, open_pubsub};
-use super::{Ipc, Qos, Receiver, Sender, TransportError};
+use super::{Drained, Ipc, Qos, Receiver, Sender, TransportError};
 
 /// The sending half of a slice topic: `[E]` payloads with a header `H`.
 ///
@@ -152,5 +152,17 @@ where
         self.subscriber()
             .receive()
             .map_err(|e| self.receive_error(e))
+    }
+
+    /// Consumes the listener's events, then hands every unread sample's header and elements
+    /// to `f`, read in place: the drain order a [`Waiter`](super::Waiter) wake-up needs.
+    pub fn drain_pending(&self, mut f: impl FnMut(&H, &[E])) -> Result<Drained, TransportError> {
+        let wakeup = self.take_wakeup()?;
+        let mut samples = 0;
+        while let Some(sample) = self.receive()? {
+            f(sample.user_header(), sample.payload());
+            samples += 1;
+        }
+        Ok(Drained { wakeup, samples })
     }
 }
