@@ -73,13 +73,19 @@ fn reproduce(senders: u64, threads: u64, rounds: u64, recheck_ms: u64) -> Report
     assert!(rx.wait_exit(Duration::from_secs(60)).unwrap().success());
     assert!(tx.wait_exit(Duration::from_secs(60)).unwrap().success());
     let report = Report::parse(&line).unwrap_or_else(|| panic!("unreadable report {line:?}"));
+    let what = if recheck_ms == 0 {
+        "lost wake-ups (waits timed out with a sample pending)"
+    } else {
+        "waits the re-check ended with a sample pending (at most that many rescued)"
+    };
     println!(
-        "senders={senders} threads={threads} recheck={recheck_ms}ms: {} misses in {} rounds \
-         ({:.5} per round), {} of them suppressed notifications; {} ms",
+        "senders={senders} threads={threads} recheck={recheck_ms}ms: {} {what} in {} rounds \
+         ({:.5} per round), {} with the notification suppressed, {} timeouts; {} ms",
         report.misses,
         report.rounds,
         report.miss_rate(),
         report.suppressed,
+        report.timeouts,
         report.ms
     );
     assert_eq!(report.samples, senders * rounds, "{report:?}");
