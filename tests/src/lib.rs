@@ -8,11 +8,14 @@
 //! - the `hnav-test-peer` binary (`src/bin/hnav-test-peer.rs`): small publisher and
 //!   subscriber roles the tests run as separate processes;
 //! - [`pattern`]: the deterministic payloads both sides of a test agree on;
+//! - [`lost_wakeup`]: both halves of the lost-wake-up reproducer (`tests/lost_wakeup.rs`);
 //! - [`tick`]: a discrete-time multi-agent run (neural maps, path constructor, conflict
 //!   resolver) for the papers' conflict experiments.
 //!
 //! Tests that SIGKILL processes live in their own test binaries (`tests/*_kill.rs`).
+//! Tests that send other signals do too (`tests/waiter_signals.rs`).
 
+pub mod lost_wakeup;
 pub mod pattern;
 pub mod swarm;
 pub mod tick;
