@@ -115,6 +115,36 @@ where
         self.sender.publish(self.sample.write_from_slice(src))
     }
 
+    /// Sets every loaned element to `init`, hands the now initialised slice to `write`, and
+    /// publishes it unless `write` fails (the loan is then dropped unsent).
+    ///
+    /// For writers that fill a `&mut [E]` in place, such as a neural map writing its values
+    /// straight into shared memory: the initial fill is what makes handing out `&mut [E]`
+    /// sound, so no caller needs `unsafe`.
+    pub fn fill_with<X>(
+        mut self,
+        init: E,
+        write: impl FnOnce(&mut [E]) -> Result<(), X>,
+    ) -> Result<usize, X>
+    where
+        E: Copy,
+        X: From<TransportError>,
+    {
+        let out = self.sample.payload_mut();
+        for v in out.iter_mut() {
+            v.write(init);
+        }
+        // SAFETY: the loop above initialised every element, and `MaybeUninit<E>` has the size,
+        // alignment and layout of `E`; the borrow of `out` ends with this slice's.
+        let values: &mut [E] =
+            unsafe { core::slice::from_raw_parts_mut(out.as_mut_ptr().cast::<E>(), out.len()) };
+        write(values)?;
+        // SAFETY: every element was initialised by the loop above; `write` could only store
+        // initialised `E`s through `&mut [E]`.
+        let sample = unsafe { self.sample.assume_init() };
+        Ok(self.sender.publish(sample)?)
+    }
+
     /// Publishes what was written through [`SliceLoan::payload_mut`].
     ///
     /// # Safety

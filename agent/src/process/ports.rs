@@ -1,0 +1,39 @@
+//! The agent's ports: the topics one agent process reads and writes.
+
+use hnav_runtime::grid::Grid;
+use hnav_runtime::launch::LifecyclePorts;
+use hnav_runtime::msg::{Candidate, Commit, MapHeader, Odometry, Role, WheelCommand};
+use hnav_runtime::topics;
+use hnav_runtime::transport::{Receiver, Sender, SliceSender, Transport, TransportError};
+
+/// The topics of agent `index`: its odometry and the commits in, its wheel commands,
+/// candidates and neural-map snapshots out, and its side of the lifecycle protocol.
+pub(super) struct Ports {
+    pub(super) odom: Receiver<Odometry>,
+    pub(super) commit: Receiver<Commit>,
+    pub(super) wheels: Sender<WheelCommand>,
+    pub(super) candidates: Sender<Candidate>,
+    pub(super) map: SliceSender<f32, MapHeader>,
+    pub(super) life: LifecyclePorts,
+}
+
+impl Ports {
+    /// Opens the ports of agent `index` in a swarm of `agents` on `grid`; `Up` is announced
+    /// later, by the handshake in [`AgentProcess::run`](super::AgentProcess::run).
+    pub(super) fn open(
+        transport: &Transport,
+        grid: &Grid,
+        index: u32,
+        agents: usize,
+    ) -> Result<Self, TransportError> {
+        let i = index as usize;
+        Ok(Self {
+            odom: transport.receiver(&topics::odometry(i), topics::state_qos())?,
+            commit: transport.receiver(topics::COMMIT, topics::commit_qos(agents))?,
+            wheels: transport.sender(&topics::wheels(i), topics::state_qos())?,
+            candidates: transport.sender(topics::CANDIDATES, topics::candidates_qos(agents))?,
+            map: transport.slice_sender(&topics::map(i), grid.len(), topics::state_qos())?,
+            life: LifecyclePorts::open(transport, Role::Agent, index, agents)?,
+        })
+    }
+}

@@ -1,0 +1,290 @@
+//! The agent's state and what it does with each input: [`Core`].
+//!
+//! Kept apart from the [`Ports`] so that the loop can borrow the ports (attached to its
+//! waiter) while it mutates the state.
+
+use hnav_runtime::grid::geometry::{cell_centre_m, cell_centre_pose, cell_index};
+use hnav_runtime::grid::Cell;
+use hnav_runtime::msg::{MapHeader, Odometry, Pose, WheelCommand};
+use hnav_runtime::scenario::{AgentSpec, ClockMode, Scenario};
+
+use super::checkpoint::{Checkpoint, CheckpointFile};
+use super::ports::Ports;
+use super::{AgentError, AgentOutcome};
+use crate::controller::{ControllerParams, WheelController};
+use crate::navigator::{Navigator, Task};
+use crate::odometry::{DeadReckoning, OdometryParams};
+
+/// One agent's state: its navigator, dead reckoning and wheel controller, and where it stands
+/// in the rounds.
+pub(super) struct Core {
+    index: u32,
+    clock: ClockMode,
+    cell_size_m: f64,
+    width: u32,
+    nav: Navigator,
+    dr: DeadReckoning,
+    ctl: WheelController,
+    checkpoint: Option<CheckpointFile>,
+    last_commit: u64,
+    outstanding: Option<u64>,
+    last_period: Option<u64>,
+    wheel_due: Option<u64>,
+    /// A candidate is due for the last odometry reading.
+    candidate_due: bool,
+    ticks: (i64, i64),
+}
+
+impl Core {
+    /// The state of agent `index` (`spec`) of `scenario`: from `resumed` if it names valid
+    /// cells, else at the start. `restarted` marks the navigator as restarted either way.
+    pub(super) fn new(
+        scenario: &Scenario,
+        spec: &AgentSpec,
+        index: u32,
+        checkpoint: Option<CheckpointFile>,
+        resumed: Option<Checkpoint>,
+        restarted: bool,
+    ) -> Result<Self, AgentError> {
+        let grid = &scenario.map.grid;
+        let cs = scenario.robot.cell_size_m;
+        let task = Task {
+            index,
+            goal: spec.goal,
+            priority: spec.effective_priority(),
+            speed: spec.speed,
+        };
+        let odo = OdometryParams::from(&scenario.robot);
+        let cell = |i: u32| grid.cell_at(i as usize);
+        let corners = scenario.map.corner_cutting;
+        let (nav, dr, last_commit, ticks) = match resumed
+            .and_then(|c| Some((c, cell(c.current)?, cell(c.next)?, cell(c.target)?)))
+        {
+            Some((c, current, next, target)) => {
+                let mut nav = Navigator::new(grid, corners, task, current, next, target)?;
+                nav.mark_restarted();
+                let dr = DeadReckoning::with_baseline(odo, c.pose, (c.ticks_left, c.ticks_right));
+                (nav, dr, c.last_commit, (c.ticks_left, c.ticks_right))
+            }
+            None => {
+                let start = cell_centre_pose(cs, spec.start, spec.start_heading_rad());
+                let mut nav =
+                    Navigator::new(grid, corners, task, spec.start, spec.start, spec.goal)?;
+                if restarted {
+                    nav.mark_restarted();
+                }
+                (nav, DeadReckoning::new(odo, start), 0, (0, 0))
+            }
+        };
+        Ok(Self {
+            index,
+            clock: scenario.sim.clock,
+            cell_size_m: cs,
+            width: grid.width(),
+            nav,
+            dr,
+            ctl: WheelController::new(ControllerParams::new(&scenario.robot, spec.speed)),
+            checkpoint,
+            last_commit,
+            outstanding: None,
+            last_period: None,
+            wheel_due: None,
+            candidate_due: false,
+            ticks,
+        })
+    }
+
+    /// The navigator (row, map, target).
+    pub(super) fn navigator(&self) -> &Navigator {
+        &self.nav
+    }
+
+    /// How the run stands now.
+    pub(super) fn outcome(&self) -> AgentOutcome {
+        AgentOutcome {
+            periods: self.last_period.map_or(0, |p| p + 1),
+            last_commit: self.last_commit,
+            at_goal: self.nav.at_goal(),
+        }
+    }
+
+    /// What the agent publishes once started: its first map and, in a fresh lockstep run,
+    /// period 0's wheel command (the sim steps the first period once every robot has one).
+    pub(super) fn begin(&mut self, p: &Ports, resume: bool) -> Result<(), AgentError> {
+        self.publish_map(p)?;
+        if self.clock == ClockMode::Lockstep && !resume {
+            self.wheel_due = Some(self.last_period.map_or(0, |p| p + 1));
+            self.send_wheels(p)?;
+        }
+        Ok(())
+    }
+
+    /// One pass over the inputs, in the order that keeps lockstep runs deterministic: commits,
+    /// odometry, then what they made due.
+    pub(super) fn step(&mut self, p: &Ports) -> Result<(), AgentError> {
+        self.on_commits(p)?;
+        self.on_odometry(p)?;
+        self.send_candidate(p)?;
+        self.send_wheels(p)
+    }
+
+    /// Applies every new commit; resends the open candidate to a coordinator that just came up.
+    fn on_commits(&mut self, p: &Ports) -> Result<(), AgentError> {
+        // Not `drain_pending`: applying a decision can fail, and the error must end the loop.
+        let wake = p.commit.take_wakeup()?;
+        let mut rebuilt = false;
+        while let Some(sample) = p.commit.receive()? {
+            let c = sample.payload();
+            if c.round <= self.last_commit {
+                continue;
+            }
+            self.last_commit = c.round;
+            if let Some(d) = c.decisions().iter().find(|d| d.agent == self.index) {
+                rebuilt |= self.nav.apply(d)?.map_rebuilt;
+            }
+            // A later round than asked for also answers the open candidate: this agent was
+            // behind (restarted, or missed by the coordinator) and counted as standing in
+            // the rounds it missed; it goes on from the round that was decided.
+            if self.outstanding.is_some_and(|r| r <= c.round) {
+                self.outstanding = None;
+            }
+        }
+        if rebuilt {
+            self.publish_map(p)?;
+        }
+        if wake.peer_up {
+            if let Some(r) = self.outstanding {
+                let cand = self.nav.candidate(r);
+                p.candidates.send(cand)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Folds in the newest odometry reading and opens the next round.
+    fn on_odometry(&mut self, p: &Ports) -> Result<(), AgentError> {
+        let mut latest: Option<Odometry> = None;
+        p.odom.drain_pending(|o| {
+            if latest.is_none_or(|l| o.period >= l.period) {
+                latest = Some(*o);
+            }
+        })?;
+        let Some(o) = latest.filter(|o| self.last_period.is_none_or(|p| o.period > p)) else {
+            return Ok(());
+        };
+        if o.agent != self.index {
+            tracing::warn!(
+                agent = self.index,
+                from = o.agent,
+                "odometry of another robot dropped"
+            );
+            return Ok(());
+        }
+        self.last_period = Some(o.period);
+        self.ticks = (o.ticks_left, o.ticks_right);
+        let pose = self.dr.update(o.ticks_left, o.ticks_right);
+        if self.nav.is_moving() {
+            let (x, y) = cell_centre_m(self.cell_size_m, self.nav.next());
+            if self.ctl.arrived(pose, x, y) && self.nav.arrived()? {
+                self.publish_map(p)?;
+            }
+        }
+        self.candidate_due = true;
+        self.wheel_due = Some(o.period + 1);
+        Ok(())
+    }
+
+    /// Publishes the candidate for round `last commit + 1` if one is due and none is open.
+    fn send_candidate(&mut self, p: &Ports) -> Result<(), AgentError> {
+        if !self.candidate_due || self.outstanding.is_some() {
+            return Ok(());
+        }
+        self.candidate_due = false;
+        // In lockstep round r+1 is decided between period r's odometry and period r+1's wheel
+        // command, for every agent, so the period names the round; a restarted agent gets it
+        // right at once. In realtime rounds run at their own pace: ask for the next one.
+        let round = match (self.clock, self.last_period) {
+            (ClockMode::Lockstep, Some(period)) => period + 1,
+            _ => self.last_commit + 1,
+        };
+        if round <= self.last_commit {
+            return Ok(()); // decided without this agent; it stood still
+        }
+        let cand = self.nav.candidate(round);
+        p.candidates.send(cand)?;
+        self.outstanding = Some(round);
+        Ok(())
+    }
+
+    /// Sends the due wheel command; in lockstep only once the open round is decided.
+    fn send_wheels(&mut self, p: &Ports) -> Result<(), AgentError> {
+        let Some(period) = self.wheel_due else {
+            return Ok(());
+        };
+        if self.clock == ClockMode::Lockstep && self.outstanding.is_some() {
+            return Ok(());
+        }
+        let pose = self.dr.pose();
+        let (l, r) = if self.nav.is_moving() {
+            let (x, y) = cell_centre_m(self.cell_size_m, self.nav.next());
+            let w = self.ctl.command(pose, x, y);
+            (w.left_rad_s, w.right_rad_s)
+        } else {
+            (0.0, 0.0)
+        };
+        p.wheels.send(WheelCommand {
+            period,
+            agent: self.index,
+            flags: 0,
+            left_rad_s: l,
+            right_rad_s: r,
+        })?;
+        self.wheel_due = None;
+        if let Some(p) = self.last_period {
+            self.store_checkpoint(p, pose);
+        }
+        Ok(())
+    }
+
+    /// Publishes the neural map, written straight into loaned shared memory.
+    fn publish_map(&mut self, p: &Ports) -> Result<(), AgentError> {
+        let map = self.nav.map();
+        let len = p.map.max_len();
+        let mut loan = p.map.loan(len)?;
+        *loan.header_mut() = MapHeader {
+            round: self.last_commit,
+            agent: self.index,
+            width: self.width,
+            height: (len / self.width.max(1) as usize) as u32,
+            iterations: self.nav.report().sweeps,
+            target: cell_index(self.width, self.nav.target()) as u32,
+            activation: map.options().activation.to_kind() as u8,
+            reserved: [0; 3],
+        };
+        // Zero first: cells the map does not write (a slice longer than the grid) read 0.
+        loan.fill_with(0.0, |values| {
+            map.write_values_f32(values).map_err(AgentError::from)
+        })?;
+        Ok(())
+    }
+
+    /// Writes the restart checkpoint for `period`; a failure is logged, not fatal: the robot
+    /// can go on without one.
+    fn store_checkpoint(&self, period: u64, pose: Pose) {
+        let Some(f) = &self.checkpoint else { return };
+        let idx = |c: Cell| cell_index(self.width, c) as u32;
+        let c = Checkpoint {
+            period,
+            ticks_left: self.ticks.0,
+            ticks_right: self.ticks.1,
+            pose,
+            current: idx(self.nav.current()),
+            next: idx(self.nav.next()),
+            target: idx(self.nav.target()),
+            last_commit: self.last_commit,
+        };
+        if let Err(e) = f.store(&c) {
+            tracing::warn!(path = %f.path().display(), "checkpoint not written: {e}");
+        }
+    }
+}
