@@ -1,6 +1,6 @@
 //! The decision round of the central compute block, free of I/O: the round's candidates in,
 //! the decisions (and the global replans) out. The coordinator process wraps it in the
-//! WaitSet loop, the consensus log and the commit topic.
+//! Waiter loop, the consensus log and the commit topic.
 //!
 //! The arbiter keeps each agent's last known row. An agent missing from a round (late, dead,
 //! restarting) keeps its cells and counts as standing still: a stable position (type d) for

@@ -1,90 +1,22 @@
-//! The `hnav-coordinator` process: the central compute block of the run.
-//!
-//! It blocks in one WaitSet on the candidate and lifecycle topics. A round (`last + 1`)
-//! closes when every live agent's candidate for it is in; in **realtime** also when
-//! `round_deadline_ms` has passed since the round's first candidate (the missing agents count
-//! as standing still); in **lockstep** only liveness closes it (an agent the supervisor
-//! reports down stops being waited for), so a run's rounds do not depend on timing. Then:
-//! [`Arbiter::decide`], append the round (and its replans) to the consensus log, and only
-//! then publish the [`Commit`] — under the default fsync policy a commit an agent sees is
-//! already durable.
-//!
-//! **Restart.** On start the log in `DIR/log` is opened; a torn tail is cut off, the complete
-//! records are replayed: the last round number, the tallies and whether the run ended. The
-//! agents still waiting for the last logged round get its commit again, rebuilt from the log
-//! (never decided twice); a round in flight when the old coordinator died is decided anew from
-//! the candidates the agents resend.
-//!
-//! Once every agent stands on its goal the coordinator logs the end of the run and decides
-//! nothing more, so the log of a lockstep run ends at the same record whatever the
-//! supervisor's timing.
+//! The coordinator's state between wake-ups: the open round's candidates, who is live, the
+//! last decided round and the consensus log it is made durable in.
 
 use std::path::Path;
 use std::time::{Duration, Instant};
 
 use hnav_runtime::consensus_log::{
-    candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LogError, LogWriter,
+    candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LogWriter,
     LoggedDecision, Record, RoundRecord, RunHeader, FORMAT_VERSION,
 };
-use hnav_runtime::launch::{LifecyclePorts, StartOutcome, LOST_WAKEUP_RECHECK};
-use hnav_runtime::msg::{
-    Candidate, Commit, Lifecycle, LifecycleEvent, Progress, Role, StopReason, MAX_AGENTS,
-};
+use hnav_runtime::msg::{Candidate, Lifecycle, LifecycleEvent, Progress, Role, StopReason};
 use hnav_runtime::scenario::{ClockMode, Scenario};
-use hnav_runtime::topics;
-use hnav_runtime::transport::{Receiver, Sender, Transport, TransportError};
-use iceoryx2::prelude::CallbackProgression;
-use iceoryx2::waitset::WaitSetRunResult;
 
+use super::ports::Ports;
+use super::{CoordinatorError, CoordinatorOutcome};
 use crate::round::Arbiter;
 
-/// How long the coordinator waits for the supervisor's start signal.
-pub const START_TIMEOUT: Duration = Duration::from_secs(60);
-
-/// What stopped or broke the coordinator.
-#[derive(Debug, thiserror::Error)]
-pub enum CoordinatorError {
-    /// The transport failed.
-    #[error(transparent)]
-    Transport(#[from] TransportError),
-    /// The consensus log failed: no commit may be published without it.
-    #[error(transparent)]
-    Log(#[from] LogError),
-    /// The log belongs to another scenario or seed.
-    #[error("the log in {dir} was written for another run: {what}")]
-    ForeignLog {
-        /// The log directory.
-        dir: String,
-        /// What differs.
-        what: String,
-    },
-    /// The swarm is larger than a commit can carry.
-    #[error("{0} agents; a commit carries at most {MAX_AGENTS}")]
-    TooManyAgents(usize),
-    /// The WaitSet failed.
-    #[error("waitset: {0}")]
-    WaitSet(String),
-}
-
-/// How the coordinator's run ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct CoordinatorOutcome {
-    /// Last committed round.
-    pub round: u64,
-    /// Whether every agent reached its goal.
-    pub all_at_goal: bool,
-    /// Candidates dropped as malformed.
-    pub dropped: u64,
-}
-
-struct Ports {
-    candidates: Receiver<Candidate>,
-    commit: Sender<Commit>,
-    progress: Sender<Progress>,
-    life: LifecyclePorts,
-}
-
-struct State {
+/// Everything the coordinator knows of the run, restored from the log on a restart.
+pub(super) struct State {
     arbiter: Arbiter,
     log: LogWriter,
     clock: ClockMode,
@@ -98,15 +30,11 @@ struct State {
     ended: bool,
     dropped: u64,
     restarts: Vec<u32>,
+    /// The supervisor's events of one drain, kept so that draining allocates nothing once warm.
+    events: Vec<(Role, u32, LifecycleEvent)>,
 }
 
-/// The coordinator process.
-pub struct CoordinatorProcess<'t> {
-    transport: &'t Transport,
-    ports: Ports,
-    state: State,
-}
-
+/// The header a log of `s` must start with.
 fn header(s: &Scenario) -> RunHeader {
     let g = &s.map.grid;
     RunHeader {
@@ -132,23 +60,11 @@ fn header(s: &Scenario) -> RunHeader {
     }
 }
 
-impl<'t> CoordinatorProcess<'t> {
-    /// Opens the ports and the log in `run_dir/log`, replaying what the log holds.
-    pub fn new(
-        transport: &'t Transport,
-        scenario: &Scenario,
-        run_dir: &Path,
-    ) -> Result<Self, CoordinatorError> {
+impl State {
+    /// Opens the log in `run_dir/log` (cutting off a torn tail), writes its header if it is
+    /// new, and replays the records it already holds.
+    pub(super) fn open(scenario: &Scenario, run_dir: &Path) -> Result<Self, CoordinatorError> {
         let n = scenario.agents.len();
-        if n > MAX_AGENTS {
-            return Err(CoordinatorError::TooManyAgents(n));
-        }
-        let ports = Ports {
-            candidates: transport.receiver(topics::CANDIDATES, topics::candidates_qos(n))?,
-            commit: transport.sender(topics::COMMIT, topics::commit_qos(n))?,
-            progress: transport.sender(topics::PROGRESS, topics::state_qos())?,
-            life: LifecyclePorts::open(transport, Role::Coordinator, 0, n)?,
-        };
         let dir = run_dir.join("log");
         let (log, recovered) = LogWriter::open(&dir, scenario.coordinator.fsync)?;
         if recovered.truncated_bytes > 0 {
@@ -170,6 +86,7 @@ impl<'t> CoordinatorProcess<'t> {
             ended: false,
             dropped: 0,
             restarts: vec![0; n],
+            events: Vec::new(),
             log,
         };
         let expected = header(scenario);
@@ -191,97 +108,21 @@ impl<'t> CoordinatorProcess<'t> {
         if state.round > 0 {
             tracing::info!(round = state.round, "resumed from the consensus log");
         }
-        Ok(CoordinatorProcess {
-            transport,
-            ports,
-            state,
-        })
+        Ok(state)
     }
 
-    /// Announces itself, waits for the start (unless `resume`) and runs rounds until the
-    /// supervisor's `Stop` or a termination signal.
-    pub fn run(&mut self, resume: bool) -> Result<CoordinatorOutcome, CoordinatorError> {
-        let started = self
-            .ports
-            .life
-            .handshake(self.transport, resume, START_TIMEOUT)?;
-        let (p, st) = (&self.ports, &mut self.state);
-        if started == StartOutcome::Stopped {
-            if !st.ended {
-                st.end(EndReason::Stopped)?;
-            }
-            return Ok(st.outcome());
-        }
-        if let Some(rec) = &st.last_record {
-            // Agents that missed the dead coordinator's last commit get it again.
-            p.commit.send_in_place(|slot| rec.write_commit(slot))?;
-        }
-        st.publish_progress(p)?;
-        let ws = self.transport.waitset()?;
-        let ws_err = |e: &dyn std::fmt::Debug| CoordinatorError::WaitSet(format!("{e:?}"));
-        let _g1 = ws
-            .attach_notification(p.candidates.listener())
-            .map_err(|e| ws_err(&e))?;
-        let _g2 = ws
-            .attach_notification(p.life.events().listener())
-            .map_err(|e| ws_err(&e))?;
-        let reason = loop {
-            let mut events: Vec<(Role, u32, LifecycleEvent)> = Vec::new();
-            let stop = p.life.drain(|r, i, e| events.push((r, i, e)))?;
-            for (role, index, ev) in events {
-                st.on_lifecycle(role, index, ev)?;
-            }
-            if let Some(reason) = stop {
-                break match reason {
-                    StopReason::TimeLimit => EndReason::TimeLimit,
-                    StopReason::Requested => EndReason::Stopped,
-                };
-            }
-            st.collect(p)?;
-            if st.ready() {
-                st.close_round(p)?;
-                continue;
-            }
-            let timeout = match (st.clock, st.opened) {
-                (ClockMode::Realtime, Some(t)) => Some(st.deadline.saturating_sub(t.elapsed())),
-                _ => None,
-            };
-            let r = match timeout {
-                Some(t) if t.is_zero() => {
-                    st.close_round(p)?;
-                    continue;
-                }
-                Some(t) => {
-                    ws.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, t)
-                }
-                None => ws.wait_and_process_once_with_timeout(
-                    |_| CallbackProgression::Continue,
-                    LOST_WAKEUP_RECHECK,
-                ),
-            };
-            match r {
-                Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
-                    break EndReason::Stopped;
-                }
-                Ok(_) => {}
-                Err(e) => return Err(ws_err(&e)),
-            }
-        };
-        if !st.ended {
-            st.end(reason)?;
-        }
-        st.log.sync()?;
-        Ok(st.outcome())
-    }
-}
-
-impl State {
-    fn outcome(&self) -> CoordinatorOutcome {
+    /// What the run came to so far.
+    pub(super) fn outcome(&self) -> CoordinatorOutcome {
         CoordinatorOutcome {
             round: self.round,
             all_at_goal: self.ended && self.arbiter.at_goal() as usize == self.arbiter.agents(),
             dropped: self.dropped,
         }
+    }
+
+    /// Whether the log already holds the end of the run.
+    pub(super) fn ended(&self) -> bool {
+        self.ended
     }
 
     /// Folds one record of an existing log into the state.
@@ -300,6 +141,26 @@ impl State {
             }
             Record::Header(_) | Record::Replan(_) => {}
         }
+    }
+
+    /// Takes in every pending supervisor event; returns how the run ends if one was `Stop`.
+    pub(super) fn hear_supervisor(
+        &mut self,
+        p: &Ports,
+    ) -> Result<Option<EndReason>, CoordinatorError> {
+        // Taken out so that applying the events may borrow the state; an error ends the
+        // process, so losing the buffer then costs nothing.
+        let mut events = std::mem::take(&mut self.events);
+        events.clear();
+        let stop = p.life.drain(|r, i, e| events.push((r, i, e)))?;
+        for &(role, index, ev) in &events {
+            self.on_lifecycle(role, index, ev)?;
+        }
+        self.events = events;
+        Ok(stop.map(|reason| match reason {
+            StopReason::TimeLimit => EndReason::TimeLimit,
+            StopReason::Requested => EndReason::Stopped,
+        }))
     }
 
     /// A supervisor event: liveness of agents, logged for the record.
@@ -340,11 +201,9 @@ impl State {
 
     /// Takes every candidate in; keeps those for the open round, re-sends the last commit to
     /// agents asking for a round already decided.
-    fn collect(&mut self, p: &Ports) -> Result<(), CoordinatorError> {
-        p.candidates.take_wakeup()?;
+    pub(super) fn collect(&mut self, p: &Ports) -> Result<(), CoordinatorError> {
         let mut resend = false;
-        while let Some(s) = p.candidates.receive()? {
-            let c = *s.payload();
+        p.candidates.drain_pending(|&c| {
             if !self.arbiter.valid(&c) {
                 self.dropped += 1;
                 tracing::warn!(
@@ -352,7 +211,7 @@ impl State {
                     round = c.round,
                     "malformed candidate dropped"
                 );
-                continue;
+                return;
             }
             let i = c.agent as usize;
             if c.round == self.round + 1 && !self.ended {
@@ -366,17 +225,23 @@ impl State {
                 // answered): the last commit brings it up to date.
                 resend = true;
             }
-        }
+        })?;
         if resend {
-            if let Some(rec) = &self.last_record {
-                p.commit.send_in_place(|slot| rec.write_commit(slot))?;
-            }
+            self.resend_last_commit(p)?;
+        }
+        Ok(())
+    }
+
+    /// Publishes the last logged round's commit again, if there is one.
+    pub(super) fn resend_last_commit(&self, p: &Ports) -> Result<(), CoordinatorError> {
+        if let Some(rec) = &self.last_record {
+            p.commit.send_in_place(|slot| rec.write_commit(slot))?;
         }
         Ok(())
     }
 
     /// Whether the open round has every live agent's candidate.
-    fn ready(&self) -> bool {
+    pub(super) fn ready(&self) -> bool {
         !self.ended
             && self.pending.iter().any(Option::is_some)
             && self
@@ -386,8 +251,17 @@ impl State {
                 .all(|(&l, c)| !l || c.is_some())
     }
 
+    /// When the open round closes without the missing candidates: in realtime
+    /// `round_deadline_ms` after its first candidate; never in lockstep, or with no round open.
+    pub(super) fn round_deadline(&self) -> Option<Instant> {
+        match (self.clock, self.opened) {
+            (ClockMode::Realtime, Some(opened)) => Some(opened + self.deadline),
+            _ => None,
+        }
+    }
+
     /// Decides the open round, makes it durable, then commits it.
-    fn close_round(&mut self, p: &Ports) -> Result<(), CoordinatorError> {
+    pub(super) fn close_round(&mut self, p: &Ports) -> Result<(), CoordinatorError> {
         let round = self.round + 1;
         let (decisions, replans) = self.arbiter.decide(round, &self.pending);
         for r in replans {
@@ -422,7 +296,8 @@ impl State {
         self.publish_progress(p)
     }
 
-    fn end(&mut self, reason: EndReason) -> Result<(), CoordinatorError> {
+    /// Logs the end of the run (durably) and decides nothing more.
+    pub(super) fn end(&mut self, reason: EndReason) -> Result<(), CoordinatorError> {
         self.log.append(&Record::End(EndRecord {
             round: self.round,
             at_goal: self.arbiter.at_goal(),
@@ -433,7 +308,14 @@ impl State {
         Ok(())
     }
 
-    fn publish_progress(&self, p: &Ports) -> Result<(), CoordinatorError> {
+    /// Flushes the log to disk.
+    pub(super) fn sync(&mut self) -> Result<(), CoordinatorError> {
+        self.log.sync()?;
+        Ok(())
+    }
+
+    /// Tells the supervisor and the sim how far the run is.
+    pub(super) fn publish_progress(&self, p: &Ports) -> Result<(), CoordinatorError> {
         let t = self.arbiter.tally();
         p.progress.send(Progress {
             round: self.round,

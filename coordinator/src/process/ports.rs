@@ -1,0 +1,31 @@
+//! The coordinator's topics: what it hears (candidates, the supervisor) and what it says
+//! (commits, progress).
+
+use hnav_runtime::launch::LifecyclePorts;
+use hnav_runtime::msg::{Candidate, Commit, Progress, Role};
+use hnav_runtime::topics;
+use hnav_runtime::transport::{Receiver, Sender, Transport, TransportError};
+
+/// Every port of the coordinator, opened before it announces itself.
+pub(super) struct Ports {
+    /// The agents' candidate steps.
+    pub(super) candidates: Receiver<Candidate>,
+    /// The decided rounds, to every agent.
+    pub(super) commit: Sender<Commit>,
+    /// The run's progress, for the supervisor and the sim.
+    pub(super) progress: Sender<Progress>,
+    /// The lifecycle protocol with the supervisor.
+    pub(super) life: LifecyclePorts,
+}
+
+impl Ports {
+    /// Opens the ports of the coordinator of a swarm of `agents`.
+    pub(super) fn open(transport: &Transport, agents: usize) -> Result<Self, TransportError> {
+        Ok(Self {
+            candidates: transport.receiver(topics::CANDIDATES, topics::candidates_qos(agents))?,
+            commit: transport.sender(topics::COMMIT, topics::commit_qos(agents))?,
+            progress: transport.sender(topics::PROGRESS, topics::state_qos())?,
+            life: LifecyclePorts::open(transport, Role::Coordinator, 0, agents)?,
+        })
+    }
+}
