@@ -121,7 +121,10 @@ fn drive(mut guard: RunGuard, file: &std::path::Path, agents: usize) -> (u64, Tr
         .spawn()
         .unwrap();
     let child = guard.child.insert(child);
-    let waiter = t.waiter().unwrap();
+    // No lost-wake-up re-check: the loop below resends the current period's commands after
+    // every wake-up, and every 50 ms they would keep the sim's lockstep deadline (measured
+    // from the last input) from ever passing. The 1 s deadline bounds a lost wake-up instead.
+    let waiter = t.waiter().unwrap().with_recheck(None);
     let _attached = waiter.attach(&truth).unwrap();
     let (mut h, mut last, mut next) = (Fnv1a64::new(), Truth::default(), 0u64);
     let started = Instant::now();
