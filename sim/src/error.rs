@@ -1,7 +1,11 @@
-//! Errors of the stepper: bad parameters and bad inputs, never a panic.
+//! Errors of the stepper and its process: bad parameters and bad inputs, never a panic, and
+//! a failing transport.
 
-/// What went wrong building or driving a [`crate::World`].
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+use hnav_runtime::transport::TransportError;
+
+/// What went wrong building or driving a [`crate::World`], or running the `hnav-sim` process
+/// around it ([`crate::process::SimProcess`]).
+#[derive(Debug, thiserror::Error)]
 pub enum SimError {
     /// A robot or sim parameter is out of range.
     #[error("bad parameter {name} = {value}: {why}")]
@@ -37,4 +41,8 @@ pub enum SimError {
         /// Robot index.
         robot: usize,
     },
+    /// The run's transport failed: a port could not be opened, a send, receive or wait failed,
+    /// or the supervisor never answered the start-up handshake.
+    #[error(transparent)]
+    Transport(#[from] TransportError),
 }

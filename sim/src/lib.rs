@@ -15,8 +15,8 @@
 //! | [`collision`] | disc–disc and disc–blocked-cell contacts (`Point2` geometry), recorded when they begin with time, robots or cell, and positions |
 //! | [`watchdog`] | stale commands are replaced by braking |
 //! | [`world`] | [`World`]: N robots, struct-of-arrays, fixed step, odometry and Truth |
-//! | [`process`] | the `hnav-sim` process: [`process::SimProcess`], topics, lockstep and realtime |
-//! | [`error`] | [`SimError`]: bad parameters and inputs, never a panic |
+//! | [`process`] | the `hnav-sim` process: [`process::SimProcess`] (`new`, `run`), its ports and state, lockstep and realtime; [`process::SimOutcome`] |
+//! | [`error`] | [`SimError`]: bad parameters and inputs, never a panic, and transport failures |
 //!
 //! ```
 //! use hnav_runtime::grid::geometry::cell_centre_pose;

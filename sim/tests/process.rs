@@ -7,7 +7,6 @@ use hnav_runtime::msg::{Odometry, Truth, WheelCommand};
 use hnav_runtime::scenario::params::RobotParams;
 use hnav_runtime::topics;
 use hnav_runtime::transport::{purge_run, RunId, Transport};
-use iceoryx2::prelude::CallbackProgression;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -122,8 +121,11 @@ fn drive(mut guard: RunGuard, file: &std::path::Path, agents: usize) -> (u64, Tr
         .spawn()
         .unwrap();
     let child = guard.child.insert(child);
-    let ws = t.waitset().unwrap();
-    let _g = ws.attach_notification(truth.listener()).unwrap();
+    // No lost-wake-up re-check: the loop below resends the current period's commands after
+    // every wake-up, and every 50 ms they would keep the sim's lockstep deadline (measured
+    // from the last input) from ever passing. The 1 s deadline bounds a lost wake-up instead.
+    let waiter = t.waiter().unwrap().with_recheck(None);
+    let _attached = waiter.attach(&truth).unwrap();
     let (mut h, mut last, mut next) = (Fnv1a64::new(), Truth::default(), 0u64);
     let started = Instant::now();
     while next < PERIODS {
@@ -131,14 +133,11 @@ fn drive(mut guard: RunGuard, file: &std::path::Path, agents: usize) -> (u64, Tr
             started.elapsed() < Duration::from_secs(60),
             "sim stalled at {next}"
         );
-        ws.wait_and_process_once_with_timeout(
-            |_| CallbackProgression::Continue,
-            Duration::from_secs(1),
-        )
-        .unwrap();
-        truth.take_wakeup().unwrap();
+        waiter
+            .wait(Some(Instant::now() + Duration::from_secs(1)))
+            .unwrap();
         truth
-            .drain(|s| {
+            .drain_pending(|s| {
                 // In order; realtime may overwrite an unread sample (latest-only QoS), lockstep
                 // cannot (the sim waits for the commands this loop sends).
                 assert!(s.period >= next, "truth periods arrive in order");
@@ -148,8 +147,7 @@ fn drive(mut guard: RunGuard, file: &std::path::Path, agents: usize) -> (u64, Tr
             })
             .unwrap();
         for rx in &odom {
-            rx.take_wakeup().unwrap();
-            rx.drain(|_| {}).unwrap();
+            rx.drain_pending(|_| {}).unwrap();
         }
         if next < PERIODS {
             send(next);

@@ -3,10 +3,9 @@
 //! `hnav_sim::process`.
 
 use std::process::ExitCode;
-use std::time::Duration;
 
 use clap::Parser;
-use hnav_runtime::launch::{process_main, LifecyclePorts, ProcessArgs, StartOutcome};
+use hnav_runtime::launch::{process_main, LifecyclePorts, ProcessArgs};
 use hnav_runtime::msg::Role;
 use hnav_runtime::transport::Transport;
 use hnav_sim::process::SimProcess;
@@ -34,13 +33,9 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let transport = Transport::builder(&run)
         .node_name(&Role::Sim.node_name(0))
         .create()?;
-    let mut sim = SimProcess::new(&transport, &scenario)?;
+    let mut sim = SimProcess::new(&transport, &scenario)?.resuming(args.common.resume);
     if !args.standalone {
         let ports = LifecyclePorts::open(&transport, Role::Sim, 0, scenario.agents.len())?;
-        let started = ports.handshake(&transport, args.common.resume, Duration::from_secs(60))?;
-        if started == StartOutcome::Stopped {
-            return Ok(());
-        }
         sim = sim.with_lifecycle(ports);
     }
     let out = sim.run(args.periods)?;

@@ -1,0 +1,171 @@
+//! The `hnav-sim` process: wheel commands in, odometry and ground truth out, over the run's
+//! transport, in lockstep or realtime per the scenario's `sim.clock`.
+//!
+//! A control period is one odometry period (`1 / sim.odometry_hz`). In lockstep a period is
+//! stepped only when every live robot's command for it is in; a robot whose publisher died or
+//! left, or (if `sim.lockstep_deadline_ms` > 0) that misses that deadline, counts as down and
+//! brakes until it sends again. Joined to the run's lifecycle protocol
+//! ([`SimProcess::with_lifecycle`]), it also learns of dead agents from the supervisor at
+//! once. A robot whose agent the supervisor restarted gets its last odometry reading again
+//! (it was published before the new agent subscribed) and is waited for from then on;
+//! without the lifecycle protocol a robot counts as live again from its first fresh command,
+//! never from a publisher merely appearing, which would stall the run.
+//! In realtime the world follows the wall clock and commands apply when they arrive. The
+//! process blocks in a [`Waiter`] throughout (on the wheel topics and the supervisor's
+//! events), until the next period is due in realtime or, if set, until the lockstep deadline.
+//!
+//! | module | what |
+//! |---|---|
+//! | `ports` | the topics: wheel commands in; odometry, Truth and lifecycle out |
+//! | `state` | the world, who is live and who has sent, and the handlers of each input |
+
+mod ports;
+mod state;
+
+use std::time::{Duration, Instant};
+
+use hnav_runtime::launch::{LifecyclePorts, StartOutcome, START_TIMEOUT};
+use hnav_runtime::scenario::params::ClockMode;
+use hnav_runtime::scenario::Scenario;
+use hnav_runtime::transport::{Transport, Waiter, Wake};
+
+use crate::error::SimError;
+use crate::world::World;
+use ports::Ports;
+use state::State;
+
+/// How a run of the process ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SimOutcome {
+    /// Control periods completed.
+    pub periods: u64,
+    /// Collisions recorded.
+    pub collisions: usize,
+    /// Whether a stop request (the supervisor's `Stop` or a termination signal) ended the run
+    /// (else the period limit did).
+    pub signalled: bool,
+}
+
+/// The simulator's state and ports.
+pub struct SimProcess<'t> {
+    transport: &'t Transport,
+    ports: Ports,
+    state: State,
+    /// Skip the wait for the supervisor's `Start` (a restarted process).
+    resume: bool,
+}
+
+impl<'t> SimProcess<'t> {
+    /// Builds the world from `scenario` (robots at their start cells' centres, facing their
+    /// `start_heading_deg`) and opens the ports.
+    pub fn new(transport: &'t Transport, scenario: &Scenario) -> Result<Self, SimError> {
+        let world = World::from_scenario(scenario)?;
+        let ports = Ports::open(transport, world.robots())?;
+        let lockstep_deadline = (scenario.sim.lockstep_deadline_ms > 0)
+            .then(|| Duration::from_millis(scenario.sim.lockstep_deadline_ms.into()));
+        Ok(SimProcess {
+            transport,
+            ports,
+            state: State::new(world, scenario.sim.clock, lockstep_deadline),
+            resume: false,
+        })
+    }
+
+    /// Joins the run's lifecycle protocol: [`SimProcess::run`] then starts with the handshake,
+    /// and the process hears the supervisor's `Stop` and learns of agents that died (their
+    /// robots brake and are not waited for) or were restarted.
+    pub fn with_lifecycle(mut self, ports: LifecyclePorts) -> Self {
+        self.ports.life = Some(ports);
+        self
+    }
+
+    /// Whether the process was restarted (`--resume`): its handshake then only announces it,
+    /// without waiting for a `Start` the supervisor sent long ago.
+    pub fn resuming(mut self, resume: bool) -> Self {
+        self.resume = resume;
+        self
+    }
+
+    /// The lifecycle ports, if joined.
+    pub fn lifecycle(&self) -> Option<&LifecyclePorts> {
+        self.ports.life.as_ref()
+    }
+
+    /// The world.
+    pub fn world(&self) -> &World {
+        &self.state.world
+    }
+
+    /// Joined to the lifecycle protocol, announces itself and waits for the start (unless
+    /// resuming, [`START_TIMEOUT`] at most); then runs until a stop request or, if given,
+    /// `max_periods` control periods.
+    pub fn run(&mut self, max_periods: Option<u64>) -> Result<SimOutcome, SimError> {
+        if let Some(life) = &self.ports.life {
+            let started = life.handshake(self.transport, self.resume, START_TIMEOUT)?;
+            if started == StartOutcome::Stopped {
+                return Ok(self.state.outcome(true));
+            }
+        }
+        let waiter = self.transport.waiter()?;
+        let _attached = self.ports.attach(&waiter)?;
+        let signalled = run_loop(&self.ports, &mut self.state, &waiter, max_periods)?;
+        Ok(self.state.outcome(signalled))
+    }
+}
+
+/// The loop of [`SimProcess::run`]: drain, step every period that can be stepped, wait.
+/// Returns whether a stop request ended it.
+fn run_loop(
+    ports: &Ports,
+    st: &mut State,
+    waiter: &Waiter,
+    max_periods: Option<u64>,
+) -> Result<bool, SimError> {
+    let period_wall = st.period_wall();
+    let started = Instant::now();
+    // Lockstep: when the robots still missing are given up on. Runs from the last time
+    // anything came in, as long as nothing does.
+    let mut give_up: Option<Instant> = None;
+    loop {
+        if max_periods.is_some_and(|m| st.period >= m) {
+            return Ok(false);
+        }
+        let news = st.on_lifecycle(ports)?;
+        if news.stop {
+            return Ok(true);
+        }
+        if st.drain(ports)? || news.any {
+            give_up = None;
+        }
+        let deadline = match st.clock {
+            ClockMode::Lockstep => {
+                if st.ready() {
+                    st.advance(ports)?;
+                    give_up = None;
+                    continue;
+                }
+                st.lockstep_deadline
+                    .map(|d| *give_up.get_or_insert_with(|| Instant::now() + d))
+            }
+            ClockMode::Realtime => {
+                // From the start, not from the last step: the schedule does not drift.
+                let due = started + period_wall.mul_f64((st.period + 1) as f64);
+                if Instant::now() >= due {
+                    st.advance(ports)?;
+                    continue;
+                }
+                Some(due)
+            }
+        };
+        match waiter.wait(deadline)? {
+            Wake::Data => {}
+            Wake::Stop => return Ok(true),
+            Wake::TimedOut => {
+                if st.clock == ClockMode::Lockstep && st.lockstep_deadline.is_some() {
+                    st.mark_missing_down();
+                    give_up = None;
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,55 @@
+//! The topics of the `hnav-sim` process: one wheel-command receiver and one odometry sender
+//! per robot, the Truth sender and, when joined to the run's lifecycle protocol, its ports.
+
+use hnav_runtime::launch::LifecyclePorts;
+use hnav_runtime::msg::{Odometry, Truth, WheelCommand};
+use hnav_runtime::topics;
+use hnav_runtime::transport::{Attachment, Receiver, Sender, Transport, TransportError, Waiter};
+
+/// The process's open ports. Kept apart from the [`State`](super::state::State) so that the
+/// waiter's attachments can borrow the receivers while the loop mutates the state.
+pub(crate) struct Ports {
+    /// Robot `i`'s wheel commands.
+    pub(crate) wheels: Vec<Receiver<WheelCommand>>,
+    /// Robot `i`'s odometry.
+    pub(crate) odom: Vec<Sender<Odometry>>,
+    /// Ground truth of every robot, once per control period.
+    pub(crate) truth: Sender<Truth>,
+    /// The lifecycle protocol's ports, if joined.
+    pub(crate) life: Option<LifecyclePorts>,
+}
+
+impl Ports {
+    /// Opens the topics of a world of `robots` robots.
+    pub(crate) fn open(transport: &Transport, robots: usize) -> Result<Self, TransportError> {
+        let q = topics::state_qos();
+        let wheels = (0..robots)
+            .map(|i| transport.receiver(&topics::wheels(i), q))
+            .collect::<Result<Vec<_>, _>>()?;
+        let odom = (0..robots)
+            .map(|i| transport.sender(&topics::odometry(i), q))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            wheels,
+            odom,
+            truth: transport.sender(topics::TRUTH, q)?,
+            life: None,
+        })
+    }
+
+    /// Attaches every wheel receiver and the supervisor's events to `waiter`; the loop waits
+    /// as long as the returned attachments live.
+    pub(crate) fn attach<'w>(
+        &self,
+        waiter: &'w Waiter,
+    ) -> Result<Vec<Attachment<'w, '_>>, TransportError> {
+        let mut attached = Vec::with_capacity(self.wheels.len() + 1);
+        for rx in &self.wheels {
+            attached.push(waiter.attach(rx)?);
+        }
+        if let Some(life) = &self.life {
+            attached.push(waiter.attach(life.events())?);
+        }
+        Ok(attached)
+    }
+}

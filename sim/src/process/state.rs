@@ -1,0 +1,191 @@
+//! The simulator's state between wake-ups and its handlers: the world, which robots are live
+//! and which have sent this period's command, and the period counter.
+
+use std::time::Duration;
+
+use hnav_runtime::msg::{LifecycleEvent, Role};
+use hnav_runtime::scenario::params::ClockMode;
+
+use super::ports::Ports;
+use super::SimOutcome;
+use crate::error::SimError;
+use crate::world::World;
+
+/// What the loop of [`SimProcess`](super::SimProcess) mutates.
+pub(crate) struct State {
+    pub(crate) world: World,
+    pub(crate) clock: ClockMode,
+    /// Robot `i` is waited for in lockstep.
+    live: Vec<bool>,
+    /// Robot `i`'s command for the current period is in.
+    have: Vec<bool>,
+    /// The control period being collected (periods stepped so far).
+    pub(crate) period: u64,
+    /// `sim.lockstep_deadline_ms`, `None` for 0 (wait indefinitely).
+    pub(crate) lockstep_deadline: Option<Duration>,
+}
+
+/// What a lifecycle drain found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct LifecycleNews {
+    /// The supervisor asked the process to stop.
+    pub(crate) stop: bool,
+    /// Some event came in.
+    pub(crate) any: bool,
+}
+
+impl State {
+    /// The state of a fresh run of `world`: every robot live, no command in, period 0.
+    pub(crate) fn new(world: World, clock: ClockMode, lockstep_deadline: Option<Duration>) -> Self {
+        let n = world.robots();
+        Self {
+            world,
+            clock,
+            live: vec![true; n],
+            have: vec![false; n],
+            period: 0,
+            lockstep_deadline,
+        }
+    }
+
+    /// The wall-clock length of one control period (one odometry period).
+    pub(crate) fn period_wall(&self) -> Duration {
+        Duration::from_secs_f64(self.world.steps_per_odometry() as f64 * self.world.model().dt)
+    }
+
+    /// How the run stands; `signalled` says whether a stop request ended it.
+    pub(crate) fn outcome(&self, signalled: bool) -> SimOutcome {
+        SimOutcome {
+            periods: self.period,
+            collisions: self.world.collisions().len(),
+            signalled,
+        }
+    }
+
+    /// Applies the supervisor's events. A dead agent's robot brakes and is not waited for; a
+    /// restarted one counts again from its first fresh command (it needs this period's
+    /// odometry before it can send one).
+    pub(crate) fn on_lifecycle(&mut self, ports: &Ports) -> Result<LifecycleNews, SimError> {
+        let Some(l) = &ports.life else {
+            return Ok(LifecycleNews {
+                stop: false,
+                any: false,
+            });
+        };
+        // Empty unless an agent was restarted: no allocation in an ordinary round.
+        let mut restarted = Vec::new();
+        let mut any = false;
+        let (live, world) = (&mut self.live, &mut self.world);
+        let stop = l.drain(|role, index, ev| {
+            any = true;
+            let Some(v) = live.get_mut(index as usize) else {
+                return;
+            };
+            match (role, ev) {
+                (Role::Agent, LifecycleEvent::Down) => {
+                    *v = false;
+                    world.brake(index);
+                }
+                (Role::Agent, LifecycleEvent::Restarted) => restarted.push(index),
+                _ => {}
+            }
+        })?;
+        self.resend_odometry(ports, &restarted)?;
+        Ok(LifecycleNews {
+            stop: stop.is_some(),
+            any,
+        })
+    }
+
+    /// A restarted agent needs an odometry reading before it can command its wheels, and the
+    /// last one may have gone out before it subscribed: sends it again and waits for the agent
+    /// from this period on. One that has already rejoined (its first fresh command came in
+    /// before the event) needs nothing, and its command must not be forgotten.
+    fn resend_odometry(&mut self, ports: &Ports, restarted: &[u32]) -> Result<(), SimError> {
+        let Some(last) = self.period.checked_sub(1) else {
+            return Ok(());
+        };
+        for &i in restarted {
+            let rejoined = self.live.get(i as usize).copied().unwrap_or(true);
+            if let (false, Some(o), Some(tx)) = (
+                rejoined,
+                self.world.odometry(i, last),
+                ports.odom.get(i as usize),
+            ) {
+                tx.send(o)?;
+                self.live[i as usize] = true;
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads every wheel topic: liveness from the wake-up events, commands for the current
+    /// period (or later) applied at the current sim time; stale ones are dropped. Returns
+    /// whether anything (an event or a sample) came in.
+    ///
+    /// The events are taken before the samples (the drain order of
+    /// [`Waiter`](hnav_runtime::transport::Waiter)), and acted on before them too, which is
+    /// why this is not `drain_pending`: a robot whose publisher died and which still sent a
+    /// fresh command counts as live from that command, not as down.
+    pub(crate) fn drain(&mut self, ports: &Ports) -> Result<bool, SimError> {
+        let now = self.world.time_ns();
+        let realtime = self.clock == ClockMode::Realtime;
+        let mut any = false;
+        for (i, rx) in ports.wheels.iter().enumerate() {
+            let w = rx.take_wakeup()?;
+            any |= w.data || w.peer_up || w.peer_left || w.peer_dead;
+            if w.peer_dead || w.peer_left {
+                self.live[i] = false;
+                self.world.brake(i as u32);
+            }
+            let (world, have, live, period) =
+                (&mut self.world, &mut self.have, &mut self.live, self.period);
+            any |= rx.drain(|c| {
+                let fresh = c.period >= period || realtime;
+                if fresh && c.agent as usize == i {
+                    // Non-finite set-points are dropped: a bad agent cannot stop the sim.
+                    if world
+                        .apply_command(c.agent, c.period, c.left_rad_s, c.right_rad_s, now)
+                        .is_ok()
+                    {
+                        have[i] = true;
+                        live[i] = true;
+                    }
+                }
+            })? > 0;
+        }
+        Ok(any)
+    }
+
+    /// Whether every live robot's command for the current period is in.
+    pub(crate) fn ready(&self) -> bool {
+        self.live.iter().zip(&self.have).all(|(&l, &h)| !l || h)
+    }
+
+    /// The lockstep deadline passed: whoever is still missing is down and brakes.
+    pub(crate) fn mark_missing_down(&mut self) {
+        for (i, (live, have)) in self.live.iter_mut().zip(&self.have).enumerate() {
+            if !have {
+                *live = false;
+                self.world.brake(i as u32);
+            }
+        }
+    }
+
+    /// Steps one control period and publishes odometry and truth for it.
+    pub(crate) fn advance(&mut self, ports: &Ports) -> Result<(), SimError> {
+        for _ in 0..self.world.steps_per_odometry() {
+            self.world.step();
+        }
+        for (i, tx) in ports.odom.iter().enumerate() {
+            if let Some(o) = self.world.odometry(i as u32, self.period) {
+                tx.send(o)?;
+            }
+        }
+        let (world, period) = (&self.world, self.period);
+        ports.truth.send_in_place(|t| world.fill_truth(period, t))?;
+        self.period += 1;
+        self.have.iter_mut().for_each(|h| *h = false);
+        Ok(())
+    }
+}
