@@ -114,11 +114,6 @@ impl ProcessArgs {
 /// error, not a hang.
 pub const START_TIMEOUT: Duration = Duration::from_secs(60);
 
-/// The lost-wake-up re-check of the loops that still block in a raw WaitSet; it is
-/// [`Waiter::LOST_WAKEUP_RECHECK`](crate::transport::Waiter::LOST_WAKEUP_RECHECK), which
-/// documents the cause. Goes once every loop waits in a [`Waiter`](crate::transport::Waiter).
-pub const LOST_WAKEUP_RECHECK: Duration = crate::transport::Waiter::LOST_WAKEUP_RECHECK;
-
 /// The `main` of a process binary: sets up logging, parses the command line and runs `run`;
 /// an error is printed as `NAME: error` and exits 1.
 pub fn process_main<A: clap::Parser>(
