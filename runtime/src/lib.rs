@@ -15,7 +15,7 @@
 //! | [`topics`] | the run's service names and their QoS, defined once for every process |
 //! | [`plan`] | [`PlanResult`](plan::PlanResult), the answer to one planning query, whichever planner gave it |
 //! | [`launch`] | the command line every process of a run shares, and the start-up handshake with the supervisor |
-//! | [`transport`] | run-scoped iceoryx2 services: publisher+notifier, subscriber+listener, WaitSets |
+//! | [`transport`] | run-scoped iceoryx2 services: publisher+notifier, subscriber+listener, the one [`Waiter`](transport::Waiter) every process blocks in |
 //! | [`supervisor`] | starting, watching, restarting and stopping a run's processes; the registry behind `hnav ps`. It sits on top: no other module uses it |
 //! | [`consensus_log`] | the durable consensus log: record types, segment format, reader, verifier |
 //! | [`hash`] | FNV-1a 64 and SplitMix64: digests and seeded random numbers, stable across platforms |
