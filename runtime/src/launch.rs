@@ -183,9 +183,8 @@ impl LifecyclePorts {
         &self,
         mut f: impl FnMut(Role, u32, LifecycleEvent),
     ) -> Result<Option<StopReason>, TransportError> {
-        self.events.take_wakeup()?;
         let mut stop = None;
-        self.events.drain(|l| {
+        self.events.drain_pending(|l| {
             let (Some(role), Some(ev)) = (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
             else {
                 return;

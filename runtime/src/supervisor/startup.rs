@@ -132,8 +132,7 @@ impl SupervisorPorts {
 
     /// Marks in `up` every child whose `Up` is pending on `ready`.
     fn take_ups(&self, children: &[&Child], up: &mut [bool]) -> Result<(), TransportError> {
-        self.ready.take_wakeup()?;
-        self.ready.drain(|l| {
+        self.ready.drain_pending(|l| {
             if l.event != LifecycleEvent::Up as u8 {
                 return;
             }

@@ -239,8 +239,7 @@ impl Watch<'_> {
     /// `AllAtGoal` once it reports every agent at its goal.
     fn on_progress(&mut self, ports: &Ports, slots: &Slots) -> Result<Option<End>, RunError> {
         let mut last = None;
-        ports.progress.take_wakeup()?;
-        ports.progress.drain(|p| last = Some(*p))?;
+        ports.progress.drain_pending(|p| last = Some(*p))?;
         let Some(p) = last else {
             return Ok(None);
         };

@@ -162,9 +162,8 @@ impl Slots {
     /// Publishes `Restarted` for every restarted process that has announced itself up.
     pub(super) fn announce_restarts(&self, life: &SupervisorPorts) -> Result<(), RunError> {
         let ready = life.ready();
-        ready.take_wakeup()?;
         let mut up = Vec::new();
-        ready.drain(|l| up.push((l.role, l.index)))?;
+        ready.drain_pending(|l| up.push((l.role, l.index)))?;
         for (role, index) in up {
             let slot = self
                 .slots
