@@ -1,5 +1,5 @@
 //! Supervisor building blocks against real processes: small shell children for spawning,
-//! exit reporting, WaitSet wake-ups, restart decisions and the escalating stop; the run
+//! exit reporting, waiter wake-ups, restart decisions and the escalating stop; the run
 //! registry; and `hnav ps` run as a binary.
 
 use std::path::{Path, PathBuf};
@@ -14,7 +14,6 @@ use hnav_runtime::supervisor::registry::{pid_alive, RunRecord, RunRegistry};
 use hnav_runtime::supervisor::restart::{GiveUpReason, RestartDecision, RestartTracker};
 use hnav_runtime::supervisor::stop::{stop_all, StopHow};
 use hnav_runtime::transport::{purge_run, RunId, Transport};
-use iceoryx2::prelude::{ipc, CallbackProgression, SignalHandlingMode, WaitSetBuilder};
 
 fn sh(dir: &Path, name: &str, script: &str) -> ChildSpec {
     ChildSpec::new(Role::Agent, 0, "/bin/sh", dir.join(format!("{name}.log")))
@@ -166,46 +165,53 @@ fn reaping_kills_leftovers_in_the_group() {
     assert!(gone_soon(grandchild), "grandchild {grandchild} survived");
 }
 
+/// A run's shared memory, purged even when the test fails.
+struct PurgeOnDrop(RunId);
+
+impl Drop for PurgeOnDrop {
+    fn drop(&mut self) {
+        let _ = purge_run(&self.0);
+    }
+}
+
 fn waitset_wake_latency(mode: WatchMode) -> Duration {
     let dir = tempfile::tempdir().unwrap();
     // `exec date` makes the timestamp writer the child itself: it exits right after writing.
     let spec = sh(dir.path(), "w", "sleep 0.2 && exec date +%s%N");
-    let ws = WaitSetBuilder::new()
-        .signal_handling_mode(SignalHandlingMode::Disabled)
-        .create::<ipc::Service>()
+    let run = PurgeOnDrop(RunId::unique("exitwake"));
+    let transport = Transport::builder(&run.0)
+        .handle_signals(false)
+        .create()
         .unwrap();
+    // Without the lost-wake-up re-check, so that a wake-up is the exit and nothing else.
+    let waiter = transport.waiter().unwrap().with_recheck(None);
     let child = Child::spawn_with(&spec, mode).unwrap();
     assert_eq!(child.exit_fd().mode(), mode);
-    let guard = ws.attach_notification(child.exit_fd()).unwrap();
+    let exit = child.watch(&waiter).unwrap();
+    let exit_id = exit.id();
 
     // No wake-up while the child runs.
     let mut early = false;
-    ws.wait_and_process_once_with_timeout(
-        |id| {
-            early |= id.has_event_from(&guard);
-            CallbackProgression::Continue
-        },
-        Duration::from_millis(50),
-    )
-    .unwrap();
+    let soon = Instant::now() + Duration::from_millis(50);
+    waiter
+        .wait_with(Some(soon), |id| early |= id == exit_id)
+        .unwrap();
     assert!(!early, "woke before the child exited");
 
     let mut woke = None;
     let started = Instant::now();
-    while woke.is_none() && started.elapsed() < Duration::from_secs(10) {
-        ws.wait_and_process_once_with_timeout(
-            |id| {
-                if id.has_event_from(&guard) {
+    let deadline = started + Duration::from_secs(10);
+    while woke.is_none() && Instant::now() < deadline {
+        waiter
+            .wait_with(Some(deadline), |id| {
+                if id == exit_id {
                     woke = Some(SystemTime::now());
                 }
-                CallbackProgression::Continue
-            },
-            Duration::from_secs(10),
-        )
-        .unwrap();
+            })
+            .unwrap();
     }
     let woke = woke.expect("no wake-up within 10 s");
-    drop(guard);
+    drop(exit);
     assert_eq!(
         child.try_reap(),
         Some(ExitInfo::Exited(0)),

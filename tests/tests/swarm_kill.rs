@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use hnav_runtime::consensus_log::{read_log, Record};
 use hnav_runtime::msg::{Commit, MapHeader};
@@ -15,7 +15,6 @@ use hnav_runtime::topics;
 use hnav_runtime::transport::{RunId, Transport};
 use hnav_tests::swarm::{repo_root, verify_log, SwarmRun};
 use hnav_tests::TestRun;
-use iceoryx2::prelude::CallbackProgression;
 
 const RUN_TIMEOUT: Duration = Duration::from_secs(600);
 
@@ -64,9 +63,9 @@ impl Observer {
             let maps = t
                 .slice_receiver::<f32, MapHeader>(&topics::map(0), topics::state_qos())
                 .unwrap();
-            let ws = t.waitset().unwrap();
-            let _g = ws.attach_notification(rx.listener()).unwrap();
-            let _gm = ws.attach_notification(maps.listener()).unwrap();
+            let waiter = t.waiter().unwrap();
+            let _commits = waiter.attach(&rx).unwrap();
+            let _maps = waiter.attach(&maps).unwrap();
             ready_tx.send(()).unwrap();
             while !st2.load(Ordering::Relaxed) {
                 let _ = maps.take_wakeup();
@@ -79,18 +78,14 @@ impl Observer {
                         .unwrap_or(f32::NAN);
                     *m2.lock().unwrap() = Some((h, v, s.payload().len()));
                 }
-                let _ = rx.take_wakeup();
-                while let Ok(Some(s)) = rx.receive() {
-                    let c = *s.payload();
+                let _ = rx.drain_pending(|c| {
                     let mut m = s2.lock().unwrap();
-                    if let Some(old) = m.insert(c.round, c) {
-                        assert_eq!(old, c, "round {} committed twice, differently", c.round);
+                    if let Some(old) = m.insert(c.round, *c) {
+                        assert_eq!(old, *c, "round {} committed twice, differently", c.round);
                     }
-                }
-                let _ = ws.wait_and_process_once_with_timeout(
-                    |_| CallbackProgression::Continue,
-                    Duration::from_millis(100),
-                );
+                });
+                // Bounded, so that the thread sees `stop`.
+                let _ = waiter.wait(Some(Instant::now() + Duration::from_millis(100)));
             }
         });
         ready_rx
@@ -252,10 +247,10 @@ fn sigint_stops_the_run_politely_and_leaves_nothing_behind() {
         .collect();
     // Interrupt a run under way: wait (bounded) until rounds are being logged.
     let seg = swarm.dir.join("log/seg-00000000.hlog");
-    let deadline = std::time::Instant::now() + Duration::from_secs(60);
+    let deadline = Instant::now() + Duration::from_secs(60);
     while std::fs::metadata(&seg).map_or(0, |m| m.len()) < 4096 {
         assert!(
-            std::time::Instant::now() < deadline,
+            Instant::now() < deadline,
             "no rounds logged within 60 s\n{}",
             swarm.log_tails()
         );

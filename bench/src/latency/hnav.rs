@@ -1,8 +1,10 @@
 //! The HNAV transport (`hnav_runtime::transport`): slice sender and receiver, measured with
-//! the same ping-pong and the same WaitSet pattern as [raw iceoryx2](super::raw).
+//! the same ping-pong as [raw iceoryx2](super::raw), waiting in the transport's `Waiter` as
+//! every HNAV process does.
+
+use std::time::Instant;
 
 use anyhow::Result;
-use iceoryx2::prelude::CallbackProgression;
 
 use hnav_runtime::transport::{RunId, SliceReceiver, SliceSender, Transport};
 
@@ -63,17 +65,11 @@ pub(crate) fn side(
             pp.check()?;
         }),
         Mode::Event => {
-            let waitset = ports.transport.waitset()?;
-            let _guard = waitset
-                .attach_notification(ports.rx.listener())
-                .map_err(|e| anyhow::anyhow!("attach listener: {e:?}"))?;
+            // The processes' own wait, re-check included: what a sample costs in HNAV.
+            let waiter = ports.transport.waiter()?;
+            let _attached = waiter.attach(&ports.rx)?;
             pp.run(role, send, || loop {
-                waitset
-                    .wait_and_process_once_with_timeout(
-                        |_| CallbackProgression::Continue,
-                        ABORT_POLL,
-                    )
-                    .map_err(|e| anyhow::anyhow!("wait: {e:?}"))?;
+                waiter.wait(Some(Instant::now() + ABORT_POLL))?;
                 // Drains the listener; a wake-up may also be "publisher appeared", hence the
                 // loop when no sample is there.
                 ports.rx.take_wakeup()?;

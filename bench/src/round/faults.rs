@@ -29,15 +29,13 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Context, Result};
-use iceoryx2::prelude::CallbackProgression;
-use iceoryx2::waitset::WaitSetRunResult;
 
 use hnav_runtime::msg::{Lifecycle, LifecycleEvent, Role};
 use hnav_runtime::scenario::FsyncPolicy;
 use hnav_runtime::supervisor::child::{Child, ChildSpec, ExitInfo, Signal};
 use hnav_runtime::supervisor::exit_fd::WatchMode;
 use hnav_runtime::topics;
-use hnav_runtime::transport::{purge_run, RunId, Sender, Transport};
+use hnav_runtime::transport::{purge_run, RunId, Sender, Transport, Wake};
 
 use super::report::{Dist, FaultPoint};
 use super::session::with_coordinator;
@@ -179,28 +177,21 @@ fn listen(
         .create()?;
     let rx =
         transport.receiver::<Lifecycle>(topics::LIFECYCLE, topics::lifecycle_qos(REJOIN_AGENTS))?;
-    let ws = transport.waitset()?;
-    let _g = ws
-        .attach_notification(rx.listener())
-        .map_err(|e| anyhow!("waitset: {e:?}"))?;
+    let waiter = transport.waiter()?;
+    let _attached = waiter.attach(&rx)?;
     let _ = ready.send(());
     while !stop.load(Ordering::Relaxed) {
-        match ws.wait_and_process_once_with_timeout(
-            |_| CallbackProgression::Continue,
-            Duration::from_millis(200),
-        ) {
-            Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => return Ok(()),
-            Ok(_) => {}
-            Err(e) => bail!("waitset: {e:?}"),
+        // The bounded wait only lets the thread see `stop`.
+        let deadline = Instant::now() + Duration::from_millis(200);
+        if waiter.wait(Some(deadline))? == Wake::Stop {
+            return Ok(());
         }
-        rx.take_wakeup()?;
-        while let Some(sample) = rx.receive()? {
+        rx.drain_pending(|l| {
             let taken = Instant::now();
-            let l = *sample.payload();
             if l.event == LifecycleEvent::Down as u8 {
                 let _ = downs.send((l.pid, taken));
             }
-        }
+        })?;
     }
     Ok(())
 }
@@ -254,30 +245,27 @@ fn kill_once(
     downs: &mpsc::Receiver<(u32, Instant)>,
 ) -> Result<(u64, u64, u64)> {
     wait_exec(child.pid())?;
-    let ws = transport.waitset()?;
-    let guard = ws
-        .attach_notification(child.exit_fd())
-        .map_err(|e| anyhow!("waitset: {e:?}"))?;
+    // No lost-wake-up re-check: an exit descriptor is not an iceoryx2 event, and a re-check
+    // would only end the wait early with nothing to show.
+    let waiter = transport.waiter()?.with_recheck(None);
+    let exit = child.watch(&waiter)?;
+    let exit_id = exit.id();
     let mut woke = None;
     let killed = Instant::now();
     child.signal(Signal::SIGKILL)?;
-    match ws.wait_and_process_once_with_timeout(
-        |id| {
-            if woke.is_none() && id.has_event_from(&guard) {
+    let deadline = killed + WAIT;
+    while woke.is_none() && Instant::now() < deadline {
+        let wake = waiter.wait_with(Some(deadline), |id| {
+            if woke.is_none() && id == exit_id {
                 woke = Some(Instant::now());
             }
-            CallbackProgression::Continue
-        },
-        WAIT,
-    ) {
-        Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
-            bail!("interrupted")
+        })?;
+        if wake == Wake::Stop {
+            bail!("interrupted");
         }
-        Ok(_) => {}
-        Err(e) => bail!("waitset: {e:?}"),
     }
     let woke = woke.ok_or_else(|| anyhow!("no exit of pid {} within {WAIT:?}", child.pid()))?;
-    drop(guard);
+    drop(exit);
     // What `hnav run` does on the wake-up: reap, then tell the others.
     match child.try_reap() {
         Some(ExitInfo::Signaled(Signal::SIGKILL)) => {}

@@ -5,15 +5,13 @@ use std::collections::HashMap;
 use std::ops::ControlFlow;
 use std::time::{Duration, Instant};
 
-use anyhow::{anyhow, bail, Result};
-use iceoryx2::prelude::CallbackProgression;
-use iceoryx2::waitset::{WaitSetAttachmentId, WaitSetRunResult};
+use anyhow::{bail, Result};
 
 use hnav_runtime::msg::{Candidate, CandidateFlags, Commit, Lifecycle, Role};
 use hnav_runtime::supervisor::child::Child;
 use hnav_runtime::supervisor::startup::SupervisorPorts;
 use hnav_runtime::topics;
-use hnav_runtime::transport::{Ipc, Receiver, RunId, Sender, Transport};
+use hnav_runtime::transport::{AttachmentId, Receiver, RunId, Sender, Transport, Wake};
 
 use super::layout::Layout;
 
@@ -122,7 +120,7 @@ impl Swarm {
 
     /// Plays up to `rounds` rounds from the next one on against the `coordinator` process:
     /// `before_send(round)`, every live agent's candidate (one `send` per agent, through its
-    /// own publisher), then a WaitSet wait until every live agent's subscriber has taken
+    /// own publisher), then a wait in the transport's `Waiter` until every live agent's subscriber has taken
     /// commit `round`; `after(obs)` may end early. Returns the rounds played. Fails if the
     /// coordinator exits or a round takes longer than 10 s.
     ///
@@ -141,24 +139,19 @@ impl Swarm {
         mut after: impl FnMut(&RoundObs) -> ControlFlow<()>,
     ) -> Result<u64> {
         let n = self.layout.agents();
-        let ws = self.transport.waitset()?;
-        let ws_err = |e: &dyn std::fmt::Debug| anyhow!("waitset: {e:?}");
-        let exit_guard = ws
-            .attach_notification(coordinator.exit_fd())
-            .map_err(|e| ws_err(&e))?;
-        let exit_id = WaitSetAttachmentId::from_guard(&exit_guard);
-        let mut guards = Vec::with_capacity(n);
-        let mut owner: HashMap<WaitSetAttachmentId<Ipc>, usize> = HashMap::with_capacity(n);
+        let waiter = self.transport.waiter()?;
+        let exit = coordinator.watch(&waiter)?;
+        let exit_id = exit.id();
+        let mut attached = Vec::with_capacity(n);
+        let mut owner: HashMap<AttachmentId, usize> = HashMap::with_capacity(n);
         for (i, rx) in self.rx.iter().enumerate() {
             if let Some(rx) = rx {
-                let g = ws
-                    .attach_notification(rx.listener())
-                    .map_err(|e| ws_err(&e))?;
-                owner.insert(WaitSetAttachmentId::from_guard(&g), i);
-                guards.push(g);
+                let a = waiter.attach(rx)?;
+                owner.insert(a.id(), i);
+                attached.push(a);
             }
         }
-        let live = guards.len();
+        let live = attached.len();
         let mut got: Vec<Option<(Instant, bool)>> = vec![None; n];
         let mut fired: Vec<usize> = Vec::with_capacity(n);
         let mut played = 0;
@@ -204,23 +197,21 @@ impl Swarm {
                 } else {
                     left
                 };
-                let r = ws.wait_and_process_once_with_timeout(
-                    |id| {
-                        if id == exit_id {
-                            coordinator_exited = true;
-                        } else if let Some(&i) = owner.get(&id) {
-                            fired.push(i);
-                        }
-                        CallbackProgression::Continue
-                    },
-                    wait,
-                );
-                match r {
-                    Ok(WaitSetRunResult::TerminationRequest | WaitSetRunResult::Interrupt) => {
-                        bail!("interrupted")
+                let wake = waiter.wait_with(Some(now + wait), |id| {
+                    if id == exit_id {
+                        coordinator_exited = true;
+                    } else if let Some(&i) = owner.get(&id) {
+                        fired.push(i);
                     }
-                    Ok(_) => {}
-                    Err(e) => return Err(ws_err(&e)),
+                })?;
+                match wake {
+                    Wake::Stop => bail!("interrupted"),
+                    // Nothing named: an interrupted wait or the waiter's lost-wake-up
+                    // re-check. Look at every receiver, or a lost wake-up stays lost.
+                    Wake::Data if fired.is_empty() && !coordinator_exited => {
+                        fired.extend(owner.values().copied());
+                    }
+                    Wake::Data | Wake::TimedOut => {}
                 }
                 if coordinator_exited {
                     let exit = coordinator.try_reap();
@@ -231,11 +222,8 @@ impl Swarm {
                 }
                 for &i in &fired {
                     let Some(rx) = &self.rx[i] else { continue };
-                    // Wake-up first, then the samples: nothing published before the
-                    // notification just consumed can be missed.
-                    rx.take_wakeup()?;
-                    while let Some(sample) = rx.receive()? {
-                        let c = sample.payload();
+                    let mut late = None;
+                    rx.drain_pending(|c| {
                         if c.round == round && got[i].is_none() {
                             let now = Instant::now();
                             let decided = c.decisions().iter().any(|d| d.agent as usize == i);
@@ -244,11 +232,11 @@ impl Swarm {
                             all_in = now;
                             missing -= 1;
                         } else if c.round > round {
-                            bail!(
-                                "agent {i} got commit {} while round {round} is open",
-                                c.round
-                            );
+                            late.get_or_insert(c.round);
                         }
+                    })?;
+                    if let Some(r) = late {
+                        bail!("agent {i} got commit {r} while round {round} is open");
                     }
                 }
             }

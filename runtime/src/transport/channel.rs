@@ -339,7 +339,7 @@ where
     }
 
     /// The listener behind the receiver (what a [`Waiter`](super::Waiter) attaches).
-    pub fn listener(&self) -> &Listener<Ipc> {
+    pub(crate) fn listener(&self) -> &Listener<Ipc> {
         &self.listener
     }
 

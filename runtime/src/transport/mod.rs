@@ -46,7 +46,7 @@ pub use node::{CleanupReport, NodeInfo, NodeLiveness, Transport, TransportBuilde
 pub use qos::{Delivery, Qos};
 pub use run::{purge_run, run_config, run_shm_files, RunId};
 pub use slice::{SliceLoan, SliceReceiver, SliceSender};
-pub use waiter::{stop_requested, Attachment, Waiter, Wake};
+pub use waiter::{stop_requested, Attachment, AttachmentId, Waiter, Wake};
 
 /// The iceoryx2 service variant HNAV uses between processes.
 pub type Ipc = iceoryx2::prelude::ipc::Service;

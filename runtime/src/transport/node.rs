@@ -6,8 +6,7 @@ use std::time::Duration;
 use iceoryx2::config::Config;
 use iceoryx2::node::{Node, NodeState, NodeView};
 use iceoryx2::prelude::{
-    CallbackProgression, NodeBuilder, NodeName, SignalHandlingMode, WaitSet, WaitSetBuilder,
-    ZeroCopySend,
+    CallbackProgression, NodeBuilder, NodeName, SignalHandlingMode, ZeroCopySend,
 };
 use iceoryx2::service::Service as _;
 
@@ -153,16 +152,6 @@ impl Transport {
     /// blocks in.
     pub fn waiter(&self) -> Result<Waiter, TransportError> {
         Waiter::create(self.run.as_str(), self.signals)
-    }
-
-    /// A raw iceoryx2 WaitSet with the same signal handling as the node, for code that must
-    /// tell its attachments apart (the benchmarks). Process loops use [`Transport::waiter`],
-    /// which also keeps a paused process running and bounds iceoryx2's lost wake-up.
-    pub fn waitset(&self) -> Result<WaitSet<Ipc>, TransportError> {
-        WaitSetBuilder::new()
-            .signal_handling_mode(self.signals)
-            .create::<Ipc>()
-            .map_err(|e| TransportError::ipc("create waitset", self.run.as_str(), e))
     }
 
     /// Every node of this run, alive or dead.

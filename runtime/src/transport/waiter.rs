@@ -131,6 +131,12 @@ pub enum Wake {
     Stop,
 }
 
+/// Names one [`Attachment`] of a [`Waiter`]: what [`Waiter::wait_with`] reports for each
+/// attachment that was signalled, to compare with [`Attachment::id`]. Only meaningful for the
+/// waiter that made it.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct AttachmentId(WaitSetAttachmentId<Ipc>);
+
 /// Something attached to a [`Waiter`]. Keep it alive as long as the waiter should watch it;
 /// dropping it detaches.
 #[must_use = "dropping an attachment detaches it at once"]
@@ -145,6 +151,13 @@ impl Debug for Attachment<'_, '_> {
         f.debug_struct("Attachment")
             .field("interval", &self.interval_of.is_some())
             .finish_non_exhaustive()
+    }
+}
+
+impl Attachment<'_, '_> {
+    /// The id [`Waiter::wait_with`] reports when this attachment is signalled.
+    pub fn id(&self) -> AttachmentId {
+        AttachmentId(WaitSetAttachmentId::from_guard(&self.guard))
     }
 }
 
@@ -285,6 +298,22 @@ impl Waiter {
     ///
     /// Errors when nothing is attached (the wait could never end) or iceoryx2's wait fails.
     pub fn wait(&self, deadline: Option<Instant>) -> Result<Wake, TransportError> {
+        self.wait_with(deadline, |_| {})
+    }
+
+    /// [`Waiter::wait`], calling `signalled` with the [`AttachmentId`] of every receiver or
+    /// descriptor that was signalled (intervals are not reported; they make the wait
+    /// [`Wake::TimedOut`]). For loops whose inputs are not interchangeable: a benchmark that
+    /// timestamps each receiver's wake-up, a supervisor that must know which child exited.
+    ///
+    /// A [`Wake::Data`] with no call means nothing was signalled (an interrupted wait or an
+    /// elapsed lost-wake-up re-check): a loop that only drains what was reported must then
+    /// drain every receiver, or a lost wake-up stays lost.
+    pub fn wait_with(
+        &self,
+        deadline: Option<Instant>,
+        mut signalled: impl FnMut(AttachmentId),
+    ) -> Result<Wake, TransportError> {
         if self.handle_signals && stop_requested() {
             return Ok(Wake::Stop);
         }
@@ -298,14 +327,15 @@ impl Waiter {
                 .min(r.unwrap_or(Duration::MAX))
                 .min(LONGEST_TIMED_SLEEP),
         };
-        let (mut signalled, mut ticked) = (false, false);
+        let (mut any_signalled, mut ticked) = (false, false);
         let intervals = self.intervals.borrow();
         let result = self.waitset.wait_and_process_once_with_timeout(
             |id| {
                 if intervals.contains(&id) {
                     ticked = true;
                 } else {
-                    signalled = true;
+                    any_signalled = true;
+                    signalled(AttachmentId(id));
                 }
                 CallbackProgression::Continue
             },
@@ -327,7 +357,7 @@ impl Waiter {
                 let deadline_passed = deadline.is_some_and(|d| Instant::now() >= d);
                 // Nothing signalled and nothing due is data too: the re-check (or the longest
                 // timed sleep) ended the wait.
-                Ok(if !signalled && (ticked || deadline_passed) {
+                Ok(if !any_signalled && (ticked || deadline_passed) {
                     Wake::TimedOut
                 } else {
                     Wake::Data
@@ -367,6 +397,35 @@ mod tests {
         let deadline = Instant::now() + Duration::from_secs(30);
         assert_eq!(waiter.wait(Some(deadline)).unwrap(), Wake::Data);
         assert!(child.wait().unwrap().success());
+    }
+
+    #[test]
+    fn wait_with_names_the_receiver_that_was_signalled() {
+        use crate::msg::{Lifecycle, Role};
+        use crate::transport::Qos;
+        let run = Run(RunId::unique("waitwith"));
+        let t = Transport::builder(&run.0)
+            .handle_signals(false)
+            .create()
+            .unwrap();
+        let quiet = t.receiver::<Lifecycle>("quiet", Qos::reliable(4)).unwrap();
+        let busy = t.receiver::<Lifecycle>("busy", Qos::reliable(4)).unwrap();
+        let tx = t.sender::<Lifecycle>("busy", Qos::reliable(4)).unwrap();
+        let waiter = t.waiter().unwrap().with_recheck(None);
+        let quiet_at = waiter.attach(&quiet).unwrap();
+        let busy_at = waiter.attach(&busy).unwrap();
+        assert_ne!(quiet_at.id(), busy_at.id());
+        // The sender's connection may already have signalled `busy`; consume that first.
+        busy.drain_pending(|_| {}).unwrap();
+        tx.send(Lifecycle::up(Role::Sim, 0)).unwrap();
+        let mut fired = Vec::new();
+        let deadline = Instant::now() + Duration::from_secs(30);
+        let wake = waiter
+            .wait_with(Some(deadline), |id| fired.push(id))
+            .unwrap();
+        assert_eq!(wake, Wake::Data);
+        assert_eq!(fired, vec![busy_at.id()]);
+        assert_eq!(busy.drain_pending(|_| {}).unwrap().samples, 1);
     }
 
     #[test]
