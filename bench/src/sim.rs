@@ -30,7 +30,7 @@ const MIN_SIDE: u32 = 9;
 
 /// Steps a world of `robots` default robots for about `seconds` of wall time and reports
 /// robot-steps per second. Robots start on every other cell of a free square grid (at least
-/// [`MIN_SIDE`] cells across) and drive
+/// `MIN_SIDE` cells across) and drive
 /// arcs of different curvature (slip noise off, collision checks on), with commands renewed
 /// every 10 ms of sim time as an agent would.
 pub fn robot_steps_per_second(robots: usize, seconds: f64) -> Result<BenchResult, SimError> {

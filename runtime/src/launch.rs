@@ -172,7 +172,7 @@ impl LifecyclePorts {
         Ok(())
     }
 
-    /// The receiver of the supervisor's events, to attach to a WaitSet.
+    /// The receiver of the supervisor's events, to attach to a `Waiter`.
     pub fn events(&self) -> &Receiver<Lifecycle> {
         &self.events
     }

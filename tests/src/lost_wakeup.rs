@@ -1,7 +1,7 @@
 //! The lost-wake-up reproducer: rounds of one sample from each of N senders to one receiver,
 //! which acks every round to all of them (the coordinator's round and its commit fan-out).
 //!
-//! The receiver blocks in a [`Waiter`] between samples. A wait that ends without being
+//! The receiver blocks in a [`Waiter`](hnav_runtime::transport::Waiter) between samples. A wait that ends without being
 //! signalled while a sample is pending is a *miss*: the sample was published and its
 //! notifier fired, yet the waiter slept. `tests/lost_wakeup.rs` runs both halves as
 //! separate processes through `hnav-test-peer` and reads the receiver's [`Report`].

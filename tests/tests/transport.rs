@@ -36,7 +36,7 @@ fn one_hundred_thousand_candidates_arrive_in_order_through_a_waitset() {
     };
     let received: u64 = report.split_whitespace().nth(1).unwrap().parse().unwrap();
     assert_eq!(received, count);
-    // The receiver only looks for samples when the WaitSet wakes it: every wake-up drains the
+    // The receiver only looks for samples when its `Waiter` wakes it: every wake-up drains the
     // queue, so wake-ups are at most one per sample and never far more than samples.
     let wakeups = field("wakeups=");
     assert!(wakeups >= 1 && wakeups <= count, "wakeups {wakeups}");

@@ -14,7 +14,7 @@
 //! - Payload: a `[u8]` slice service of `size` bytes with the [`Stamp`] user header. It is not
 //!   filled per iteration: we measure transfer, not memset.
 //! - Modes: [`Mode::Poll`] spins on `receive`; [`Mode::Event`] also notifies and the receiver
-//!   blocks in an iceoryx2 WaitSet, identically for raw iceoryx2 and HNAV.
+//!   blocks until woken: raw iceoryx2 in a WaitSet, HNAV in its `Waiter`.
 //!
 //! Results: `DIR/latency.csv` (iceoryx2 and hnav) and `DIR/latency-sockets.csv` (uds, tcp).
 
@@ -128,7 +128,7 @@ impl core::str::FromStr for TransportKind {
 pub enum Mode {
     /// Busy-loop on `receive` (the benchmark's explicit polling mode).
     Poll,
-    /// Block until woken: iceoryx2 WaitSet + listener, or a blocking socket read.
+    /// Block until woken: an iceoryx2 WaitSet (raw) or the HNAV `Waiter`, or a blocking socket read.
     Event,
 }
 

@@ -31,7 +31,7 @@ pub struct Summary {
     pub queries: usize,
     /// Queries where a path was found.
     pub found: usize,
-    /// Found paths whose length equals the optimal length within [`OPTIMAL_TOLERANCE`].
+    /// Found paths whose length equals the optimal length within `OPTIMAL_TOLERANCE`.
     pub optimal: usize,
     /// Mean of length / optimal over found paths with a positive optimal length.
     pub mean_ratio: f64,

@@ -3,13 +3,13 @@
 //!
 //! **Detection** (no coordinator process needed): a child (`sleep 60`) is spawned with the
 //! supervisor's own [`Child::spawn`] (its own process group, a pidfd exit descriptor), the
-//! descriptor is attached to a WaitSet, and the child is sent SIGKILL. Measured from just
+//! descriptor is attached to a `Waiter`, and the child is sent SIGKILL. Measured from just
 //! before `kill(2)`:
 //!
-//! - (a) the WaitSet wakes on the exit descriptor;
+//! - (a) the waiter wakes on the exit descriptor;
 //! - (b1) the supervisor's reaction is done: reaped (`try_reap`, as `hnav run` does) and
 //!   `Lifecycle::down` published on `lifecycle`;
-//! - (b2) a subscriber in another thread, blocked in its own WaitSet as the coordinator is,
+//! - (b2) a subscriber in another thread, blocked in its own `Waiter` as the coordinator is,
 //!   has taken that `Down` sample.
 //!
 //! Not included: the dead node's iceoryx2 clean-up (`hnav run` does it after publishing
@@ -71,7 +71,7 @@ pub fn run(
     for (measure, label, samples) in [
         (
             "kill_to_wake",
-            format!("(a) SIGKILL -> supervisor WaitSet wakes ({how})"),
+            format!("(a) SIGKILL -> supervisor's waiter wakes ({how})"),
             &det.wake,
         ),
         (
@@ -164,7 +164,7 @@ fn detection(trials: usize) -> Result<(WatchMode, Detection)> {
     Ok(out)
 }
 
-/// The coordinator's side: a `lifecycle` subscriber in a WaitSet; reports each `Down` with
+/// The coordinator's side: a `lifecycle` subscriber in a `Waiter`; reports each `Down` with
 /// the instant its sample was taken.
 fn listen(
     run: &RunId,

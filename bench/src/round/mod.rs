@@ -4,17 +4,17 @@
 //! ## Round latency
 //!
 //! For each swarm size and fsync policy: a scenario (an open 32 x 32 map, the agents of
-//! [`layout`], `[coordinator] fsync`, lockstep clock) is written to a temporary directory,
+//! `layout`, `[coordinator] fsync`, lockstep clock) is written to a temporary directory,
 //! the real `hnav-coordinator` next to this executable is started on it, and this process
 //! plays the supervisor's start-up handshake and all N agents: one candidate publisher and
 //! one commit subscriber per agent, as each real agent has.
 //!
 //! A round: every agent's candidate is sent through its own publisher; the clock starts just
 //! before the N-th `send` (publish + notify) is called; it stops when the last of the N commit
-//! subscribers has taken commit r, all N blocking in one WaitSet (no polling, no sleeps).
+//! subscribers has taken commit r, all N blocking in one `Waiter` (no polling, no sleeps).
 //! The time therefore includes: the last candidate's publish and notification, the
 //! coordinator's wake-up and reading of the candidates, the
-//! conflict resolution ([`layout`]'s rounds have real crossing conflicts, no global
+//! conflict resolution (`layout`'s rounds have real crossing conflicts, no global
 //! replans), encoding and appending the round to the consensus log plus its `fdatasync`
 //! under `every-record`, publishing the commit to N subscribers and notifying N listeners,
 //! and this thread's wake-up and N takes. It excludes the agents' own work (neural map,
@@ -29,7 +29,7 @@
 //!
 //! ## Faults
 //!
-//! See [`faults`]: SIGKILL -> exit-descriptor wake-up -> `Down` published -> `Down` taken by
+//! See `faults`: SIGKILL -> exit-descriptor wake-up -> `Down` published -> `Down` taken by
 //! another thread; `Restarted` -> the restarted agent's first decision.
 
 mod faults;

@@ -52,7 +52,7 @@ pub struct Session {
 }
 
 impl Session {
-    /// The coordinator process (its exit descriptor wakes a WaitSet when it dies).
+    /// The coordinator process (its exit descriptor wakes a `Waiter` when it dies).
     pub fn child(&self) -> &Child {
         &self.child
     }

@@ -5,9 +5,9 @@
 //! `round_deadline_ms` has passed since the round's first candidate (the missing agents count
 //! as standing still); in **lockstep** only liveness closes it (an agent the supervisor
 //! reports down stops being waited for), so a run's rounds do not depend on timing. Then:
-//! [`Arbiter::decide`], append the round (and its replans) to the consensus log, and only
-//! then publish the [`Commit`] — under the default fsync policy a commit an agent sees is
-//! already durable.
+//! [`Arbiter::decide`](crate::round::Arbiter::decide), append the round (and its replans) to
+//! the consensus log, and only then publish the [`Commit`](hnav_runtime::msg::Commit) — under
+//! the default fsync policy a commit an agent sees is already durable.
 //!
 //! **Restart.** On start the log in `DIR/log` is opened; a torn tail is cut off, the complete
 //! records are replayed: the last round number, the tallies and whether the run ended. The

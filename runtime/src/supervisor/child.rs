@@ -9,7 +9,7 @@
 //! of a restarted child stays in one place, in order.
 //!
 //! Its exit is reported by an [`ExitFd`] (a pidfd, see [`super::exit_fd`]) that an iceoryx2
-//! WaitSet can block on next to the run's topics: no timer, no polling of `waitpid`.
+//! `Waiter` can block on next to the run's topics: no timer, no polling of `waitpid`.
 //!
 //! Reaping is explicit ([`Child::try_reap`]) and happens exactly once; afterwards the child is
 //! never signalled again, because its pid may already belong to an unrelated process. A
@@ -172,7 +172,7 @@ impl core::fmt::Display for ExitInfo {
     }
 }
 
-/// A started child process. Its methods take `&self`, so a WaitSet guard on
+/// A started child process. Its methods take `&self`, so a waiter attachment on
 /// [`Child::exit_fd`] can stay attached while the child is signalled or reaped.
 #[derive(Debug)]
 pub struct Child {
@@ -270,7 +270,7 @@ impl Child {
         self.started
     }
 
-    /// The descriptor that becomes readable when the child exits; attach it to a WaitSet
+    /// The descriptor that becomes readable when the child exits; attach it to a `Waiter`
     /// with `attach_notification`, and drop the guard once the exit is handled (it stays
     /// readable).
     pub fn exit_fd(&self) -> &ExitFd {

@@ -1,7 +1,7 @@
 //! A file descriptor that becomes readable the instant a child process exits.
 //!
-//! The supervisor already sleeps in an iceoryx2 [`WaitSet`](iceoryx2::prelude::WaitSet) for
-//! lifecycle messages; a child's exit must wake that same wait, or the supervisor would have
+//! The supervisor already sleeps in its [`Waiter`](crate::transport::Waiter) (iceoryx2's
+//! `WaitSet` underneath) for lifecycle messages; a child's exit must wake that same wait, or the supervisor would have
 //! to poll `waitpid` on a timer (late by up to a tick, and awake for nothing in between).
 //! The WaitSet multiplexes anything that is [`SynchronousMultiplexing`], so an [`ExitFd`]
 //! implements that trait around one of two descriptors:
@@ -19,7 +19,7 @@
 //!
 //! Both stay readable once the child has exited (the pipe keeps reporting end-of-file, the
 //! pidfd keeps reporting the exit): level-triggered, so a wake-up is never lost, but a
-//! WaitSet guard must be dropped once its child is handled or every wait returns at once.
+//! waiter attachment must be dropped once its child is handled or every wait returns at once.
 
 use std::io;
 use std::os::fd::{FromRawFd, IntoRawFd, OwnedFd, RawFd};
@@ -42,8 +42,8 @@ pub enum WatchMode {
     WaiterThread,
 }
 
-/// Readable once the watched child has exited; attach it to a WaitSet with
-/// `waitset.attach_notification(child.exit_fd())`.
+/// Readable once the watched child has exited; a [`Waiter`](crate::transport::Waiter) watches
+/// it through [`Child::watch`](super::child::Child::watch).
 #[derive(Debug)]
 pub struct ExitFd {
     fd: FileDescriptor,

@@ -10,7 +10,7 @@
 //! | module | what it holds |
 //! |---|---|
 //! | [`child`] | one child process: spawn in its own process group with an appended log, reap, describe its exit, signal it or its group |
-//! | [`exit_fd`] | the pidfd (or waiter-thread pipe) that makes a child's exit wake an iceoryx2 WaitSet |
+//! | [`exit_fd`] | the pidfd (or waiter-thread pipe) that makes a child's exit wake the supervisor's `Waiter` |
 //! | [`restart`] | per-child restart decisions: policy, cap, doubling backoff |
 //! | [`stop`] | the escalating stop of a run's children: wait, SIGTERM, SIGKILL, reap |
 //! | [`registry`] | the on-disk list of live runs and their processes that `hnav ps` reads |

@@ -7,7 +7,7 @@
 //! The doubling is capped (by default at [`DEFAULT_BACKOFF_CAP`]) so a late restart is not
 //! delayed for minutes.
 //!
-//! The tracker only decides; the supervisor waits (a WaitSet deadline, not a sleep) and
+//! The tracker only decides; the supervisor waits (a `Waiter` deadline, not a sleep) and
 //! respawns.
 
 use std::time::Duration;

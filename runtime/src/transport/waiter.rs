@@ -197,9 +197,9 @@ impl Waiter {
     /// The longest one [`Waiter::wait`] sleeps with nothing signalled before it returns
     /// [`Wake::Data`] so that the loop looks at its inputs again.
     ///
-    /// A bound on iceoryx2 0.10's lost wake-up (see the [module docs](self)), not a timer:
-    /// lockstep loops wait on data, never on time, so re-checking changes no decision; it
-    /// only bounds a stall (`hnav-bench round` saw one in about 5 000 rounds at 128 agents)
+    /// A bound on iceoryx2 0.10's lost wake-up (see the `transport::waiter` module docs), not
+    /// a timer: lockstep loops wait on data, never on time, so re-checking changes no
+    /// decision; it only bounds a stall (`hnav-bench round` saw one in about 5 000 rounds at 128 agents)
     /// to this long.
     pub const LOST_WAKEUP_RECHECK: Duration = Duration::from_millis(50);
 

@@ -7,7 +7,7 @@
 //!    process group with its output in `DIR/logs/<node>.log`, and wait until every one has
 //!    announced itself on `ready`; then publish `Start` (see [`crate::launch`] and
 //!    [`super::startup`]).
-//! 3. Watch: block in a WaitSet on the children's exit descriptors (a child's death wakes it
+//! 3. Watch: block in a `Waiter` on the children's exit descriptors (a child's death wakes it
 //!    at once) with a short tick for the progress bar and the fault schedule. A dead child is
 //!    reaped, its stale iceoryx2 resources removed (which wakes its peers with a "peer dead"
 //!    event), the others told on the lifecycle topic, and it is restarted under its role's

@@ -24,7 +24,7 @@ struct Slot {
     restart_at: Option<Instant>,
     /// Restarted, `Restarted` not yet announced: that waits until the new process is up, so
     /// that peers reacting to it (the sim resends odometry) find its ports. A `Cell`, because
-    /// the slots stay borrowed by the WaitSet's guards on the children's exit descriptors
+    /// the slots stay borrowed by the waiter's attachments on the children's exit descriptors
     /// while `Up`s are taken.
     announce: Cell<bool>,
 }
