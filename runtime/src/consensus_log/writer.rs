@@ -42,7 +42,7 @@ use std::time::{Duration, Instant};
 
 use super::error::LogError;
 use super::frame::{encode_frame, MAGIC};
-use super::reader::{check_header, read_log, RecordPos, TornTail};
+use super::reader::{check_header, read_log, LogContents, RecordPos, TornTail};
 use super::record::Record;
 use super::segment::{list_segments, segment_path, DEFAULT_SEGMENT_BYTES};
 use crate::scenario::FsyncPolicy;
@@ -142,20 +142,21 @@ impl LogWriter {
             return Ok((writer, recovered));
         };
         let contents = read_log(&dir)?;
+        let last = drop_empty_last_segment(&dir, &segments, &contents, syncing)?;
         let path = segments[last].clone();
         let mut file = OpenOptions::new()
             .append(true)
             .open(&path)
             .map_err(|e| LogError::io(&path, e))?;
-        let mut truncated_bytes = 0;
-        if let Some(torn) = &contents.torn {
+        // A torn tail of a dropped segment went with its file.
+        let truncated_bytes = contents.torn.as_ref().map_or(0, |t| t.bytes);
+        if let Some(torn) = contents.torn.as_ref().filter(|t| t.segment as usize == last) {
             let io = |e| LogError::io(&path, e);
             file.set_len(torn.offset).map_err(io)?;
             if torn.offset < MAGIC_LEN {
                 file.write_all(&MAGIC).map_err(io)?;
             }
             file.sync_all().map_err(io)?;
-            truncated_bytes = torn.bytes;
         }
         let len = file.metadata().map_err(|e| LogError::io(&path, e))?.len();
         let records = contents.records.len() as u64;
@@ -320,6 +321,36 @@ impl Drop for LogWriter {
             let _ = self.sync_file();
         }
     }
+}
+
+/// Removes the last segment if it holds no complete record and is not the first one (a crash
+/// between creating it and writing the record it was made for); returns the index of the
+/// segment to append to.
+///
+/// Appending goes on in the segment before it, so the next append decides again whether to
+/// roll over. That keeps the writer's rule that a segment ends only when the next segment's
+/// first record would not have fitted, which is what [`verify`](super::verify()) checks to
+/// find records missing at the end of a segment: after a restart the first record appended
+/// is often not the one the segment was created for.
+fn drop_empty_last_segment(
+    dir: &Path,
+    segments: &[PathBuf],
+    contents: &LogContents,
+    syncing: bool,
+) -> Result<usize, LogError> {
+    let last = segments.len() - 1;
+    let holds_records = contents
+        .positions
+        .last()
+        .is_some_and(|p| p.segment as usize == last);
+    if last == 0 || holds_records {
+        return Ok(last);
+    }
+    std::fs::remove_file(&segments[last]).map_err(|e| LogError::io(&segments[last], e))?;
+    if syncing {
+        sync_dir(dir)?;
+    }
+    Ok(last - 1)
 }
 
 /// Creates a segment holding only the magic; with `syncing`, syncs it and the directory.

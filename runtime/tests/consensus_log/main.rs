@@ -9,5 +9,6 @@
 mod cli;
 mod fixtures;
 mod format;
+mod lost;
 mod summary;
 mod writer;

@@ -97,16 +97,28 @@ fn a_torn_segment_magic_is_rewritten_and_corruption_is_refused() {
         .all(|s| fs::metadata(s).unwrap().len() <= 200));
     assert_intact(tmp.path());
 
-    // A crash right after creating the next segment leaves it (nearly) empty.
+    // A crash right after creating the next segment leaves it (nearly) empty: the writer
+    // removes it and goes on in the segment before, which still has room for the record
+    // appended after the restart.
+    let last = segment_path(tmp.path(), log.segments.len() as u32 - 1);
+    let last_len = fs::metadata(&last).unwrap().len();
     let next = segment_path(tmp.path(), log.segments.len() as u32);
     fs::write(&next, &MAGIC[..5]).unwrap();
     {
         let (mut w, rec) = LogWriter::open_with(tmp.path(), opts).unwrap();
         assert_eq!((rec.records.len(), rec.truncated_bytes), (records.len(), 5));
         w.append(&round(21, 2)).unwrap();
+        assert_eq!(w.segment() as usize, log.segments.len() - 1);
     }
     assert_intact(tmp.path());
-    assert_eq!(fs::read(&next).unwrap()[..8], MAGIC);
+    assert!(!next.exists(), "the empty segment is gone");
+    assert!(fs::metadata(&last).unwrap().len() > last_len);
+
+    // Only the magic (the crash came after it was written): the same.
+    fs::write(&next, MAGIC).unwrap();
+    let (_, rec) = LogWriter::open_with(tmp.path(), opts).unwrap();
+    assert_eq!(rec.records.len(), records.len() + 1);
+    assert!(!next.exists(), "the empty segment is gone");
 
     // Damage before the last complete record: open fails and changes nothing.
     let first = segment_path(tmp.path(), 0);

@@ -1,21 +1,32 @@
 //! [`verify`]: read a whole log and report whether it is intact. Never modifies a file.
 //!
-//! A log is intact when it has no corruption and no torn tail, its first record is a header
-//! (of this build's [`FORMAT_VERSION`](super::FORMAT_VERSION)) and no other record is one,
-//! the rounds of its round records strictly increase, it has at most one end record, and
-//! every agent index in it is below the header's agent count and every verdict is known.
+//! A log is intact when
+//! - it has no corruption and no torn tail, and every segment but the last ends on a record
+//!   boundary (the reader's rules);
+//! - its first record is a header (of this build's [`FORMAT_VERSION`](super::FORMAT_VERSION))
+//!   and no other record is one;
+//! - its round records count up from round 1 without a gap, and every other record belongs to
+//!   the round the coordinator writes it at (`order`), so a lost round record is named;
+//! - no segment but the last lost complete records at its end (`segments`);
+//! - it has at most one end record, nothing follows it, and it closes at the last round;
+//! - every agent index in it is below the header's agent count and every verdict is known.
+//!
+//! A log without an end record is intact but *not closed* ([`VerifyReport::is_closed`]): the
+//! run was cut short (a crash of the whole run, a kill of the supervisor) or is still going.
+//! That is a different finding from a damaged log, so it does not change the status.
+
+mod order;
+mod segments;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::error::LogError;
-use super::reader::{LogReader, RecordPos, TornTail};
+use super::reader::{LogReader, TornTail};
 use super::record::{EndRecord, Record};
 use super::segment::segment_name;
-use crate::msg::Verdict;
-
-/// At most this many order problems are listed; the rest are counted.
-const MAX_LISTED: usize = 20;
+use order::OrderCheck;
+use segments::SegmentCheck;
 
 /// Records of each kind.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -95,6 +106,12 @@ impl VerifyReport {
         self.end.is_some()
     }
 
+    /// Whether the run's log was closed by an end record (an intact log without one belongs
+    /// to a run that was cut short or is still going).
+    pub fn is_closed(&self) -> bool {
+        self.has_end()
+    }
+
     /// A short multi-line report.
     pub fn render(&self) -> String {
         let mut s = String::new();
@@ -124,13 +141,19 @@ impl VerifyReport {
                     e.round, e.at_goal
                 )
             }
-            None => _ = writeln!(s, "end        none"),
+            None => {
+                _ = writeln!(
+                    s,
+                    "end        none: not closed (the run was cut short or is still going)"
+                )
+            }
         }
         match &self.torn {
             Some(t) => _ = writeln!(s, "torn tail  {} bytes at {}", t.bytes, torn_place(t)),
             None => _ = writeln!(s, "torn tail  none"),
         }
         let status = match self.status() {
+            VerifyStatus::Intact if !self.is_closed() => "intact, not closed",
             VerifyStatus::Intact => "intact",
             VerifyStatus::NotIntact => "NOT INTACT",
             VerifyStatus::Unreadable => "UNREADABLE",
@@ -177,6 +200,7 @@ pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
     };
     report.segments = reader.segments().len();
     let mut order = OrderCheck::default();
+    let mut spans = SegmentCheck::default();
     let mut last_segment = None;
     loop {
         match reader.next_record() {
@@ -186,6 +210,7 @@ pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
                     last_segment = Some(pos.segment);
                 }
                 report.bytes += pos.len;
+                spans.record(pos);
                 order.check(&mut report, pos, &record);
             }
             Ok(None) => break,
@@ -202,8 +227,12 @@ pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
             .push(format!("torn tail: {} bytes at {}", t.bytes, torn_place(t)));
         report.torn = Some(t.clone());
     }
-    if report.error.is_none() && report.counts.header == 0 {
-        report.problems.push("no complete header record".into());
+    if report.error.is_none() {
+        if report.counts.header == 0 {
+            report.problems.push("no complete header record".into());
+        }
+        let segments = report.segments;
+        spans.finish(&mut report, segments);
     }
     if order.unlisted > 0 {
         report
@@ -211,73 +240,4 @@ pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
             .push(format!("... and {} more order problems", order.unlisted));
     }
     report
-}
-
-#[derive(Default)]
-struct OrderCheck {
-    agents: Option<usize>,
-    listed: usize,
-    unlisted: usize,
-}
-
-impl OrderCheck {
-    fn problem(&mut self, report: &mut VerifyReport, pos: RecordPos, what: String) {
-        if self.listed < MAX_LISTED {
-            self.listed += 1;
-            let at = format!("{} byte {}", segment_name(pos.segment), pos.offset);
-            report.problems.push(format!("{at}: {what}"));
-        } else {
-            self.unlisted += 1;
-        }
-    }
-
-    fn agent(&mut self, report: &mut VerifyReport, pos: RecordPos, agent: u32) {
-        if let Some(n) = self.agents {
-            if agent as usize >= n {
-                self.problem(report, pos, format!("agent {agent} of a run of {n} agents"));
-            }
-        }
-    }
-
-    fn check(&mut self, report: &mut VerifyReport, pos: RecordPos, record: &Record) {
-        match record {
-            Record::Header(h) => {
-                report.counts.header += 1;
-                if report.counts.header > 1 {
-                    self.problem(report, pos, "a second header record".into());
-                } else {
-                    self.agents = Some(h.agents.len());
-                }
-            }
-            Record::Round(r) => {
-                report.counts.round += 1;
-                if let Some(prev) = report.last_round.filter(|&p| r.round <= p) {
-                    let what = format!("round {} after round {prev}", r.round);
-                    self.problem(report, pos, what);
-                }
-                report.first_round.get_or_insert(r.round);
-                report.last_round = Some(r.round);
-                for d in &r.decisions {
-                    self.agent(report, pos, d.agent);
-                    if Verdict::from_u8(d.verdict).is_none() {
-                        let what = format!("agent {}: unknown verdict {}", d.agent, d.verdict);
-                        self.problem(report, pos, what);
-                    }
-                }
-            }
-            Record::Lifecycle(_) => report.counts.lifecycle += 1,
-            Record::Replan(r) => {
-                report.counts.replan += 1;
-                self.agent(report, pos, r.agent);
-            }
-            Record::End(e) => {
-                report.counts.end += 1;
-                if report.end.is_some() {
-                    self.problem(report, pos, "a second end record".into());
-                } else {
-                    report.end = Some(*e);
-                }
-            }
-        }
-    }
 }

@@ -1,0 +1,126 @@
+//! The record-order rules of [`verify`](super::verify): one header first, rounds counting up
+//! from 1 without a gap, every other record at the round the coordinator writes it at, and
+//! nothing after the end record.
+//!
+//! The coordinator (`coordinator::process::state`) writes a replan record for round `n + 1`
+//! just before the round record `n + 1`, and a lifecycle or end record at the last round it
+//! logged (`n`, 0 before the first round). A restarted coordinator resumes from the last
+//! round record, so a round decided twice (replans logged, then a crash before the round
+//! record) repeats only its replan records. These rules are what lets a lost record show: a
+//! round record removed from the middle of a segment leaves a gap, and records lost at the
+//! end of one segment leave a gap before the next segment's first round.
+
+use super::VerifyReport;
+use crate::consensus_log::reader::RecordPos;
+use crate::consensus_log::record::Record;
+use crate::consensus_log::segment::segment_name;
+use crate::msg::Verdict;
+
+/// At most this many order problems are listed; the rest are counted.
+const MAX_LISTED: usize = 20;
+
+/// The running state of the order rules over the records read so far.
+#[derive(Default)]
+pub(super) struct OrderCheck {
+    agents: Option<usize>,
+    listed: usize,
+    /// Problems found beyond [`MAX_LISTED`].
+    pub unlisted: usize,
+    end_seen: bool,
+}
+
+impl OrderCheck {
+    fn problem(&mut self, report: &mut VerifyReport, pos: RecordPos, what: String) {
+        if self.listed < MAX_LISTED {
+            self.listed += 1;
+            let at = format!("{} byte {}", segment_name(pos.segment), pos.offset);
+            report.problems.push(format!("{at}: {what}"));
+        } else {
+            self.unlisted += 1;
+        }
+    }
+
+    fn agent(&mut self, report: &mut VerifyReport, pos: RecordPos, agent: u32) {
+        if let Some(n) = self.agents {
+            if agent as usize >= n {
+                self.problem(report, pos, format!("agent {agent} of a run of {n} agents"));
+            }
+        }
+    }
+
+    /// A record other than a round must belong to `expected`, the round it is written at.
+    fn at_round(&mut self, report: &mut VerifyReport, pos: RecordPos, record: &Record, expected: u64) {
+        let Some(round) = record.round().filter(|&r| r != expected) else {
+            return;
+        };
+        let last = report.last_round.unwrap_or(0);
+        let what = format!(
+            "{} record for round {round}, but the last round logged before it is {last} \
+             (expected round {expected})",
+            record.kind()
+        );
+        self.problem(report, pos, what);
+    }
+
+    /// Applies the rules to the next record and counts it.
+    pub(super) fn check(&mut self, report: &mut VerifyReport, pos: RecordPos, record: &Record) {
+        if self.end_seen && !matches!(record, Record::End(_)) {
+            let what = format!("{} record after the end record", record.kind());
+            self.problem(report, pos, what);
+        }
+        let last = report.last_round.unwrap_or(0);
+        match record {
+            Record::Header(h) => {
+                report.counts.header += 1;
+                if report.counts.header > 1 {
+                    self.problem(report, pos, "a second header record".into());
+                } else {
+                    self.agents = Some(h.agents.len());
+                }
+            }
+            Record::Round(r) => {
+                report.counts.round += 1;
+                if let Some(prev) = report.last_round.filter(|&p| r.round <= p) {
+                    let what = format!("round {} after round {prev}", r.round);
+                    self.problem(report, pos, what);
+                } else if r.round > last + 1 {
+                    let missing = if r.round == last + 2 {
+                        format!("round {} is missing", last + 1)
+                    } else {
+                        format!("rounds {} to {} are missing", last + 1, r.round - 1)
+                    };
+                    let what = format!("{missing} (round {} follows round {last})", r.round);
+                    self.problem(report, pos, what);
+                }
+                report.first_round.get_or_insert(r.round);
+                report.last_round = Some(r.round);
+                for d in &r.decisions {
+                    self.agent(report, pos, d.agent);
+                    if Verdict::from_u8(d.verdict).is_none() {
+                        let what = format!("agent {}: unknown verdict {}", d.agent, d.verdict);
+                        self.problem(report, pos, what);
+                    }
+                }
+            }
+            Record::Lifecycle(_) => {
+                report.counts.lifecycle += 1;
+                self.at_round(report, pos, record, last);
+            }
+            Record::Replan(r) => {
+                report.counts.replan += 1;
+                self.agent(report, pos, r.agent);
+                self.at_round(report, pos, record, last + 1);
+            }
+            Record::End(e) => {
+                report.counts.end += 1;
+                if report.end.is_some() {
+                    self.problem(report, pos, "a second end record".into());
+                } else {
+                    report.end = Some(*e);
+                    self.at_round(report, pos, record, last);
+                }
+                self.end_seen = true;
+            }
+        }
+    }
+}
