@@ -129,7 +129,7 @@ impl LogWriter {
             }
         }
         let segments = list_segments(&dir)?;
-        let Some(last) = segments.len().checked_sub(1) else {
+        if segments.is_empty() {
             let path = segment_path(&dir, 0);
             let file = create_segment(&path, &dir, syncing)?;
             let writer = Self::new(dir, options, file, path, 0, MAGIC_LEN, 0);
@@ -140,7 +140,7 @@ impl LogWriter {
                 torn: None,
             };
             return Ok((writer, recovered));
-        };
+        }
         let contents = read_log(&dir)?;
         let last = drop_empty_last_segment(&dir, &segments, &contents, syncing)?;
         let path = segments[last].clone();
@@ -150,7 +150,11 @@ impl LogWriter {
             .map_err(|e| LogError::io(&path, e))?;
         // A torn tail of a dropped segment went with its file.
         let truncated_bytes = contents.torn.as_ref().map_or(0, |t| t.bytes);
-        if let Some(torn) = contents.torn.as_ref().filter(|t| t.segment as usize == last) {
+        if let Some(torn) = contents
+            .torn
+            .as_ref()
+            .filter(|t| t.segment as usize == last)
+        {
             let io = |e| LogError::io(&path, e);
             file.set_len(torn.offset).map_err(io)?;
             if torn.offset < MAGIC_LEN {

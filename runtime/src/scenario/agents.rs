@@ -12,6 +12,7 @@ use super::error::{Loc, ScenarioError};
 use super::{AgentSpec, FaultTarget, Scenario};
 use crate::grid::{reachable_from, Cell, Grid};
 use crate::hash::SplitMix64;
+use crate::msg::MAX_AGENTS;
 
 /// Connected-component label of every free cell (`u32::MAX` for blocked cells).
 fn components(grid: &Grid, rule: crate::grid::CornerCutting) -> Vec<u32> {
@@ -40,6 +41,13 @@ pub(super) fn with_agent_count(
     let at = Loc::new(&s.source_name, 0);
     if n == 0 {
         return Err(ScenarioError::NoAgents { at });
+    }
+    if n > MAX_AGENTS {
+        return Err(ScenarioError::TooManyAgents {
+            at,
+            agents: n,
+            max: MAX_AGENTS,
+        });
     }
     let mut out = s.clone();
     if n <= s.agents.len() {

@@ -10,9 +10,10 @@ use super::build_params::{build_coordinator, build_restart, build_robot, build_s
 use super::error::{Loc, ScenarioError};
 use super::lines::{toml_error, Lines};
 use super::raw::{RawMap, RawScenario};
-use super::validate::{build_agent, build_fault, check_agent, Seen};
+use super::validate::{build_agent, build_fault, check_agent, check_reachable, Seen};
 use super::{MapSpec, Scenario};
 use crate::grid::{read_map_file, read_map_rows, CornerCutting, GridError};
+use crate::msg::MAX_AGENTS;
 
 /// Parses and validates a scenario.
 pub(super) fn parse(
@@ -32,12 +33,25 @@ pub(super) fn parse(
             at: Loc::new(source_name, 1),
         });
     }
+    if let Some(extra) = raw.agents.get(MAX_AGENTS) {
+        return Err(ScenarioError::TooManyAgents {
+            at: lines.at(extra),
+            agents: raw.agents.len(),
+            max: MAX_AGENTS,
+        });
+    }
+    let allow_unreachable = raw.allow_unreachable.unwrap_or(false);
     let mut agents = Vec::with_capacity(raw.agents.len());
+    let mut goal_locs = Vec::with_capacity(raw.agents.len());
     let mut seen = Seen::default();
     for (i, a) in raw.agents.iter().enumerate() {
         let (spec, at) = build_agent(i, a, &map.grid, &lines)?;
         check_agent(i, &spec, &at, &map.grid, &robot, &mut seen)?;
         agents.push(spec);
+        goal_locs.push(at.goal);
+    }
+    if !allow_unreachable {
+        check_reachable(&agents, &map, |i| goal_locs[i].clone())?;
     }
     let mut faults = Vec::with_capacity(raw.faults.len());
     for (i, f) in raw.faults.iter().enumerate() {
@@ -53,6 +67,7 @@ pub(super) fn parse(
         restart,
         agents,
         faults,
+        allow_unreachable,
     })
 }
 

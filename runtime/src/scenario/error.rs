@@ -264,6 +264,35 @@ pub enum ScenarioError {
         /// What is wrong.
         problem: String,
     },
+    /// More agents than a run can carry: the round and truth messages have room for
+    /// [`MAX_AGENTS`](crate::msg::MAX_AGENTS).
+    #[error(
+        "{at}: {agents} agents, but a run holds at most {max} (the limit of its message format)"
+    )]
+    TooManyAgents {
+        /// The first agent beyond the limit, or the scenario for a requested agent count.
+        at: Loc,
+        /// Agents in the scenario or requested.
+        agents: usize,
+        /// The limit.
+        max: usize,
+    },
+    /// An agent's goal cannot be reached from its start, walls and the corner-cutting rule
+    /// considered, and the scenario does not say `allow_unreachable = true`.
+    #[error(
+        "{at}: agent {agent}: goal {goal} is unreachable from start {start} \
+         (write allow_unreachable = true at the top of the scenario to run it anyway)"
+    )]
+    UnreachableGoal {
+        /// The agent's goal.
+        at: Loc,
+        /// Agent number.
+        agent: usize,
+        /// Start cell.
+        start: Cell,
+        /// Goal cell.
+        goal: Cell,
+    },
     /// [`crate::scenario::Scenario::with_agent_count`] could not place enough agents.
     #[error("{at}: cannot place {requested} agents: only {placed} distinct start/goal pairs fit the map")]
     NotEnoughFreeCells {
@@ -311,6 +340,8 @@ impl ScenarioError {
             | BadPriority { at, .. }
             | FaultAgentOutOfRange { at, .. }
             | BadFault { at, .. }
+            | TooManyAgents { at, .. }
+            | UnreachableGoal { at, .. }
             | NotEnoughFreeCells { at, .. } => at,
         };
         (at.line > 0).then_some(at.line)

@@ -10,6 +10,9 @@
 //! * every agent (start, goal, speed, priority, start heading) in order, and every fault in
 //!   order.
 //!
+//! * `allow_unreachable`, only when it is `true` (appended last), so that the hash of every
+//!   scenario without the key, and every log written before it existed, stays the same.
+//!
 //! It does **not** cover the scenario `name`, the source file name, or the map file's path
 //! (only the map's content), so renaming or moving files keeps the hash.
 //!
@@ -125,6 +128,9 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
             FaultSignal::Kill => 9,
             FaultSignal::Term => 15,
         });
+    }
+    if s.allow_unreachable {
+        h.bytes(b"allow_unreachable");
     }
     h.finish()
 }

@@ -4,6 +4,8 @@
 //!
 //! ```toml
 //! name = "demo"                        # required; names the output directory
+//! allow_unreachable = false            # optional, top level: run even if a goal cannot be
+//!                                      # reached from its start (default: refuse the scenario)
 //!
 //! [map]                                # exactly one of `file` and `rows`
 //! file = "../maps/random-32-32-10.map" # MovingAI .map, relative to the scenario file
@@ -65,7 +67,8 @@
 //! Unknown keys are errors (a typo must not silently fall back to a default). Every semantic
 //! error names the file and line and has its own [`ScenarioError`] variant: a speed that is
 //! not positive, a start or goal outside the map or on an obstacle, two agents sharing a start
-//! or a goal, no agents, both or neither of `map.file`/`map.rows`, a fault naming a missing
+//! or a goal, no agents, more than [`MAX_AGENTS`](crate::msg::MAX_AGENTS) agents, a goal that
+//! cannot be reached from its start (unless `allow_unreachable = true`), both or neither of `map.file`/`map.rows`, a fault naming a missing
 //! agent, and malformed map files (wrapping [`crate::grid::GridError`]).
 //!
 //! # Example
@@ -235,6 +238,9 @@ pub struct Scenario {
     pub agents: Vec<AgentSpec>,
     /// The fault plan.
     pub faults: Vec<FaultSpec>,
+    /// Whether a goal that cannot be reached from its start is accepted (the agent then
+    /// reports it in the run) instead of refused ([`ScenarioError::UnreachableGoal`]).
+    pub allow_unreachable: bool,
 }
 
 impl Scenario {

@@ -16,6 +16,7 @@ use super::params::{ClockMode, FsyncPolicy, RestartPolicy};
 #[serde(deny_unknown_fields)]
 pub(super) struct RawScenario {
     pub name: Spanned<String>,
+    pub allow_unreachable: Option<bool>,
     pub map: Spanned<RawMap>,
     pub robot: Option<RawRobot>,
     pub sim: Option<RawSim>,

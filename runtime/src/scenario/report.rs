@@ -90,7 +90,8 @@ impl ScenarioReport {
                 let shortest = octile_shortest_path_len(g, a.start, a.goal, rule);
                 if shortest.is_none() {
                     warnings.push(format!(
-                        "agent {index}: goal {} is unreachable from start {}",
+                        "agent {index}: goal {} is unreachable from start {} (allowed by \
+                         allow_unreachable = true: the agent will report it and stand still)",
                         a.goal, a.start
                     ));
                 }

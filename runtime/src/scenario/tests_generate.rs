@@ -125,3 +125,47 @@ fn report_lists_agents() {
     assert_eq!(json["agents"][1]["goal"], serde_json::json!([0, 3]));
     assert_eq!(json["scenario_hash"].as_str().map(str::len), Some(16));
 }
+
+#[test]
+fn allow_unreachable_counts_in_the_hash_only_when_set() {
+    let a = parse(BASE).unwrap();
+    assert!(!a.allow_unreachable);
+    let b = parse(&format!("allow_unreachable = false\n{BASE}")).unwrap();
+    assert_eq!(a.scenario_hash(), b.scenario_hash(), "false is the default");
+    let c = parse(&format!("allow_unreachable = true\n{BASE}")).unwrap();
+    assert!(c.allow_unreachable);
+    assert_ne!(a.scenario_hash(), c.scenario_hash());
+}
+
+#[test]
+fn validate_refuses_unreachable_goals_and_too_many_agents() {
+    let mut s = parse(BASE).unwrap();
+    // Wall agent 0's goal (5, 3) in: (4, 3) and (5, 2) are its only free neighbours.
+    s.map.grid.set_blocked(Cell::new(4, 3), true);
+    s.map.grid.set_blocked(Cell::new(5, 2), true);
+    s.map.grid.set_blocked(Cell::new(4, 2), true);
+    let e = s.validate().unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "t.toml: agent 0: goal (5, 3) is unreachable from start (0, 0) (write \
+         allow_unreachable = true at the top of the scenario to run it anyway)"
+    );
+    s.allow_unreachable = true;
+    assert!(s.validate().is_ok());
+
+    let s = parse(BASE).unwrap();
+    let e = s
+        .with_agent_count(crate::msg::MAX_AGENTS + 1, 0)
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ScenarioError::TooManyAgents {
+                agents: 257,
+                max: 256,
+                ..
+            }
+        ),
+        "{e}"
+    );
+}

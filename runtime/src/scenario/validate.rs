@@ -9,8 +9,9 @@ use super::error::{Loc, ScenarioError};
 use super::lines::Lines;
 use super::params::RobotParams;
 use super::raw::{RawAgent, RawFault, RawFaultAction, RawRole};
-use super::{AgentSpec, FaultAction, FaultSignal, FaultSpec, FaultTarget, Scenario};
-use crate::grid::{Cell, Endpoint, Grid};
+use super::{AgentSpec, FaultAction, FaultSignal, FaultSpec, FaultTarget, MapSpec, Scenario};
+use crate::grid::{reachable_from, Cell, Endpoint, Grid};
+use crate::msg::MAX_AGENTS;
 
 /// Lines of one agent's keys, for errors found after conversion.
 #[derive(Clone, Debug)]
@@ -264,16 +265,61 @@ pub(super) fn build_fault(
     })
 }
 
+/// Refuses the first agent whose goal is not in its start's connected part of the map (walls
+/// and the corner-cutting rule considered; other robots are not walls). `goal_at` gives the
+/// place to name for agent `i`.
+///
+/// Floods the map once per connected part that holds a start rather than once per agent,
+/// so a swarm in one open area costs one flood.
+pub(super) fn check_reachable(
+    agents: &[AgentSpec],
+    map: &MapSpec,
+    goal_at: impl Fn(usize) -> Loc,
+) -> Result<(), ScenarioError> {
+    let grid = &map.grid;
+    let mut part = vec![u32::MAX; grid.len()];
+    let mut parts = 0u32;
+    for (i, a) in agents.iter().enumerate() {
+        let start = grid.index(a.start);
+        if part[start] == u32::MAX {
+            let reached = reachable_from(grid, a.start, map.corner_cutting);
+            for (label, _) in part.iter_mut().zip(reached).filter(|(_, r)| *r) {
+                *label = parts;
+            }
+            parts += 1;
+        }
+        if part[grid.index(a.goal)] != part[start] {
+            return Err(ScenarioError::UnreachableGoal {
+                at: goal_at(i),
+                agent: i,
+                start: a.start,
+                goal: a.goal,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Re-checks a scenario built or changed in code (no lines available).
 pub(super) fn revalidate(s: &Scenario) -> Result<(), ScenarioError> {
     let at = Loc::new(&s.source_name, 0);
     if s.agents.is_empty() {
         return Err(ScenarioError::NoAgents { at });
     }
+    if s.agents.len() > MAX_AGENTS {
+        return Err(ScenarioError::TooManyAgents {
+            at,
+            agents: s.agents.len(),
+            max: MAX_AGENTS,
+        });
+    }
     let locs = AgentLocs::all(at.clone());
     let mut seen = Seen::default();
     for (i, a) in s.agents.iter().enumerate() {
         check_agent(i, a, &locs, &s.map.grid, &s.robot, &mut seen)?;
+    }
+    if !s.allow_unreachable {
+        check_reachable(&s.agents, &s.map, |_| at.clone())?;
     }
     for (i, f) in s.faults.iter().enumerate() {
         if let FaultTarget::Agent(a) = f.target {

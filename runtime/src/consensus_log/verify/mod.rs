@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 
 use super::error::LogError;
 use super::reader::{LogReader, TornTail};
-use super::record::{EndRecord, Record};
+use super::record::EndRecord;
 use super::segment::segment_name;
 use order::OrderCheck;
 use segments::SegmentCheck;

@@ -49,7 +49,13 @@ impl OrderCheck {
     }
 
     /// A record other than a round must belong to `expected`, the round it is written at.
-    fn at_round(&mut self, report: &mut VerifyReport, pos: RecordPos, record: &Record, expected: u64) {
+    fn at_round(
+        &mut self,
+        report: &mut VerifyReport,
+        pos: RecordPos,
+        record: &Record,
+        expected: u64,
+    ) {
         let Some(round) = record.round().filter(|&r| r != expected) else {
             return;
         };
