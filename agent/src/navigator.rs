@@ -21,7 +21,7 @@
 //! and the coordinator replans it. Right after a block, a step down is allowed: that is the
 //! sidestep of a yielding robot.
 
-use hnav_runtime::grid::{Cell, CornerCutting, Direction, Grid};
+use hnav_runtime::grid::{reachable_from, Cell, CornerCutting, Direction, Grid};
 use hnav_runtime::msg::{Candidate, CandidateFlags, ConflictKind, Decision, Verdict, NO_CELL};
 
 use crate::error::Error;
@@ -67,6 +67,9 @@ pub struct Navigator {
     next: Cell,
     mask: DirectionMask,
     flags: u32,
+    /// The goal is not in the robot's connected part of the map (walls only: robots the
+    /// agent learns as obstacles move away again, so they never make a goal unreachable).
+    unreachable: bool,
 }
 
 impl Navigator {
@@ -85,6 +88,8 @@ impl Navigator {
             corner_cutting,
             ..PlanOptions::default()
         };
+        let unreachable = grid.contains(task.goal)
+            && !reachable_from(grid, current, corner_cutting)[grid.index(task.goal)];
         let mut map = NeuralMap::new(grid, options.map_options())?;
         let report = map.build(target, StopRule::FullActivation)?;
         let constructor = PathConstructor::new(PathOptions {
@@ -104,6 +109,7 @@ impl Navigator {
             next,
             mask: DirectionMask::default(),
             flags: 0,
+            unreachable,
         })
     }
 
@@ -130,6 +136,12 @@ impl Navigator {
     /// The neural map.
     pub fn map(&self) -> &NeuralMap {
         &self.map
+    }
+
+    /// Whether the goal cannot be reached from the robot's cell through free cells: the
+    /// agent then reports [`CandidateFlags::NO_PATH`] and stands still.
+    pub fn goal_unreachable(&self) -> bool {
+        self.unreachable
     }
 
     /// The last build of the map.
@@ -170,10 +182,12 @@ impl Navigator {
         let mut probable = NO_CELL;
         if self.at_goal() {
             flags |= CandidateFlags::AT_GOAL | CandidateFlags::STANDING;
-        } else if matches!(
-            self.report.outcome,
-            Outcome::Unreachable | Outcome::SweepLimit
-        ) {
+        } else if self.unreachable
+            || matches!(
+                self.report.outcome,
+                Outcome::Unreachable | Outcome::SweepLimit
+            )
+        {
             flags |= CandidateFlags::NO_PATH | CandidateFlags::STANDING;
         } else if !self.is_moving() {
             let mask = std::mem::take(&mut self.mask);

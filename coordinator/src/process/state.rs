@@ -6,9 +6,12 @@ use std::time::{Duration, Instant};
 
 use hnav_runtime::consensus_log::{
     candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LogWriter,
-    LoggedDecision, Record, RoundRecord, RunHeader, FORMAT_VERSION,
+    LoggedDecision, Record, RoundRecord, RunHeader, UnreachableRecord, FORMAT_VERSION,
 };
-use hnav_runtime::msg::{Candidate, Lifecycle, LifecycleEvent, Progress, Role, StopReason};
+use hnav_runtime::grid::{reachable_from, Cell, CornerCutting, Grid};
+use hnav_runtime::msg::{
+    Candidate, CandidateFlags, Lifecycle, LifecycleEvent, Progress, Role, StopReason,
+};
 use hnav_runtime::scenario::{ClockMode, Scenario};
 
 use super::ports::Ports;
@@ -32,6 +35,13 @@ pub(super) struct State {
     restarts: Vec<u32>,
     /// The supervisor's events of one drain, kept so that draining allocates nothing once warm.
     events: Vec<(Role, u32, LifecycleEvent)>,
+    /// The map's walls, for confirming an agent's report of an unreachable goal.
+    walls: Grid,
+    corners: CornerCutting,
+    goals: Vec<Cell>,
+    /// Per agent: `None` until it first reports its goal unreachable, then whether the walls
+    /// confirm it. An agent stays in its connected part of the map, so one check is enough.
+    unreachable: Vec<Option<bool>>,
 }
 
 /// The header a log of `s` must start with.
@@ -87,6 +97,10 @@ impl State {
             dropped: 0,
             restarts: vec![0; n],
             events: Vec::new(),
+            walls: scenario.map.grid.clone(),
+            corners: scenario.map.corner_cutting,
+            goals: scenario.agents.iter().map(|a| a.goal).collect(),
+            unreachable: vec![None; n],
             log,
         };
         let expected = header(scenario);
@@ -139,8 +153,53 @@ impl State {
                     *r = (*r).max(l.restarts);
                 }
             }
+            Record::Unreachable(u) => {
+                if let Some(r) = self.unreachable.get_mut(u.agent as usize) {
+                    *r = Some(true);
+                }
+            }
             Record::Header(_) | Record::Replan(_) => {}
         }
+    }
+
+    /// Agents whose goal is confirmed unreachable.
+    fn unreachable_agents(&self) -> usize {
+        self.unreachable
+            .iter()
+            .filter(|r| **r == Some(true))
+            .count()
+    }
+
+    /// Whether every agent is at its goal or confirmed unable to reach it.
+    fn settled(&self) -> bool {
+        self.arbiter.at_goal() as usize + self.unreachable_agents() == self.arbiter.agents()
+    }
+
+    /// Logs, once per agent and before the round's record, a goal its agent reports
+    /// unreachable (`NO_PATH`) when the walls confirm it. A report the walls do not confirm
+    /// (the agent's map counts robots it was blocked by as obstacles, and robots move on) is
+    /// not logged: the agent stands still as it asked and is asked again later.
+    fn confirm_unreachable(&mut self, round: u64) -> Result<(), CoordinatorError> {
+        for (i, c) in self.pending.iter().enumerate() {
+            let Some(c) = c.filter(|c| c.flags & CandidateFlags::NO_PATH != 0) else {
+                continue;
+            };
+            if self.unreachable[i].is_some() || self.walls.cell_at(c.current as usize).is_none() {
+                continue;
+            }
+            let reach = reachable_from(&self.walls, self.goals[i], self.corners);
+            let unreachable = !reach[c.current as usize];
+            self.unreachable[i] = Some(unreachable);
+            if unreachable {
+                tracing::warn!(agent = i, "goal unreachable; the agent stands still");
+                self.log.append(&Record::Unreachable(UnreachableRecord {
+                    round,
+                    agent: i as u32,
+                    cell: c.current,
+                }))?;
+            }
+        }
+        Ok(())
     }
 
     /// Takes in every pending supervisor event; returns how the run ends if one was `Stop`.
@@ -263,6 +322,7 @@ impl State {
     /// Decides the open round, makes it durable, then commits it.
     pub(super) fn close_round(&mut self, p: &Ports) -> Result<(), CoordinatorError> {
         let round = self.round + 1;
+        self.confirm_unreachable(round)?;
         let (decisions, replans) = self.arbiter.decide(round, &self.pending);
         for r in replans {
             self.log.append(&Record::Replan(r.clone()))?;
@@ -292,6 +352,8 @@ impl State {
         self.opened = None;
         if self.arbiter.at_goal() as usize == self.arbiter.agents() {
             self.end(EndReason::AllAtGoal)?;
+        } else if self.settled() {
+            self.end(EndReason::AllAtGoalOrUnreachable)?;
         }
         self.publish_progress(p)
     }
@@ -323,7 +385,7 @@ impl State {
             at_goal: self.arbiter.at_goal(),
             conflicts: t.conflicts(),
             replans: t.replans(),
-            done: u8::from(self.ended && self.arbiter.at_goal() as usize == t.agents().len()),
+            done: u8::from(self.ended && self.settled()),
             reserved: [0; 7],
         })?;
         Ok(())

@@ -48,7 +48,7 @@ pub use frame::{encode_frame, FRAME_HEADER_LEN, MAGIC, MAX_RECORD_LEN};
 pub use reader::{read_log, LogContents, LogReader, RecordPos, TornTail};
 pub use record::{
     candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision, Record,
-    ReplanRecord, RoundRecord, RunHeader,
+    ReplanRecord, RoundRecord, RunHeader, UnreachableRecord,
 };
 pub use segment::{list_segments, segment_name, segment_path, DEFAULT_SEGMENT_BYTES};
 pub use tally::{AgentTally, Tally};

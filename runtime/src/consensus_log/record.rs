@@ -22,10 +22,14 @@ pub enum Record {
     Replan(ReplanRecord),
     /// The run ended.
     End(EndRecord),
+    /// An agent reported that its goal cannot be reached (logged once per agent; last in
+    /// the enum so that the encoding of the other kinds is unchanged).
+    Unreachable(UnreachableRecord),
 }
 
 impl Record {
-    /// Lower-case name of the record's kind (`header`, `round`, `lifecycle`, `replan`, `end`).
+    /// Lower-case name of the record's kind (`header`, `round`, `lifecycle`, `replan`, `end`,
+    /// `unreachable`).
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Header(_) => "header",
@@ -33,6 +37,7 @@ impl Record {
             Self::Lifecycle(_) => "lifecycle",
             Self::Replan(_) => "replan",
             Self::End(_) => "end",
+            Self::Unreachable(_) => "unreachable",
         }
     }
 
@@ -44,6 +49,7 @@ impl Record {
             Self::Lifecycle(r) => Some(r.round),
             Self::Replan(r) => Some(r.round),
             Self::End(r) => Some(r.round),
+            Self::Unreachable(r) => Some(r.round),
         }
     }
 }
@@ -196,6 +202,19 @@ impl LifecycleRecord {
     }
 }
 
+/// An agent whose goal cannot be reached from its robot's cell through free cells (walls and
+/// the corner-cutting rule; other robots are not walls): it stands still from then on.
+/// Written like a replan, just before the record of the round it is reported in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct UnreachableRecord {
+    /// The round the agent reported it in.
+    pub round: u64,
+    /// Agent index.
+    pub agent: u32,
+    /// The robot's cell (row-major index).
+    pub cell: u32,
+}
+
 /// A global replan for one agent.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ReplanRecord {
@@ -231,15 +250,18 @@ pub enum EndReason {
     TimeLimit,
     /// The supervisor (or an operator) stopped the run.
     Stopped,
+    /// Every agent is at its goal or has reported its goal unreachable (at least one has).
+    AllAtGoalOrUnreachable,
 }
 
 impl EndReason {
-    /// Lower-case name (`all-at-goal`, `time-limit`, `stopped`).
+    /// Lower-case name (`all-at-goal`, `time-limit`, `stopped`, `all-at-goal-or-unreachable`).
     pub fn name(self) -> &'static str {
         match self {
             Self::AllAtGoal => "all-at-goal",
             Self::TimeLimit => "time-limit",
             Self::Stopped => "stopped",
+            Self::AllAtGoalOrUnreachable => "all-at-goal-or-unreachable",
         }
     }
 }

@@ -86,6 +86,15 @@ pub fn describe(record: &Record, width: u32) -> String {
                 s.push_str("not found");
             }
         }
+        Record::Unreachable(u) => {
+            let _ = write!(
+                s,
+                "unreachable round {}  a{} at {}",
+                u.round,
+                u.agent,
+                cell(u.cell, width)
+            );
+        }
         Record::End(e) => {
             let _ = write!(
                 s,
@@ -140,6 +149,7 @@ pub fn to_json(pos: &RecordPos, record: &Record) -> Value {
         Record::Lifecycle(r) => serde_json::to_value(r),
         Record::Replan(r) => serde_json::to_value(r),
         Record::End(r) => serde_json::to_value(r),
+        Record::Unreachable(r) => serde_json::to_value(r),
     };
     let mut object = Map::new();
     object.insert("segment".into(), json!(pos.segment));

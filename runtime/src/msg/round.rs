@@ -228,7 +228,8 @@ pub struct Progress {
     pub conflicts: u32,
     /// Global replans so far.
     pub replans: u32,
-    /// 1 once every agent is at its goal, else 0.
+    /// 1 once the run has ended with every agent at its goal or (reported) unable to reach
+    /// it, else 0.
     pub done: u8,
     /// Zero.
     pub reserved: [u8; 7],

@@ -28,6 +28,8 @@ pub struct AgentSummary {
     pub conflicts: u32,
     /// Global replans.
     pub replans: u32,
+    /// Whether the agent reported its goal unreachable (an unreachable record in the log).
+    pub unreachable: bool,
 }
 
 /// The whole run.
@@ -71,6 +73,7 @@ impl RunSummary {
         let mut tally = Tally::default();
         let mut rounds = 0;
         let mut end = "incomplete".to_string();
+        let mut unreachable = Vec::new();
         for r in &contents.records {
             match r {
                 Record::Header(h) => {
@@ -82,6 +85,7 @@ impl RunSummary {
                     tally.fold_round(rec);
                 }
                 Record::End(e) => end = e.reason.name().to_string(),
+                Record::Unreachable(u) => unreachable.push(u.agent),
                 Record::Lifecycle(_) | Record::Replan(_) => {}
             }
         }
@@ -94,6 +98,7 @@ impl RunSummary {
                 length: t.length,
                 conflicts: t.conflicts,
                 replans: t.replans,
+                unreachable: unreachable.contains(&id),
             })
             .collect();
         if let (Some(t), Some(h)) = (truth, header) {
@@ -129,14 +134,14 @@ impl RunSummary {
     pub fn render(&self) -> String {
         let mut s = String::from("agent  goal  steps  length  conflicts  replans\n");
         for a in &self.agents {
+            let goal = match (a.reached_goal, a.unreachable) {
+                (true, _) => "yes",
+                (false, true) => "unreachable",
+                (false, false) => "NO",
+            };
             s += &format!(
                 "{:>5}  {:>4}  {:>5}  {:>6.2}  {:>9}  {:>7}\n",
-                a.id,
-                if a.reached_goal { "yes" } else { "NO" },
-                a.steps,
-                a.length,
-                a.conflicts,
-                a.replans
+                a.id, goal, a.steps, a.length, a.conflicts, a.replans
             );
         }
         let at_goal = self.agents.iter().filter(|a| a.reached_goal).count();

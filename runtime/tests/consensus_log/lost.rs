@@ -6,8 +6,7 @@ use std::fs;
 use std::path::Path;
 
 use hnav_runtime::consensus_log::{
-    segment_path, verify, EndReason, EndRecord, LifecycleRecord, Record, ReplanRecord,
-    VerifyStatus,
+    segment_path, verify, EndReason, EndRecord, LifecycleRecord, Record, ReplanRecord, VerifyStatus,
 };
 
 use super::fixtures::{assert_intact, header, round, write_log, ONE_SEGMENT};
@@ -16,7 +15,10 @@ use super::fixtures::{assert_intact, header, round, write_log, ONE_SEGMENT};
 /// their segment, which must hold all of them.
 fn remove_frames(dir: &Path, at: &[(u32, usize)], from: usize, to: usize) {
     let segment = at[from].0;
-    assert_eq!(at[to].0, segment, "the removed records and the next share a segment");
+    assert_eq!(
+        at[to].0, segment,
+        "the removed records and the next share a segment"
+    );
     let path = segment_path(dir, segment);
     let mut bytes = fs::read(&path).unwrap();
     bytes.drain(at[from].1..at[to].1);
@@ -25,7 +27,12 @@ fn remove_frames(dir: &Path, at: &[(u32, usize)], from: usize, to: usize) {
 
 fn problems(dir: &Path) -> String {
     let report = verify(dir);
-    assert_eq!(report.status(), VerifyStatus::NotIntact, "{}", report.render());
+    assert_eq!(
+        report.status(),
+        VerifyStatus::NotIntact,
+        "{}",
+        report.render()
+    );
     report.problems.join("\n")
 }
 
@@ -61,10 +68,16 @@ fn a_round_removed_from_the_middle_of_a_segment_is_a_gap_naming_it() {
     // records[5] is round 5.
     remove_frames(&one, &at, 5, 6);
     let p = problems(&one);
-    assert!(p.contains("round 5 is missing (round 6 follows round 4)"), "{p}");
+    assert!(
+        p.contains("round 5 is missing (round 6 follows round 4)"),
+        "{p}"
+    );
     remove_frames(&three, &at, 5, 8);
     let p = problems(&three);
-    assert!(p.contains("rounds 5 to 7 are missing (round 8 follows round 4)"), "{p}");
+    assert!(
+        p.contains("rounds 5 to 7 are missing (round 8 follows round 4)"),
+        "{p}"
+    );
 
     // The first round is round 1.
     let late = tmp.path().join("late");
@@ -121,7 +134,11 @@ fn the_end_record_closes_the_log() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = |name: &str| tmp.path().join(name);
 
-    write_log(&dir("open"), &[header(2), round(1, 2), round(2, 2)], ONE_SEGMENT);
+    write_log(
+        &dir("open"),
+        &[header(2), round(1, 2), round(2, 2)],
+        ONE_SEGMENT,
+    );
     let report = verify(dir("open"));
     assert_eq!(report.status(), VerifyStatus::Intact, "{}", report.render());
     assert!(!report.has_end(), "not closed");
@@ -133,9 +150,16 @@ fn the_end_record_closes_the_log() {
     assert!(p.contains("round record after the end record"), "{p}");
     assert!(p.contains("lifecycle record after the end record"), "{p}");
 
-    write_log(&dir("early"), &[header(2), round(1, 2), round(2, 2), end(1)], ONE_SEGMENT);
+    write_log(
+        &dir("early"),
+        &[header(2), round(1, 2), round(2, 2), end(1)],
+        ONE_SEGMENT,
+    );
     let p = problems(&dir("early"));
-    assert!(p.contains("end record for round 1, but the last round logged before it is 2"), "{p}");
+    assert!(
+        p.contains("end record for round 1, but the last round logged before it is 2"),
+        "{p}"
+    );
 }
 
 #[test]

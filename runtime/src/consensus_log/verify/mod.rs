@@ -41,12 +41,14 @@ pub struct KindCounts {
     pub replan: u64,
     /// End records.
     pub end: u64,
+    /// Unreachable records.
+    pub unreachable: u64,
 }
 
 impl KindCounts {
     /// All records.
     pub fn total(&self) -> u64 {
-        self.header + self.round + self.lifecycle + self.replan + self.end
+        self.header + self.round + self.lifecycle + self.replan + self.end + self.unreachable
     }
 }
 
@@ -128,6 +130,10 @@ impl VerifyReport {
             c.replan,
             c.end
         );
+        if c.unreachable > 0 {
+            s.pop();
+            let _ = writeln!(s, ", {} unreachable", c.unreachable);
+        }
         match (self.first_round, self.last_round) {
             (Some(a), Some(b)) => _ = writeln!(s, "rounds     {a}..{b}"),
             _ => _ = writeln!(s, "rounds     none"),
@@ -141,6 +147,7 @@ impl VerifyReport {
                     e.round, e.at_goal
                 )
             }
+            None if self.status() == VerifyStatus::Unreadable => _ = writeln!(s, "end        none"),
             None => {
                 _ = writeln!(
                     s,
