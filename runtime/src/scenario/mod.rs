@@ -201,7 +201,8 @@ pub enum FaultSignal {
 /// One planned fault.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
 pub struct FaultSpec {
-    /// The decision round at which it fires.
+    /// The decision round at which it fires: once it is committed (in lockstep exactly then,
+    /// the run holding there until the fault is done).
     pub at_round: u64,
     /// What to do.
     pub action: FaultAction,
