@@ -49,7 +49,7 @@ fn two_lockstep_runs_to_the_time_limit_write_the_same_log() {
         a.len(),
         b.len()
     );
-    let contents = read_log(&tmp.path().join("a/log")).unwrap();
+    let contents = read_log(tmp.path().join("a/log")).unwrap();
     let last_round = contents
         .records
         .iter()

@@ -107,9 +107,6 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
         Ok(End::TimeLimit) => StopReason::TimeLimit,
         _ => StopReason::Requested,
     };
-    if let Ok(End::CannotGoOn(why)) = &result {
-        tracing::error!("{why}");
-    }
     let _ = ports.life.publish(Lifecycle::stop(reason));
     for s in stop_all(slots.children(), STOP_GRACE) {
         tracing::debug!(node = s.role.node_name(s.index), how = ?s.how, "stopped");
