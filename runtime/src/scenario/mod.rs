@@ -39,7 +39,7 @@
 //! round_deadline_ms = 50
 //! fsync = "every-record"               # or "batched", "none"
 //! replan_after_rounds = 3
-//! time_limit_s = 120.0
+//! time_limit_s = 120.0                 # lockstep: simulated time, in rounds; realtime: wall clock
 //!
 //! [restart]                            # per role; defaults: agent and coordinator
 //! agent = { policy = "on-failure", max_restarts = 3, backoff_ms = 100 }   # "on-failure",
