@@ -177,11 +177,25 @@ impl LifecyclePorts {
         &self.events
     }
 
+    /// Tells the supervisor that the sim holds before stepping `period` (`Hold` on `ready`).
+    pub fn hold(&self, period: u64) -> Result<(), TransportError> {
+        self.ready.send(Lifecycle::hold(period))?;
+        Ok(())
+    }
+
     /// Hands every pending supervisor event with a known role and event (and, for `Stop`, a
     /// known reason) to `f`; returns the reason of the last `Stop` among them, if any.
     pub fn drain(
         &self,
         mut f: impl FnMut(Role, u32, LifecycleEvent),
+    ) -> Result<Option<StopReason>, TransportError> {
+        self.drain_samples(|role, ev, l| f(role, l.index, ev))
+    }
+
+    /// [`LifecyclePorts::drain`], handing `f` the whole sample too (a `Resume`'s period).
+    pub fn drain_samples(
+        &self,
+        mut f: impl FnMut(Role, LifecycleEvent, &Lifecycle),
     ) -> Result<Option<StopReason>, TransportError> {
         let mut stop = None;
         self.events.drain_pending(|l| {
@@ -195,7 +209,7 @@ impl LifecyclePorts {
                     None => return,
                 }
             }
-            f(role, l.index, ev);
+            f(role, ev, l);
         })?;
         Ok(stop)
     }

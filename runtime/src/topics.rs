@@ -10,7 +10,7 @@
 //! | `commit` | [`Commit`](crate::msg::Commit) | coordinator -> agents | latest, deep buffer |
 //! | `map/<i>` | `[f32]` + [`MapHeader`](crate::msg::MapHeader) | agent i -> coordinator, viewers | latest |
 //! | `progress` | [`Progress`](crate::msg::Progress) | coordinator -> supervisor | latest |
-//! | `ready` | [`Lifecycle`](crate::msg::Lifecycle) | every process -> supervisor | latest, deep buffer |
+//! | `ready` | [`Lifecycle`](crate::msg::Lifecycle) (`Up`; the sim's `Hold`) | every process -> supervisor | latest, deep buffer |
 //! | `lifecycle` | [`Lifecycle`](crate::msg::Lifecycle) | supervisor -> every process | latest, deep buffer |
 //!
 //! Why "latest" (overwrite the oldest) for commits and lifecycle events, where every sample

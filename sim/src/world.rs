@@ -97,7 +97,7 @@ impl World {
         let per = |period_s: f64| ((period_s / model.dt).round() as u64).max(1);
         Ok(World {
             steps_per_slip: per(sim.slip_hold_s),
-            steps_per_odometry: per(1.0 / f64::from(sim.odometry_hz)),
+            steps_per_odometry: sim.steps_per_control_period(),
             watchdog: Watchdog::from_ms(sim.watchdog_ms),
             step_ns,
             steps: 0,

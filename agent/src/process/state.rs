@@ -232,6 +232,12 @@ impl Core {
         } else {
             (0.0, 0.0)
         };
+        // Before the command, not after: once the sim has every command of a period it may
+        // hold there for a planned fault and the supervisor kill this agent, which must then
+        // resume from this period's checkpoint in every run, never from the one before.
+        if let Some(p) = self.last_period {
+            self.store_checkpoint(p, pose);
+        }
         p.wheels.send(WheelCommand {
             period,
             agent: self.index,
@@ -240,9 +246,6 @@ impl Core {
             right_rad_s: r,
         })?;
         self.wheel_due = None;
-        if let Some(p) = self.last_period {
-            self.store_checkpoint(p, pose);
-        }
         Ok(())
     }
 

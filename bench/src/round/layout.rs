@@ -103,7 +103,7 @@ impl Layout {
     }
 
     /// The scenario file's text: the open map, the agents, the coordinator's fsync policy,
-    /// the lockstep clock.
+    /// the lockstep clock, a time limit no bench reaches.
     pub fn scenario_toml(&self, fsync: FsyncPolicy) -> String {
         let mut s = String::from("# Written by `hnav-bench round`.\nname = \"bench-round\"\n\n");
         s.push_str("[map]\nrows = [\n");
@@ -114,6 +114,9 @@ impl Layout {
         s.push_str("]\n\n[sim]\nclock = \"lockstep\"\n\n[coordinator]\n");
         let _ = writeln!(s, "fsync = \"{}\"", fsync_name(fsync));
         s.push_str("replan_after_rounds = 3\n");
+        // The bench plays as many rounds as it is asked for: a lockstep coordinator ends the
+        // run after its time limit's rounds (12 000 by default), so the limit is set far out.
+        s.push_str("time_limit_s = 1e9\n");
         for i in 0..self.n {
             let (sx, sy) = self.start(i);
             let (gx, gy) = self.goal(i);

@@ -15,9 +15,14 @@
 //! (never decided twice); a round in flight when the old coordinator died is decided anew from
 //! the candidates the agents resend.
 //!
-//! Once every agent stands on its goal the coordinator logs the end of the run and decides
+//! Once every agent stands on its goal, or in lockstep once the round of the time limit
+//! (`time_limit_s` of simulated time, [`SimParams::rounds_in`]) is committed, the coordinator
+//! logs the end of the run, says so on the progress topic ([`Progress::done`]) and decides
 //! nothing more, so the log of a lockstep run ends at the same record whatever the
-//! supervisor's timing.
+//! supervisor's timing. In realtime the supervisor's wall clock ends the run.
+//!
+//! [`SimParams::rounds_in`]: hnav_runtime::scenario::params::SimParams::rounds_in
+//! [`Progress::done`]: hnav_runtime::msg::Progress::done
 
 use std::path::Path;
 
@@ -107,6 +112,8 @@ impl<'t> CoordinatorProcess<'t> {
             }
             return Ok(st.outcome());
         }
+        // A coordinator that died between its last round and the run's end ends it now.
+        st.end_if_over()?;
         // Agents that missed the dead coordinator's last commit get it again.
         st.resend_last_commit(p)?;
         st.publish_progress(p)?;
@@ -126,10 +133,13 @@ impl<'t> CoordinatorProcess<'t> {
 /// ends.
 fn rounds(p: &Ports, st: &mut State, waiter: &Waiter) -> Result<EndReason, CoordinatorError> {
     loop {
+        // Candidates first, then the supervisor: an event sent before a candidate (an agent's
+        // `Restarted` before the round the sim resumed for) is then always heard before that
+        // round closes, so it is logged at the same round in every lockstep run.
+        st.collect(p)?;
         if let Some(reason) = st.hear_supervisor(p)? {
             return Ok(reason);
         }
-        st.collect(p)?;
         if st.ready() {
             st.close_round(p)?;
             continue;

@@ -30,7 +30,10 @@ pub(super) struct State {
     present: Vec<Candidate>,
     live: Vec<bool>,
     opened: Option<Instant>,
-    ended: bool,
+    /// In lockstep, the round after which the time limit ends the run.
+    round_limit: Option<u64>,
+    /// Why the run ended, once the log holds its end.
+    end: Option<EndReason>,
     dropped: u64,
     restarts: Vec<u32>,
     /// The supervisor's events of one drain, kept so that draining allocates nothing once warm.
@@ -93,7 +96,9 @@ impl State {
             present: Vec::with_capacity(n),
             live: vec![true; n],
             opened: None,
-            ended: false,
+            round_limit: (scenario.sim.clock == ClockMode::Lockstep)
+                .then(|| scenario.sim.rounds_in(scenario.coordinator.time_limit_s)),
+            end: None,
             dropped: 0,
             restarts: vec![0; n],
             events: Vec::new(),
@@ -129,14 +134,14 @@ impl State {
     pub(super) fn outcome(&self) -> CoordinatorOutcome {
         CoordinatorOutcome {
             round: self.round,
-            all_at_goal: self.ended && self.arbiter.at_goal() as usize == self.arbiter.agents(),
+            all_at_goal: self.ended() && self.arbiter.at_goal() as usize == self.arbiter.agents(),
             dropped: self.dropped,
         }
     }
 
     /// Whether the log already holds the end of the run.
     pub(super) fn ended(&self) -> bool {
-        self.ended
+        self.end.is_some()
     }
 
     /// Folds one record of an existing log into the state.
@@ -147,7 +152,7 @@ impl State {
                 self.arbiter.replay(rec);
                 self.last_record = Some(rec.clone());
             }
-            Record::End(_) => self.ended = true,
+            Record::End(e) => self.end = Some(e.reason),
             Record::Lifecycle(l) => {
                 if let Some(r) = self.restarts.get_mut(l.index as usize) {
                     *r = (*r).max(l.restarts);
@@ -242,7 +247,7 @@ impl State {
                 *r += 1;
             }
         }
-        if !self.ended {
+        if !self.ended() {
             let restarts = self
                 .restarts
                 .get(index as usize)
@@ -273,7 +278,7 @@ impl State {
                 return;
             }
             let i = c.agent as usize;
-            if c.round == self.round + 1 && !self.ended {
+            if c.round == self.round + 1 && !self.ended() {
                 if self.pending.iter().all(Option::is_none) {
                     self.opened = Some(Instant::now());
                 }
@@ -301,7 +306,7 @@ impl State {
 
     /// Whether the open round has every live agent's candidate.
     pub(super) fn ready(&self) -> bool {
-        !self.ended
+        !self.ended()
             && self.pending.iter().any(Option::is_some)
             && self
                 .live
@@ -350,12 +355,25 @@ impl State {
         self.round = round;
         self.pending.iter_mut().for_each(|c| *c = None);
         self.opened = None;
+        self.end_if_over()?;
+        self.publish_progress(p)
+    }
+
+    /// Ends the run once every agent is at its goal or, in lockstep, once the round of its
+    /// time limit is committed: the limit is counted here, in rounds of simulated time, so
+    /// that a lockstep run ends at the same record whatever the wall clock says.
+    pub(super) fn end_if_over(&mut self) -> Result<(), CoordinatorError> {
+        if self.ended() || self.round == 0 {
+            return Ok(());
+        }
         if self.arbiter.at_goal() as usize == self.arbiter.agents() {
             self.end(EndReason::AllAtGoal)?;
         } else if self.settled() {
             self.end(EndReason::AllAtGoalOrUnreachable)?;
+        } else if self.round_limit.is_some_and(|limit| self.round >= limit) {
+            self.end(EndReason::TimeLimit)?;
         }
-        self.publish_progress(p)
+        Ok(())
     }
 
     /// Logs the end of the run (durably) and decides nothing more.
@@ -366,7 +384,7 @@ impl State {
             reason,
         }))?;
         self.log.sync()?;
-        self.ended = true;
+        self.end = Some(reason);
         Ok(())
     }
 
@@ -385,7 +403,14 @@ impl State {
             at_goal: self.arbiter.at_goal(),
             conflicts: t.conflicts(),
             replans: t.replans(),
-            done: u8::from(self.ended && self.settled()),
+            done: match self.end {
+                // Nothing is left to decide for the unreachable ones either.
+                Some(EndReason::AllAtGoal | EndReason::AllAtGoalOrUnreachable) => {
+                    Progress::ALL_AT_GOAL
+                }
+                Some(EndReason::TimeLimit) => Progress::TIME_LIMIT,
+                Some(EndReason::Stopped) | None => 0,
+            },
             reserved: [0; 7],
         })?;
         Ok(())

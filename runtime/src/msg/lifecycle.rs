@@ -1,6 +1,12 @@
 //! The lifecycle protocol's payload and its vocabulary: which process ([`Role`], with the one
 //! spelling of its name), what happened to it ([`LifecycleEvent`]), why a run is stopped
 //! ([`StopReason`]), and the [`Lifecycle`] sample built by its constructors.
+//!
+//! Besides a process's `Up` and the supervisor's `Start`, `Down`, `Restarted` and `Stop`, a
+//! lockstep run with a fault plan has one more exchange: the sim holds before stepping a
+//! fault's period and says so with `Hold` on `ready`; the supervisor fires the fault, waits
+//! until it is done (the target reaped and, if it is restarted, up again) and answers with
+//! `Resume` on `lifecycle`. Both carry the period ([`Lifecycle::period`]).
 
 use std::time::{SystemTime, UNIX_EPOCH};
 
@@ -88,6 +94,11 @@ pub enum LifecycleEvent {
     Start = 4,
     /// Supervisor to all: finish cleanly and exit; [`Lifecycle::reason`] says why.
     Stop = 5,
+    /// Sim to supervisor (on `ready`): every live robot's command for the period is in, and
+    /// the sim holds before stepping it because a fault is planned at that round.
+    Hold = 6,
+    /// Supervisor to all: the faults of the held period are done, step on.
+    Resume = 7,
 }
 
 impl LifecycleEvent {
@@ -99,11 +110,14 @@ impl LifecycleEvent {
             3 => Some(Self::Restarted),
             4 => Some(Self::Start),
             5 => Some(Self::Stop),
+            6 => Some(Self::Hold),
+            7 => Some(Self::Resume),
             _ => None,
         }
     }
 
-    /// Lower-case name (`up`, `down`, `restarted`, `start`, `stop`), as in `hnav log show`.
+    /// Lower-case name (`up`, `down`, `restarted`, `start`, `stop`, `hold`, `resume`), as in
+    /// `hnav log show`.
     pub fn name(self) -> &'static str {
         match self {
             Self::Up => "up",
@@ -111,6 +125,8 @@ impl LifecycleEvent {
             Self::Restarted => "restarted",
             Self::Start => "start",
             Self::Stop => "stop",
+            Self::Hold => "hold",
+            Self::Resume => "resume",
         }
     }
 }
@@ -152,7 +168,8 @@ pub struct Lifecycle {
     pub time_ns: u64,
     /// OS process id of the process the event is about; 0 when the sender does not say.
     pub pid: u32,
-    /// Agent index for [`Role::Agent`], else 0.
+    /// Agent index for [`Role::Agent`], else 0. For `Hold` and `Resume`, the low 32 bits of
+    /// the period ([`Lifecycle::period`]).
     pub index: u32,
     /// A [`Role`] as `u8`. `Start` and `Stop` are addressed to every process and carry
     /// [`Role::Sim`] and index 0 as placeholders, since a receiver drops unknown roles.
@@ -163,7 +180,8 @@ pub struct Lifecycle {
     pub reason: u8,
     /// Zero.
     pub reserved: u8,
-    /// Restarts of this process so far.
+    /// Restarts of this process so far. For `Hold` and `Resume`, the high 32 bits of the
+    /// period.
     pub restarts: u32,
 }
 
@@ -194,6 +212,27 @@ impl Lifecycle {
             reason: reason as u8,
             ..Self::about(Role::Sim, 0, LifecycleEvent::Stop, 0)
         }
+    }
+
+    /// `Hold`: the sim holds before stepping `period` (a fault is planned at that round).
+    pub fn hold(period: u64) -> Self {
+        Self::at_period(LifecycleEvent::Hold, period).with_pid(std::process::id())
+    }
+
+    /// `Resume`: the faults planned at `period` are done; the sim steps it.
+    pub fn resume(period: u64) -> Self {
+        Self::at_period(LifecycleEvent::Resume, period)
+    }
+
+    /// The period a `Hold` or `Resume` is about (meaningless for other events).
+    pub fn period(&self) -> u64 {
+        u64::from(self.index) | (u64::from(self.restarts) << 32)
+    }
+
+    /// An event about the sim's `period`, split over `index` (low half) and `restarts` (high
+    /// half) so that the sample keeps its 24-byte layout.
+    fn at_period(event: LifecycleEvent, period: u64) -> Self {
+        Self::about(Role::Sim, period as u32, event, (period >> 32) as u32)
     }
 
     /// The same event about the process with id `pid`.
@@ -255,16 +294,18 @@ mod tests {
             LifecycleEvent::Restarted,
             LifecycleEvent::Start,
             LifecycleEvent::Stop,
+            LifecycleEvent::Hold,
+            LifecycleEvent::Resume,
         ] {
             assert_eq!(LifecycleEvent::from_u8(e as u8), Some(e));
         }
         for s in [StopReason::Requested, StopReason::TimeLimit] {
             assert_eq!(StopReason::from_u8(s as u8), Some(s));
         }
-        assert_eq!(LifecycleEvent::from_u8(6), None);
+        assert_eq!(LifecycleEvent::from_u8(8), None);
         for bad in [0u8, 5, 200, 255] {
             assert_eq!(Role::from_u8(bad), None);
-            assert_eq!(LifecycleEvent::from_u8(bad.max(6)), None);
+            assert_eq!(LifecycleEvent::from_u8(bad.max(8)), None);
             assert_eq!(StopReason::from_u8(bad.max(3)), None);
         }
         assert_eq!(StopReason::from_u8(0), None);
@@ -315,5 +356,27 @@ mod tests {
         assert_eq!(fields(stop), (sim, 0, LifecycleEvent::Stop as u8, 2, 0, 0));
         assert_eq!(Lifecycle::stop(StopReason::Requested).reason, 1);
         assert!(start.time_ns > 0);
+    }
+
+    /// A period travels whole in a `Hold` or `Resume`, past 32 bits too.
+    #[test]
+    fn hold_and_resume_carry_their_period() {
+        for period in [
+            0u64,
+            50,
+            u64::from(u32::MAX),
+            u64::from(u32::MAX) + 7,
+            u64::MAX,
+        ] {
+            let hold = Lifecycle::hold(period);
+            assert_eq!(hold.event, LifecycleEvent::Hold as u8);
+            assert_eq!(hold.role, Role::Sim as u8);
+            assert_eq!(hold.period(), period);
+            assert_eq!(hold.pid, std::process::id());
+            let resume = Lifecycle::resume(period);
+            assert_eq!(resume.event, LifecycleEvent::Resume as u8);
+            assert_eq!(resume.period(), period);
+            assert_eq!((resume.reason, resume.reserved), (0, 0));
+        }
     }
 }

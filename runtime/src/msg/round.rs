@@ -228,11 +228,19 @@ pub struct Progress {
     pub conflicts: u32,
     /// Global replans so far.
     pub replans: u32,
-    /// 1 once the run has ended with every agent at its goal or (reported) unable to reach
-    /// it, else 0.
+    /// [`Progress::ALL_AT_GOAL`] once every agent is at its goal or (reported) unable to reach
+    /// it, [`Progress::TIME_LIMIT`] once a lockstep run has committed its last round, else 0:
+    /// the coordinator has ended the run and decides nothing more.
     pub done: u8,
     /// Zero.
     pub reserved: [u8; 7],
+}
+
+impl Progress {
+    /// [`Progress::done`]: every agent is at its goal or reported unable to reach it.
+    pub const ALL_AT_GOAL: u8 = 1;
+    /// [`Progress::done`]: a lockstep run committed the last round of its time limit.
+    pub const TIME_LIMIT: u8 = 2;
 }
 
 #[cfg(test)]

@@ -41,7 +41,7 @@
 //! round_deadline_ms = 50
 //! fsync = "every-record"               # or "batched", "none"
 //! replan_after_rounds = 3
-//! time_limit_s = 120.0
+//! time_limit_s = 120.0                 # lockstep: simulated time, in rounds; realtime: wall clock
 //!
 //! [restart]                            # per role; defaults: agent and coordinator
 //! agent = { policy = "on-failure", max_restarts = 3, backoff_ms = 100 }   # "on-failure",
@@ -204,7 +204,8 @@ pub enum FaultSignal {
 /// One planned fault.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
 pub struct FaultSpec {
-    /// The decision round at which it fires.
+    /// The decision round at which it fires: once it is committed (in lockstep exactly then,
+    /// the run holding there until the fault is done).
     pub at_round: u64,
     /// What to do.
     pub action: FaultAction,

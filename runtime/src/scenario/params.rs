@@ -152,6 +152,29 @@ impl Default for SimParams {
     }
 }
 
+impl SimParams {
+    /// Physics steps in one control period (one odometry period, `1 / odometry_hz`), rounded
+    /// to whole steps and at least one: what the sim steps between two odometry readings.
+    pub fn steps_per_control_period(&self) -> u64 {
+        let step_s = f64::from(self.step_ms) * 1e-3;
+        let period_s = 1.0 / f64::from(self.odometry_hz.max(1));
+        ((period_s / step_s).round() as u64).max(1)
+    }
+
+    /// The control period in seconds of simulated time: one decision round in lockstep.
+    pub fn control_period_s(&self) -> f64 {
+        self.steps_per_control_period() as f64 * f64::from(self.step_ms) * 1e-3
+    }
+
+    /// How many lockstep rounds `seconds` of simulated time hold (rounded up, at least one):
+    /// the round after which a lockstep run with that time limit ends.
+    pub fn rounds_in(&self, seconds: f64) -> u64 {
+        // The epsilon keeps 1.5 s of 10 ms periods at 150 rounds, not 151 from a rounding
+        // error of the division.
+        ((seconds / self.control_period_s() - 1e-9).ceil() as u64).max(1)
+    }
+}
+
 /// When the consensus log is flushed to disk (`[coordinator] fsync`).
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -174,7 +197,8 @@ pub struct CoordinatorParams {
     pub fsync: FsyncPolicy,
     /// Rounds an agent may stay blocked before the coordinator replans it globally.
     pub replan_after_rounds: u32,
-    /// Wall-clock limit of the whole run in seconds.
+    /// Limit of the whole run in seconds: wall-clock in realtime; in lockstep seconds of
+    /// simulated time, counted in rounds ([`SimParams::rounds_in`]).
     pub time_limit_s: f64,
 }
 
@@ -264,6 +288,26 @@ mod tests {
         assert_eq!(RestartConfig::default().sim.policy, RestartPolicy::Never);
         assert_eq!(SimParams::default().clock, ClockMode::Lockstep);
         assert_eq!(CoordinatorParams::default().fsync, FsyncPolicy::EveryRecord);
+    }
+
+    /// The lockstep time limit in rounds: 10 ms periods by default, rounded up, at least one.
+    #[test]
+    fn a_time_limit_counts_control_periods() {
+        let sim = SimParams::default();
+        assert_eq!(sim.steps_per_control_period(), 10);
+        assert!((sim.control_period_s() - 0.01).abs() < 1e-12);
+        assert_eq!(sim.rounds_in(1.5), 150);
+        assert_eq!(sim.rounds_in(300.0), 30_000);
+        assert_eq!(sim.rounds_in(0.015), 2);
+        assert_eq!(sim.rounds_in(1e-6), 1);
+        let coarse = SimParams {
+            step_ms: 4,
+            odometry_hz: 30,
+            ..sim
+        };
+        // 33.3 ms rounds to 8 steps of 4 ms: 32 ms periods.
+        assert_eq!(coarse.steps_per_control_period(), 8);
+        assert_eq!(coarse.rounds_in(1.0), 32);
     }
 
     #[test]

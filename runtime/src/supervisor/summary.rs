@@ -51,12 +51,18 @@ pub struct RunSummary {
     pub end: String,
     /// The consensus log directory.
     pub log: PathBuf,
+    /// Why the supervisor ended the run early because it could not go on (the sim or the
+    /// coordinator down and not restarted, or no agent left); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cannot_go_on: Option<String>,
 }
 
 impl RunSummary {
     /// Whether every robot reached its goal without a collision.
     pub fn success(&self) -> bool {
-        self.collisions == 0 && self.agents.iter().all(|a| a.reached_goal)
+        self.cannot_go_on.is_none()
+            && self.collisions == 0
+            && self.agents.iter().all(|a| a.reached_goal)
     }
 
     /// Builds the summary from the log in `log_dir` and the last ground truth (poses in
@@ -119,6 +125,7 @@ impl RunSummary {
             wall_time_s,
             end,
             log: log_dir.to_path_buf(),
+            cannot_go_on: None,
         })
     }
 

@@ -10,6 +10,10 @@
 //! (it was published before the new agent subscribed) and is waited for from then on;
 //! without the lifecycle protocol a robot counts as live again from its first fresh command,
 //! never from a publisher merely appearing, which would stall the run.
+//! With a fault plan, a lockstep sim holds before stepping the period of each fault's round
+//! (every live robot's command for it in), says so with `Hold`, and steps on at the
+//! supervisor's `Resume`, once the fault is done: a fault then fires at its round exactly and
+//! the run stays a function of its scenario (see [`hnav_runtime::msg::LifecycleEvent`]).
 //! In realtime the world follows the wall clock and commands apply when they arrive. The
 //! process blocks in a [`Waiter`] throughout (on the wheel topics and the supervisor's
 //! events), until the next period is due in realtime or, if set, until the lockstep deadline.
@@ -53,6 +57,8 @@ pub struct SimProcess<'t> {
     state: State,
     /// Skip the wait for the supervisor's `Start` (a restarted process).
     resume: bool,
+    /// The rounds of the scenario's planned faults.
+    fault_rounds: Vec<u64>,
 }
 
 impl<'t> SimProcess<'t> {
@@ -68,14 +74,19 @@ impl<'t> SimProcess<'t> {
             ports,
             state: State::new(world, scenario.sim.clock, lockstep_deadline),
             resume: false,
+            fault_rounds: scenario.faults.iter().map(|f| f.at_round).collect(),
         })
     }
 
     /// Joins the run's lifecycle protocol: [`SimProcess::run`] then starts with the handshake,
     /// and the process hears the supervisor's `Stop` and learns of agents that died (their
-    /// robots brake and are not waited for) or were restarted.
+    /// robots brake and are not waited for) or were restarted. In lockstep it also holds
+    /// before stepping past the round of each planned fault until the supervisor's `Resume`.
     pub fn with_lifecycle(mut self, ports: LifecyclePorts) -> Self {
         self.ports.life = Some(ports);
+        if self.state.clock == ClockMode::Lockstep {
+            self.state.hold_at(self.fault_rounds.iter().copied());
+        }
         self
     }
 
@@ -140,12 +151,18 @@ fn run_loop(
         let deadline = match st.clock {
             ClockMode::Lockstep => {
                 if st.ready() {
-                    st.advance(ports)?;
-                    give_up = None;
-                    continue;
+                    if !st.holding(ports)? {
+                        st.advance(ports)?;
+                        give_up = None;
+                        continue;
+                    }
+                    // Held for a fault: nothing is missing, the supervisor's `Resume` (or a
+                    // restarted robot's first command) is what comes next.
+                    None
+                } else {
+                    st.lockstep_deadline
+                        .map(|d| *give_up.get_or_insert_with(|| Instant::now() + d))
                 }
-                st.lockstep_deadline
-                    .map(|d| *give_up.get_or_insert_with(|| Instant::now() + d))
             }
             ClockMode::Realtime => {
                 // From the start, not from the last step: the schedule does not drift.

@@ -1,6 +1,7 @@
 //! The simulator's state between wake-ups and its handlers: the world, which robots are live
 //! and which have sent this period's command, and the period counter.
 
+use std::collections::VecDeque;
 use std::time::Duration;
 
 use hnav_runtime::msg::{LifecycleEvent, Role};
@@ -23,6 +24,12 @@ pub(crate) struct State {
     pub(crate) period: u64,
     /// `sim.lockstep_deadline_ms`, `None` for 0 (wait indefinitely).
     pub(crate) lockstep_deadline: Option<Duration>,
+    /// Lockstep with a fault plan: the periods to hold before, ascending (the distinct
+    /// `at_round`s of the scenario's faults; round `r` is committed just before period `r`
+    /// is stepped).
+    holds: VecDeque<u64>,
+    /// The `Hold` for the first of `holds` has been sent.
+    hold_sent: bool,
 }
 
 /// What a lifecycle drain found.
@@ -45,7 +52,39 @@ impl State {
             have: vec![false; n],
             period: 0,
             lockstep_deadline,
+            holds: VecDeque::new(),
+            hold_sent: false,
         }
+    }
+
+    /// Holds before stepping each of `periods` until the supervisor's `Resume` for it.
+    pub(crate) fn hold_at(&mut self, periods: impl IntoIterator<Item = u64>) {
+        let mut v: Vec<u64> = periods.into_iter().collect();
+        v.sort_unstable();
+        v.dedup();
+        self.holds = v.into();
+        self.hold_sent = false;
+    }
+
+    /// Whether the current period, ready to be stepped, waits for the supervisor's `Resume`;
+    /// the first time, tells it with `Hold`. Fault rounds behind the current period are
+    /// dropped; a restarted sim, which starts again at period 0, holds at every fault round
+    /// once more, and the supervisor resumes those already done at once.
+    pub(crate) fn holding(&mut self, ports: &Ports) -> Result<bool, SimError> {
+        while self.holds.front().is_some_and(|&p| p < self.period) {
+            self.holds.pop_front();
+            self.hold_sent = false;
+        }
+        if self.holds.front() != Some(&self.period) {
+            return Ok(false);
+        }
+        if !self.hold_sent {
+            if let Some(l) = &ports.life {
+                l.hold(self.period)?;
+            }
+            self.hold_sent = true;
+        }
+        Ok(true)
     }
 
     /// The wall-clock length of one control period (one odometry period).
@@ -62,9 +101,10 @@ impl State {
         }
     }
 
-    /// Applies the supervisor's events. A dead agent's robot brakes and is not waited for; a
-    /// restarted one counts again from its first fresh command (it needs this period's
-    /// odometry before it can send one).
+    /// Applies the supervisor's events. A dead agent's robot brakes and is not waited for, and
+    /// a command it sent for this period is void (the brake overrode it); a restarted one
+    /// counts again from its first fresh command (it needs this period's odometry before it
+    /// can send one). A `Resume` for the period held at ends the hold.
     pub(crate) fn on_lifecycle(&mut self, ports: &Ports) -> Result<LifecycleNews, SimError> {
         let Some(l) = &ports.life else {
             return Ok(LifecycleNews {
@@ -75,21 +115,33 @@ impl State {
         // Empty unless an agent was restarted: no allocation in an ordinary round.
         let mut restarted = Vec::new();
         let mut any = false;
-        let (live, world) = (&mut self.live, &mut self.world);
-        let stop = l.drain(|role, index, ev| {
+        let mut resumed = None;
+        let (live, have, world) = (&mut self.live, &mut self.have, &mut self.world);
+        let stop = l.drain_samples(|role, ev, sample| {
             any = true;
-            let Some(v) = live.get_mut(index as usize) else {
+            if ev == LifecycleEvent::Resume {
+                resumed = Some(sample.period());
+                return;
+            }
+            let index = sample.index;
+            let (Some(v), Some(h)) = (live.get_mut(index as usize), have.get_mut(index as usize))
+            else {
                 return;
             };
             match (role, ev) {
                 (Role::Agent, LifecycleEvent::Down) => {
                     *v = false;
+                    *h = false;
                     world.brake(index);
                 }
                 (Role::Agent, LifecycleEvent::Restarted) => restarted.push(index),
                 _ => {}
             }
         })?;
+        if resumed.is_some() && resumed == self.holds.front().copied() {
+            self.holds.pop_front();
+            self.hold_sent = false;
+        }
         self.resend_odometry(ports, &restarted)?;
         Ok(LifecycleNews {
             stop: stop.is_some(),
@@ -136,6 +188,7 @@ impl State {
             any |= w.data || w.peer_up || w.peer_left || w.peer_dead;
             if w.peer_dead || w.peer_left {
                 self.live[i] = false;
+                self.have[i] = false;
                 self.world.brake(i as u32);
             }
             let (world, have, live, period) =

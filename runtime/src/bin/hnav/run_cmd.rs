@@ -3,7 +3,8 @@
 //!
 //! Exit codes: 0 every robot reached its goal without a collision, 1 the run ended otherwise
 //! (time limit, collisions, stopped), 2 the run could not happen (bad scenario, a process
-//! that would not start).
+//! that would not start), 3 the run was ended early because it could not go on (the sim or
+//! the coordinator down and not restarted, or no agent left; the summary is still written).
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -76,7 +77,10 @@ pub fn run_command(a: RunArgs) -> ExitCode {
             print!("{}", summary.render());
             println!("summary   {}", dir.join("summary.json").display());
             println!("log       {}", summary.log.display());
-            if summary.success() {
+            if let Some(why) = &summary.cannot_go_on {
+                eprintln!("error: {why}");
+                ExitCode::from(3)
+            } else if summary.success() {
                 ExitCode::SUCCESS
             } else {
                 ExitCode::from(1)

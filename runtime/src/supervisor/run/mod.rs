@@ -11,13 +11,16 @@
 //!    at once) with a short tick for the progress bar and the fault schedule. A dead child is
 //!    reaped, its stale iceoryx2 resources removed (which wakes its peers with a "peer dead"
 //!    event), the others told on the lifecycle topic, and it is restarted under its role's
-//!    policy with `--resume` (module `slots`). The progress bar (`progress`) and the
-//!    scenario's planned faults (`faults`) follow the coordinator's progress topic.
-//! 4. End when the coordinator reports every agent at its goal, the time limit passes, or
-//!    the supervisor is asked to stop (SIGINT/SIGTERM): publish `Stop` with its
-//!    [`StopReason`], give the children a grace period, then SIGTERM and SIGKILL their
-//!    process groups; remove the run's shared memory; write `DIR/summary.json` from the
-//!    consensus log and the last ground truth.
+//!    policy with `--resume` (module `slots`). The progress bar (`progress`) follows the
+//!    coordinator's progress topic; the scenario's planned faults (`faults`) too in realtime,
+//!    and the sim's `Hold` at each fault's round in lockstep.
+//! 4. End when the coordinator reports every agent at its goal, or (lockstep) the last round
+//!    of the time limit committed; when the time limit passes on the wall clock (realtime);
+//!    when the run cannot go on (the sim or the coordinator down and not restarted, or no
+//!    agent left); or when the supervisor is asked to stop (SIGINT/SIGTERM): publish `Stop`
+//!    with its [`StopReason`], give the children a grace period, then SIGTERM and SIGKILL
+//!    their process groups; remove the run's shared memory; write `DIR/summary.json` from
+//!    the consensus log and the last ground truth.
 
 mod error;
 mod faults;
@@ -34,7 +37,7 @@ use super::stop::stop_all;
 use super::summary::RunSummary;
 use crate::launch::ProcessArgs;
 use crate::msg::{Lifecycle, Progress, StopReason, Truth};
-use crate::scenario::Scenario;
+use crate::scenario::{ClockMode, Scenario};
 use crate::topics;
 use crate::transport::{purge_run, Receiver, RunId, Transport, Wake};
 use error::io;
@@ -119,14 +122,17 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     if let Err(e) = record.remove() {
         tracing::warn!("run registry entry not removed: {e}");
     }
-    result?;
-    let summary = RunSummary::from_log(
+    let end = result?;
+    let mut summary = RunSummary::from_log(
         run.as_str(),
         &dir.join("log"),
         truth.as_ref(),
         scenario.robot.cell_size_m,
         started.elapsed().as_secs_f64(),
     )?;
+    if let End::CannotGoOn(why) = end {
+        summary.cannot_go_on = Some(why);
+    }
     summary.write_json(&dir).map_err(io(&dir))?;
     Ok(summary)
 }
@@ -146,11 +152,13 @@ fn prepare_dir(dir: &Path) -> Result<(), RunError> {
 }
 
 /// How the watched part of a run ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 enum End {
     AllAtGoal,
     TimeLimit,
     Signalled,
+    /// The sim or the coordinator is gone for good, or no agent is left: why.
+    CannotGoOn(String),
 }
 
 /// Spawns the processes, runs the start-up handshake, then watches until the run ends,
@@ -169,18 +177,25 @@ fn supervise(
     if ports.life.start(transport, &children, STARTUP_TIMEOUT)? == Startup::Interrupted {
         return Ok(End::Signalled);
     }
+    let lockstep = scenario.sim.clock == ClockMode::Lockstep;
     let mut watch = Watch {
         view: ProgressView::new(show_progress, scenario.agents.len()),
         faults: FaultSchedule::new(&scenario.faults),
+        lockstep,
         t0: Instant::now(),
-        limit: Duration::from_secs_f64(scenario.coordinator.time_limit_s.max(0.0)),
+        // In lockstep the coordinator counts the limit in rounds and says when it is reached.
+        limit: (!lockstep)
+            .then(|| Duration::from_secs_f64(scenario.coordinator.time_limit_s.max(0.0))),
     };
     loop {
         if let Some(end) = watch.until_change(transport, ports, slots)? {
             watch.view.finish();
             return Ok(end);
         }
-        slots.reap_and_restart(transport, &ports.life)?;
+        if let Some(why) = slots.reap_and_restart(transport, &ports.life)? {
+            watch.view.finish();
+            return Ok(End::CannotGoOn(why));
+        }
         slots.write_record(record);
     }
 }
@@ -189,8 +204,10 @@ fn supervise(
 struct Watch<'s> {
     view: ProgressView,
     faults: FaultSchedule<'s>,
+    lockstep: bool,
     t0: Instant,
-    limit: Duration,
+    /// The wall-clock limit (realtime only).
+    limit: Option<Duration>,
 }
 
 impl Watch<'_> {
@@ -208,11 +225,17 @@ impl Watch<'_> {
             attached.push(c.watch(&waiter)?);
         }
         loop {
-            slots.announce_restarts(&ports.life)?;
+            for period in slots.announce_restarts(&ports.life)? {
+                self.faults.on_hold(slots, period);
+            }
+            if let Some(period) = self.faults.resume_due(slots) {
+                ports.life.publish(Lifecycle::resume(period))?;
+            }
             if let Some(end) = self.on_progress(ports, slots)? {
                 return Ok(Some(end));
             }
-            if self.t0.elapsed() >= self.limit {
+            let left = self.limit.map(|l| l.saturating_sub(self.t0.elapsed()));
+            if left.is_some_and(|l| l.is_zero()) {
                 return Ok(Some(End::TimeLimit));
             }
             let now = Instant::now();
@@ -222,7 +245,7 @@ impl Watch<'_> {
             }
             // The next tick of the progress bar and the fault schedule, sooner if a restart
             // is due, never past the time limit.
-            let mut until = now + TICK.min(self.limit.saturating_sub(self.t0.elapsed()));
+            let mut until = now + left.map_or(TICK, |l| TICK.min(l));
             if let Some(d) = due {
                 until = until.min(d);
             }
@@ -235,8 +258,8 @@ impl Watch<'_> {
         }
     }
 
-    /// Shows the coordinator's latest progress and fires the faults due by its round;
-    /// `AllAtGoal` once it reports every agent at its goal.
+    /// Shows the coordinator's latest progress and, in realtime, fires the faults due by its
+    /// round; `AllAtGoal` or `TimeLimit` once it reports that it ended the run.
     fn on_progress(&mut self, ports: &Ports, slots: &Slots) -> Result<Option<End>, RunError> {
         let mut last = None;
         ports.progress.drain_pending(|p| last = Some(*p))?;
@@ -244,8 +267,14 @@ impl Watch<'_> {
             return Ok(None);
         };
         self.view.show(&p);
-        self.faults.fire(slots, p.round);
-        Ok((p.done == 1).then_some(End::AllAtGoal))
+        if !self.lockstep {
+            self.faults.fire_due(slots, p.round);
+        }
+        Ok(match p.done {
+            Progress::ALL_AT_GOAL => Some(End::AllAtGoal),
+            Progress::TIME_LIMIT => Some(End::TimeLimit),
+            _ => None,
+        })
     }
 }
 

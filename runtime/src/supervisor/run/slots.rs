@@ -8,11 +8,11 @@ use std::time::Instant;
 
 use super::error::RunError;
 use crate::launch::ProcessArgs;
-use crate::msg::{Lifecycle, Role};
+use crate::msg::{Lifecycle, LifecycleEvent, Role};
 use crate::scenario::Scenario;
-use crate::supervisor::child::{Child, ChildError, ChildSpec};
+use crate::supervisor::child::{Child, ChildError, ChildSpec, ExitInfo};
 use crate::supervisor::registry::RunRecord;
-use crate::supervisor::restart::{RestartDecision, RestartTracker};
+use crate::supervisor::restart::{GiveUpReason, RestartDecision, RestartTracker};
 use crate::supervisor::startup::SupervisorPorts;
 use crate::transport::Transport;
 
@@ -94,6 +94,25 @@ impl Slots {
             .and_then(|s| s.child.as_ref())
     }
 
+    /// Whether the incarnation `pid` of `role`/`index` is over for good or replaced: it was
+    /// reaped, and it is either not restarted or its successor is up and announced.
+    pub(super) fn settled(&self, role: Role, index: u32, pid: u32) -> bool {
+        self.slots
+            .iter()
+            .find(|s| s.spec.role == role && s.spec.index == index)
+            .is_none_or(|s| match &s.child {
+                Some(c) => c.pid() != pid && !s.announce.get(),
+                None => s.restart_at.is_none(),
+            })
+    }
+
+    /// Whether an agent runs or is due to be restarted.
+    fn any_agent_left(&self) -> bool {
+        self.slots
+            .iter()
+            .any(|s| s.spec.role == Role::Agent && (s.child.is_some() || s.restart_at.is_some()))
+    }
+
     /// The earliest pending restart.
     pub(super) fn next_restart(&self) -> Option<Instant> {
         self.slots.iter().filter_map(|s| s.restart_at).min()
@@ -112,13 +131,18 @@ impl Slots {
         }
     }
 
-    /// Reaps exited children, tells the others (`Down`), and restarts what is due.
+    /// Reaps exited children, tells the others (`Down`), and restarts what is due. Returns
+    /// why the run cannot go on, if it cannot: the sim or the coordinator is down and not
+    /// restarted, or no agent is left.
     pub(super) fn reap_and_restart(
         &mut self,
         transport: &Transport,
         life: &SupervisorPorts,
-    ) -> Result<(), RunError> {
+    ) -> Result<Option<String>, RunError> {
         let mut died = false;
+        // The sim or the coordinator gone for good ends the run; an agent only if it was
+        // the last one.
+        let (mut core_gone, mut agent_gone) = (None, None);
         for s in &mut self.slots {
             let Some(exit) = s.child.as_ref().and_then(|c| c.try_reap()) else {
                 continue;
@@ -131,7 +155,12 @@ impl Slots {
             match s.tracker.on_exit(&exit) {
                 RestartDecision::Restart { after } => s.restart_at = Some(Instant::now() + after),
                 RestartDecision::GiveUp(why) => {
-                    tracing::warn!(node = role.node_name(index), ?why, "not restarted")
+                    tracing::warn!(node = role.node_name(index), %why, "not restarted");
+                    let gone = gone_for_good(role, index, &exit, why);
+                    match role {
+                        Role::Agent => agent_gone = Some(gone),
+                        Role::Sim | Role::Coordinator => core_gone = Some(gone),
+                    }
                 }
             }
         }
@@ -140,6 +169,12 @@ impl Slots {
             if let Err(e) = transport.cleanup_dead_nodes() {
                 tracing::warn!("dead-node clean-up failed: {e}");
             }
+        }
+        if core_gone.is_some() {
+            return Ok(core_gone);
+        }
+        if let Some(gone) = agent_gone.filter(|_| !self.any_agent_left()) {
+            return Ok(Some(format!("no agent is left; the last: {gone}")));
         }
         let now = Instant::now();
         for s in &mut self.slots {
@@ -156,14 +191,20 @@ impl Slots {
                 s.announce.set(true);
             }
         }
-        Ok(())
+        Ok(None)
     }
 
-    /// Publishes `Restarted` for every restarted process that has announced itself up.
-    pub(super) fn announce_restarts(&self, life: &SupervisorPorts) -> Result<(), RunError> {
+    /// Publishes `Restarted` for every restarted process that has announced itself up;
+    /// returns the periods of the sim's `Hold`s among what came in on `ready`.
+    pub(super) fn announce_restarts(&self, life: &SupervisorPorts) -> Result<Vec<u64>, RunError> {
         let ready = life.ready();
         let mut up = Vec::new();
-        ready.drain_pending(|l| up.push((l.role, l.index)))?;
+        let mut holds = Vec::new();
+        ready.drain_pending(|l| match LifecycleEvent::from_u8(l.event) {
+            Some(LifecycleEvent::Up) => up.push((l.role, l.index)),
+            Some(LifecycleEvent::Hold) => holds.push(l.period()),
+            _ => {}
+        })?;
         for (role, index) in up {
             let slot = self
                 .slots
@@ -178,6 +219,16 @@ impl Slots {
                 ))?;
             }
         }
-        Ok(())
+        Ok(holds)
     }
+}
+
+/// Why the run cannot go on without `role`/`index`, which ended with `exit` and is not
+/// restarted for `why`.
+fn gone_for_good(role: Role, index: u32, exit: &ExitInfo, why: GiveUpReason) -> String {
+    let who = match role {
+        Role::Agent => format!("hnav-agent {index}"),
+        other => format!("hnav-{}", other.name()),
+    };
+    format!("{who} ended ({exit}) and is not restarted ({why}): the run cannot go on")
 }
