@@ -199,3 +199,63 @@ pub fn wait_for_ps(
         "run {run_id} not listed as expected within {timeout:?}; last output:\n{last}"
     ))
 }
+
+/// What a short `hnav` command printed, and how it ended.
+#[derive(Debug)]
+pub struct HnavOutput {
+    /// Its exit status.
+    pub status: ExitStatus,
+    /// Its stdout.
+    pub stdout: String,
+    /// Its stderr.
+    pub stderr: String,
+}
+
+/// Runs `hnav ARGS...` with the run registry in `registry` and waits up to `timeout` for it
+/// to exit (it is killed after that, and the error says so), collecting its output.
+pub fn hnav_output(
+    args: &[String],
+    registry: &Path,
+    timeout: Duration,
+) -> Result<HnavOutput, String> {
+    use std::io::Read;
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(workspace_bin("hnav"))
+        .args(args)
+        .env("HNAV_RUNS_DIR", registry)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("cannot start hnav: {e}"))?;
+    let pid = child.id();
+    let read = |mut r: Box<dyn Read + Send>| {
+        std::thread::spawn(move || {
+            let mut s = String::new();
+            let _ = r.read_to_string(&mut s);
+            s
+        })
+    };
+    let out = read(Box::new(child.stdout.take().ok_or("no stdout")?));
+    let err = read(Box::new(child.stderr.take().ok_or("no stderr")?));
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(child.wait());
+    });
+    let status = match rx.recv_timeout(timeout) {
+        Ok(Ok(status)) => status,
+        Ok(Err(e)) => return Err(format!("hnav {args:?}: {e}")),
+        Err(_) => {
+            let _ = nix::sys::signal::kill(
+                nix::unistd::Pid::from_raw(pid as i32),
+                nix::sys::signal::Signal::SIGKILL,
+            );
+            return Err(format!("hnav {args:?} did not exit within {timeout:?}"));
+        }
+    };
+    Ok(HnavOutput {
+        status,
+        stdout: out.join().unwrap_or_default(),
+        stderr: err.join().unwrap_or_default(),
+    })
+}

@@ -150,6 +150,15 @@ pub enum LogError {
     /// A record to append could not be encoded.
     #[error("cannot encode record: {0}")]
     Encode(#[from] bincode::error::EncodeError),
+    /// Another process holds the log's writer lock: two writers would interleave their
+    /// records.
+    #[error("{}: the consensus log is already being written by another process{}; a log has one writer", dir.display(), holder.as_ref().map(|p| format!(" (pid {p})")).unwrap_or_default())]
+    Locked {
+        /// The log directory.
+        dir: PathBuf,
+        /// The pid the lock file names, if it could be read.
+        holder: Option<String>,
+    },
     /// An earlier write or fsync failed; the writer refuses further appends because the
     /// file's durable state is unknown. Reopen the log to recover.
     #[error("{}: an earlier write or fsync failed; reopen the log", path.display())]

@@ -53,7 +53,7 @@ pub use record::{
 pub use segment::{list_segments, segment_name, segment_path, DEFAULT_SEGMENT_BYTES};
 pub use tally::{AgentTally, Tally};
 pub use verify::{verify, KindCounts, VerifyReport, VerifyStatus};
-pub use writer::{LogWriter, Recovered, WriterOptions, BATCH_INTERVAL, BATCH_RECORDS};
+pub use writer::{LogWriter, Recovered, WriterOptions, BATCH_INTERVAL, BATCH_RECORDS, WRITER_LOCK};
 
 /// The format version this build writes into [`RunHeader::version`] and accepts on reading.
 pub const FORMAT_VERSION: u32 = 1;

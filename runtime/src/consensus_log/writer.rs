@@ -11,6 +11,11 @@
 //! | [`FsyncPolicy::Batched`] | the write; `fdatasync` every [`BATCH_RECORDS`] records or when [`BATCH_INTERVAL`] has passed since the last one (checked on append) | the unsynced tail may be lost, although its commits may already have been published |
 //! | [`FsyncPolicy::None`] | the write; never syncs (benchmarks only) | anything not yet written back by the OS may be lost |
 //!
+//! A writer holds an exclusive lock on [`WRITER_LOCK`] in the log directory from
+//! [`LogWriter::open`] until it is dropped, so two processes can never append to one log (a
+//! second `open` fails with [`LogError::Locked`]). The kernel drops the lock of a killed
+//! writer, so a coordinator restarted with `--resume` after a SIGKILL opens the log again.
+//!
 //! Under `Batched` and `None` a crash can also damage several unsynced records in an order
 //! the reader cannot tell from corruption; under `EveryRecord` only the record in flight can
 //! be torn, and reopening cuts exactly that.
@@ -45,7 +50,12 @@ use super::frame::{encode_frame, MAGIC};
 use super::reader::{check_header, read_log, LogContents, RecordPos, TornTail};
 use super::record::Record;
 use super::segment::{list_segments, segment_path, DEFAULT_SEGMENT_BYTES};
+use crate::file_lock::{try_lock, FileLock, TryLock};
 use crate::scenario::FsyncPolicy;
+
+/// The writer's lock file in the log directory (ignored by the reader, which reads only
+/// segment files).
+pub const WRITER_LOCK: &str = ".writer.lock";
 
 /// Under [`FsyncPolicy::Batched`], sync at the latest after this many records.
 pub const BATCH_RECORDS: u32 = 32;
@@ -102,6 +112,8 @@ pub struct LogWriter {
     unsynced: u32,
     last_sync: Instant,
     poisoned: bool,
+    /// Held, never read: the lock lasts as long as the writer.
+    _lock: FileLock,
 }
 
 impl LogWriter {
@@ -128,11 +140,12 @@ impl LogWriter {
                 sync_dir(parent.unwrap_or(Path::new(".")))?;
             }
         }
+        let lock = lock_log(&dir)?;
         let segments = list_segments(&dir)?;
         if segments.is_empty() {
             let path = segment_path(&dir, 0);
             let file = create_segment(&path, &dir, syncing)?;
-            let writer = Self::new(dir, options, file, path, 0, MAGIC_LEN, 0);
+            let writer = Self::new(dir, options, (file, lock), path, 0, MAGIC_LEN, 0);
             let recovered = Recovered {
                 records: Vec::new(),
                 positions: Vec::new(),
@@ -164,7 +177,7 @@ impl LogWriter {
         }
         let len = file.metadata().map_err(|e| LogError::io(&path, e))?.len();
         let records = contents.records.len() as u64;
-        let writer = Self::new(dir, options, file, path, last as u32, len, records);
+        let writer = Self::new(dir, options, (file, lock), path, last as u32, len, records);
         let recovered = Recovered {
             records: contents.records,
             positions: contents.positions,
@@ -177,13 +190,14 @@ impl LogWriter {
     fn new(
         dir: PathBuf,
         options: WriterOptions,
-        file: File,
+        (file, lock): (File, FileLock),
         path: PathBuf,
         segment: u32,
         len: u64,
         records: u64,
     ) -> Self {
         Self {
+            _lock: lock,
             dir,
             options,
             file,
@@ -355,6 +369,19 @@ fn drop_empty_last_segment(
         sync_dir(dir)?;
     }
     Ok(last - 1)
+}
+
+/// Takes the log's writer lock, or says which process holds it.
+fn lock_log(dir: &Path) -> Result<FileLock, LogError> {
+    let path = dir.join(WRITER_LOCK);
+    match try_lock(&path, &[("pid", std::process::id().to_string())]) {
+        Ok(TryLock::Acquired(lock)) => Ok(lock),
+        Ok(TryLock::Held(holder)) => Err(LogError::Locked {
+            dir: dir.to_path_buf(),
+            holder: holder.get("pid").map(str::to_string),
+        }),
+        Err(e) => Err(LogError::io(&path, e)),
+    }
 }
 
 /// Creates a segment holding only the magic; with `syncing`, syncs it and the directory.

@@ -206,15 +206,22 @@ impl Child {
             .map_err(log_err)?;
         let err = out.try_clone().map_err(log_err)?;
         let mut command = Command::new(&spec.program);
-        // SAFETY: the closure runs in the forked child before exec and only calls prctl(2),
-        // which is async-signal-safe; it touches no memory shared with the parent.
+        let parent = std::process::id() as libc::pid_t;
+        // SAFETY: the closure runs in the forked child before exec and only calls prctl(2) and
+        // getppid(2), which are async-signal-safe, and builds an io::Error from a raw errno
+        // (no allocation); it touches no memory shared with the parent.
         unsafe {
-            command.pre_exec(|| {
+            command.pre_exec(move || {
                 // No orphans: if the supervisor dies (even by SIGKILL) the child is killed.
                 // The death signal follows the spawning *thread*; the supervisor spawns every
                 // child from its main thread, which lives as long as the supervisor.
                 if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL) != 0 {
                     return Err(std::io::Error::last_os_error());
+                }
+                // A supervisor that died between the fork and the prctl sent no signal: the
+                // child has been re-parented already and must not start.
+                if libc::getppid() != parent {
+                    return Err(std::io::Error::from_raw_os_error(libc::ESRCH));
                 }
                 Ok(())
             });

@@ -13,6 +13,8 @@
 //! | [`exit_fd`] | the pidfd (or waiter-thread pipe) that makes a child's exit wake the supervisor's `Waiter` |
 //! | [`restart`] | per-child restart decisions: policy, cap, doubling backoff |
 //! | [`stop`] | the escalating stop of a run's children: wait, SIGTERM, SIGKILL, reap |
+//! | [`run_dir`] | a run's hold on its output directory: the directory lock, and `--force` for a finished run's outputs |
+//! | [`clean`] | removing what a dead run left: leftover processes, shared memory, iceoryx2 files, registry entry |
 //! | [`registry`] | the on-disk list of live runs and their processes that `hnav ps` reads |
 //! | [`startup`] | the supervisor's half of the lifecycle protocol: the start-up handshake and the events it publishes |
 //! | [`run`] | `hnav run`: spawn, start-up handshake, watch and restart, faults, stop, summary |
@@ -20,11 +22,13 @@
 //! | [`ps`] | what `hnav ps` shows: each registered process as running, exited or dead, as JSON or a table |
 
 pub mod child;
+pub mod clean;
 pub mod exit_fd;
 pub mod ps;
 pub mod registry;
 pub mod restart;
 pub mod run;
+pub mod run_dir;
 pub mod startup;
 pub mod stop;
 pub mod summary;

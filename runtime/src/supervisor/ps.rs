@@ -1,15 +1,18 @@
 //! What `hnav ps` shows: every registered run with the current state of its processes.
 //!
-//! The state combines two sources. `kill(pid, 0)` ([`pid_alive`]) says whether the pid
-//! exists. The run's iceoryx2 node list says whether the process died without leaving the
+//! The state combines two sources. [`process_alive`] says whether the pid exists and is
+//! still the process the run started (its start time is recorded). The run's iceoryx2 node list says whether the process died without leaving the
 //! run: its node is then `Dead`, and its shared memory remains until somebody cleans up.
 //! A dead node takes precedence: its pid may already be a zombie or be reused.
+//!
+//! A run whose supervisor is gone is *dead* (`stale` in JSON): the table marks it and names
+//! the command that removes what it left, `hnav clean RUN` ([`super::clean`]).
 
 use std::path::PathBuf;
 
 use serde::Serialize;
 
-use super::registry::{pid_alive, RunEntry, RunRegistry};
+use super::registry::{process_alive, RunEntry, RunRegistry};
 use crate::msg::Role;
 use crate::transport::{NodeLiveness, RunId, Transport};
 
@@ -115,7 +118,7 @@ impl RunStatus {
                 let state = if let Some(i) = found {
                     dead.remove(i);
                     ProcessState::Dead
-                } else if pid_alive(p.pid) {
+                } else if process_alive(p.pid, p.start_ticks) {
                     ProcessState::Running
                 } else {
                     ProcessState::Exited
@@ -167,7 +170,8 @@ impl PsReport {
     }
 
     /// A table with the columns RUN, DIR, ROLE, INDEX, PID, STATE, one row per process and
-    /// per unmatched dead node; a stale run is marked after its id.
+    /// per unmatched dead node; a dead run (its supervisor gone) is marked after its id, and
+    /// a note under the table names `hnav clean RUN` for each.
     pub fn render_table(&self) -> String {
         if self.runs.is_empty() {
             return "no live runs\n".to_string();
@@ -183,7 +187,7 @@ impl PsReport {
         let mut any_dead = false;
         for run in &self.runs {
             let id = if run.stale {
-                format!("{} (stale)", run.run_id)
+                format!("{} (dead)", run.run_id)
             } else {
                 run.run_id.clone()
             };
@@ -231,6 +235,12 @@ impl PsReport {
                 .collect();
             out.push_str(line.join("  ").trim_end());
             out.push('\n');
+        }
+        for run in self.runs.iter().filter(|r| r.stale) {
+            out.push_str(&format!(
+                "run {} is dead (its supervisor, pid {}, is gone): `hnav clean {}` removes what it left\n",
+                run.run_id, run.supervisor_pid, run.run_id
+            ));
         }
         if any_dead {
             out.push_str(

@@ -8,7 +8,14 @@
 //! describe live processes, which a crash of the machine ends anyway.
 //!
 //! A supervisor that died without cleaning up leaves its file behind. Readers notice that its
-//! `supervisor_pid` is gone and report the run as *stale*.
+//! supervisor is gone and report the run as *stale* (dead); `hnav clean` removes what it
+//! left ([`super::clean`]). "Gone" means the pid does not exist, is a zombie, or now belongs
+//! to another process: every record keeps the start time of each pid it names (from
+//! `/proc/<pid>/stat`), so a reused pid is never taken for the run's process.
+//!
+//! A supervisor also holds an exclusive lock on `<runs dir>/<run_id>.lock` for its lifetime
+//! ([`RunRegistry::claim`]): a second `hnav run` with the same id is refused before it
+//! touches anything, and the kernel drops the lock when the supervisor dies.
 //!
 //! The directory is `$HNAV_RUNS_DIR` if that is set, else `<temp dir>/hnav-runs`.
 //! Tests use [`RunRegistry::at`] rather than the environment, which all the tests of one
@@ -20,6 +27,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use serde::{Deserialize, Serialize};
 
+use crate::file_lock::{try_lock, FileLock, TryLock};
 use crate::msg::Role;
 use crate::transport::RunId;
 
@@ -36,6 +44,16 @@ pub enum RegistryError {
         path: PathBuf,
         /// The cause.
         source: std::io::Error,
+    },
+    /// Another live supervisor holds the run id.
+    #[error("run id {run} is in use by a live run (supervisor pid {}, directory {}); choose another --run, or stop that run first", pid.as_deref().unwrap_or("unknown"), dir.as_deref().unwrap_or("unknown"))]
+    InUse {
+        /// The run id.
+        run: String,
+        /// The holder's pid, as its lock file names it.
+        pid: Option<String>,
+        /// The holder's run directory, as its lock file names it.
+        dir: Option<String>,
     },
     /// A record is not valid JSON of the expected shape.
     #[error("{path}: not a run record: {source}")]
@@ -79,10 +97,12 @@ impl RunRegistry {
             .duration_since(std::time::UNIX_EPOCH)
             .map(|d| d.as_millis() as u64)
             .unwrap_or(0);
+        let supervisor_pid = std::process::id();
         RunRecord {
             run_id: run.as_str().to_string(),
             dir: dir.into(),
-            supervisor_pid: std::process::id(),
+            supervisor_pid,
+            supervisor_start_ticks: process_start_ticks(supervisor_pid),
             started_unix_ms,
             processes: Vec::new(),
             file: self.dir.join(format!("{}.json", run.as_str())),
@@ -109,7 +129,7 @@ impl RunRegistry {
             }
             match RunRecord::read(&entry.path()) {
                 Ok(record) => {
-                    let stale = !pid_alive(record.supervisor_pid);
+                    let stale = !record.supervisor_alive();
                     runs.push(RunEntry { record, stale });
                 }
                 Err(e) => tracing::warn!(error = %e, "skipping run record"),
@@ -121,6 +141,61 @@ impl RunRegistry {
         });
         runs
     }
+
+    /// The record of `run`, if the registry has one.
+    pub fn find(&self, run: &RunId) -> Result<Option<RunRecord>, RegistryError> {
+        let path = self.record_path(run);
+        match RunRecord::read(&path) {
+            Ok(r) => Ok(Some(r)),
+            Err(RegistryError::Io { source, .. })
+                if source.kind() == std::io::ErrorKind::NotFound =>
+            {
+                Ok(None)
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    /// Claims `run` for this process (a supervisor starting it in `dir`, or `hnav clean`
+    /// removing it) until the claim is released or the process dies. Refused with
+    /// [`RegistryError::InUse`] while another process holds it.
+    pub fn claim(&self, run: &RunId, dir: &Path) -> Result<RunClaim, RegistryError> {
+        let path = self.dir.join(format!("{}.lock", run.as_str()));
+        let fields = [
+            ("run", run.as_str().to_string()),
+            ("pid", std::process::id().to_string()),
+            ("dir", dir.display().to_string()),
+        ];
+        match try_lock(&path, &fields) {
+            Ok(TryLock::Acquired(lock)) => Ok(RunClaim { lock }),
+            Ok(TryLock::Held(holder)) => Err(RegistryError::InUse {
+                run: run.as_str().to_string(),
+                pid: holder.get("pid").map(str::to_string),
+                dir: holder.get("dir").map(str::to_string),
+            }),
+            Err(source) => Err(RegistryError::Io { path, source }),
+        }
+    }
+
+    fn record_path(&self, run: &RunId) -> PathBuf {
+        self.dir.join(format!("{}.json", run.as_str()))
+    }
+}
+
+/// A run id claimed with [`RunRegistry::claim`].
+#[derive(Debug)]
+pub struct RunClaim {
+    lock: FileLock,
+}
+
+impl RunClaim {
+    /// Gives the id up and removes its lock file.
+    pub fn release(self) -> Result<(), RegistryError> {
+        let path = self.lock.path().to_path_buf();
+        self.lock
+            .remove()
+            .map_err(|source| RegistryError::Io { path, source })
+    }
 }
 
 /// One process of a run, as its supervisor last recorded it.
@@ -130,8 +205,11 @@ pub struct ProcessRecord {
     pub role: Role,
     /// The agent index, else 0.
     pub index: u32,
-    /// The pid of its current incarnation.
+    /// The pid of its current incarnation (also its process group: every child leads its own).
     pub pid: u32,
+    /// When that pid started (clock ticks since boot), to tell it from a reused pid.
+    #[serde(default)]
+    pub start_ticks: Option<u64>,
     /// Restarts so far.
     pub restarts: u32,
 }
@@ -145,6 +223,9 @@ pub struct RunRecord {
     pub dir: PathBuf,
     /// The supervisor's pid.
     pub supervisor_pid: u32,
+    /// When the supervisor started (clock ticks since boot), to tell it from a reused pid.
+    #[serde(default)]
+    pub supervisor_start_ticks: Option<u64>,
     /// When the supervisor started the run, in milliseconds since the Unix epoch.
     pub started_unix_ms: u64,
     /// The run's processes, one entry per role and index.
@@ -174,12 +255,26 @@ impl RunRecord {
         &self.file
     }
 
+    /// Whether the supervisor that wrote this record still runs.
+    pub fn supervisor_alive(&self) -> bool {
+        process_alive(self.supervisor_pid, self.supervisor_start_ticks)
+    }
+
     /// Records the current incarnation of `role`/`index`, replacing an older one.
     pub fn set_process(&mut self, role: Role, index: u32, pid: u32, restarts: u32) {
+        let start_ticks = match self
+            .processes
+            .iter()
+            .find(|p| p.role == role && p.index == index && p.pid == pid)
+        {
+            Some(p) if p.start_ticks.is_some() => p.start_ticks,
+            _ => process_start_ticks(pid),
+        };
         let new = ProcessRecord {
             role,
             index,
             pid,
+            start_ticks,
             restarts,
         };
         match self
@@ -262,6 +357,28 @@ pub fn pid_alive(pid: u32) -> bool {
     }
 }
 
+/// Whether `pid` is alive ([`pid_alive`]) and, when `start_ticks` is known, is still the
+/// process that started then rather than a later one that got the same pid.
+pub fn process_alive(pid: u32, start_ticks: Option<u64>) -> bool {
+    if !pid_alive(pid) {
+        return false;
+    }
+    match (start_ticks, process_start_ticks(pid)) {
+        (Some(want), Some(now)) => want == now,
+        // Without /proc to ask, the pid is all there is.
+        _ => true,
+    }
+}
+
+/// When `pid` started, in clock ticks since boot: field 22 of `/proc/<pid>/stat`.
+pub fn process_start_ticks(pid: u32) -> Option<u64> {
+    // The command name (field 2) is parenthesised and may itself hold spaces or ')'.
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    let after_name = &stat[stat.rfind(')')? + 1..];
+    // Field 3 (the state) is the first after the name, so field 22 is the 20th.
+    after_name.split_whitespace().nth(19)?.parse().ok()
+}
+
 /// Reads the state letter of `/proc/<pid>/stat` (after the parenthesised command name).
 fn is_zombie(pid: u32) -> bool {
     std::fs::read_to_string(format!("/proc/{pid}/stat"))
@@ -271,4 +388,18 @@ fn is_zombie(pid: u32) -> bool {
                 .map(|i| s[i + 1..].trim_start().starts_with('Z'))
         })
         .unwrap_or(false)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn this_process_is_alive_and_a_wrong_start_time_is_not() {
+        let me = std::process::id();
+        let ticks = process_start_ticks(me).expect("/proc names our start time");
+        assert!(process_alive(me, Some(ticks)));
+        assert!(process_alive(me, None));
+        assert!(!process_alive(me, Some(ticks + 1)), "a reused pid");
+    }
 }

@@ -44,7 +44,7 @@ pub use channel::{Drained, Receiver, Sender, Wakeup};
 pub use error::TransportError;
 pub use node::{CleanupReport, NodeInfo, NodeLiveness, Transport, TransportBuilder};
 pub use qos::{Delivery, Qos};
-pub use run::{purge_run, run_config, run_shm_files, RunId};
+pub use run::{purge_run, run_config, run_iceoryx2_files, run_shm_files, RunId};
 pub use slice::{SliceLoan, SliceReceiver, SliceSender};
 pub use waiter::{stop_requested, Attachment, AttachmentId, Waiter, Wake};
 

@@ -1,6 +1,7 @@
 //! Run identity: service names and the per-run iceoryx2 configuration.
 
-use std::path::PathBuf;
+use std::os::unix::ffi::OsStrExt;
+use std::path::{Path, PathBuf};
 
 use iceoryx2::config::Config;
 use iceoryx2::prelude::{FileName, SemanticString, ServiceName};
@@ -95,25 +96,75 @@ pub fn run_config(run: &RunId) -> Config {
     config
 }
 
-/// The shared-memory files of a run that exist now in `/dev/shm`.
-pub fn run_shm_files(run: &RunId) -> Vec<PathBuf> {
-    let prefix = run.prefix();
-    let Ok(dir) = std::fs::read_dir(SHM_DIR) else {
+/// Whether the file `name` is one iceoryx2 made for the run with file prefix `prefix`.
+///
+/// iceoryx2 follows the prefix with a hash or node id (16 or more hex or decimal digits) or
+/// with `node`. The extra check keeps the files of run `a_<hex>...` away from run `a`, whose
+/// prefix `hnav_a_` they also start with, unless the longer id itself continues with 16 hex
+/// digits or `node` after the underscore.
+fn belongs_to_run(name: &[u8], prefix: &str) -> bool {
+    let Some(rest) = name.strip_prefix(prefix.as_bytes()) else {
+        return false;
+    };
+    let first = rest
+        .split(|&b| b == b'_' || b == b'.')
+        .next()
+        .unwrap_or_default();
+    first == b"node" || (first.len() >= 16 && first.iter().all(u8::is_ascii_hexdigit))
+}
+
+/// The files of `dir` (not recursive) that belong to the run with file prefix `prefix`.
+fn files_of_run_in(dir: &Path, prefix: &str) -> Vec<PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
         return Vec::new();
     };
-    dir.filter_map(Result::ok)
-        .filter(|e| e.file_name().to_string_lossy().starts_with(&prefix))
+    entries
+        .filter_map(Result::ok)
+        .filter(|e| belongs_to_run(e.file_name().as_bytes(), prefix))
+        .filter(|e| e.file_type().is_ok_and(|t| !t.is_dir()))
         .map(|e| e.path())
         .collect()
 }
 
+/// The shared-memory files of a run that exist now in `/dev/shm`.
+pub fn run_shm_files(run: &RunId) -> Vec<PathBuf> {
+    files_of_run_in(Path::new(SHM_DIR), &run.prefix())
+}
+
+/// The files of a run that exist now under iceoryx2's root directory (`/tmp/iceoryx2` by
+/// default, or the root of [`run_config`]): event and service files, node monitors, and the
+/// files in each of the run's node directories (`nodes/<node id>/`).
+pub fn run_iceoryx2_files(run: &RunId) -> Vec<PathBuf> {
+    let config = run_config(run);
+    let prefix = run.prefix();
+    let std_path = |bytes: &[u8]| PathBuf::from(std::ffi::OsStr::from_bytes(bytes));
+    let node_dir = std_path(config.global.node_dir().as_bytes());
+    let root = std_path(config.global.root_path().as_bytes());
+    let mut files = files_of_run_in(&root, &prefix);
+    files.extend(files_of_run_in(
+        &std_path(config.global.service_dir().as_bytes()),
+        &prefix,
+    ));
+    files.extend(files_of_run_in(&node_dir, &prefix));
+    if let Ok(entries) = std::fs::read_dir(&node_dir) {
+        for e in entries.filter_map(Result::ok) {
+            if e.file_type().is_ok_and(|t| t.is_dir()) {
+                files.extend(files_of_run_in(&e.path(), &prefix));
+            }
+        }
+    }
+    files
+}
+
 /// Removes what a finished run left behind: stale resources of dead nodes, then the run's
-/// global management segment, then any file of the run still in `/dev/shm`.
+/// global management segment, then any file of the run still in `/dev/shm` or under
+/// iceoryx2's root directory ([`run_iceoryx2_files`]; a node directory left empty goes too).
 ///
 /// Call it only when no process of the run is alive any more (the supervisor after the last
-/// child was reaped, a test after its children exited): it returns an error and removes
-/// nothing if a live node of the run is found. Returns the number of files removed in the
-/// last step, which is 0 when every process exited cleanly.
+/// child was reaped, a test after its children exited, `hnav clean` after a supervisor's
+/// death): it returns an error and removes nothing if a live node of the run is found.
+/// Returns the number of files removed in the last step, which is 0 when every process
+/// exited cleanly.
 pub fn purge_run(run: &RunId) -> Result<usize, TransportError> {
     let config = run_config(run);
     let report = super::node::cleanup_dead_nodes_in(&config)?;
@@ -128,10 +179,21 @@ pub fn purge_run(run: &RunId) -> Result<usize, TransportError> {
     // guarantees no new one is being created), so nothing maps the global management segment.
     let _ = unsafe { iceoryx2::testing::remove_global_mgmt_segment::<Ipc>(&config) };
     let mut removed = 0;
-    for file in run_shm_files(run) {
+    for file in run_shm_files(run)
+        .into_iter()
+        .chain(run_iceoryx2_files(run))
+    {
         if std::fs::remove_file(&file).is_ok() {
-            tracing::debug!(file = %file.display(), "removed stale shared memory");
+            tracing::debug!(file = %file.display(), "removed a file the run left");
             removed += 1;
+        }
+        // A node's own directory goes once its last file is gone (this fails, harmlessly,
+        // for the shared directories and for a node directory that is not empty yet).
+        if let Some(parent) = file
+            .parent()
+            .filter(|p| p.parent().is_some_and(|pp| pp.ends_with("nodes")))
+        {
+            let _ = std::fs::remove_dir(parent);
         }
     }
     Ok(removed)
@@ -157,6 +219,31 @@ mod tests {
         let b = RunId::unique("t e/st");
         assert_ne!(a, b);
         assert!(RunId::new(a.as_str()).is_ok());
+    }
+
+    #[test]
+    fn files_of_a_longer_run_id_are_not_taken() {
+        let hash = "8e87768bd42e4142a6bc3d611ff9f2be43bee772";
+        let p = RunId::new("a").unwrap().prefix();
+        assert!(belongs_to_run(
+            format!("hnav_a_{hash}.service").as_bytes(),
+            &p
+        ));
+        assert!(belongs_to_run(
+            format!("hnav_a_{hash}_{hash}.data").as_bytes(),
+            &p
+        ));
+        assert!(belongs_to_run(
+            b"hnav_a_1426107235257767498930479707019.event",
+            &p
+        ));
+        assert!(belongs_to_run(b"hnav_a_node.details", &p));
+        assert!(!belongs_to_run(
+            format!("hnav_a_b_{hash}.service").as_bytes(),
+            &p
+        ));
+        assert!(!belongs_to_run(b"hnav_a_run-1-17f_node.details", &p));
+        assert!(!belongs_to_run(b"hnav_ab_node.details", &p));
     }
 
     #[test]

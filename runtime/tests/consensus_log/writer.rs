@@ -168,3 +168,29 @@ fn append_latency_per_policy() {
         );
     }
 }
+
+/// Two writers on one log would interleave their records (issue 11: two coordinators in one
+/// `--out` directory): the second `open` is refused while the first writer lives, and the
+/// log can be opened again once it is gone.
+#[test]
+fn a_second_writer_of_one_log_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("log");
+    let (mut first, _) = LogWriter::open(&dir, FsyncPolicy::EveryRecord).unwrap();
+    first.append(&header(2)).unwrap();
+    let err = LogWriter::open(&dir, FsyncPolicy::EveryRecord).unwrap_err();
+    assert!(matches!(err, LogError::Locked { .. }), "{err}");
+    let text = err.to_string();
+    assert!(
+        text.contains(&dir.display().to_string())
+            && text.contains(&format!("pid {}", std::process::id())),
+        "{text}"
+    );
+    first.append(&round(1, 2)).unwrap();
+    drop(first);
+    let (mut again, rec) = LogWriter::open(&dir, FsyncPolicy::EveryRecord).unwrap();
+    assert_eq!(rec.records.len(), 2);
+    again.append(&round(2, 2)).unwrap();
+    drop(again);
+    assert_intact(&dir);
+}

@@ -4,6 +4,7 @@
 //! Exit codes: 0 all good, 1 checks ran and found problems (or the report could not be
 //! written), 2 the input could not be loaded or is invalid (and for usage errors, via clap).
 
+mod clean_cmd;
 mod log_cmd;
 mod ps_cmd;
 mod run_cmd;
@@ -48,6 +49,8 @@ enum Command {
     Run(run_cmd::RunArgs),
     /// List the live runs on this machine and their processes.
     Ps(ps_cmd::PsArgs),
+    /// Remove what dead runs left behind (processes, shared memory, registry entries).
+    Clean(clean_cmd::CleanArgs),
     /// Inspect a run's consensus log.
     Log {
         #[command(subcommand)]
@@ -80,6 +83,7 @@ fn main() -> ExitCode {
         } => map_check(map, scen),
         Command::Run(args) => run_cmd::run_command(args),
         Command::Ps(args) => ps_cmd::run(args),
+        Command::Clean(args) => clean_cmd::run(args),
         Command::Log { command } => log_cmd::run(command),
     }
 }

@@ -1,10 +1,12 @@
-//! `hnav run SCENARIO [--agents N] [--mode lockstep|realtime] [--seed S] [--out DIR]`: the
-//! supervisor. The work is in `hnav_runtime::supervisor::run`.
+//! `hnav run SCENARIO [--agents N] [--mode lockstep|realtime] [--seed S] [--out DIR]
+//! [--force]`: the supervisor. The work is in `hnav_runtime::supervisor::run`.
 //!
 //! Exit codes: 0 every robot reached its goal without a collision, 1 the run ended otherwise
 //! (time limit, collisions, stopped), 2 the run could not happen (bad scenario, a process
-//! that would not start), 3 the run was ended early because it could not go on (the sim or
-//! the coordinator down and not restarted, or no agent left; the summary is still written).
+//! that would not start, a run id or directory held by a live run, a finished run's
+//! directory without `--force`), 3 the run was ended early because it could not go on (the
+//! sim or the coordinator down and not restarted, or no agent left; the summary is still
+//! written).
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -35,6 +37,10 @@ pub struct RunArgs {
     /// so they can clean the run's shared memory up even if the supervisor dies.
     #[arg(long, value_name = "ID")]
     pub run: Option<String>,
+    /// Replace the outputs of a finished run in the run directory (its log/, agents/, logs/
+    /// and summary.json; nothing else there is touched).
+    #[arg(long)]
+    pub force: bool,
     /// Where the process binaries are [default: next to this executable].
     #[arg(long, value_name = "DIR")]
     pub bin_dir: Option<PathBuf>,
@@ -71,6 +77,7 @@ pub fn run_command(a: RunArgs) -> ExitCode {
         },
         bin_dir,
         progress: std::io::stderr().is_terminal(),
+        force: a.force,
     };
     match run(&opts) {
         Ok(summary) => {

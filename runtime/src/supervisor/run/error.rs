@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 use crate::consensus_log::LogError;
 use crate::scenario::ScenarioError;
 use crate::supervisor::child::ChildError;
+use crate::supervisor::registry::RegistryError;
+use crate::supervisor::run_dir::RunDirError;
 use crate::supervisor::startup::StartupError;
 use crate::transport::TransportError;
 
@@ -34,6 +36,12 @@ pub enum RunError {
     /// A process did not come up.
     #[error("start-up failed: {0}")]
     Startup(#[from] StartupError),
+    /// The run id is taken by a live run (or the registry is unusable).
+    #[error(transparent)]
+    Registry(#[from] RegistryError),
+    /// The run directory is held by a live run, or holds a finished run's outputs.
+    #[error(transparent)]
+    RunDir(#[from] RunDirError),
     /// The consensus log could not be read for the summary.
     #[error(transparent)]
     Log(#[from] LogError),

@@ -1,7 +1,9 @@
 //! `hnav run`: one run of a scenario, end to end.
 //!
-//! 1. Prepare the run directory (a previous run's log and checkpoints are removed: a log
-//!    left there would make the new coordinator resume the old run) and register the run for
+//! 1. Clean the runs of the registry whose supervisor is dead ([`super::clean`]); claim the
+//!    run id (refused while a live supervisor holds it) and then the run directory (refused
+//!    while a live run holds it, and when it holds a finished run's outputs unless `--force`,
+//!    see [`super::run_dir`]), both before anything is spawned; register the run for
 //!    `hnav ps`.
 //! 2. Spawn `hnav-sim`, `hnav-coordinator` and one `hnav-agent` per robot, each in its own
 //!    process group with its output in `DIR/logs/<node>.log`, and wait until every one has
@@ -31,7 +33,9 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use super::child::Child;
+use super::clean::clean_dead_runs;
 use super::registry::{RunRecord, RunRegistry};
+use super::run_dir::RunDir;
 use super::startup::{Startup, SupervisorPorts};
 use super::stop::stop_all;
 use super::summary::RunSummary;
@@ -63,6 +67,8 @@ pub struct RunOptions {
     pub bin_dir: PathBuf,
     /// Show a progress bar (on a terminal).
     pub progress: bool,
+    /// Replace the outputs of a finished run in the run directory (`--force`).
+    pub force: bool,
 }
 
 struct Ports {
@@ -76,6 +82,33 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     let scenario = opts.args.scenario()?;
     let run = opts.args.run_id()?;
     let dir = opts.args.dir.clone().ok_or(RunError::NoRunDir)?;
+    let registry = RunRegistry::default_location();
+    for cleaned in clean_dead_runs(&registry) {
+        match cleaned {
+            Ok(c) => tracing::info!("{c} (its supervisor was dead)"),
+            Err(e) => tracing::warn!("a dead run was not cleaned: {e}"),
+        }
+    }
+    let id = registry.claim(&run, &dir)?;
+    let result = RunDir::claim(&dir, &run, opts.force)
+        .map_err(RunError::from)
+        .and_then(|owned| {
+            let result = run_owned(opts, scenario, run, dir, &registry);
+            owned.release()?;
+            result
+        });
+    id.release()?;
+    result
+}
+
+/// The run once its id and directory are its own.
+fn run_owned(
+    opts: &RunOptions,
+    scenario: Scenario,
+    run: RunId,
+    dir: PathBuf,
+    registry: &RunRegistry,
+) -> Result<RunSummary, RunError> {
     prepare_dir(&dir)?;
     let transport = Transport::builder(&run)
         .node_name("supervisor")
@@ -87,7 +120,6 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
         progress: transport.receiver(topics::PROGRESS, topics::state_qos())?,
         truth: transport.receiver(topics::TRUTH, topics::state_qos())?,
     };
-    let registry = RunRegistry::default_location();
     let mut record = registry.new_record(&run, &dir);
     let started = Instant::now();
     let mut slots = Slots::new(&opts.args, &opts.bin_dir, &scenario, &dir);
@@ -137,17 +169,11 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     Ok(summary)
 }
 
-/// Removes what a previous run left in `dir` that a new one would mistake for its own.
+/// Creates the directory of the processes' logs; [`RunDir::claim`] has removed (with
+/// `--force`) or refused whatever an earlier run left.
 fn prepare_dir(dir: &Path) -> Result<(), RunError> {
-    for sub in ["log", "agents", "logs"] {
-        let p = dir.join(sub);
-        if p.exists() {
-            std::fs::remove_dir_all(&p).map_err(io(&p))?;
-        }
-    }
     let logs = dir.join("logs");
     std::fs::create_dir_all(&logs).map_err(io(&logs))?;
-    let _ = std::fs::remove_file(dir.join("summary.json"));
     Ok(())
 }
 
