@@ -19,9 +19,11 @@
 //! | [`supervisor`] | starting, watching, restarting and stopping a run's processes; the registry behind `hnav ps`. It sits on top: no other module uses it |
 //! | [`consensus_log`] | the durable consensus log: record types, segment format, reader, verifier |
 //! | [`hash`] | FNV-1a 64 and SplitMix64: digests and seeded random numbers, stable across platforms |
+//! | [`diag`] | printing that never panics: `outln!`/`errln!` and the `tracing` writer drop (and count) a failed write |
 //! | [`logging`] | `tracing` set-up shared by the binaries, with iceoryx2's own logs routed into it |
 
 pub mod consensus_log;
+pub mod diag;
 pub mod grid;
 pub mod hash;
 pub mod launch;

@@ -150,6 +150,16 @@ pub enum LogError {
     /// A record to append could not be encoded.
     #[error("cannot encode record: {0}")]
     Encode(#[from] bincode::error::EncodeError),
+    /// The disk holding the log is full. Fatal for the run: a restart would meet the same
+    /// full disk. The log stays readable: a partial record was cut off.
+    #[error("no space left on device writing the consensus log in {}", dir.display())]
+    NoSpace {
+        /// The log directory.
+        dir: PathBuf,
+        /// The operating system's error.
+        #[source]
+        source: std::io::Error,
+    },
     /// An earlier write or fsync failed; the writer refuses further appends because the
     /// file's durable state is unknown. Reopen the log to recover.
     #[error("{}: an earlier write or fsync failed; reopen the log", path.display())]

@@ -13,6 +13,7 @@
 use std::time::Duration;
 
 use super::child::ExitInfo;
+use crate::launch::EXIT_NO_SPACE;
 use crate::scenario::{RestartPolicy, RestartRule};
 
 /// The longest backoff [`RestartTracker`] uses unless told otherwise (or unless the rule's
@@ -43,6 +44,9 @@ pub enum GiveUpReason {
         /// The cap that was reached.
         max_restarts: u32,
     },
+    /// The child exited with [`EXIT_NO_SPACE`]: the run directory's disk is full, and a
+    /// restart would meet the same full disk. The run cannot go on.
+    NoSpace,
 }
 
 impl core::fmt::Display for GiveUpReason {
@@ -53,6 +57,7 @@ impl core::fmt::Display for GiveUpReason {
             GiveUpReason::LimitReached { max_restarts } => {
                 write!(f, "restart limit of {max_restarts} reached")
             }
+            GiveUpReason::NoSpace => f.write_str("no space left on device"),
         }
     }
 }
@@ -93,6 +98,9 @@ impl RestartTracker {
 
     /// Decides what to do about `exit`; a [`RestartDecision::Restart`] counts as one restart.
     pub fn on_exit(&mut self, exit: &ExitInfo) -> RestartDecision {
+        if exit.code() == Some(i32::from(EXIT_NO_SPACE)) {
+            return RestartDecision::GiveUp(GiveUpReason::NoSpace);
+        }
         let wanted = match self.rule.policy {
             RestartPolicy::Never => return RestartDecision::GiveUp(GiveUpReason::Never),
             RestartPolicy::OnFailure => exit.is_failure(),

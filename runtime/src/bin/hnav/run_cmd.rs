@@ -3,7 +3,8 @@
 //!
 //! Exit codes: 0 every robot reached its goal without a collision, 1 the run ended otherwise
 //! (time limit, collisions, stopped), 2 the run could not happen (bad scenario, a process
-//! that would not start).
+//! that would not start), 3 the run started but could not go on (a process stopped on a full
+//! disk; the message names it and the directory).
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -11,7 +12,11 @@ use std::process::ExitCode;
 
 use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::scenario::{ClockMode, Scenario};
-use hnav_runtime::supervisor::run::{default_run_dir, new_run_id, run, RunOptions};
+use hnav_runtime::supervisor::run::{default_run_dir, new_run_id, run, RunError, RunOptions};
+
+/// The exit code of a run that started but could not go on (a process stopped on a full
+/// disk): neither a finished run (0, 1) nor one that never started (2).
+const EXIT_RUN_BROKEN: u8 = 3;
 
 /// `hnav run` arguments.
 #[derive(clap::Args, Debug)]
@@ -44,7 +49,7 @@ pub fn run_command(a: RunArgs) -> ExitCode {
     let name = match Scenario::load(&a.scenario) {
         Ok(s) => default_run_dir(&s),
         Err(e) => {
-            eprintln!("error: {e}");
+            hnav_runtime::errln!("error: {e}");
             return ExitCode::from(2);
         }
     };
@@ -54,7 +59,7 @@ pub fn run_command(a: RunArgs) -> ExitCode {
             .and_then(|p| p.parent().map(PathBuf::from))
     });
     let Some(bin_dir) = bin_dir else {
-        eprintln!("error: cannot locate the process binaries; pass --bin-dir");
+        hnav_runtime::errln!("error: cannot locate the process binaries; pass --bin-dir");
         return ExitCode::from(2);
     };
     let dir = a.out.unwrap_or(name);
@@ -73,17 +78,21 @@ pub fn run_command(a: RunArgs) -> ExitCode {
     };
     match run(&opts) {
         Ok(summary) => {
-            print!("{}", summary.render());
-            println!("summary   {}", dir.join("summary.json").display());
-            println!("log       {}", summary.log.display());
+            hnav_runtime::out!("{}", summary.render());
+            hnav_runtime::outln!("summary   {}", dir.join("summary.json").display());
+            hnav_runtime::outln!("log       {}", summary.log.display());
             if summary.success() {
                 ExitCode::SUCCESS
             } else {
                 ExitCode::from(1)
             }
         }
+        Err(e @ RunError::NoSpace { .. }) => {
+            hnav_runtime::errln!("error: {e}");
+            ExitCode::from(EXIT_RUN_BROKEN)
+        }
         Err(e) => {
-            eprintln!("error: {e}");
+            hnav_runtime::errln!("error: {e}");
             ExitCode::from(2)
         }
     }

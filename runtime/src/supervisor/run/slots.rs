@@ -3,7 +3,7 @@
 
 use std::cell::Cell;
 use std::ffi::OsString;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::error::RunError;
@@ -12,7 +12,7 @@ use crate::msg::{Lifecycle, Role};
 use crate::scenario::Scenario;
 use crate::supervisor::child::{Child, ChildError, ChildSpec};
 use crate::supervisor::registry::RunRecord;
-use crate::supervisor::restart::{RestartDecision, RestartTracker};
+use crate::supervisor::restart::{GiveUpReason, RestartDecision, RestartTracker};
 use crate::supervisor::startup::SupervisorPorts;
 use crate::transport::Transport;
 
@@ -32,6 +32,8 @@ struct Slot {
 /// Every process of the run: the sim, the coordinator and one agent per robot, in that order.
 pub(super) struct Slots {
     slots: Vec<Slot>,
+    /// The run directory, named when a process stops on a full disk.
+    dir: PathBuf,
 }
 
 impl Slots {
@@ -70,7 +72,10 @@ impl Slots {
         for i in 0..scenario.agents.len() as u32 {
             add(Role::Agent, i, "hnav-agent");
         }
-        Self { slots }
+        Self {
+            slots,
+            dir: dir.to_path_buf(),
+        }
     }
 
     /// Starts every process.
@@ -130,6 +135,12 @@ impl Slots {
             life.publish(Lifecycle::down(role, index, s.tracker.restarts()))?;
             match s.tracker.on_exit(&exit) {
                 RestartDecision::Restart { after } => s.restart_at = Some(Instant::now() + after),
+                RestartDecision::GiveUp(GiveUpReason::NoSpace) => {
+                    return Err(RunError::NoSpace {
+                        node: role.node_name(index),
+                        writes: role_writes(role, index, &self.dir),
+                    })
+                }
                 RestartDecision::GiveUp(why) => {
                     tracing::warn!(node = role.node_name(index), ?why, "not restarted")
                 }
@@ -179,5 +190,22 @@ impl Slots {
             }
         }
         Ok(())
+    }
+}
+
+/// What a process of `role` writes in the run directory `dir`, for the message of a run that
+/// ended on a full disk.
+fn role_writes(role: Role, index: u32, dir: &Path) -> String {
+    let log = dir
+        .join("logs")
+        .join(format!("{}.log", role.node_name(index)));
+    match role {
+        Role::Coordinator => format!("the consensus log in {}", dir.join("log").display()),
+        Role::Agent => format!(
+            "its checkpoint {} or its log {}",
+            dir.join("agents").join(format!("{index}.ckpt")).display(),
+            log.display()
+        ),
+        Role::Sim => format!("its log {}", log.display()),
     }
 }
