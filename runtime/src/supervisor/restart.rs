@@ -126,3 +126,30 @@ impl RestartTracker {
         base.saturating_mul(factor).min(self.cap.max(base))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_full_disk_is_never_restarted_whatever_the_policy() {
+        for policy in [RestartPolicy::Always, RestartPolicy::OnFailure] {
+            let rule = RestartRule {
+                policy,
+                max_restarts: 3,
+                backoff_ms: 10,
+            };
+            let mut t = RestartTracker::new(rule);
+            let full = ExitInfo::Exited(i32::from(EXIT_NO_SPACE));
+            assert_eq!(
+                t.on_exit(&full),
+                RestartDecision::GiveUp(GiveUpReason::NoSpace)
+            );
+            assert_eq!(t.restarts(), 0);
+            assert!(matches!(
+                t.on_exit(&ExitInfo::Exited(1)),
+                RestartDecision::Restart { .. }
+            ));
+        }
+    }
+}
