@@ -117,7 +117,8 @@ impl Slots {
         }
     }
 
-    /// Reaps exited children, tells the others (`Down`), and restarts what is due.
+    /// Reaps exited children, tells the others (`Down`), and restarts what is due. A child
+    /// that stopped on a full disk ends the run instead: [`RunError::NoSpace`].
     pub(super) fn reap_and_restart(
         &mut self,
         transport: &Transport,
