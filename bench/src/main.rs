@@ -59,19 +59,25 @@ struct SimCli {
 
 fn sim(args: SimCli) -> Result<()> {
     if !args.json {
-        println!(
+        hnav_runtime::outln!(
             "{:>8} {:>14} {:>10} {:>18}",
-            "robots", "steps", "seconds", "robot-steps/s"
+            "robots",
+            "steps",
+            "seconds",
+            "robot-steps/s"
         );
     }
     for robots in args.robots {
         let r = hnav_bench::sim::robot_steps_per_second(robots, args.seconds)?;
         if args.json {
-            println!("{}", serde_json::to_string(&r)?);
+            hnav_runtime::outln!("{}", serde_json::to_string(&r)?);
         } else {
-            println!(
+            hnav_runtime::outln!(
                 "{:>8} {:>14} {:>10.2} {:>18.3e}",
-                r.robots, r.steps, r.elapsed_s, r.robot_steps_per_s
+                r.robots,
+                r.steps,
+                r.elapsed_s,
+                r.robot_steps_per_s
             );
         }
     }
@@ -99,7 +105,7 @@ fn seed002(args: Seed002Cli) -> Result<()> {
         timing_repeats: args.repeats,
         ..Seed002Config::default()
     };
-    print!("{}", run(&config)?.render());
+    hnav_runtime::out!("{}", run(&config)?.render());
     Ok(())
 }
 
@@ -169,16 +175,16 @@ fn plan_cmd(args: PlanCli) -> Result<()> {
     };
     let summary = plan::run(&plan_args, |line| {
         if json {
-            println!("{}", serde_json::to_string(line).unwrap_or_default());
+            hnav_runtime::outln!("{}", serde_json::to_string(line).unwrap_or_default());
         } else {
-            println!("{}", plan::render(line));
+            hnav_runtime::outln!("{}", plan::render(line));
         }
     })?;
     if let Some(s) = summary {
         if json {
-            println!("{}", serde_json::to_string(&s)?);
+            hnav_runtime::outln!("{}", serde_json::to_string(&s)?);
         } else {
-            println!("{}", s.render());
+            hnav_runtime::outln!("{}", s.render());
         }
     }
     Ok(())
@@ -206,7 +212,7 @@ fn latency(args: LatencyArgs) -> Result<()> {
     opts.only = args.only;
     opts.sizes = args.sizes;
     let report = latency::run(&opts)?;
-    print!("{}", report.render());
+    hnav_runtime::out!("{}", report.render());
     Ok(())
 }
 
@@ -227,7 +233,7 @@ fn main() -> std::process::ExitCode {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             // `{:#}` prints the whole context chain on one line, without a backtrace.
-            eprintln!("error: {e:#}");
+            hnav_runtime::errln!("error: {e:#}");
             std::process::ExitCode::from(2)
         }
     }

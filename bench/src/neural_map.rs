@@ -15,9 +15,15 @@ use hnav_runtime::grid::{Cell, Grid};
 
 /// Runs the benchmark and prints its tables; `quick` spends 0.05 s instead of 0.3 s a point.
 pub fn run(quick: bool) {
-    println!(
+    hnav_runtime::outln!(
         "{:>10} {:>7} {:>7} {:>7} {:>14} {:>12} {:>12}",
-        "grid", "act", "target", "sweeps", "updates", "time/map", "updates/s"
+        "grid",
+        "act",
+        "target",
+        "sweeps",
+        "updates",
+        "time/map",
+        "updates/s"
     );
     for n in [20u32, 128, 512, 1024] {
         let grid = Grid::new(n, n).unwrap();
@@ -35,7 +41,7 @@ pub fn run(quick: bool) {
                 let (best, r) = best_of(budget, || {
                     map.build(target, StopRule::FullActivation).unwrap()
                 });
-                println!(
+                hnav_runtime::outln!(
                     "{:>10} {:>7} {:>7} {:>7} {:>14} {:>12} {:>12.3e}",
                     format!("{n}x{n}"),
                     format!("{activation:?}").to_lowercase(),
@@ -49,8 +55,8 @@ pub fn run(quick: bool) {
         }
     }
     plans(if quick { 0.05 } else { 0.3 });
-    println!();
-    println!("tanh / linear time per map above is the dissertation's comparison (it reports up to 2.5x).");
+    hnav_runtime::outln!();
+    hnav_runtime::outln!("tanh / linear time per map above is the dissertation's comparison (it reports up to 2.5x).");
 }
 
 /// Best-of-several wall time of `f`, with at least 3 runs and `budget` seconds in total.
@@ -70,10 +76,14 @@ fn best_of<T>(budget: f64, mut f: impl FnMut() -> T) -> (f64, T) {
 }
 
 fn plans(budget: f64) {
-    println!();
-    println!(
+    hnav_runtime::outln!();
+    hnav_runtime::outln!(
         "{:>10} {:>7} {:>7} {:>7} {:>12}",
-        "grid", "act", "sweeps", "steps", "time/query"
+        "grid",
+        "act",
+        "sweeps",
+        "steps",
+        "time/query"
     );
     for n in [20u32, 128, 512, 1024] {
         let grid = Grid::new(n, n).unwrap();
@@ -85,7 +95,7 @@ fn plans(budget: f64) {
             let mut planner = Planner::new(&grid, &options).unwrap();
             let (s, g) = (Cell::new(0, 0), Cell::new(n - 1, n - 1));
             let (best, r) = best_of(budget, || planner.query(s, g).unwrap());
-            println!(
+            hnav_runtime::outln!(
                 "{:>10} {:>7} {:>7} {:>7} {:>12}",
                 format!("{n}x{n}"),
                 format!("{activation:?}").to_lowercase(),

@@ -114,8 +114,14 @@ impl ProcessArgs {
 /// error, not a hang.
 pub const START_TIMEOUT: Duration = Duration::from_secs(60);
 
+/// The exit code of a process that stopped because the disk of the run directory is full
+/// (ENOSPC's errno). The supervisor does not restart such a process: its successor would meet
+/// the same full disk. It ends the run instead and names the cause.
+pub const EXIT_NO_SPACE: u8 = 28;
+
 /// The `main` of a process binary: sets up logging, parses the command line and runs `run`;
-/// an error is printed as `NAME: error` and exits 1.
+/// an error is printed as `NAME: error` and exits 1, or [`EXIT_NO_SPACE`] when the error is
+/// a full disk (or the disk was too full to print it).
 pub fn process_main<A: clap::Parser>(
     name: &str,
     run: impl FnOnce(&A) -> Result<(), Box<dyn std::error::Error>>,
@@ -125,8 +131,12 @@ pub fn process_main<A: clap::Parser>(
     match run(&args) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("{name}: {e}");
-            std::process::ExitCode::FAILURE
+            crate::errln!("{name}: {e}");
+            if crate::diag::is_no_space(e.as_ref()) || crate::diag::no_space_seen() {
+                std::process::ExitCode::from(EXIT_NO_SPACE)
+            } else {
+                std::process::ExitCode::FAILURE
+            }
         }
     }
 }

@@ -23,7 +23,10 @@ pub fn init() {
         .unwrap_or_else(|| EnvFilter::new(DEFAULT_FILTER));
     let _ = tracing_subscriber::fmt()
         .with_env_filter(filter)
-        .with_writer(std::io::stderr)
+        // A failed write (a full disk under a redirected stderr) must not panic the process,
+        // nor be reported on the very stream that just failed.
+        .with_writer(|| crate::diag::StderrWriter)
+        .log_internal_errors(false)
         .try_init();
     // iceoryx2 filters by its own level before its message reaches `tracing`; open it exactly
     // as far as the most verbose directive, so the tracing filter decides and nothing more

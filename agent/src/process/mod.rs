@@ -57,6 +57,15 @@ pub enum AgentError {
     /// Planning failed.
     #[error(transparent)]
     Plan(#[from] crate::Error),
+    /// The disk of the run directory is full: the checkpoint cannot be written.
+    #[error("no space left on device writing the checkpoint {}", path.display())]
+    NoSpace {
+        /// The checkpoint file.
+        path: std::path::PathBuf,
+        /// The operating system's error.
+        #[source]
+        source: std::io::Error,
+    },
 }
 
 /// How the agent's run ended.

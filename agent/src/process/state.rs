@@ -3,6 +3,7 @@
 //! Kept apart from the [`Ports`] so that the loop can borrow the ports (attached to its
 //! waiter) while it mutates the state.
 
+use hnav_runtime::diag::is_no_space_io;
 use hnav_runtime::grid::geometry::{cell_centre_m, cell_centre_pose, cell_index};
 use hnav_runtime::grid::Cell;
 use hnav_runtime::msg::{MapHeader, Odometry, Pose, WheelCommand};
@@ -236,7 +237,7 @@ impl Core {
         // hold there for a planned fault and the supervisor kill this agent, which must then
         // resume from this period's checkpoint in every run, never from the one before.
         if let Some(p) = self.last_period {
-            self.store_checkpoint(p, pose);
+            self.store_checkpoint(p, pose)?;
         }
         p.wheels.send(WheelCommand {
             period,
@@ -271,10 +272,14 @@ impl Core {
         Ok(())
     }
 
-    /// Writes the restart checkpoint for `period`; a failure is logged, not fatal: the robot
-    /// can go on without one.
-    fn store_checkpoint(&self, period: u64, pose: Pose) {
-        let Some(f) = &self.checkpoint else { return };
+    /// Writes the restart checkpoint for `period`. A failure is logged, not fatal (the robot
+    /// can go on without one), except a full disk: that ends the agent with
+    /// [`AgentError::NoSpace`], because a restart into the same full disk would not help and
+    /// the supervisor must learn why the run cannot go on.
+    fn store_checkpoint(&self, period: u64, pose: Pose) -> Result<(), AgentError> {
+        let Some(f) = &self.checkpoint else {
+            return Ok(());
+        };
         let idx = |c: Cell| cell_index(self.width, c) as u32;
         let c = Checkpoint {
             period,
@@ -286,8 +291,16 @@ impl Core {
             target: idx(self.nav.target()),
             last_commit: self.last_commit,
         };
-        if let Err(e) = f.store(&c) {
-            tracing::warn!(path = %f.path().display(), "checkpoint not written: {e}");
+        match f.store(&c) {
+            Err(e) if is_no_space_io(&e) => Err(AgentError::NoSpace {
+                path: f.path().to_path_buf(),
+                source: e,
+            }),
+            Err(e) => {
+                tracing::warn!(path = %f.path().display(), "checkpoint not written: {e}");
+                Ok(())
+            }
+            Ok(()) => Ok(()),
         }
     }
 }

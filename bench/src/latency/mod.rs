@@ -309,9 +309,10 @@ fn measure(
     size: usize,
 ) -> Result<[Point; 2]> {
     let what = format!("{}/{} {size} B", transport.name(), mode.name());
-    eprintln!(
+    hnav_runtime::errln!(
         "measuring {what}: {} + {} warm-up round trips",
-        opts.iterations, opts.warmup
+        opts.iterations,
+        opts.warmup
     );
     // Every point gets its own services, so nothing of one run can leak into the next.
     let prefix = format!("{}/{}/{size}", transport.name(), mode.name());

@@ -62,7 +62,7 @@ pub fn run(
     mut each: impl FnMut(&FaultPoint),
 ) -> Result<Vec<FaultPoint>> {
     let mut points = Vec::new();
-    eprintln!("fault detection: {trials} SIGKILLs of `sleep 60`");
+    hnav_runtime::errln!("fault detection: {trials} SIGKILLs of `sleep 60`");
     let (mode, det) = detection(trials)?;
     let how = match mode {
         WatchMode::Pidfd => "pidfd",
@@ -96,14 +96,14 @@ pub fn run(
         points.push(p);
     }
     for &policy in fsync {
-        eprintln!(
+        hnav_runtime::errln!(
             "rejoin: {REJOIN_AGENTS} agents, fsync {}: {trials} Down/Restarted trials of agent \
              {VICTIM}",
             super::layout::fsync_name(policy)
         );
         let (samples, late, stalled) = rejoin(program, policy, trials)?;
         if late > 0 {
-            eprintln!(
+            hnav_runtime::errln!(
                 "note: in {late} of {trials} trials agent {VICTIM}'s first candidate missed \
                  the round and its decision came a round later"
             );
@@ -294,7 +294,7 @@ fn kill_once(
 fn rejoin(program: &Path, fsync: FsyncPolicy, trials: usize) -> Result<(Vec<u64>, usize, usize)> {
     with_coordinator(program, REJOIN_AGENTS, fsync, |session, swarm| {
         if let Some(t) = session.startup() {
-            eprintln!(
+            hnav_runtime::errln!(
                 "for scale, not in (c): this hnav-coordinator took {:.1} ms from spawn to Up",
                 t.as_secs_f64() * 1e3
             );
@@ -341,7 +341,7 @@ fn rejoin(program: &Path, fsync: FsyncPolicy, trials: usize) -> Result<(Vec<u64>
                 );
             };
             if stall {
-                eprintln!(
+                hnav_runtime::errln!(
                     "warning: trial {trial} stalled (lost wake-up of the coordinator, see \
                      `hnav-bench round`); left out"
                 );

@@ -138,7 +138,7 @@ fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
         let d = fdatasync_baseline()?;
         let dir = std::env::temp_dir();
         if args.json {
-            println!(
+            hnav_runtime::outln!(
                 "{}",
                 serde_json::json!({
                     "bench": "fdatasync",
@@ -150,7 +150,7 @@ fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
                 })
             );
         } else {
-            println!(
+            hnav_runtime::outln!(
                 "raw 1 KiB append + fdatasync in {}: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs \
                  ({} samples)",
                 dir.display(),
@@ -162,31 +162,31 @@ fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
         }
     }
     if !args.json {
-        println!(
+        hnav_runtime::outln!(
             "decision round: last of N candidates sent -> commit taken by all N agents' \
              subscribers"
         );
-        println!("{}", report::round_header());
+        hnav_runtime::outln!("{}", report::round_header());
     }
     let mut points = Vec::new();
     for &agents in &args.agents {
         for &fsync in &args.fsync {
-            eprintln!(
+            hnav_runtime::errln!(
                 "round: {agents} agents, fsync {}: {} warm-up + {rounds} measured rounds",
                 layout::fsync_name(fsync),
                 args.warmup
             );
             let point = measure_point(program, agents, fsync, args.warmup, rounds)?;
             if args.json {
-                println!("{}", point.json());
+                hnav_runtime::outln!("{}", point.json());
             } else {
-                println!("{}", point.row());
+                hnav_runtime::outln!("{}", point.row());
             }
             points.push(point);
         }
     }
     if !args.json {
-        println!(
+        hnav_runtime::outln!(
             "(p50/p99/max: from just before the N-th candidate's send to the N-th commit \
              taken; 1st: to the first commit taken, i.e. without the fan-out to N subscribers; \
              includes \
@@ -200,7 +200,7 @@ fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
     }
     if let Some(dir) = &args.out {
         let path = report::write_round_csv(dir, &points)?;
-        eprintln!("wrote {}", path.display());
+        hnav_runtime::errln!("wrote {}", path.display());
     }
     Ok(())
 }
@@ -276,17 +276,17 @@ fn measure_point(
 
 fn faults_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
     if !args.json {
-        println!("{}", report::fault_header());
+        hnav_runtime::outln!("{}", report::fault_header());
     }
     let points = faults::run(program, args.trials, &args.fsync, |p| {
         if args.json {
-            println!("{}", p.json());
+            hnav_runtime::outln!("{}", p.json());
         } else {
-            println!("{}", p.row());
+            hnav_runtime::outln!("{}", p.row());
         }
     })?;
     if !args.json {
-        println!(
+        hnav_runtime::outln!(
             "(a)/(b) from just before kill(2) of `sleep 60` spawned by the supervisor's Child; \
              (b1) includes waitpid and the publish; the dead node's iceoryx2 clean-up is not \
              included. (c) from publishing Restarted (the agent's ports already open) to its \
@@ -297,7 +297,7 @@ fn faults_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
     }
     if let Some(dir) = &args.out {
         let path = report::write_fault_csv(dir, &points)?;
-        eprintln!("wrote {}", path.display());
+        hnav_runtime::errln!("wrote {}", path.display());
     }
     Ok(())
 }

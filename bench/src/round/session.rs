@@ -124,7 +124,7 @@ pub fn with_coordinator<T>(
         Ok(_) => {
             let _ = std::fs::remove_dir_all(&dir);
         }
-        Err(_) => eprintln!("kept the run's files in {}", dir.display()),
+        Err(_) => hnav_runtime::errln!("kept the run's files in {}", dir.display()),
     }
     let out = result?;
     purged.context("remove the run's shared memory")?;

@@ -43,7 +43,7 @@ pub struct RoundObs<'a> {
 /// An `after` for [`Swarm::play`] that never ends early; it reports a stalled round.
 pub fn keep_going(obs: &RoundObs) -> ControlFlow<()> {
     if obs.stalled {
-        eprintln!(
+        hnav_runtime::errln!(
             "warning: round {} stalled: no commit for {STALL_AFTER:?} although every candidate \
              was sent; it completed only after an unrelated lifecycle event woke the \
              coordinator (a lost wake-up); not counted in the latencies",

@@ -159,6 +159,16 @@ pub enum LogError {
         /// The pid the lock file names, if it could be read.
         holder: Option<String>,
     },
+    /// The disk holding the log is full. Fatal for the run: a restart would meet the same
+    /// full disk. The log stays readable: a partial record was cut off.
+    #[error("no space left on device writing the consensus log in {}", dir.display())]
+    NoSpace {
+        /// The log directory.
+        dir: PathBuf,
+        /// The operating system's error.
+        #[source]
+        source: std::io::Error,
+    },
     /// An earlier write or fsync failed; the writer refuses further appends because the
     /// file's durable state is unknown. Reopen the log to recover.
     #[error("{}: an earlier write or fsync failed; reopen the log", path.display())]

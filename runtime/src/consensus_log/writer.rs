@@ -134,7 +134,7 @@ impl LogWriter {
         let dir = dir.as_ref().to_path_buf();
         let syncing = options.fsync != FsyncPolicy::None;
         if !dir.is_dir() {
-            std::fs::create_dir_all(&dir).map_err(|e| LogError::io(&dir, e))?;
+            std::fs::create_dir_all(&dir).map_err(|e| write_error(&dir, &dir, e))?;
             if syncing {
                 let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
                 sync_dir(parent.unwrap_or(Path::new(".")))?;
@@ -168,7 +168,7 @@ impl LogWriter {
             .as_ref()
             .filter(|t| t.segment as usize == last)
         {
-            let io = |e| LogError::io(&path, e);
+            let io = |e| write_error(&dir, &path, e);
             file.set_len(torn.offset).map_err(io)?;
             if torn.offset < MAGIC_LEN {
                 file.write_all(&MAGIC).map_err(io)?;
@@ -236,7 +236,7 @@ impl LogWriter {
             if self.file.set_len(offset).is_err() {
                 self.poisoned = true;
             }
-            return Err(LogError::io(&self.path, e));
+            return Err(write_error(&self.dir, &self.path, e));
         }
         self.len += frame;
         self.records += 1;
@@ -305,7 +305,7 @@ impl LogWriter {
                 // After a failed fsync the kernel may have dropped the dirty pages: the
                 // durable state of the file is unknown.
                 self.poisoned = true;
-                return Err(LogError::io(&self.path, e));
+                return Err(write_error(&self.dir, &self.path, e));
             }
             self.unsynced = 0;
         }
@@ -386,18 +386,37 @@ fn lock_log(dir: &Path) -> Result<FileLock, LogError> {
 
 /// Creates a segment holding only the magic; with `syncing`, syncs it and the directory.
 fn create_segment(path: &Path, dir: &Path, syncing: bool) -> Result<File, LogError> {
-    let io = |e| LogError::io(path, e);
     let mut file = OpenOptions::new()
         .append(true)
         .create_new(true)
         .open(path)
-        .map_err(io)?;
-    file.write_all(&MAGIC).map_err(io)?;
+        .map_err(|e| write_error(dir, path, e))?;
+    let written = file
+        .write_all(&MAGIC)
+        .and_then(|()| if syncing { file.sync_data() } else { Ok(()) });
+    if let Err(e) = written {
+        // A segment without its whole magic would read as damage; remove it (a full disk
+        // still allows that), so the log ends on the previous, complete segment.
+        let _ = std::fs::remove_file(path);
+        return Err(write_error(dir, path, e));
+    }
     if syncing {
-        file.sync_data().map_err(io)?;
         sync_dir(dir)?;
     }
     Ok(file)
+}
+
+/// The error of a failed write to `path` in the log `dir`: [`LogError::NoSpace`] for a full
+/// disk, which the coordinator reports as fatal, else [`LogError::Io`].
+fn write_error(dir: &Path, path: &Path, e: std::io::Error) -> LogError {
+    if crate::diag::is_no_space_io(&e) {
+        LogError::NoSpace {
+            dir: dir.to_path_buf(),
+            source: e,
+        }
+    } else {
+        LogError::io(path, e)
+    }
 }
 
 fn sync_dir(dir: &Path) -> Result<(), LogError> {

@@ -13,6 +13,7 @@
 use std::time::Duration;
 
 use super::child::ExitInfo;
+use crate::launch::EXIT_NO_SPACE;
 use crate::scenario::{RestartPolicy, RestartRule};
 
 /// The longest backoff [`RestartTracker`] uses unless told otherwise (or unless the rule's
@@ -43,6 +44,9 @@ pub enum GiveUpReason {
         /// The cap that was reached.
         max_restarts: u32,
     },
+    /// The child exited with [`EXIT_NO_SPACE`]: the run directory's disk is full, and a
+    /// restart would meet the same full disk. The run cannot go on.
+    NoSpace,
 }
 
 impl core::fmt::Display for GiveUpReason {
@@ -53,6 +57,7 @@ impl core::fmt::Display for GiveUpReason {
             GiveUpReason::LimitReached { max_restarts } => {
                 write!(f, "restart limit of {max_restarts} reached")
             }
+            GiveUpReason::NoSpace => f.write_str("no space left on device"),
         }
     }
 }
@@ -93,6 +98,9 @@ impl RestartTracker {
 
     /// Decides what to do about `exit`; a [`RestartDecision::Restart`] counts as one restart.
     pub fn on_exit(&mut self, exit: &ExitInfo) -> RestartDecision {
+        if exit.code() == Some(i32::from(EXIT_NO_SPACE)) {
+            return RestartDecision::GiveUp(GiveUpReason::NoSpace);
+        }
         let wanted = match self.rule.policy {
             RestartPolicy::Never => return RestartDecision::GiveUp(GiveUpReason::Never),
             RestartPolicy::OnFailure => exit.is_failure(),
@@ -116,5 +124,32 @@ impl RestartTracker {
         let base = Duration::from_millis(self.rule.backoff_ms);
         let factor = 1u32.checked_shl(n).unwrap_or(u32::MAX);
         base.saturating_mul(factor).min(self.cap.max(base))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_full_disk_is_never_restarted_whatever_the_policy() {
+        for policy in [RestartPolicy::Always, RestartPolicy::OnFailure] {
+            let rule = RestartRule {
+                policy,
+                max_restarts: 3,
+                backoff_ms: 10,
+            };
+            let mut t = RestartTracker::new(rule);
+            let full = ExitInfo::Exited(i32::from(EXIT_NO_SPACE));
+            assert_eq!(
+                t.on_exit(&full),
+                RestartDecision::GiveUp(GiveUpReason::NoSpace)
+            );
+            assert_eq!(t.restarts(), 0);
+            assert!(matches!(
+                t.on_exit(&ExitInfo::Exited(1)),
+                RestartDecision::Restart { .. }
+            ));
+        }
     }
 }

@@ -6,6 +6,7 @@
 //! comes from the sim's ground truth — its true pose lies in its goal cell — not from what the
 //! agents believed.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
@@ -129,11 +130,16 @@ impl RunSummary {
         })
     }
 
-    /// Writes `summary.json` into `dir`; returns its path.
+    /// Writes `summary.json` into `dir` atomically; returns its path.
+    ///
+    /// The text goes to a temporary file in `dir`, is synced, and is renamed over
+    /// `summary.json` (then the directory is synced): a reader finds the whole summary or
+    /// none, never a truncated one, even when the disk fills up or the supervisor dies
+    /// half-way. On failure the temporary file is removed.
     pub fn write_json(&self, dir: &Path) -> std::io::Result<PathBuf> {
         let path = dir.join("summary.json");
-        let text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
-        std::fs::write(&path, text + "\n")?;
+        let text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)? + "\n";
+        write_atomically(&path, text.as_bytes())?;
         Ok(path)
     }
 
@@ -164,4 +170,30 @@ impl RunSummary {
         );
         s
     }
+}
+
+/// Replaces `path` by a file holding `bytes`, whole or not at all (see
+/// [`RunSummary::write_json`]).
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path.file_name().unwrap_or_default().to_string_lossy();
+    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let written = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
+    // The rename is durable once the directory is; a failure here leaves a complete file.
+    if let Ok(d) = std::fs::File::open(dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
 }

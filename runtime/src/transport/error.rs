@@ -21,6 +21,15 @@ pub enum TransportError {
         /// Why it is rejected.
         why: String,
     },
+    /// The directory where iceoryx2 keeps the user's node and service files
+    /// ([`ipc_root`](super::ipc_root)) cannot be used by this process.
+    #[error("cannot use the shared-memory directory {}: {problem}", dir.display())]
+    IpcRoot {
+        /// The directory.
+        dir: std::path::PathBuf,
+        /// What is wrong (permissions, owner, not a directory).
+        problem: String,
+    },
     /// An iceoryx2 operation failed.
     #[error("{op} on {service:?} failed: {detail}")]
     Iceoryx {

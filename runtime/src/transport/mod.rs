@@ -17,6 +17,10 @@
 //!   from shared memory and written there directly; no intermediate `Vec`.
 //! - **QoS from the swarm size** ([`Qos`]): iceoryx2's defaults allow two publishers per service;
 //!   HNAV sizes every service from the agent count.
+//! - **One directory per user** ([`ipc_root`]): iceoryx2 keeps node and service files in
+//!   `/tmp/iceoryx2/` for root and `/tmp/iceoryx2-<uid>/` for other users (or
+//!   `$HNAV_IPC_ROOT`), so several users can run on one machine; a directory this process
+//!   may not use is a clear error before any file is created.
 //! - **Liveness** ([`Transport::nodes`], [`Transport::cleanup_dead_nodes`], [`purge_run`]):
 //!   list a run's processes, detect dead ones, remove what they left behind.
 //!
@@ -44,7 +48,9 @@ pub use channel::{Drained, Receiver, Sender, Wakeup};
 pub use error::TransportError;
 pub use node::{CleanupReport, NodeInfo, NodeLiveness, Transport, TransportBuilder};
 pub use qos::{Delivery, Qos};
-pub use run::{purge_run, run_config, run_iceoryx2_files, run_shm_files, RunId};
+pub use run::{
+    ipc_root, purge_run, run_config, run_iceoryx2_files, run_shm_files, RunId, IPC_ROOT_ENV,
+};
 pub use slice::{SliceLoan, SliceReceiver, SliceSender};
 pub use waiter::{stop_requested, Attachment, AttachmentId, Waiter, Wake};
 

@@ -10,6 +10,7 @@ use iceoryx2::prelude::{
 };
 use iceoryx2::service::Service as _;
 
+use super::run::check_ipc_root;
 use super::{
     run_config, Ipc, Qos, Receiver, RunId, Sender, SliceReceiver, SliceSender, TransportError,
     Waiter,
@@ -42,6 +43,7 @@ impl TransportBuilder {
     /// Creates the node.
     pub fn create(self) -> Result<Transport, TransportError> {
         let config = run_config(&self.run);
+        check_ipc_root(&config)?;
         let signals = if self.handle_signals {
             SignalHandlingMode::HandleTerminationRequests
         } else {

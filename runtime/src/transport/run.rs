@@ -1,10 +1,11 @@
 //! Run identity: service names and the per-run iceoryx2 configuration.
 
 use std::os::unix::ffi::OsStrExt;
+use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 
 use iceoryx2::config::Config;
-use iceoryx2::prelude::{FileName, SemanticString, ServiceName};
+use iceoryx2::prelude::{FileName, Path as IoxPath, SemanticString, ServiceName};
 
 use super::{Ipc, TransportError};
 
@@ -83,7 +84,35 @@ impl core::fmt::Display for RunId {
     }
 }
 
-/// The iceoryx2 configuration of a run: the defaults with the run's own file prefix.
+/// The environment variable that replaces [`ipc_root`]'s per-user default (a group of users
+/// who share runs can point it at one directory they may all write).
+pub const IPC_ROOT_ENV: &str = "HNAV_IPC_ROOT";
+
+/// The directory where iceoryx2 keeps this user's node and service files (its
+/// `global.root-path`): `$HNAV_IPC_ROOT` if set, else iceoryx2's own `/tmp/iceoryx2/` for
+/// root and `/tmp/iceoryx2-<uid>/` for every other user.
+///
+/// iceoryx2 creates its directory readable by its owner and group only, so one directory
+/// for every user would lock out all but the first to run; shared-memory file names are
+/// run-scoped already ([`RunId::prefix`]), so per-user directories are all it takes for
+/// several users to run side by side.
+pub fn ipc_root() -> PathBuf {
+    if let Some(dir) = std::env::var_os(IPC_ROOT_ENV).filter(|d| !d.is_empty()) {
+        return PathBuf::from(dir);
+    }
+    match effective_uid() {
+        0 => PathBuf::from("/tmp/iceoryx2/"),
+        uid => PathBuf::from(format!("/tmp/iceoryx2-{uid}/")),
+    }
+}
+
+fn effective_uid() -> u32 {
+    // SAFETY: geteuid has no preconditions and cannot fail.
+    unsafe { libc::geteuid() }
+}
+
+/// The iceoryx2 configuration of a run: the defaults with this user's [`ipc_root`] and the
+/// run's own file prefix.
 ///
 /// Every process of a run must build its nodes with this config (the transport does), and
 /// tools that inspect a run (`Node::list`) must pass it too: other prefixes are invisible.
@@ -93,7 +122,97 @@ pub fn run_config(run: &RunId) -> Config {
     if let Ok(prefix) = FileName::new(run.prefix().as_bytes()) {
         config.global.prefix = prefix;
     }
+    let mut root = ipc_root().into_os_string().into_encoded_bytes();
+    if root.last() != Some(&b'/') {
+        root.push(b'/');
+    }
+    match IoxPath::new(&root) {
+        Ok(path) => config.global.set_root_path(&path),
+        Err(_) => tracing::warn!(
+            "{IPC_ROOT_ENV}={} is not a usable path (too long, or not a path); using {}",
+            String::from_utf8_lossy(&root),
+            config.global.root_path()
+        ),
+    }
     config
+}
+
+/// Checks that this process may use the iceoryx2 directory of `config` (and its `nodes/` and
+/// `services/`), or create it, before a node is created: iceoryx2 would otherwise report only
+/// an `InternalError`, after leaving a management file of the run in `/dev/shm`.
+pub(crate) fn check_ipc_root(config: &Config) -> Result<(), TransportError> {
+    let root = PathBuf::from(config.global.root_path().to_string());
+    let problem = |problem: String| TransportError::IpcRoot {
+        dir: root.clone(),
+        problem,
+    };
+    let uid = effective_uid();
+    match std::fs::metadata(&root) {
+        Ok(m) if !m.is_dir() => return Err(problem("it is not a directory".into())),
+        Ok(m) => {
+            let is_default = std::env::var_os(IPC_ROOT_ENV).is_none_or(|d| d.is_empty());
+            if is_default && uid != 0 && m.uid() != uid {
+                return Err(problem(format!(
+                    "it belongs to uid {} (mode {:04o}), not to this user (uid {uid}); remove \
+                     it, or set {IPC_ROOT_ENV} to a directory of your own",
+                    m.uid(),
+                    m.mode() & 0o7777
+                )));
+            }
+            for dir in [
+                root.clone(),
+                root.join(config.global.node.directory.to_string()),
+                root.join(config.global.service.directory.to_string()),
+            ] {
+                if let Err(why) = accessible(&dir, libc::R_OK | libc::W_OK | libc::X_OK) {
+                    return Err(TransportError::IpcRoot { dir, problem: why });
+                }
+            }
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            let parent = root
+                .parent()
+                .filter(|p| !p.as_os_str().is_empty())
+                .unwrap_or(std::path::Path::new("/"));
+            if let Err(why) = accessible(parent, libc::W_OK | libc::X_OK) {
+                return Err(problem(format!(
+                    "it does not exist and cannot be created in {}: {why}",
+                    parent.display()
+                )));
+            }
+        }
+        Err(e) => return Err(problem(e.to_string())),
+    }
+    Ok(())
+}
+
+/// Whether this process may access an existing `dir` in `mode`; a missing one is fine (the
+/// node creates it). The error says what is missing, for whom.
+fn accessible(dir: &std::path::Path, mode: libc::c_int) -> Result<(), String> {
+    let Ok(meta) = std::fs::metadata(dir) else {
+        return Ok(());
+    };
+    let Ok(c_path) = std::ffi::CString::new(dir.as_os_str().as_encoded_bytes()) else {
+        return Err("its path holds a NUL byte".into());
+    };
+    // SAFETY: `c_path` is a valid NUL-terminated string; faccessat only reads it.
+    let rc = unsafe { libc::faccessat(libc::AT_FDCWD, c_path.as_ptr(), mode, libc::AT_EACCESS) };
+    if rc == 0 {
+        return Ok(());
+    }
+    let wanted = if mode & libc::R_OK != 0 {
+        "read, write and enter"
+    } else {
+        "write and enter"
+    };
+    Err(format!(
+        "permission denied: this user (uid {}) may not {wanted} it (owner uid {}, group {}, \
+         mode {:04o})",
+        effective_uid(),
+        meta.uid(),
+        meta.gid(),
+        meta.mode() & 0o7777
+    ))
 }
 
 /// Whether the file `name` is one iceoryx2 made for the run with file prefix `prefix`.

@@ -51,9 +51,11 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             "collision"
         );
     }
-    println!(
+    hnav_runtime::outln!(
         "periods={} collisions={} signalled={}",
-        out.periods, out.collisions, out.signalled
+        out.periods,
+        out.collisions,
+        out.signalled
     );
     Ok(())
 }

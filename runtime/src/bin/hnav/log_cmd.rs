@@ -57,7 +57,7 @@ fn show_cmd(dir: &Path, json: bool) -> ExitCode {
     let mut reader = match LogReader::open(dir) {
         Ok(r) => r,
         Err(e) => {
-            eprintln!("error: {e}");
+            hnav_runtime::errln!("error: {e}");
             return ExitCode::from(if e.is_unreadable() { 2 } else { 1 });
         }
     };
@@ -70,7 +70,7 @@ fn show_cmd(dir: &Path, json: bool) -> ExitCode {
             Ok(None) => break,
             Err(e) => {
                 let _ = out.flush();
-                eprintln!("error: {e}");
+                hnav_runtime::errln!("error: {e}");
                 return ExitCode::from(if e.is_unreadable() { 2 } else { 1 });
             }
         };
@@ -89,7 +89,7 @@ fn show_cmd(dir: &Path, json: bool) -> ExitCode {
     }
     let _ = out.flush();
     if let Some(t) = reader.torn_tail() {
-        eprintln!(
+        hnav_runtime::errln!(
             "note: torn tail: {} bytes at {} byte {} ({})",
             t.bytes,
             segment_name(t.segment),

@@ -104,20 +104,20 @@ fn check(
     let scenario = match loaded {
         Ok(s) => s,
         Err(e) => {
-            eprintln!("error: {e}");
+            hnav_runtime::errln!("error: {e}");
             return ExitCode::from(2);
         }
     };
     let report = ScenarioReport::new(&scenario);
-    print!("{}", report.render());
+    hnav_runtime::out!("{}", report.render());
     let dir = out.unwrap_or_else(|| default_out_dir(&scenario.name));
     match report.write_json(&dir) {
         Ok(p) => {
-            println!("report    {}", p.display());
+            hnav_runtime::outln!("report    {}", p.display());
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {}: cannot write report: {e}", dir.display());
+            hnav_runtime::errln!("error: {}: cannot write report: {e}", dir.display());
             ExitCode::from(1)
         }
     }
@@ -126,7 +126,7 @@ fn check(
 fn map_check(map: PathBuf, scen: Option<PathBuf>) -> ExitCode {
     match check_map(&map, scen.as_deref()) {
         Ok(c) => {
-            print!("{}", c.render(20));
+            hnav_runtime::out!("{}", c.render(20));
             if c.is_ok() {
                 ExitCode::SUCCESS
             } else {
@@ -134,7 +134,7 @@ fn map_check(map: PathBuf, scen: Option<PathBuf>) -> ExitCode {
             }
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            hnav_runtime::errln!("error: {e}");
             ExitCode::from(2)
         }
     }

@@ -21,9 +21,9 @@ pub fn run(args: PsArgs) -> ExitCode {
     hnav_runtime::logging::init();
     let report = PsReport::of(&RunRegistry::default_location());
     if args.json {
-        println!("{}", report.to_json());
+        hnav_runtime::outln!("{}", report.to_json());
     } else {
-        print!("{}", report.render_table());
+        hnav_runtime::out!("{}", report.render_table());
     }
     ExitCode::SUCCESS
 }

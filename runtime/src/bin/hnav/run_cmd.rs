@@ -5,8 +5,9 @@
 //! (time limit, collisions, stopped), 2 the run could not happen (bad scenario, a process
 //! that would not start, a run id or directory held by a live run, a finished run's
 //! directory without `--force`), 3 the run was ended early because it could not go on (the
-//! sim or the coordinator down and not restarted, or no agent left; the summary is still
-//! written).
+//! sim or the coordinator down and not restarted, or no agent left: the summary is still
+//! written; or a process stopped on a full disk: no summary, the message names it and the
+//! directory).
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -14,7 +15,11 @@ use std::process::ExitCode;
 
 use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::scenario::{ClockMode, Scenario};
-use hnav_runtime::supervisor::run::{default_run_dir, new_run_id, run, RunOptions};
+use hnav_runtime::supervisor::run::{default_run_dir, new_run_id, run, RunError, RunOptions};
+
+/// The exit code of a run that started but could not go on (a process stopped on a full
+/// disk): neither a finished run (0, 1) nor one that never started (2).
+const EXIT_RUN_BROKEN: u8 = 3;
 
 /// `hnav run` arguments.
 #[derive(clap::Args, Debug)]
@@ -51,7 +56,7 @@ pub fn run_command(a: RunArgs) -> ExitCode {
     let name = match Scenario::load(&a.scenario) {
         Ok(s) => default_run_dir(&s),
         Err(e) => {
-            eprintln!("error: {e}");
+            hnav_runtime::errln!("error: {e}");
             return ExitCode::from(2);
         }
     };
@@ -61,7 +66,7 @@ pub fn run_command(a: RunArgs) -> ExitCode {
             .and_then(|p| p.parent().map(PathBuf::from))
     });
     let Some(bin_dir) = bin_dir else {
-        eprintln!("error: cannot locate the process binaries; pass --bin-dir");
+        hnav_runtime::errln!("error: cannot locate the process binaries; pass --bin-dir");
         return ExitCode::from(2);
     };
     let dir = a.out.unwrap_or(name);
@@ -81,20 +86,24 @@ pub fn run_command(a: RunArgs) -> ExitCode {
     };
     match run(&opts) {
         Ok(summary) => {
-            print!("{}", summary.render());
-            println!("summary   {}", dir.join("summary.json").display());
-            println!("log       {}", summary.log.display());
+            hnav_runtime::out!("{}", summary.render());
+            hnav_runtime::outln!("summary   {}", dir.join("summary.json").display());
+            hnav_runtime::outln!("log       {}", summary.log.display());
             if let Some(why) = &summary.cannot_go_on {
-                eprintln!("error: {why}");
-                ExitCode::from(3)
+                hnav_runtime::errln!("error: {why}");
+                ExitCode::from(EXIT_RUN_BROKEN)
             } else if summary.success() {
                 ExitCode::SUCCESS
             } else {
                 ExitCode::from(1)
             }
         }
+        Err(e @ RunError::NoSpace { .. }) => {
+            hnav_runtime::errln!("error: {e}");
+            ExitCode::from(EXIT_RUN_BROKEN)
+        }
         Err(e) => {
-            eprintln!("error: {e}");
+            hnav_runtime::errln!("error: {e}");
             ExitCode::from(2)
         }
     }

@@ -42,6 +42,15 @@ pub enum RunError {
     /// The run directory is held by a live run, or holds a finished run's outputs.
     #[error(transparent)]
     RunDir(#[from] RunDirError),
+    /// A process stopped because the run directory's disk is full
+    /// ([`EXIT_NO_SPACE`](crate::launch::EXIT_NO_SPACE)); it is not restarted, the run ends.
+    #[error("no space left on device: {node} stopped writing {writes}; the run cannot go on (a restart would meet the same full disk)")]
+    NoSpace {
+        /// The process's node name (`coordinator`, `agent-3`, ...).
+        node: String,
+        /// What it writes there.
+        writes: String,
+    },
     /// The consensus log could not be read for the summary.
     #[error(transparent)]
     Log(#[from] LogError),

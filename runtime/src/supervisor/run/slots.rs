@@ -3,7 +3,7 @@
 
 use std::cell::Cell;
 use std::ffi::OsString;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::error::RunError;
@@ -32,6 +32,8 @@ struct Slot {
 /// Every process of the run: the sim, the coordinator and one agent per robot, in that order.
 pub(super) struct Slots {
     slots: Vec<Slot>,
+    /// The run directory, named when a process stops on a full disk.
+    dir: PathBuf,
 }
 
 impl Slots {
@@ -70,7 +72,10 @@ impl Slots {
         for i in 0..scenario.agents.len() as u32 {
             add(Role::Agent, i, "hnav-agent");
         }
-        Self { slots }
+        Self {
+            slots,
+            dir: dir.to_path_buf(),
+        }
     }
 
     /// Starts every process.
@@ -133,7 +138,8 @@ impl Slots {
 
     /// Reaps exited children, tells the others (`Down`), and restarts what is due. Returns
     /// why the run cannot go on, if it cannot: the sim or the coordinator is down and not
-    /// restarted, or no agent is left.
+    /// restarted, or no agent is left. A child that stopped on a full disk ends the run
+    /// instead: [`RunError::NoSpace`].
     pub(super) fn reap_and_restart(
         &mut self,
         transport: &Transport,
@@ -154,6 +160,12 @@ impl Slots {
             life.publish(Lifecycle::down(role, index, s.tracker.restarts()))?;
             match s.tracker.on_exit(&exit) {
                 RestartDecision::Restart { after } => s.restart_at = Some(Instant::now() + after),
+                RestartDecision::GiveUp(GiveUpReason::NoSpace) => {
+                    return Err(RunError::NoSpace {
+                        node: role.node_name(index),
+                        writes: role_writes(role, index, &self.dir),
+                    })
+                }
                 RestartDecision::GiveUp(why) => {
                     tracing::warn!(node = role.node_name(index), %why, "not restarted");
                     let gone = gone_for_good(role, index, &exit, why);
@@ -231,4 +243,21 @@ fn gone_for_good(role: Role, index: u32, exit: &ExitInfo, why: GiveUpReason) -> 
         other => format!("hnav-{}", other.name()),
     };
     format!("{who} ended ({exit}) and is not restarted ({why}): the run cannot go on")
+}
+
+/// What a process of `role` writes in the run directory `dir`, for the message of a run that
+/// ended on a full disk.
+fn role_writes(role: Role, index: u32, dir: &Path) -> String {
+    let log = dir
+        .join("logs")
+        .join(format!("{}.log", role.node_name(index)));
+    match role {
+        Role::Coordinator => format!("the consensus log in {}", dir.join("log").display()),
+        Role::Agent => format!(
+            "its checkpoint {} or its log {}",
+            dir.join("agents").join(format!("{index}.ckpt")).display(),
+            log.display()
+        ),
+        Role::Sim => format!("its log {}", log.display()),
+    }
 }
