@@ -189,6 +189,42 @@ impl Default for CoordinatorParams {
     }
 }
 
+/// Run parameters of the supervisor (`[run]`). They decide whether a run gets going, not what
+/// it does, so the scenario hash leaves them out.
+#[derive(Clone, Copy, PartialEq, Debug, Default, Serialize)]
+pub struct RunParams {
+    /// How long the processes get to come up, in seconds; `None` for the default that scales
+    /// with the map ([`default_startup_timeout_s`]).
+    pub startup_timeout_s: Option<f64>,
+}
+
+impl RunParams {
+    /// Largest `startup_timeout_s` accepted: one day.
+    pub const MAX_STARTUP_TIMEOUT_S: f64 = 86_400.0;
+}
+
+/// Neuron updates per second one core is assumed to manage while an agent builds its neural
+/// map: a fifth of what the release kernel reaches on the 2-core VM of the benchmarks
+/// (5.5e8), for margin against a loaded machine.
+const ASSUMED_UPDATES_PER_S: f64 = 1e8;
+
+/// The start-up timeout of a run of `agents` agents on a `width` x `height` map with `cores`
+/// cores, in seconds: 60 s for spawning and loading, plus the time the agents need to build
+/// their neural maps at [`ASSUMED_UPDATES_PER_S`], capped at
+/// [`RunParams::MAX_STARTUP_TIMEOUT_S`].
+///
+/// A build toward a goal in a corner sweeps about `max(width, height)` times over a box that
+/// grows to the whole map, about `width * height * max(width, height) / 3` updates; the agents
+/// build at once, `ceil(agents / cores)` to a core. In release builds that is some 5x the
+/// measured time; debug builds are 10-30x slower and need an explicit `startup_timeout_s` on
+/// maps of more than a few hundred cells a side.
+pub fn default_startup_timeout_s(width: u32, height: u32, agents: usize, cores: usize) -> f64 {
+    let (w, h) = (f64::from(width), f64::from(height));
+    let updates = w * h * w.max(h) / 3.0;
+    let per_core = agents.max(1).div_ceil(cores.max(1)) as f64;
+    (60.0 + updates * per_core / ASSUMED_UPDATES_PER_S).min(RunParams::MAX_STARTUP_TIMEOUT_S)
+}
+
 /// When the supervisor restarts a process of a role.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -264,6 +300,34 @@ mod tests {
         assert_eq!(RestartConfig::default().sim.policy, RestartPolicy::Never);
         assert_eq!(SimParams::default().clock, ClockMode::Lockstep);
         assert_eq!(CoordinatorParams::default().fsync, FsyncPolicy::EveryRecord);
+    }
+
+    #[test]
+    fn the_default_startup_timeout_grows_with_the_map_and_the_agents_per_core() {
+        // A small map costs nothing beyond the base.
+        assert!((default_startup_timeout_s(32, 32, 4, 2) - 60.0).abs() < 0.01);
+        // 1024 x 1024, 2 agents on 2 cores: 3.6e8 updates, 3.6 s on top.
+        let one = default_startup_timeout_s(1024, 1024, 2, 2);
+        assert!((one - 63.58).abs() < 0.01, "{one}");
+        // Twice the agents per core, twice the build time; the long side counts.
+        let two = default_startup_timeout_s(1024, 1024, 4, 2);
+        assert!((two - 60.0 - 2.0 * (one - 60.0)).abs() < 1e-9, "{two}");
+        assert_eq!(
+            default_startup_timeout_s(1024, 16, 1, 1),
+            default_startup_timeout_s(16, 1024, 1, 1)
+        );
+        // 5000 x 5000 (the map that did not come up within 60 s): 417 s of building.
+        let big = default_startup_timeout_s(5000, 5000, 1, 2);
+        assert!((big - 476.67).abs() < 0.01, "{big}");
+        // Zero cores or agents count as one; the cap holds for absurd maps.
+        assert_eq!(
+            default_startup_timeout_s(64, 64, 0, 0),
+            default_startup_timeout_s(64, 64, 1, 1)
+        );
+        assert_eq!(
+            default_startup_timeout_s(u32::MAX, u32::MAX, 1000, 1),
+            RunParams::MAX_STARTUP_TIMEOUT_S
+        );
     }
 
     #[test]

@@ -44,8 +44,6 @@ use slots::Slots;
 
 pub use error::RunError;
 
-/// How long the processes get to come up.
-pub const STARTUP_TIMEOUT: Duration = Duration::from_secs(60);
 /// How long a child gets after `Stop`, and again after SIGTERM.
 pub const STOP_GRACE: Duration = Duration::from_secs(3);
 /// Refresh period of the progress bar and the fault schedule.
@@ -166,7 +164,7 @@ fn supervise(
     slots.spawn_all()?;
     slots.write_record(record);
     let children: Vec<&Child> = slots.children().collect();
-    if ports.life.start(transport, &children, STARTUP_TIMEOUT)? == Startup::Interrupted {
+    if ports.life.start(transport, &children, scenario.startup_timeout())? == Startup::Interrupted {
         return Ok(End::Signalled);
     }
     let mut watch = Watch {

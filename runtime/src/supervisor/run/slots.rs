@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use super::error::RunError;
 use crate::launch::ProcessArgs;
-use crate::msg::{Lifecycle, Role};
+use crate::msg::{Lifecycle, LifecycleEvent, Role};
 use crate::scenario::Scenario;
 use crate::supervisor::child::{Child, ChildError, ChildSpec};
 use crate::supervisor::registry::RunRecord;
@@ -163,7 +163,12 @@ impl Slots {
     pub(super) fn announce_restarts(&self, life: &SupervisorPorts) -> Result<(), RunError> {
         let ready = life.ready();
         let mut up = Vec::new();
-        ready.drain_pending(|l| up.push((l.role, l.index)))?;
+        ready.drain_pending(|l| {
+            // A start-up phase report is not yet the process being up.
+            if l.event == LifecycleEvent::Up as u8 {
+                up.push((l.role, l.index));
+            }
+        })?;
         for (role, index) in up {
             let slot = self
                 .slots
