@@ -27,7 +27,7 @@ mod ports;
 mod state;
 
 use std::path::Path;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use hnav_runtime::launch::{ProcessArgs, StartOutcome};
 use hnav_runtime::msg::StartupPhase;
@@ -112,7 +112,13 @@ impl<'t> AgentProcess<'t> {
         } else {
             None
         };
+        let building = Instant::now();
         let core = Core::new(scenario, spec, index, checkpoint, resumed, args.resume)?;
+        // What a user needs to pick `[run] startup_timeout_s` for a large map.
+        tracing::info!(
+            seconds = building.elapsed().as_secs_f64(),
+            "neural map built"
+        );
         Ok(AgentProcess {
             startup_timeout: scenario.startup_timeout(),
             transport,

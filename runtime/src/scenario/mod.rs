@@ -311,3 +311,5 @@ mod test_support;
 mod tests;
 #[cfg(test)]
 mod tests_generate;
+#[cfg(test)]
+mod tests_run;

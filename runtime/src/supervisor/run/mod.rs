@@ -56,7 +56,8 @@ pub struct RunOptions {
     pub args: ProcessArgs,
     /// Where `hnav-sim`, `hnav-coordinator` and `hnav-agent` are.
     pub bin_dir: PathBuf,
-    /// Show a progress bar (on a terminal).
+    /// Whether stderr is a terminal: a progress bar there, else a progress line every few
+    /// seconds.
     pub progress: bool,
 }
 
