@@ -9,5 +9,6 @@
 mod cli;
 mod fixtures;
 mod format;
+mod run_dir;
 mod summary;
 mod writer;
