@@ -39,15 +39,24 @@ fn check_exit_codes_are_the_documented_ones() {
     let o = hnav(&["check", &good, "--out", &format!("{blocker}/sub")]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     assert!(text(&o).contains("cannot write report"), "{}", text(&o));
-    let bad = write(tmp.path(), "bad.toml", &SCENARIO.replace("[3, 2]", "[1, 1]"));
+    let bad = write(
+        tmp.path(),
+        "bad.toml",
+        &SCENARIO.replace("[3, 2]", "[1, 1]"),
+    );
     let o = hnav(&["check", &bad]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    let o = hnav(&["check", &tmp.path().join("missing.toml").display().to_string()]);
+    let o = hnav(&[
+        "check",
+        &tmp.path().join("missing.toml").display().to_string(),
+    ]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     // What the README says, `hnav check --help` says too.
     let help = text(&hnav(&["check", "--help"]));
     assert!(
-        help.contains("Exit 0 when the scenario is valid and the report is written, 1 when it is valid but"),
+        help.contains(
+            "Exit 0 when the scenario is valid and the report is written, 1 when it is valid but"
+        ),
         "{help}"
     );
 }
@@ -55,7 +64,11 @@ fn check_exit_codes_are_the_documented_ones() {
 #[test]
 fn check_spells_cells_as_x_y_in_errors_and_summary() {
     let tmp = tempfile::tempdir().unwrap();
-    let bad = write(tmp.path(), "bad.toml", &SCENARIO.replace("[3, 2]", "[1, 1]"));
+    let bad = write(
+        tmp.path(),
+        "bad.toml",
+        &SCENARIO.replace("[3, 2]", "[1, 1]"),
+    );
     let o = hnav(&["check", &bad]);
     assert!(
         text(&o).contains(":6: agent 0 goal [1, 1] is on an obstacle"),

@@ -92,13 +92,12 @@ fn a_run_off_a_terminal_prints_progress_lines_and_plain_logs() {
     let (code, lines) = all_lines(&mut peer);
     let text = lines.join("\n");
     assert_eq!(code, Some(0), "{text}");
-    let progress: Vec<&String> = lines.iter().filter(|l| l.starts_with("progress: ")).collect();
+    let progress: Vec<&String> = lines
+        .iter()
+        .filter(|l| l.starts_with("progress: "))
+        .collect();
     assert!(!progress.is_empty(), "{text}");
-    assert!(
-        progress[0].contains("/1 agents at goal"),
-        "{}",
-        progress[0]
-    );
+    assert!(progress[0].contains("/1 agents at goal"), "{}", progress[0]);
     let logs = tmp.path().join("out/logs");
     let mut seen = 0;
     for entry in std::fs::read_dir(&logs).unwrap() {
@@ -112,5 +111,9 @@ fn a_run_off_a_terminal_prints_progress_lines_and_plain_logs() {
             String::from_utf8_lossy(&bytes)
         );
     }
-    assert!(seen > 0, "the processes logged nothing in {}", logs.display());
+    assert!(
+        seen > 0,
+        "the processes logged nothing in {}",
+        logs.display()
+    );
 }

@@ -6,9 +6,7 @@ use std::path::Path;
 
 use toml::Spanned;
 
-use super::build_params::{
-    build_coordinator, build_restart, build_robot, build_run, build_sim,
-};
+use super::build_params::{build_coordinator, build_restart, build_robot, build_run, build_sim};
 use super::error::{Loc, ScenarioError};
 use super::lines::{toml_error, Lines};
 use super::raw::{RawMap, RawScenario};

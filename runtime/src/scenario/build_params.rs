@@ -219,7 +219,10 @@ pub(super) fn build_restart(raw: Option<RawRestart>) -> RestartConfig {
     }
 }
 
-pub(super) fn build_run(raw: Option<RawRun>, lines: &Lines<'_>) -> Result<RunParams, ScenarioError> {
+pub(super) fn build_run(
+    raw: Option<RawRun>,
+    lines: &Lines<'_>,
+) -> Result<RunParams, ScenarioError> {
     let Some(v) = raw.and_then(|r| r.startup_timeout_s) else {
         return Ok(RunParams::default());
     };

@@ -54,11 +54,17 @@ fn huge_and_tiny_numbers_print_in_scientific_notation() {
     assert!(e.to_string().ends_with("got -1e-300"), "{e}");
     let e = parse(&BASE.replace("speed = 2.0", "speed = 1e300")).unwrap_err();
     assert!(
-        e.to_string()
-            .starts_with("t.toml:15: agent 1 speed 1e300 cells/s exceeds the robot's 2.625 cells/s"),
+        e.to_string().starts_with(
+            "t.toml:15: agent 1 speed 1e300 cells/s exceeds the robot's 2.625 cells/s"
+        ),
         "{e}"
     );
-    for (x, shown) in [(0.25, "0.25"), (120.0, "120"), (1e15, "1e15"), (3e-7, "3e-7")] {
+    for (x, shown) in [
+        (0.25, "0.25"),
+        (120.0, "120"),
+        (1e15, "1e15"),
+        (3e-7, "3e-7"),
+    ] {
         assert_eq!(error::number(x).to_string(), shown);
     }
 }

@@ -276,14 +276,18 @@ mod tests {
                 matches!(&err, StartupError::NotUp { missing, .. } if missing == &[late]),
                 "{err}"
             );
-            assert!(err.to_string().contains("agent-0 reported nothing"), "{err}");
+            assert!(
+                err.to_string().contains("agent-0 reported nothing"),
+                "{err}"
+            );
         });
     }
 
     #[test]
     fn a_timeout_names_the_last_phase_each_late_child_reported() {
         with_run("sleep 30", |transport, ports, child, ready| {
-            let phase = |mib| Lifecycle::phase(Role::Agent, 0, StartupPhase::BuildingNeuralMap, mib);
+            let phase =
+                |mib| Lifecycle::phase(Role::Agent, 0, StartupPhase::BuildingNeuralMap, mib);
             ready.send(phase(12)).unwrap();
             ready.send(phase(430)).unwrap();
             let err = ports

@@ -103,7 +103,11 @@ mod tests {
             e.to_string(),
             "create node on \"supervisor\" failed: insufficient permissions"
         );
-        let e = TransportError::ipc("create node", "supervisor", NodeCreationFailure::InternalError);
+        let e = TransportError::ipc(
+            "create node",
+            "supervisor",
+            NodeCreationFailure::InternalError,
+        );
         assert!(e.to_string().ends_with("failed: internal error"), "{e}");
         assert_eq!(
             in_words("ServiceInCorruptedState(UnableToOpenStaticConfig)"),

@@ -69,7 +69,10 @@ fn show_json_names_enumerations_and_spells_cells_as_x_y() {
     assert_eq!(d[1]["kind"], "crossing");
     assert_eq!(d[1]["refused"], json!(["N", "NE"]));
     let life = &lines[3];
-    assert_eq!((&life["role"], &life["event"]), (&json!("agent"), &json!("restarted")));
+    assert_eq!(
+        (&life["role"], &life["event"]),
+        (&json!("agent"), &json!("restarted"))
+    );
     assert_eq!(lines[4]["waypoints"][0], json!([2, 1]));
     assert_eq!(lines.last().unwrap()["reason"], "all-at-goal");
 }

@@ -165,7 +165,11 @@ fn supervise(
     slots.spawn_all()?;
     slots.write_record(record);
     let children: Vec<&Child> = slots.children().collect();
-    if ports.life.start(transport, &children, scenario.startup_timeout())? == Startup::Interrupted {
+    if ports
+        .life
+        .start(transport, &children, scenario.startup_timeout())?
+        == Startup::Interrupted
+    {
         return Ok(End::Signalled);
     }
     let mut watch = Watch {
