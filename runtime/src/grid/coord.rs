@@ -106,7 +106,7 @@ mod tests {
         assert_eq!(Cell::new(0, 0).offset(-1, 0), None);
         assert_eq!(Cell::new(0, 3).offset(1, -1), Some(Cell::new(1, 2)));
         assert_eq!(Cell::new(u32::MAX, 0).offset(1, 0), None);
-        assert_eq!(Cell::new(2, 3).to_string(), "(2, 3)");
+        assert_eq!(Cell::new(2, 3).to_string(), "[2, 3]");
     }
 }
 
