@@ -211,7 +211,7 @@ const ASSUMED_UPDATES_PER_S: f64 = 1e7;
 
 /// The start-up timeout of a run of `agents` agents on a `width` x `height` map with `cores`
 /// cores, in seconds: 60 s for spawning and loading, plus the time the agents need to build
-/// their neural maps at [`ASSUMED_UPDATES_PER_S`], capped at
+/// their neural maps at an assumed 1e7 neuron updates per second per core, capped at
 /// [`RunParams::MAX_STARTUP_TIMEOUT_S`].
 ///
 /// A build toward a goal in a corner sweeps about `max(width, height)` times over a box that

@@ -28,7 +28,7 @@ pub enum TransportError {
         op: &'static str,
         /// The service or node concerned.
         service: String,
-        /// iceoryx2's error in words ([`in_words`]).
+        /// iceoryx2's error in words (`InsufficientPermissions` becomes "insufficient permissions").
         detail: String,
     },
 }
