@@ -98,7 +98,7 @@ fn bad_cells_are_errors() {
         "{e}"
     );
     let e = plan_query(&g, Cell::new(0, 0), Cell::new(2, 2), &o).unwrap_err();
-    assert_eq!(e.to_string(), "goal (2, 2) is on an obstacle");
+    assert_eq!(e.to_string(), "goal [2, 2] is on an obstacle");
     let same = plan_query(&g, Cell::new(1, 1), Cell::new(1, 1), &o).unwrap();
     assert!(same.found && same.steps == 0 && same.path == vec![Cell::new(1, 1)]);
     let open = Grid::new(1, 1).unwrap();

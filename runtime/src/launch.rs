@@ -17,6 +17,13 @@
 //!    `lifecycle` topic;
 //! 3. each process waits for `Start`, then runs.
 //!
+//! Before step 1 a process may report a slow phase of its start-up on `ready`
+//! ([`LifecyclePorts::report_phase`], e.g. an agent building its neural map), so that a
+//! supervisor that gives up can say what each late process was doing. The supervisor's
+//! bound, and each process's bound on its wait for `Start`, is the scenario's one start-up
+//! timeout ([`Scenario::startup_timeout`]); a process starts its clock after the
+//! supervisor, so it never gives up first.
+//!
 //! A process the supervisor restarts (`--resume`) skips step 3: its peers are already
 //! running, and a new publisher connects to existing subscribers on its first send. During
 //! the run the supervisor publishes `Down` and `Restarted` for processes that die and come
@@ -27,7 +34,7 @@ use std::ffi::OsString;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use crate::msg::{Lifecycle, LifecycleEvent, Role, StopReason};
+use crate::msg::{Lifecycle, LifecycleEvent, Role, StartupPhase, StopReason};
 use crate::scenario::{ClockMode, Scenario, ScenarioError};
 use crate::topics;
 use crate::transport::{Receiver, RunId, Sender, Transport, TransportError, Wake};
@@ -109,11 +116,6 @@ impl ProcessArgs {
     }
 }
 
-/// How long a process waits for the supervisor's `Start` ([`LifecyclePorts::handshake`]):
-/// the one start-up timeout of the run's processes. A supervisor that never answers is an
-/// error, not a hang.
-pub const START_TIMEOUT: Duration = Duration::from_secs(60);
-
 /// The exit code of a process that stopped because the disk of the run directory is full
 /// (ENOSPC's errno). The supervisor does not restart such a process: its successor would meet
 /// the same full disk. It ends the run instead and names the cause.
@@ -174,6 +176,15 @@ impl LifecyclePorts {
             ready: transport.sender(topics::READY, q)?,
             events: transport.receiver(topics::LIFECYCLE, q)?,
         })
+    }
+
+    /// Tells the supervisor that this process has entered start-up `phase` of `size` (see
+    /// [`StartupPhase`]). Only before `Up`, and only for phases that can take long: every
+    /// report takes a slot of the `ready` buffer the `Up`s share.
+    pub fn report_phase(&self, phase: StartupPhase, size: u32) -> Result<(), TransportError> {
+        self.ready
+            .send(Lifecycle::phase(self.role, self.index, phase, size))?;
+        Ok(())
     }
 
     /// Publishes `Up` for this process (call once every other port is open).
@@ -256,7 +267,10 @@ impl LifecyclePorts {
                     return Err(TransportError::ipc(
                         "wait for start",
                         "lifecycle",
-                        format!("no Start from the supervisor within {timeout:?}"),
+                        format!(
+                            "no Start from the supervisor within {:.1} s",
+                            timeout.as_secs_f64()
+                        ),
                     ))
                 }
             }

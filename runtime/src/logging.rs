@@ -6,6 +6,8 @@
 //! limited to errors: iceoryx2 warns about things HNAV does on purpose (running without a
 //! config file, cleaning up after killed processes).
 
+use std::io::IsTerminal;
+
 use iceoryx2::prelude::{set_log_level, LogLevel};
 use tracing::level_filters::LevelFilter;
 use tracing_subscriber::EnvFilter;
@@ -14,7 +16,9 @@ use tracing_subscriber::EnvFilter;
 pub const DEFAULT_FILTER: &str = "info,iceoryx2_bb_loggers=error";
 
 /// Installs a stderr subscriber filtered by `HNAV_LOG`, else `RUST_LOG`, else
-/// [`DEFAULT_FILTER`]. Calling it twice is harmless (the second call does nothing).
+/// [`DEFAULT_FILTER`]. Colours only when stderr is a terminal: the run's processes write to
+/// `DIR/logs/<node>.log`, which must read as plain text. Calling it twice is harmless (the
+/// second call does nothing).
 pub fn init() {
     let filter = std::env::var("HNAV_LOG")
         .or_else(|_| std::env::var("RUST_LOG"))
@@ -27,6 +31,7 @@ pub fn init() {
         // nor be reported on the very stream that just failed.
         .with_writer(|| crate::diag::StderrWriter)
         .log_internal_errors(false)
+        .with_ansi(std::io::stderr().is_terminal())
         .try_init();
     // iceoryx2 filters by its own level before its message reaches `tracing`; open it exactly
     // as far as the most verbose directive, so the tracing filter decides and nothing more

@@ -142,6 +142,15 @@ impl NeuralMap {
         Ok(map)
     }
 
+    /// The memory [`NeuralMap::new`] allocates for `grid`, in bytes: two buffers of mantissas
+    /// and exponents, the denominators and the diagonal mask, each one value per cell of the
+    /// padded grid. An agent reports it while it builds its map.
+    pub fn footprint(grid: &Grid) -> usize {
+        let cells = (grid.width() as usize + 2) * (grid.height() as usize + 2);
+        let per_cell = 2 * (size_of::<f32>() + size_of::<i32>()) + size_of::<f32>() + 1;
+        cells * per_cell
+    }
+
     /// The options the map was created with.
     pub fn options(&self) -> &NeuralMapOptions {
         &self.options

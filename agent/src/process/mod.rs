@@ -27,12 +27,15 @@ mod ports;
 mod state;
 
 use std::path::Path;
+use std::time::{Duration, Instant};
 
-use hnav_runtime::launch::{ProcessArgs, StartOutcome, START_TIMEOUT};
+use hnav_runtime::launch::{ProcessArgs, StartOutcome};
+use hnav_runtime::msg::StartupPhase;
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::transport::{Transport, TransportError, Wake};
 
 use crate::navigator::Navigator;
+use crate::neural_map::NeuralMap;
 use checkpoint::CheckpointFile;
 use ports::Ports;
 use state::Core;
@@ -84,6 +87,7 @@ pub struct AgentProcess<'t> {
     transport: &'t Transport,
     ports: Ports,
     core: Core,
+    startup_timeout: Duration,
 }
 
 impl<'t> AgentProcess<'t> {
@@ -102,14 +106,30 @@ impl<'t> AgentProcess<'t> {
             .get(index as usize)
             .ok_or(AgentError::NoSuchAgent { index, agents })?;
         let ports = Ports::open(transport, &scenario.map.grid, index, agents)?;
+        if !args.resume {
+            // Only a first start has a supervisor waiting on a bound; a restarted agent
+            // builds its map just the same but nobody times it.
+            let mib = NeuralMap::footprint(&scenario.map.grid).div_ceil(1 << 20);
+            let size = u32::try_from(mib).unwrap_or(u32::MAX);
+            ports
+                .life
+                .report_phase(StartupPhase::BuildingNeuralMap, size)?;
+        }
         let checkpoint = args.dir.as_deref().and_then(|d| open_checkpoint(d, index));
         let resumed = if args.resume {
             checkpoint.as_ref().and_then(|c| c.load())
         } else {
             None
         };
+        let building = Instant::now();
         let core = Core::new(scenario, spec, index, checkpoint, resumed, args.resume)?;
+        // What a user needs to pick `[run] startup_timeout_s` for a large map.
+        tracing::info!(
+            seconds = building.elapsed().as_secs_f64(),
+            "neural map built"
+        );
         Ok(AgentProcess {
+            startup_timeout: scenario.startup_timeout(),
             transport,
             ports,
             core,
@@ -127,7 +147,7 @@ impl<'t> AgentProcess<'t> {
         let started = self
             .ports
             .life
-            .handshake(self.transport, resume, START_TIMEOUT)?;
+            .handshake(self.transport, resume, self.startup_timeout)?;
         let (p, core) = (&self.ports, &mut self.core);
         if started == StartOutcome::Stopped {
             return Ok(core.outcome());

@@ -174,6 +174,6 @@ mod tests {
             CornerCutting::Forbidden,
         )
         .unwrap_err();
-        assert_eq!(e.to_string(), "goal (1, 1) is on a blocked cell");
+        assert_eq!(e.to_string(), "goal [1, 1] is on a blocked cell");
     }
 }

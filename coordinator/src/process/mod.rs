@@ -25,9 +25,10 @@
 //! [`Progress::done`]: hnav_runtime::msg::Progress::done
 
 use std::path::Path;
+use std::time::Duration;
 
 use hnav_runtime::consensus_log::{EndReason, LogError};
-use hnav_runtime::launch::{StartOutcome, START_TIMEOUT};
+use hnav_runtime::launch::StartOutcome;
 use hnav_runtime::msg::MAX_AGENTS;
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::transport::{Transport, TransportError, Waiter, Wake};
@@ -76,6 +77,7 @@ pub struct CoordinatorProcess<'t> {
     transport: &'t Transport,
     ports: Ports,
     state: State,
+    startup_timeout: Duration,
 }
 
 impl<'t> CoordinatorProcess<'t> {
@@ -92,6 +94,7 @@ impl<'t> CoordinatorProcess<'t> {
         let ports = Ports::open(transport, n)?;
         let state = State::open(scenario, run_dir)?;
         Ok(CoordinatorProcess {
+            startup_timeout: scenario.startup_timeout(),
             transport,
             ports,
             state,
@@ -104,7 +107,7 @@ impl<'t> CoordinatorProcess<'t> {
         let started = self
             .ports
             .life
-            .handshake(self.transport, resume, START_TIMEOUT)?;
+            .handshake(self.transport, resume, self.startup_timeout)?;
         let (p, st) = (&self.ports, &mut self.state);
         if started == StartOutcome::Stopped {
             if !st.ended() {

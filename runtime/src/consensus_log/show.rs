@@ -11,19 +11,20 @@ use crate::msg::{ConflictKind, LifecycleEvent, Role, Verdict, NO_CELL};
 
 const DIRECTIONS: [&str; 8] = ["N", "NE", "E", "SE", "S", "SW", "W", "NW"];
 
-/// A cell as `[x,y]` for a grid `width` cells wide (`-` for none, `#index` without a width).
+/// A cell as `[x, y]` (0-based column and row, the one spelling of a cell in every output
+/// of HNAV) for a grid `width` cells wide (`-` for none, `#index` without a width).
 pub fn cell(index: u32, width: u32) -> String {
     if index == NO_CELL {
         "-".into()
     } else if width == 0 {
         format!("#{index}")
     } else {
-        format!("[{},{}]", index % width, index / width)
+        format!("[{}, {}]", index % width, index / width)
     }
 }
 
 /// One line describing `record`; `width` is the grid width from the log's header (0 if
-/// unknown) for printing cells as `[x,y]`.
+/// unknown) for printing cells as `[x, y]`.
 pub fn describe(record: &Record, width: u32) -> String {
     let mut s = String::new();
     match record {
@@ -141,25 +142,90 @@ fn decision(s: &mut String, d: &LoggedDecision, width: u32) {
 }
 
 /// One JSON object for `record` at `pos`: `segment`, `offset`, `kind` and the record's
-/// fields.
-pub fn to_json(pos: &RecordPos, record: &Record) -> Value {
+/// fields, for a grid `width` cells wide (from the log's header; 0 if unknown). Enumerations
+/// are their names (`"accept"`, `"crossing"`, `"agent"`, `"up"`, `"time-limit"`; an unknown
+/// code stays its number), cells are `[x, y]` as everywhere else (`null` for none; the linear
+/// index when the width is unknown), refused directions a list of compass names.
+pub fn to_json(pos: &RecordPos, record: &Record, width: u32) -> Value {
+    let cell = |index: u32| cell_json(index, width);
     let fields = match record {
-        Record::Header(r) => serde_json::to_value(r),
-        Record::Round(r) => serde_json::to_value(r),
-        Record::Lifecycle(r) => serde_json::to_value(r),
-        Record::Replan(r) => serde_json::to_value(r),
-        Record::End(r) => serde_json::to_value(r),
-        Record::Unreachable(r) => serde_json::to_value(r),
+        Record::Header(h) => json!({
+            "version": h.version,
+            "scenario_hash": h.scenario_hash,
+            "seed": h.seed,
+            "clock": h.clock,
+            "width": h.width,
+            "height": h.height,
+            "agents": h.agents.iter().map(|a| json!({
+                "start": cell_json(a.start, h.width),
+                "goal": cell_json(a.goal, h.width),
+                "speed": a.speed,
+                "priority": a.priority,
+            })).collect::<Vec<_>>(),
+        }),
+        Record::Round(r) => json!({
+            "round": r.round,
+            "candidates": r.candidates,
+            "candidates_digest": r.candidates_digest,
+            "decisions": r.decisions.iter().map(|d| json!({
+                "agent": d.agent,
+                "verdict": name_or_code(Verdict::from_u8(d.verdict).map(Verdict::name), d.verdict),
+                "kind": name_or_code(ConflictKind::from_u8(d.kind).map(ConflictKind::name), d.kind),
+                "refused": (0..8)
+                    .filter(|b| d.refused & (1 << b) != 0)
+                    .map(|b| DIRECTIONS[b])
+                    .collect::<Vec<_>>(),
+                "cell": cell(d.cell),
+                "waypoint": cell(d.waypoint),
+            })).collect::<Vec<_>>(),
+        }),
+        Record::Lifecycle(l) => json!({
+            "round": l.round,
+            "role": name_or_code(Role::from_u8(l.role).map(Role::name), l.role),
+            "index": l.index,
+            "event": name_or_code(LifecycleEvent::from_u8(l.event).map(LifecycleEvent::name), l.event),
+            "restarts": l.restarts,
+        }),
+        Record::Replan(r) => json!({
+            "round": r.round,
+            "agent": r.agent,
+            "planner": r.planner,
+            "found": r.found,
+            "waypoints": r.waypoints.iter().map(|&w| cell(w)).collect::<Vec<_>>(),
+        }),
+        Record::End(e) => json!({
+            "round": e.round,
+            "at_goal": e.at_goal,
+            "reason": e.reason.name(),
+        }),
+        Record::Unreachable(u) => json!({
+            "round": u.round,
+            "agent": u.agent,
+            "cell": cell(u.cell),
+        }),
     };
     let mut object = Map::new();
     object.insert("segment".into(), json!(pos.segment));
     object.insert("offset".into(), json!(pos.offset));
     object.insert("kind".into(), json!(record.kind()));
-    match fields {
-        Ok(Value::Object(map)) => object.extend(map),
-        // Not reached for these plain structs; kept visible rather than unwrapped.
-        Ok(other) => _ = object.insert("fields".into(), other),
-        Err(e) => _ = object.insert("error".into(), json!(e.to_string())),
+    if let Value::Object(map) = fields {
+        object.extend(map);
     }
     Value::Object(object)
+}
+
+/// A cell as JSON: `[x, y]`, `null` for none, the linear index without a width.
+fn cell_json(index: u32, width: u32) -> Value {
+    if index == NO_CELL {
+        Value::Null
+    } else if width == 0 {
+        json!(index)
+    } else {
+        json!([index % width, index / width])
+    }
+}
+
+/// An enumeration's name, or its code when the code is unknown.
+fn name_or_code(name: Option<&str>, code: u8) -> Value {
+    name.map_or_else(|| json!(code), |n| json!(n))
 }

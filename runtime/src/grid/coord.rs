@@ -55,7 +55,7 @@ impl PartialOrd for Cell {
 
 impl fmt::Display for Cell {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "({}, {})", self.x, self.y)
+        write!(f, "[{}, {}]", self.x, self.y)
     }
 }
 
@@ -106,7 +106,7 @@ mod tests {
         assert_eq!(Cell::new(0, 0).offset(-1, 0), None);
         assert_eq!(Cell::new(0, 3).offset(1, -1), Some(Cell::new(1, 2)));
         assert_eq!(Cell::new(u32::MAX, 0).offset(1, 0), None);
-        assert_eq!(Cell::new(2, 3).to_string(), "(2, 3)");
+        assert_eq!(Cell::new(2, 3).to_string(), "[2, 3]");
     }
 }
 

@@ -221,7 +221,7 @@ pub enum GridError {
         value: String,
     },
     /// A start or goal outside the map.
-    #[error("{source_name}:{line}: {endpoint} ({x}, {y}) is outside the {width}x{height} map")]
+    #[error("{source_name}:{line}: {endpoint} [{x}, {y}] is outside the {width}x{height} map")]
     OutsideMap {
         /// File name or `"<inline>"`.
         source_name: String,
@@ -239,7 +239,7 @@ pub enum GridError {
         height: u32,
     },
     /// A start or goal on a blocked cell.
-    #[error("{source_name}:{line}: {endpoint} ({x}, {y}) is on an obstacle ({ch:?})")]
+    #[error("{source_name}:{line}: {endpoint} [{x}, {y}] is on an obstacle ({ch:?})")]
     OnObstacle {
         /// File name or `"<inline>"`.
         source_name: String,

@@ -380,7 +380,7 @@ mod tests {
         ));
         assert_eq!(
             errs[2].to_string(),
-            "m.scen:5: start (1, 0) is on an obstacle ('@')"
+            "m.scen:5: start [1, 0] is on an obstacle ('@')"
         );
     }
 }

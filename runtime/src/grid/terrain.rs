@@ -32,8 +32,12 @@ impl Terrain {
         for (i, &v) in values.iter().enumerate() {
             let ok = v.is_finite() && (kind == TerrainKind::Elevation || v >= 0.0);
             if !ok {
+                let layer = match kind {
+                    TerrainKind::Elevation => "an elevation layer (finite metres)",
+                    TerrainKind::Cost => "a cost layer (finite, >= 0)",
+                };
                 return Err(GridError::BadTerrain {
-                    problem: format!("value {v} at index {i} is not valid for {kind:?}"),
+                    problem: format!("value {v} at index {i} is not valid for {layer}"),
                 });
             }
         }

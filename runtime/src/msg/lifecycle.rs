@@ -1,6 +1,7 @@
 //! The lifecycle protocol's payload and its vocabulary: which process ([`Role`], with the one
 //! spelling of its name), what happened to it ([`LifecycleEvent`]), why a run is stopped
-//! ([`StopReason`]), and the [`Lifecycle`] sample built by its constructors.
+//! ([`StopReason`]), what a process is busy with before it is up ([`StartupPhase`]), and the
+//! [`Lifecycle`] sample built by its constructors.
 //!
 //! Besides a process's `Up` and the supervisor's `Start`, `Down`, `Restarted` and `Stop`, a
 //! lockstep run with a fault plan has one more exchange: the sim holds before stepping a
@@ -99,6 +100,10 @@ pub enum LifecycleEvent {
     Hold = 6,
     /// Supervisor to all: the faults of the held period are done, step on.
     Resume = 7,
+    /// A process to the supervisor, on `ready` before its `Up`: it has entered a slow
+    /// start-up phase ([`Lifecycle::reason`] holds the [`StartupPhase`], [`Lifecycle::restarts`]
+    /// its size), so that a start-up timeout can say what the process was doing.
+    Phase = 8,
 }
 
 impl LifecycleEvent {
@@ -112,12 +117,13 @@ impl LifecycleEvent {
             5 => Some(Self::Stop),
             6 => Some(Self::Hold),
             7 => Some(Self::Resume),
+            8 => Some(Self::Phase),
             _ => None,
         }
     }
 
-    /// Lower-case name (`up`, `down`, `restarted`, `start`, `stop`, `hold`, `resume`), as in
-    /// `hnav log show`.
+    /// Lower-case name (`up`, `down`, `restarted`, `start`, `stop`, `hold`, `resume`,
+    /// `phase`), as in `hnav log show`.
     pub fn name(self) -> &'static str {
         match self {
             Self::Up => "up",
@@ -127,6 +133,36 @@ impl LifecycleEvent {
             Self::Stop => "stop",
             Self::Hold => "hold",
             Self::Resume => "resume",
+            Self::Phase => "phase",
+        }
+    }
+}
+
+/// A slow part of a process's start-up, reported with [`Lifecycle::phase`] when the process
+/// enters it. A process that reports nothing before its `Up` is still loading its scenario and
+/// map or opening its ports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum StartupPhase {
+    /// An agent allocates and builds its neural map toward its goal; the size is the map's
+    /// memory in MiB.
+    BuildingNeuralMap = 1,
+}
+
+impl StartupPhase {
+    /// Decodes a phase byte received from another process.
+    pub fn from_u8(v: u8) -> Option<Self> {
+        match v {
+            1 => Some(Self::BuildingNeuralMap),
+            _ => None,
+        }
+    }
+
+    /// What the process is doing, for an error message: `size` is the [`Lifecycle::restarts`]
+    /// field of the report.
+    pub fn describe(self, size: u32) -> String {
+        match self {
+            Self::BuildingNeuralMap => format!("building its neural map, {size} MiB"),
         }
     }
 }
@@ -176,12 +212,13 @@ pub struct Lifecycle {
     pub role: u8,
     /// A [`LifecycleEvent`] as `u8`.
     pub event: u8,
-    /// For `Stop`, a [`StopReason`] as `u8`; zero for every other event.
+    /// For `Stop`, a [`StopReason`] as `u8`; for `Phase`, a [`StartupPhase`] as `u8`; zero
+    /// for every other event.
     pub reason: u8,
     /// Zero.
     pub reserved: u8,
     /// Restarts of this process so far. For `Hold` and `Resume`, the high 32 bits of the
-    /// period.
+    /// period; for `Phase`, the size of the phase in the unit [`StartupPhase::describe`] names.
     pub restarts: u32,
 }
 
@@ -233,6 +270,16 @@ impl Lifecycle {
     /// half) so that the sample keeps its 24-byte layout.
     fn at_period(event: LifecycleEvent, period: u64) -> Self {
         Self::about(Role::Sim, period as u32, event, (period >> 32) as u32)
+    }
+
+    /// `Phase`: the calling process (with its own pid) has entered start-up `phase`, of
+    /// `size` (see [`StartupPhase`]).
+    pub fn phase(role: Role, index: u32, phase: StartupPhase, size: u32) -> Self {
+        Self {
+            reason: phase as u8,
+            restarts: size,
+            ..Self::about(role, index, LifecycleEvent::Phase, 0).with_pid(std::process::id())
+        }
     }
 
     /// The same event about the process with id `pid`.
@@ -296,16 +343,21 @@ mod tests {
             LifecycleEvent::Stop,
             LifecycleEvent::Hold,
             LifecycleEvent::Resume,
+            LifecycleEvent::Phase,
         ] {
             assert_eq!(LifecycleEvent::from_u8(e as u8), Some(e));
         }
+        let p = StartupPhase::BuildingNeuralMap;
+        assert_eq!(StartupPhase::from_u8(p as u8), Some(p));
+        assert_eq!(StartupPhase::from_u8(0), None);
+        assert_eq!(StartupPhase::from_u8(2), None);
         for s in [StopReason::Requested, StopReason::TimeLimit] {
             assert_eq!(StopReason::from_u8(s as u8), Some(s));
         }
-        assert_eq!(LifecycleEvent::from_u8(8), None);
+        assert_eq!(LifecycleEvent::from_u8(9), None);
         for bad in [0u8, 5, 200, 255] {
             assert_eq!(Role::from_u8(bad), None);
-            assert_eq!(LifecycleEvent::from_u8(bad.max(8)), None);
+            assert_eq!(LifecycleEvent::from_u8(bad.max(9)), None);
             assert_eq!(StopReason::from_u8(bad.max(3)), None);
         }
         assert_eq!(StopReason::from_u8(0), None);
@@ -355,6 +407,12 @@ mod tests {
         let stop = Lifecycle::stop(StopReason::TimeLimit);
         assert_eq!(fields(stop), (sim, 0, LifecycleEvent::Stop as u8, 2, 0, 0));
         assert_eq!(Lifecycle::stop(StopReason::Requested).reason, 1);
+        let phase = Lifecycle::phase(Role::Agent, 4, StartupPhase::BuildingNeuralMap, 430);
+        assert_eq!(phase.pid, std::process::id());
+        assert_eq!(
+            fields(phase),
+            (agent, 4, LifecycleEvent::Phase as u8, 1, 0, 430)
+        );
         assert!(start.time_ns > 0);
     }
 

@@ -35,7 +35,7 @@
 //! |---|---|
 //! | `round` | the decision round: [`Candidate`], [`Decision`], [`Commit`], [`Progress`] |
 //! | `motion` | wheels and ground truth: [`WheelCommand`], [`Odometry`], [`Pose`], [`Truth`] |
-//! | `lifecycle` | the supervisor's protocol: [`Role`] and its names, [`LifecycleEvent`], [`StopReason`], [`Lifecycle`] and its constructors |
+//! | `lifecycle` | the supervisor's protocol: [`Role`] and its names, [`LifecycleEvent`], [`StopReason`], [`StartupPhase`], [`Lifecycle`] and its constructors |
 //! | `map` | the neural-map snapshot: [`MapHeader`], [`ActivationKind`] |
 
 mod lifecycle;
@@ -43,7 +43,7 @@ mod map;
 mod motion;
 mod round;
 
-pub use lifecycle::{Lifecycle, LifecycleEvent, Role, StopReason};
+pub use lifecycle::{Lifecycle, LifecycleEvent, Role, StartupPhase, StopReason};
 pub use map::{ActivationKind, MapHeader};
 pub use motion::{Odometry, Pose, Truth, WheelCommand};
 pub use round::{Candidate, CandidateFlags, Commit, ConflictKind, Decision, Progress, Verdict};

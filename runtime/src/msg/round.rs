@@ -87,6 +87,16 @@ impl Verdict {
             _ => None,
         }
     }
+
+    /// Lower-case name (`accept`, `block`, `hold`, `replan`), as in `hnav log show`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Accept => "accept",
+            Self::Block => "block",
+            Self::Hold => "hold",
+            Self::Replan => "replan",
+        }
+    }
 }
 
 /// Why the coordinator refused or held a move (the dissertation's conflict types, Fig. 3-6,

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use toml::Spanned;
 
-use super::build_params::{build_coordinator, build_restart, build_robot, build_sim};
+use super::build_params::{build_coordinator, build_restart, build_robot, build_run, build_sim};
 use super::error::{Loc, ScenarioError};
 use super::lines::{toml_error, Lines};
 use super::raw::{RawMap, RawScenario};
@@ -28,6 +28,7 @@ pub(super) fn parse(
     let sim = build_sim(raw.sim, &lines)?;
     let coordinator = build_coordinator(raw.coordinator, &lines)?;
     let restart = build_restart(raw.restart);
+    let run = build_run(raw.run, &lines)?;
     if raw.agents.is_empty() {
         return Err(ScenarioError::NoAgents {
             at: Loc::new(source_name, 1),
@@ -65,6 +66,7 @@ pub(super) fn parse(
         sim,
         coordinator,
         restart,
+        run,
         agents,
         faults,
         allow_unreachable,

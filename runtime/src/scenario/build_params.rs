@@ -1,12 +1,15 @@
-//! Validation of the parameter sections `[robot]`, `[sim]`, `[coordinator]` and `[restart]`:
+//! Validation of the parameter sections `[robot]`, `[sim]`, `[coordinator]`, `[restart]` and
+//! `[run]`:
 //! defaults for missing keys, range checks with the key's line for present ones.
 
 use toml::Spanned;
 
 use super::error::{Loc, ScenarioError};
 use super::lines::Lines;
-use super::params::{CoordinatorParams, RestartConfig, RestartRule, RobotParams, SimParams};
-use super::raw::{RawCoordinator, RawRestart, RawRestartRule, RawRobot, RawSim};
+use super::params::{
+    CoordinatorParams, RestartConfig, RestartRule, RobotParams, RunParams, SimParams,
+};
+use super::raw::{RawCoordinator, RawRestart, RawRestartRule, RawRobot, RawRun, RawSim};
 
 /// Reads an optional float with a default and checks it.
 fn float(
@@ -32,7 +35,7 @@ fn float(
     Err(ScenarioError::InvalidParameter {
         at,
         key: key.into(),
-        problem: format!("{problem}, got {x}"),
+        problem: format!("{problem}, got {}", super::error::number(x)),
     })
 }
 
@@ -214,4 +217,28 @@ pub(super) fn build_restart(raw: Option<RawRestart>) -> RestartConfig {
         coordinator: rule(r.coordinator, d.coordinator),
         sim: rule(r.sim, d.sim),
     }
+}
+
+pub(super) fn build_run(
+    raw: Option<RawRun>,
+    lines: &Lines<'_>,
+) -> Result<RunParams, ScenarioError> {
+    let Some(v) = raw.and_then(|r| r.startup_timeout_s) else {
+        return Ok(RunParams::default());
+    };
+    let x = *v.get_ref();
+    let max = RunParams::MAX_STARTUP_TIMEOUT_S;
+    if x.is_finite() && x > 0.0 && x <= max {
+        return Ok(RunParams {
+            startup_timeout_s: Some(x),
+        });
+    }
+    Err(ScenarioError::InvalidParameter {
+        at: lines.at(&v),
+        key: "run.startup_timeout_s".into(),
+        problem: format!(
+            "must be a number of seconds in (0, {max}], got {}",
+            super::error::number(x)
+        ),
+    })
 }

@@ -7,6 +7,29 @@ use std::fmt;
 
 use crate::grid::{Cell, GridError};
 
+/// A number from a scenario as an error message prints it: as written for ordinary
+/// magnitudes, in scientific notation (`1e300`) where `{}` of an `f64` would print hundreds of
+/// digits.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Number(pub f64);
+
+/// [`Number`] of `x`.
+pub(crate) fn number(x: f64) -> Number {
+    Number(x)
+}
+
+impl fmt::Display for Number {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        let a = x.abs();
+        if x == 0.0 || !x.is_finite() || (1e-6..1e15).contains(&a) {
+            write!(f, "{x}")
+        } else {
+            write!(f, "{x:e}")
+        }
+    }
+}
+
 /// A place in a scenario file: the file name and a 1-based line (0 = no line, e.g. for a
 /// scenario built or changed in code).
 #[derive(Clone, PartialEq, Eq, Debug)]
@@ -211,7 +234,7 @@ pub enum ScenarioError {
         cell: Cell,
     },
     /// Speed zero, negative or not finite.
-    #[error("{at}: agent {agent} speed must be a positive number of cells/s, got {speed}")]
+    #[error("{at}: agent {agent} speed must be a positive number of cells/s, got {}", number(*.speed))]
     NonPositiveSpeed {
         /// Where.
         at: Loc,
@@ -221,7 +244,7 @@ pub enum ScenarioError {
         speed: f64,
     },
     /// Speed above what the wheels can do.
-    #[error("{at}: agent {agent} speed {speed} cells/s exceeds the robot's {max:.3} cells/s (max_wheel_speed_rad_s * wheel_radius_m / cell_size_m)")]
+    #[error("{at}: agent {agent} speed {} cells/s exceeds the robot's {} cells/s (max_wheel_speed_rad_s * wheel_radius_m / cell_size_m)", number(*.speed), number((*.max * 1000.0).round() / 1000.0))]
     SpeedTooHigh {
         /// Where.
         at: Loc,
@@ -233,7 +256,7 @@ pub enum ScenarioError {
         max: f64,
     },
     /// Priority zero, negative or not finite.
-    #[error("{at}: agent {agent} priority must be a positive number, got {priority}")]
+    #[error("{at}: agent {agent} priority must be a positive number, got {}", number(*.priority))]
     BadPriority {
         /// Where.
         at: Loc,

@@ -48,6 +48,11 @@
 //! coordinator = { policy = "on-failure" }                                 # sim "never"
 //! sim = { policy = "never" }           # policies: "never", "on-failure", "always"
 //!
+//! [run]
+//! startup_timeout_s = 60.0             # how long the processes get to come up; default
+//!                                      # 60 s plus the agents' neural-map builds, scaled
+//!                                      # with the map (params::default_startup_timeout_s)
+//!
 //! [[agents]]                           # one table per robot, numbered from 0
 //! start = [0, 0]                       # [x, y]: x = column, y = row, origin top-left
 //! goal = [31, 31]
@@ -119,8 +124,8 @@ use serde::{Deserialize, Serialize};
 
 pub use error::{Loc, ScenarioError};
 pub use params::{
-    ClockMode, ClockModeError, CoordinatorParams, FsyncPolicy, RestartConfig, RestartPolicy,
-    RestartRule, RobotParams, SimParams,
+    default_startup_timeout_s, ClockMode, ClockModeError, CoordinatorParams, FsyncPolicy,
+    RestartConfig, RestartPolicy, RestartRule, RobotParams, RunParams, SimParams,
 };
 pub use report::{default_out_dir, ScenarioReport};
 
@@ -235,6 +240,8 @@ pub struct Scenario {
     pub coordinator: CoordinatorParams,
     /// Restart rules per role.
     pub restart: RestartConfig,
+    /// The supervisor's run parameters.
+    pub run: RunParams,
     /// The robots, numbered from 0.
     pub agents: Vec<AgentSpec>,
     /// The fault plan.
@@ -280,6 +287,18 @@ impl Scenario {
         hash::scenario_hash(self)
     }
 
+    /// How long the run's processes get to come up: `[run] startup_timeout_s`, else
+    /// [`default_startup_timeout_s`] for this map, these agents and this machine's cores.
+    /// The supervisor's start-up handshake and each process's wait for `Start` use it.
+    pub fn startup_timeout(&self) -> std::time::Duration {
+        let secs = self.run.startup_timeout_s.unwrap_or_else(|| {
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let g = &self.map.grid;
+            default_startup_timeout_s(g.width(), g.height(), self.agents.len(), cores)
+        });
+        std::time::Duration::from_secs_f64(secs)
+    }
+
     /// A copy with exactly `n` agents: the first `n` if there are enough, otherwise all of
     /// them plus agents with seeded random starts and goals (free, distinct starts, distinct
     /// goals, start != goal, goal reachable under the map's corner-cutting rule; speed 1,
@@ -299,3 +318,5 @@ mod test_support;
 mod tests;
 #[cfg(test)]
 mod tests_generate;
+#[cfg(test)]
+mod tests_run;

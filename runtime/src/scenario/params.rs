@@ -213,6 +213,41 @@ impl Default for CoordinatorParams {
     }
 }
 
+/// Run parameters of the supervisor (`[run]`). They decide whether a run gets going, not what
+/// it does, so the scenario hash leaves them out.
+#[derive(Clone, Copy, PartialEq, Debug, Default, Serialize)]
+pub struct RunParams {
+    /// How long the processes get to come up, in seconds; `None` for the default that scales
+    /// with the map ([`default_startup_timeout_s`]).
+    pub startup_timeout_s: Option<f64>,
+}
+
+impl RunParams {
+    /// Largest `startup_timeout_s` accepted: one day.
+    pub const MAX_STARTUP_TIMEOUT_S: f64 = 86_400.0;
+}
+
+/// Neuron updates per second one core is assumed to manage while an agent builds its neural
+/// map toward its goal: half of what `hnav-agent` (the workspace's default build) measured on
+/// the shared 2-core VM, 2.0-2.3e7 on empty 512, 1024 and 2048 cells square maps with the goal
+/// in a corner (2.0 s, 17.3 s and 145 s), for margin against a busier machine.
+const ASSUMED_UPDATES_PER_S: f64 = 1e7;
+
+/// The start-up timeout of a run of `agents` agents on a `width` x `height` map with `cores`
+/// cores, in seconds: 60 s for spawning and loading, plus the time the agents need to build
+/// their neural maps at an assumed 1e7 neuron updates per second per core, capped at
+/// [`RunParams::MAX_STARTUP_TIMEOUT_S`].
+///
+/// A build toward a goal in a corner sweeps about `max(width, height)` times over a box that
+/// grows to the whole map, about `width * height * max(width, height) / 3` updates; the agents
+/// build at once, `ceil(agents / cores)` to a core.
+pub fn default_startup_timeout_s(width: u32, height: u32, agents: usize, cores: usize) -> f64 {
+    let (w, h) = (f64::from(width), f64::from(height));
+    let updates = w * h * w.max(h) / 3.0;
+    let per_core = agents.max(1).div_ceil(cores.max(1)) as f64;
+    (60.0 + updates * per_core / ASSUMED_UPDATES_PER_S).min(RunParams::MAX_STARTUP_TIMEOUT_S)
+}
+
 /// When the supervisor restarts a process of a role.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -308,6 +343,34 @@ mod tests {
         // 33.3 ms rounds to 8 steps of 4 ms: 32 ms periods.
         assert_eq!(coarse.steps_per_control_period(), 8);
         assert_eq!(coarse.rounds_in(1.0), 32);
+    }
+
+    #[test]
+    fn the_default_startup_timeout_grows_with_the_map_and_the_agents_per_core() {
+        // A small map costs nothing beyond the base.
+        assert!((default_startup_timeout_s(32, 32, 4, 2) - 60.0).abs() < 0.01);
+        // 1024 x 1024, 2 agents on 2 cores: 3.6e8 updates, 36 s on top (17.3 s measured).
+        let one = default_startup_timeout_s(1024, 1024, 2, 2);
+        assert!((one - 95.79).abs() < 0.01, "{one}");
+        // Twice the agents per core, twice the build time; the long side counts.
+        let two = default_startup_timeout_s(1024, 1024, 4, 2);
+        assert!((two - 60.0 - 2.0 * (one - 60.0)).abs() < 1e-9, "{two}");
+        assert_eq!(
+            default_startup_timeout_s(1024, 16, 1, 1),
+            default_startup_timeout_s(16, 1024, 1, 1)
+        );
+        // 5000 x 5000 (the map that did not come up within 60 s): 70 minutes of building.
+        let big = default_startup_timeout_s(5000, 5000, 1, 2);
+        assert!((big - 4226.67).abs() < 0.01, "{big}");
+        // Zero cores or agents count as one; the cap holds for absurd maps.
+        assert_eq!(
+            default_startup_timeout_s(64, 64, 0, 0),
+            default_startup_timeout_s(64, 64, 1, 1)
+        );
+        assert_eq!(
+            default_startup_timeout_s(u32::MAX, u32::MAX, 1000, 1),
+            RunParams::MAX_STARTUP_TIMEOUT_S
+        );
     }
 
     #[test]

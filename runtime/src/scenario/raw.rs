@@ -22,6 +22,7 @@ pub(super) struct RawScenario {
     pub sim: Option<RawSim>,
     pub coordinator: Option<RawCoordinator>,
     pub restart: Option<RawRestart>,
+    pub run: Option<RawRun>,
     #[serde(default)]
     pub agents: Vec<Spanned<RawAgent>>,
     #[serde(default)]
@@ -75,6 +76,13 @@ pub(super) struct RawCoordinator {
     pub fsync: Option<FsyncPolicy>,
     pub replan_after_rounds: Option<Spanned<u32>>,
     pub time_limit_s: Option<Spanned<f64>>,
+}
+
+/// `[run]`.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawRun {
+    pub startup_timeout_s: Option<Spanned<f64>>,
 }
 
 /// `[restart]`.

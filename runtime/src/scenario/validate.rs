@@ -188,7 +188,8 @@ pub(super) fn check_agent(
             at: at.start_heading.clone(),
             key: format!("agents[{i}].start_heading_deg"),
             problem: format!(
-                "must be a number of degrees in [-{m}, {m}], got {h}",
+                "must be a number of degrees in [-{m}, {m}], got {}",
+                super::error::number(h),
                 m = AgentSpec::MAX_START_HEADING_DEG
             ),
         });

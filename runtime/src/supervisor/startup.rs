@@ -4,13 +4,15 @@
 //!
 //! [`SupervisorPorts::start`] is the start-up handshake, once for `hnav run` and for the
 //! stand-in supervisor of `hnav-bench round`: wait (bounded) until every expected process has
-//! announced itself, fail at once if one of them exits, then publish `Start`.
+//! announced itself, fail at once if one of them exits, then publish `Start`. It keeps the
+//! last start-up phase each process reported ([`crate::launch::LifecyclePorts::report_phase`])
+//! so that a timeout names what every late process was doing.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use super::child::{Child, ExitInfo};
-use crate::msg::{Lifecycle, LifecycleEvent, Role};
+use crate::msg::{Lifecycle, LifecycleEvent, Role, StartupPhase};
 use crate::topics;
 use crate::transport::{Receiver, Sender, Transport, TransportError, Wake};
 
@@ -28,16 +30,42 @@ pub enum StartupError {
         log: PathBuf,
     },
     /// Some processes had not announced themselves when the time was up.
-    #[error("not up within {timeout:?}: {}", missing.join(", "))]
+    #[error(
+        "not up within {:.1} s (run.startup_timeout_s): {}",
+        timeout.as_secs_f64(),
+        missing.iter().map(LateProcess::to_string).collect::<Vec<_>>().join("; ")
+    )]
     NotUp {
         /// The bound.
         timeout: Duration,
-        /// Node names of the processes still missing.
-        missing: Vec<String>,
+        /// The processes still missing, with what each was doing.
+        missing: Vec<LateProcess>,
     },
     /// The transport failed.
     #[error(transparent)]
     Transport(#[from] TransportError),
+}
+
+/// A process that was not up when the start-up timeout passed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LateProcess {
+    /// Its node name.
+    pub node: String,
+    /// The last start-up phase it reported and that phase's size, if it reported one.
+    pub phase: Option<(StartupPhase, u32)>,
+}
+
+impl std::fmt::Display for LateProcess {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.phase {
+            Some((phase, size)) => write!(f, "{} was {}", self.node, phase.describe(size)),
+            None => write!(
+                f,
+                "{} reported nothing (still loading the scenario and map or opening its ports)",
+                self.node
+            ),
+        }
+    }
 }
 
 /// How the start-up handshake ended, when it did not fail.
@@ -96,9 +124,10 @@ impl SupervisorPorts {
             attached.push(c.watch(&waiter)?);
         }
         let mut up = vec![false; children.len()];
+        let mut phases = vec![None; children.len()];
         let deadline = Instant::now() + timeout;
         loop {
-            self.take_ups(children, &mut up)?;
+            self.take_ups(children, &mut up, &mut phases)?;
             if up.iter().all(|&u| u) {
                 let all_up = Instant::now();
                 self.publish(Lifecycle::start())?;
@@ -118,9 +147,12 @@ impl SupervisorPorts {
             if left.is_zero() {
                 let missing = children
                     .iter()
-                    .zip(&up)
-                    .filter(|(_, &u)| !u)
-                    .map(|(c, _)| c.spec().role.node_name(c.spec().index))
+                    .zip(up.iter().zip(&phases))
+                    .filter(|(_, (&u, _))| !u)
+                    .map(|(c, (_, &phase))| LateProcess {
+                        node: c.spec().role.node_name(c.spec().index),
+                        phase,
+                    })
                     .collect();
                 return Err(StartupError::NotUp { timeout, missing });
             }
@@ -130,20 +162,32 @@ impl SupervisorPorts {
         }
     }
 
-    /// Marks in `up` every child whose `Up` is pending on `ready`.
-    fn take_ups(&self, children: &[&Child], up: &mut [bool]) -> Result<(), TransportError> {
+    /// Marks in `up` every child whose `Up` is pending on `ready`, and keeps in `phases` the
+    /// last start-up phase each child reported.
+    fn take_ups(
+        &self,
+        children: &[&Child],
+        up: &mut [bool],
+        phases: &mut [Option<(StartupPhase, u32)>],
+    ) -> Result<(), TransportError> {
         self.ready.drain_pending(|l| {
-            if l.event != LifecycleEvent::Up as u8 {
-                return;
-            }
-            let Some(role) = Role::from_u8(l.role) else {
+            let (Some(role), Some(event)) =
+                (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
+            else {
                 return;
             };
             let found = children
                 .iter()
                 .position(|c| c.spec().role == role && c.spec().index == l.index);
-            if let Some(i) = found {
-                up[i] = true;
+            let Some(i) = found else { return };
+            match event {
+                LifecycleEvent::Up => up[i] = true,
+                LifecycleEvent::Phase => {
+                    if let Some(p) = StartupPhase::from_u8(l.reason) {
+                        phases[i] = Some((p, l.restarts));
+                    }
+                }
+                _ => {}
             }
         })?;
         Ok(())
@@ -224,9 +268,35 @@ mod tests {
             let err = ports
                 .start(transport, &[child], Duration::from_millis(300))
                 .unwrap_err();
+            let late = LateProcess {
+                node: "agent-0".into(),
+                phase: None,
+            };
             assert!(
-                matches!(&err, StartupError::NotUp { missing, .. } if missing == &["agent-0"]),
+                matches!(&err, StartupError::NotUp { missing, .. } if missing == &[late]),
                 "{err}"
+            );
+            assert!(
+                err.to_string().contains("agent-0 reported nothing"),
+                "{err}"
+            );
+        });
+    }
+
+    #[test]
+    fn a_timeout_names_the_last_phase_each_late_child_reported() {
+        with_run("sleep 30", |transport, ports, child, ready| {
+            let phase =
+                |mib| Lifecycle::phase(Role::Agent, 0, StartupPhase::BuildingNeuralMap, mib);
+            ready.send(phase(12)).unwrap();
+            ready.send(phase(430)).unwrap();
+            let err = ports
+                .start(transport, &[child], Duration::from_millis(300))
+                .unwrap_err();
+            assert_eq!(
+                err.to_string(),
+                "not up within 0.3 s (run.startup_timeout_s): \
+                 agent-0 was building its neural map, 430 MiB"
             );
         });
     }

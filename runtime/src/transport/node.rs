@@ -55,7 +55,7 @@ impl TransportBuilder {
         if let Some(name) = &self.name {
             let node_name = NodeName::new(name).map_err(|e| TransportError::InvalidName {
                 name: name.clone(),
-                why: format!("{e:?}"),
+                why: super::error::in_words(&format!("{e:?}")),
             })?;
             builder = builder.name(&node_name);
         }

@@ -68,7 +68,7 @@ impl RunId {
         let name = format!("hnav/{}/{}", self.0, topic);
         ServiceName::new(&name).map_err(|e| TransportError::InvalidName {
             name,
-            why: format!("{e:?}"),
+            why: super::error::in_words(&format!("{e:?}")),
         })
     }
 

@@ -42,7 +42,7 @@ fn hnav_log_verify_and_show_exit_codes() {
     assert_eq!(code, 0);
     assert_eq!(out.lines().count(), records.len());
     assert!(
-        out.contains("accept a0->[2,2] block a1 crossing (N,NE)"),
+        out.contains("accept a0->[2, 2] block a1 crossing (N,NE)"),
         "{out}"
     );
     assert!(out.lines().last().unwrap().contains("all-at-goal"), "{out}");

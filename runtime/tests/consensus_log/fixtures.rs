@@ -43,7 +43,7 @@ pub fn header(agents: u32) -> Record {
 
 /// Round `n` of `agents` agents: even agents move to cell `22 + agent`, odd ones are blocked
 /// crossing (north and north-east refused). Round 1 of two agents is shown as
-/// `accept a0->[2,2] block a1 crossing (N,NE)`.
+/// `accept a0->[2, 2] block a1 crossing (N,NE)`.
 pub fn round(n: u64, agents: u32) -> Record {
     Record::Round(RoundRecord {
         round: n,

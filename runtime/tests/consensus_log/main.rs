@@ -10,5 +10,6 @@ mod cli;
 mod fixtures;
 mod format;
 mod lost;
+mod run_dir;
 mod summary;
 mod writer;

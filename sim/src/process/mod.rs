@@ -28,7 +28,7 @@ mod state;
 
 use std::time::{Duration, Instant};
 
-use hnav_runtime::launch::{LifecyclePorts, StartOutcome, START_TIMEOUT};
+use hnav_runtime::launch::{LifecyclePorts, StartOutcome};
 use hnav_runtime::scenario::params::ClockMode;
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::transport::{Transport, Waiter, Wake};
@@ -59,6 +59,8 @@ pub struct SimProcess<'t> {
     resume: bool,
     /// The rounds of the scenario's planned faults.
     fault_rounds: Vec<u64>,
+    /// How long the handshake waits for `Start`: the scenario's start-up timeout.
+    startup_timeout: Duration,
 }
 
 impl<'t> SimProcess<'t> {
@@ -75,6 +77,7 @@ impl<'t> SimProcess<'t> {
             state: State::new(world, scenario.sim.clock, lockstep_deadline),
             resume: false,
             fault_rounds: scenario.faults.iter().map(|f| f.at_round).collect(),
+            startup_timeout: scenario.startup_timeout(),
         })
     }
 
@@ -108,11 +111,11 @@ impl<'t> SimProcess<'t> {
     }
 
     /// Joined to the lifecycle protocol, announces itself and waits for the start (unless
-    /// resuming, [`START_TIMEOUT`] at most); then runs until a stop request or, if given,
+    /// resuming, the scenario's start-up timeout at most); then runs until a stop request or, if given,
     /// `max_periods` control periods.
     pub fn run(&mut self, max_periods: Option<u64>) -> Result<SimOutcome, SimError> {
         if let Some(life) = &self.ports.life {
-            let started = life.handshake(self.transport, self.resume, START_TIMEOUT)?;
+            let started = life.handshake(self.transport, self.resume, self.startup_timeout)?;
             if started == StartOutcome::Stopped {
                 return Ok(self.state.outcome(true));
             }

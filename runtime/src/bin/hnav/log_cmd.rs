@@ -1,4 +1,5 @@
-//! `hnav log verify|show DIR`: inspect a run's consensus log (never modifies it).
+//! `hnav log verify|show DIR`: inspect a run's consensus log (never modifies it). DIR is the
+//! log directory or the run directory holding it in `log/`.
 //!
 //! Exit codes of `verify`: 0 intact, 1 not intact (torn tail, corruption, order problems),
 //! 2 the directory cannot be read as a log at all (missing, unreadable, no segments).
@@ -19,12 +20,13 @@ pub enum LogCommand {
     /// Check a consensus log: exit 0 when intact, 1 when torn/corrupt/out of order, 2 when
     /// unreadable.
     Verify {
-        /// The log directory (holding seg-00000000.hlog, ...).
+        /// The log directory (holding seg-00000000.hlog, ...) or the run directory (holding
+        /// it in log/).
         dir: PathBuf,
     },
     /// Print one line per record.
     Show {
-        /// The log directory.
+        /// The log directory or the run directory.
         dir: PathBuf,
         /// One JSON object per line instead of text.
         #[arg(long)]
@@ -35,8 +37,26 @@ pub enum LogCommand {
 /// Runs a `hnav log` subcommand.
 pub fn run(cmd: LogCommand) -> ExitCode {
     match cmd {
-        LogCommand::Verify { dir } => verify_cmd(&dir),
-        LogCommand::Show { dir, json } => show_cmd(&dir, json),
+        LogCommand::Verify { dir } => verify_cmd(&log_dir(&dir)),
+        LogCommand::Show { dir, json } => show_cmd(&log_dir(&dir), json),
+    }
+}
+
+/// The log directory `dir` names: `dir` itself if it holds a segment, else `dir/log` if that
+/// is a directory (`dir` is a run directory), else `dir` (whose errors then name it).
+fn log_dir(dir: &Path) -> PathBuf {
+    let has_segment = std::fs::read_dir(dir).is_ok_and(|entries| {
+        entries.flatten().any(|e| {
+            let name = e.file_name();
+            let name = name.to_string_lossy();
+            name.starts_with("seg-") && name.ends_with(".hlog")
+        })
+    });
+    let inner = dir.join("log");
+    if !has_segment && inner.is_dir() {
+        inner
+    } else {
+        dir.to_path_buf()
     }
 }
 
@@ -78,7 +98,7 @@ fn show_cmd(dir: &Path, json: bool) -> ExitCode {
             width = h.width;
         }
         let written = if json {
-            writeln!(out, "{}", to_json(&pos, &record))
+            writeln!(out, "{}", to_json(&pos, &record, width))
         } else {
             writeln!(out, "{}", describe(&record, width))
         };

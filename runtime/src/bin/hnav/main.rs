@@ -3,6 +3,8 @@
 //!
 //! Exit codes: 0 all good, 1 checks ran and found problems (or the report could not be
 //! written), 2 the input could not be loaded or is invalid (and for usage errors, via clap).
+//! For `hnav check`: 0 the scenario is valid and its report written, 1 it is valid but the
+//! report could not be written, 2 it is invalid or cannot be read (README, *Command line*).
 
 mod clean_cmd;
 mod log_cmd;
@@ -27,6 +29,10 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Load and validate a scenario, print a summary and write scenario-report.json.
+    ///
+    /// Exit 0 when the scenario is valid and the report is written, 1 when it is valid but
+    /// the report cannot be written, 2 when it is invalid or cannot be read (`file:line:
+    /// problem` on stderr).
     Check {
         /// The scenario TOML file.
         scenario: PathBuf,

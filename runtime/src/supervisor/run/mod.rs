@@ -51,8 +51,6 @@ use slots::Slots;
 
 pub use error::RunError;
 
-/// How long the processes get to come up.
-pub const STARTUP_TIMEOUT: Duration = Duration::from_secs(60);
 /// How long a child gets after `Stop`, and again after SIGTERM.
 pub const STOP_GRACE: Duration = Duration::from_secs(3);
 /// Refresh period of the progress bar and the fault schedule.
@@ -65,7 +63,8 @@ pub struct RunOptions {
     pub args: ProcessArgs,
     /// Where `hnav-sim`, `hnav-coordinator` and `hnav-agent` are.
     pub bin_dir: PathBuf,
-    /// Show a progress bar (on a terminal).
+    /// Whether stderr is a terminal: a progress bar there, else a progress line every few
+    /// seconds.
     pub progress: bool,
     /// Replace the outputs of a finished run in the run directory (`--force`).
     pub force: bool,
@@ -200,7 +199,11 @@ fn supervise(
     slots.spawn_all()?;
     slots.write_record(record);
     let children: Vec<&Child> = slots.children().collect();
-    if ports.life.start(transport, &children, STARTUP_TIMEOUT)? == Startup::Interrupted {
+    if ports
+        .life
+        .start(transport, &children, scenario.startup_timeout())?
+        == Startup::Interrupted
+    {
         return Ok(End::Signalled);
     }
     let lockstep = scenario.sim.clock == ClockMode::Lockstep;

@@ -215,6 +215,7 @@ impl Slots {
         ready.drain_pending(|l| match LifecycleEvent::from_u8(l.event) {
             Some(LifecycleEvent::Up) => up.push((l.role, l.index)),
             Some(LifecycleEvent::Hold) => holds.push(l.period()),
+            // A start-up phase report is not yet the process being up.
             _ => {}
         })?;
         for (role, index) in up {

@@ -1,0 +1,70 @@
+//! Unit tests of `[run]` and of how scenario errors print numbers.
+
+use std::time::Duration;
+
+use super::test_support::{parse, BASE};
+use super::*;
+
+#[test]
+fn startup_timeout_is_read_or_scales_with_the_map() {
+    let s = parse(&format!("{BASE}[run]\nstartup_timeout_s = 2.5\n")).unwrap();
+    assert_eq!(s.run.startup_timeout_s, Some(2.5));
+    assert_eq!(s.startup_timeout(), Duration::from_millis(2500));
+    let s = parse(BASE).unwrap();
+    assert_eq!(s.run, RunParams::default());
+    // 6 x 4 cells: nothing beyond the base.
+    let d = s.startup_timeout().as_secs_f64();
+    assert!((d - 60.0).abs() < 0.01, "{d}");
+    // The timeout decides whether a run starts, not what it does.
+    let other = parse(&format!("{BASE}[run]\nstartup_timeout_s = 9\n")).unwrap();
+    assert_eq!(s.scenario_hash(), other.scenario_hash());
+}
+
+#[test]
+fn bad_startup_timeouts_name_line_and_range() {
+    for (value, got) in [
+        ("0", "0"),
+        ("-3", "-3"),
+        ("nan", "NaN"),
+        ("86401", "86401"),
+        ("1e300", "1e300"),
+    ] {
+        let e = parse(&format!("{BASE}[run]\nstartup_timeout_s = {value}\n")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "t.toml:17: run.startup_timeout_s must be a number of seconds in (0, 86400], \
+                 got {got}"
+            )
+        );
+    }
+    let e = parse(&format!("{BASE}[run]\nstartup = 3\n")).unwrap_err();
+    assert!(e.to_string().starts_with("t.toml:17: unknown key"), "{e}");
+}
+
+/// `{}` of an `f64` prints 1e300 as 301 digits; an error message must stay readable.
+#[test]
+fn huge_and_tiny_numbers_print_in_scientific_notation() {
+    let e = parse(&BASE.replace("speed = 2.0", "speed = -1e300")).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "t.toml:15: agent 1 speed must be a positive number of cells/s, got -1e300"
+    );
+    let e = parse(&format!("{BASE}[robot]\ncell_size_m = -1e-300\n")).unwrap_err();
+    assert!(e.to_string().ends_with("got -1e-300"), "{e}");
+    let e = parse(&BASE.replace("speed = 2.0", "speed = 1e300")).unwrap_err();
+    assert!(
+        e.to_string().starts_with(
+            "t.toml:15: agent 1 speed 1e300 cells/s exceeds the robot's 2.625 cells/s"
+        ),
+        "{e}"
+    );
+    for (x, shown) in [
+        (0.25, "0.25"),
+        (120.0, "120"),
+        (1e15, "1e15"),
+        (3e-7, "3e-7"),
+    ] {
+        assert_eq!(error::number(x).to_string(), shown);
+    }
+}
