@@ -144,7 +144,7 @@ fn an_unreachable_goal_is_refused_by_check_and_run_unless_allowed() {
     let path = dir.path().join("walled.toml");
     std::fs::write(&path, WALLED).unwrap();
     let want = format!(
-        "error: {}:8: agent 0: goal (4, 2) is unreachable from start (0, 0) (write \
+        "error: {}:8: agent 0: goal [4, 2] is unreachable from start [0, 0] (write \
          allow_unreachable = true at the top of the scenario to run it anyway)",
         path.display()
     );
@@ -188,7 +188,7 @@ fn an_unreachable_goal_is_refused_by_check_and_run_unless_allowed() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
-        stdout.contains("warning: agent 0: goal (4, 2) is unreachable from start (0, 0)"),
+        stdout.contains("warning: agent 0: goal [4, 2] is unreachable from start [0, 0]"),
         "{stdout}"
     );
 }

@@ -80,6 +80,6 @@ fn an_unreachable_goal_is_reported_once_and_ends_the_run_when_the_rest_are_done(
         .filter(|l| l.starts_with("unreachable "))
         .collect();
     assert_eq!(reports.len(), 1, "reported once:\n{text}");
-    assert!(reports[0].contains("a0 at [0,0]"), "{}", reports[0]);
+    assert!(reports[0].contains("a0 at [0, 0]"), "{}", reports[0]);
     drop(run);
 }

@@ -147,7 +147,7 @@ fn validate_refuses_unreachable_goals_and_too_many_agents() {
     let e = s.validate().unwrap_err();
     assert_eq!(
         e.to_string(),
-        "t.toml: agent 0: goal (5, 3) is unreachable from start (0, 0) (write \
+        "t.toml: agent 0: goal [5, 3] is unreachable from start [0, 0] (write \
          allow_unreachable = true at the top of the scenario to run it anyway)"
     );
     s.allow_unreachable = true;
