@@ -117,3 +117,21 @@ fn a_run_off_a_terminal_prints_progress_lines_and_plain_logs() {
         logs.display()
     );
 }
+
+/// A realtime run whose time limit is too large for a `Duration` (1e300 s passes validation:
+/// it is a positive finite number) runs to its goal instead of panicking at the start.
+#[test]
+fn a_huge_realtime_time_limit_does_not_panic() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = open_map_scenario(
+        tmp.path(),
+        6,
+        "[sim]\nclock = \"realtime\"\n[coordinator]\ntime_limit_s = 1e300",
+    );
+    let mut run = TestRun::new("uxhuge");
+    let mut peer = hnav_run(&mut run, &scenario, tmp.path());
+    let (code, lines) = all_lines(&mut peer);
+    let text = lines.join("\n");
+    assert!(!text.contains("panicked"), "{text}");
+    assert_eq!(code, Some(0), "{text}");
+}

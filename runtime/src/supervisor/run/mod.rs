@@ -213,8 +213,11 @@ fn supervise(
         lockstep,
         t0: Instant::now(),
         // In lockstep the coordinator counts the limit in rounds and says when it is reached.
-        limit: (!lockstep)
-            .then(|| Duration::from_secs_f64(scenario.coordinator.time_limit_s.max(0.0))),
+        // A limit too large for a Duration (a valid scenario may say 1e300 s) never ends it.
+        limit: (!lockstep).then(|| {
+            Duration::try_from_secs_f64(scenario.coordinator.time_limit_s.max(0.0))
+                .unwrap_or(Duration::MAX)
+        }),
     };
     loop {
         if let Some(end) = watch.until_change(transport, ports, slots)? {
