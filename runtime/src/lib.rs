@@ -18,11 +18,13 @@
 //! | [`transport`] | run-scoped iceoryx2 services: publisher+notifier, subscriber+listener, the one [`Waiter`](transport::Waiter) every process blocks in |
 //! | [`supervisor`] | starting, watching, restarting and stopping a run's processes; the registry behind `hnav ps`. It sits on top: no other module uses it |
 //! | [`consensus_log`] | the durable consensus log: record types, segment format, reader, verifier |
+//! | [`clock`] | `CLOCK_MONOTONIC` in nanoseconds: one time base for the supervisor, the processes and observers of a host |
 //! | [`hash`] | FNV-1a 64 and SplitMix64: digests and seeded random numbers, stable across platforms |
 //! | [`diag`] | printing that never panics: `outln!`/`errln!` and the `tracing` writer drop (and count) a failed write |
 //! | [`file_lock`] | exclusive `flock` locks that name their holder: a run's directory, its run id, its consensus log |
 //! | [`logging`] | `tracing` set-up shared by the binaries, with iceoryx2's own logs routed into it |
 
+pub mod clock;
 pub mod consensus_log;
 pub mod diag;
 pub mod file_lock;

@@ -11,6 +11,7 @@
 //! |---|---|
 //! | [`child`] | one child process: spawn in its own process group with an appended log, reap, describe its exit, signal it or its group |
 //! | [`exit_fd`] | the pidfd (or waiter-thread pipe) that makes a child's exit wake the supervisor's `Waiter` |
+//! | [`events`] | the run's event journal `DIR/events.jsonl`: signals, exits, hangs, respawns, each stamped with the host's monotonic clock |
 //! | [`restart`] | per-child restart decisions: policy, cap, doubling backoff |
 //! | [`stop`] | the escalating stop of a run's children: wait, SIGTERM, SIGKILL, reap |
 //! | [`run_dir`] | a run's hold on its output directory: the directory lock, and `--force` for a finished run's outputs |
@@ -23,6 +24,7 @@
 
 pub mod child;
 pub mod clean;
+pub mod events;
 pub mod exit_fd;
 pub mod ps;
 pub mod registry;

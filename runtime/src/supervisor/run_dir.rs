@@ -19,8 +19,9 @@ use crate::transport::RunId;
 pub const LOCK_FILE: &str = ".hnav-run.lock";
 
 /// What a run writes into its directory: the consensus log, the agents' checkpoints, the
-/// processes' output and the summary. `--force` removes these and nothing else.
-pub const RUN_OUTPUTS: [&str; 4] = ["log", "agents", "logs", "summary.json"];
+/// processes' output, the summary and the event journal. `--force` removes these and nothing
+/// else.
+pub const RUN_OUTPUTS: [&str; 5] = ["log", "agents", "logs", "summary.json", "events.jsonl"];
 
 /// Why a run directory cannot be claimed.
 #[derive(Debug, thiserror::Error)]

@@ -11,6 +11,7 @@ use super::slots::Slots;
 use crate::msg::Role;
 use crate::scenario::{FaultSignal, FaultSpec, FaultTarget};
 use crate::supervisor::child::Signal;
+use crate::supervisor::events::RunEvent;
 
 /// Which of the scenario's faults have fired, and the hold in progress.
 pub(super) struct FaultSchedule<'s> {
@@ -95,6 +96,13 @@ impl<'s> FaultSchedule<'s> {
             tracing::warn!("fault not injected: {e}");
             return None;
         }
+        slots.events().record(RunEvent::Signalled {
+            node: role.node_name(index),
+            pid: c.pid(),
+            signal: signal.to_string(),
+            fault: Some(i),
+            round,
+        });
         Some((role, index, c.pid()))
     }
 }

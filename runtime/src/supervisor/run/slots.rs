@@ -11,6 +11,7 @@ use crate::launch::ProcessArgs;
 use crate::msg::{Lifecycle, LifecycleEvent, Role};
 use crate::scenario::Scenario;
 use crate::supervisor::child::{Child, ChildError, ChildSpec, ExitInfo};
+use crate::supervisor::events::{RunEvent, RunEvents};
 use crate::supervisor::registry::RunRecord;
 use crate::supervisor::restart::{GiveUpReason, RestartDecision, RestartTracker};
 use crate::supervisor::startup::SupervisorPorts;
@@ -34,6 +35,8 @@ pub(super) struct Slots {
     slots: Vec<Slot>,
     /// The run directory, named when a process stops on a full disk.
     dir: PathBuf,
+    /// `DIR/events.jsonl`: exits, respawns, `Up`s and the faults' signals.
+    events: RunEvents,
 }
 
 impl Slots {
@@ -75,7 +78,13 @@ impl Slots {
         Self {
             slots,
             dir: dir.to_path_buf(),
+            events: RunEvents::create(dir),
         }
+    }
+
+    /// The run's event journal.
+    pub(super) fn events(&self) -> &RunEvents {
+        &self.events
     }
 
     /// Starts every process.
@@ -154,9 +163,14 @@ impl Slots {
                 continue;
             };
             died = true;
-            s.child = None;
+            let pid = s.child.take().map_or(0, |c| c.pid());
             let (role, index) = (s.spec.role, s.spec.index);
             tracing::warn!(node = role.node_name(index), %exit, "process exited");
+            self.events.record(RunEvent::Exited {
+                node: role.node_name(index),
+                pid,
+                how: exit.to_string(),
+            });
             life.publish(Lifecycle::down(role, index, s.tracker.restarts()))?;
             match s.tracker.on_exit(&exit) {
                 RestartDecision::Restart { after } => s.restart_at = Some(Instant::now() + after),
@@ -169,6 +183,10 @@ impl Slots {
                 RestartDecision::GiveUp(why) => {
                     tracing::warn!(node = role.node_name(index), %why, "not restarted");
                     let gone = gone_for_good(role, index, &exit, why);
+                    self.events.record(RunEvent::GaveUp {
+                        node: role.node_name(index),
+                        why: gone.clone(),
+                    });
                     match role {
                         Role::Agent => agent_gone = Some(gone),
                         Role::Sim | Role::Coordinator => core_gone = Some(gone),
@@ -199,6 +217,11 @@ impl Slots {
                     pid = child.pid(),
                     "restarted"
                 );
+                self.events.record(RunEvent::Spawned {
+                    node: spec.role.node_name(spec.index),
+                    pid: child.pid(),
+                    restarts: s.tracker.restarts(),
+                });
                 s.child = Some(child);
                 s.announce.set(true);
             }
@@ -225,6 +248,10 @@ impl Slots {
                 .find(|s| s.announce.get() && s.spec.role as u8 == role && s.spec.index == index);
             if let Some(s) = slot {
                 s.announce.set(false);
+                self.events.record(RunEvent::Up {
+                    node: s.spec.role.node_name(s.spec.index),
+                    pid: s.child.as_ref().map_or(0, |c| c.pid()),
+                });
                 life.publish(Lifecycle::restarted(
                     s.spec.role,
                     s.spec.index,
