@@ -35,7 +35,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use crate::msg::{Lifecycle, LifecycleEvent, Role, StartupPhase, StopReason};
-use crate::scenario::{ClockMode, Scenario, ScenarioError};
+use crate::scenario::{fault_arg, ClockMode, FaultSpec, FaultTarget, Loc, Scenario, ScenarioError};
 use crate::topics;
 use crate::transport::{Receiver, RunId, Sender, Transport, TransportError, Wake};
 
@@ -63,11 +63,17 @@ pub struct ProcessArgs {
     /// Restarted by the supervisor: the run is under way, skip the start handshake.
     #[arg(long)]
     pub resume: bool,
+    /// Faults of `hnav run --kill/--term/--freeze`, appended to the scenario's `[[faults]]`
+    /// (`kill=agent:3@round:40`; see `scenario::fault_arg`).
+    #[arg(long = "fault", value_name = "FLAG=FAULT", hide = true,
+          value_parser = crate::scenario::fault_arg::parse_process_arg)]
+    pub faults: Vec<FaultSpec>,
 }
 
 impl ProcessArgs {
     /// The scenario with the overrides applied: `--seed` replaces `sim.seed`, `--agents`
-    /// takes the first N agents or adds seeded random ones, `--mode` replaces `sim.clock`.
+    /// takes the first N agents or adds seeded random ones, `--mode` replaces `sim.clock`,
+    /// and the command line's faults follow the scenario's.
     pub fn scenario(&self) -> Result<Scenario, ScenarioError> {
         let mut s = Scenario::load(&self.scenario)?;
         if let Some(seed) = self.seed {
@@ -80,6 +86,19 @@ impl ProcessArgs {
         }
         if let Some(m) = self.mode {
             s.sim.clock = m;
+        }
+        for f in &self.faults {
+            if let FaultTarget::Agent(a) = f.target {
+                if a >= s.agents.len() {
+                    return Err(ScenarioError::FaultAgentOutOfRange {
+                        at: Loc::new("the command line", 0),
+                        fault: s.faults.len(),
+                        index: i64::try_from(a).unwrap_or(i64::MAX),
+                        agents: s.agents.len(),
+                    });
+                }
+            }
+            s.faults.push(*f);
         }
         Ok(s)
     }
@@ -111,6 +130,9 @@ impl ProcessArgs {
         }
         if self.resume {
             a.push("--resume".into());
+        }
+        for f in &self.faults {
+            a.extend(["--fault".into(), fault_arg::to_process_arg(f).into()]);
         }
         a
     }
@@ -299,6 +321,18 @@ mod tests {
             mode: Some(ClockMode::Realtime),
             dir: Some("out".into()),
             resume: true,
+            faults: vec![
+                FaultSpec {
+                    at: crate::scenario::FaultTime::Seconds(2.5),
+                    action: crate::scenario::FaultAction::Kill(crate::scenario::FaultSignal::Term),
+                    target: FaultTarget::Coordinator,
+                },
+                FaultSpec {
+                    at: crate::scenario::FaultTime::Round(60),
+                    action: crate::scenario::FaultAction::Freeze { for_s: Some(0.3) },
+                    target: FaultTarget::Agent(5),
+                },
+            ],
         };
         let mut argv: Vec<OsString> = vec!["x".into()];
         argv.extend(a.to_args());

@@ -155,6 +155,7 @@ fn session<T>(
         mode: None,
         dir: Some(dir.to_path_buf()),
         resume: false,
+        faults: Vec::new(),
     };
     let log_file = dir.join("coordinator.log");
     let spec = ChildSpec {

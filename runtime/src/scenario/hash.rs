@@ -8,7 +8,8 @@
 //!   the corner-cutting rule;
 //! * `[robot]`, `[sim]` (including the seed), `[coordinator]` and `[restart]`, every field;
 //! * every agent (start, goal, speed, priority, start heading) in order, and every fault in
-//!   order.
+//!   order (the scenario's `[[faults]]`, then the command line's: both change the run). A
+//!   kill at a round keeps the encoding it had before times in seconds and freezes existed.
 //!
 //! * `allow_unreachable`, only when it is `true` (appended last), so that the hash of every
 //!   scenario without the key, and every log written before it existed, stays the same.
@@ -21,7 +22,7 @@
 //! variants as one `u64` code, options as a presence code then the value.
 
 use super::params::{ClockMode, FsyncPolicy, RestartPolicy, RestartRule};
-use super::{FaultAction, FaultSignal, FaultTarget, Scenario};
+use super::{FaultAction, FaultSignal, FaultSpec, FaultTarget, FaultTime, Scenario};
 use crate::grid::{CornerCutting, TerrainKind};
 use crate::hash::Fnv1a64;
 
@@ -32,6 +33,33 @@ fn rule(h: &mut Fnv1a64, r: &RestartRule) {
         RestartPolicy::Always => 2,
     };
     h.u64(policy).u64(r.max_restarts.into()).u64(r.backoff_ms);
+}
+
+/// One fault. A kill at a round is encoded as before times in seconds and freezes existed
+/// (round, code 0, target, signal number), so the hash of every such plan, and the header of
+/// every log written with one, stays the same; the other kinds get codes of their own.
+fn fault(h: &mut Fnv1a64, f: &FaultSpec) {
+    match f.at {
+        FaultTime::Round(r) => h.u64(r),
+        FaultTime::Seconds(s) => h.f64(s),
+    };
+    h.u64(match (f.at, f.action) {
+        (FaultTime::Round(_), FaultAction::Kill(_)) => 0,
+        (FaultTime::Seconds(_), FaultAction::Kill(_)) => 1,
+        (FaultTime::Round(_), FaultAction::Freeze { .. }) => 2,
+        (FaultTime::Seconds(_), FaultAction::Freeze { .. }) => 3,
+    });
+    match f.target {
+        FaultTarget::Agent(i) => h.u64(0).u64(i as u64),
+        FaultTarget::Coordinator => h.u64(1),
+        FaultTarget::Sim => h.u64(2),
+    };
+    match f.action {
+        FaultAction::Kill(FaultSignal::Kill) => h.u64(9),
+        FaultAction::Kill(FaultSignal::Term) => h.u64(15),
+        FaultAction::Freeze { for_s: None } => h.u64(0),
+        FaultAction::Freeze { for_s: Some(d) } => h.u64(1).f64(d),
+    };
 }
 
 /// The hash described in the [module docs](self).
@@ -115,19 +143,7 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
     }
     h.u64(s.faults.len() as u64);
     for f in &s.faults {
-        h.u64(f.at_round);
-        h.u64(match f.action {
-            FaultAction::Kill => 0,
-        });
-        match f.target {
-            FaultTarget::Agent(i) => h.u64(0).u64(i as u64),
-            FaultTarget::Coordinator => h.u64(1),
-            FaultTarget::Sim => h.u64(2),
-        };
-        h.u64(match f.signal {
-            FaultSignal::Kill => 9,
-            FaultSignal::Term => 15,
-        });
+        fault(&mut h, f);
     }
     if s.allow_unreachable {
         h.bytes(b"allow_unreachable");

@@ -61,12 +61,15 @@
 //! start_heading_deg = 90.0             # optional, in [-360, 360]; default 0 = facing +x (towards
 //!                                      # larger columns); 90 faces +y (towards larger rows)
 //!
-//! [[faults]]                           # optional fault plan
-//! at_round = 10
-//! action = "kill"
+//! [[faults]]                           # optional fault plan (more on the command line:
+//!                                      # `hnav run --kill/--term/--freeze`, [`fault_arg`])
+//! at_round = 10                        # exactly one of at_round and at_s (seconds after
+//!                                      # Start; in lockstep the round of that simulated time)
+//! action = "kill"                      # or "freeze": SIGSTOP, then SIGCONT after for_s
 //! role = "agent"                       # or "coordinator", "sim"
 //! index = 0                            # agent number; only (and always) with role = "agent"
-//! signal = "KILL"                      # or "TERM"; default "KILL"
+//! signal = "KILL"                      # kill only: or "TERM"; default "KILL"
+//! # for_s = 0.3                        # freeze only: seconds stopped; omitted = never continued
 //! ```
 //!
 //! Unknown keys are errors (a typo must not silently fall back to a default). Every semantic
@@ -111,6 +114,7 @@ mod agents;
 mod build;
 mod build_params;
 pub mod error;
+pub mod fault_arg;
 mod hash;
 mod lines;
 pub mod params;
@@ -178,10 +182,28 @@ impl AgentSpec {
 }
 
 /// What a fault does.
-#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+#[derive(Clone, Copy, PartialEq, Debug)]
 pub enum FaultAction {
-    /// Send a signal to the process.
-    Kill,
+    /// Send the process this signal.
+    Kill(FaultSignal),
+    /// SIGSTOP the process, then SIGCONT it after `for_s` seconds of wall-clock time
+    /// (`None`: never continued; hang detection is then what ends the freeze).
+    Freeze {
+        /// How long it stays stopped.
+        for_s: Option<f64>,
+    },
+}
+
+/// When a fault fires.
+#[derive(Clone, Copy, PartialEq, Debug)]
+pub enum FaultTime {
+    /// Once this decision round is committed (in lockstep exactly then, the run holding
+    /// there until the fault is done).
+    Round(u64),
+    /// This long after `Start`: in realtime on the supervisor's wall clock; in lockstep at
+    /// the round that much simulated time takes ([`SimParams::rounds_in`]), so that it is
+    /// as exact and reproducible as a round.
+    Seconds(f64),
 }
 
 /// Which process a fault hits.
@@ -206,18 +228,27 @@ pub enum FaultSignal {
     Term,
 }
 
-/// One planned fault.
-#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+/// One planned fault, from the scenario's `[[faults]]` or the command line
+/// ([`fault_arg`]).
+#[derive(Clone, Copy, PartialEq, Debug)]
 pub struct FaultSpec {
-    /// The decision round at which it fires: once it is committed (in lockstep exactly then,
-    /// the run holding there until the fault is done).
-    pub at_round: u64,
-    /// What to do.
+    /// When it fires.
+    pub at: FaultTime,
+    /// What it does.
     pub action: FaultAction,
     /// To whom.
     pub target: FaultTarget,
-    /// With which signal.
-    pub signal: FaultSignal,
+}
+
+impl FaultSpec {
+    /// The round a lockstep run fires it at: its round, or the round its seconds of
+    /// simulated time take.
+    pub fn lockstep_round(&self, sim: &SimParams) -> u64 {
+        match self.at {
+            FaultTime::Round(r) => r,
+            FaultTime::Seconds(s) => sim.rounds_in(s),
+        }
+    }
 }
 
 /// A validated scenario. See the [module docs](self) for the file format.
@@ -316,6 +347,8 @@ impl Scenario {
 mod test_support;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_faults;
 #[cfg(test)]
 mod tests_generate;
 #[cfg(test)]

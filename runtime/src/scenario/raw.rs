@@ -114,11 +114,12 @@ pub(super) struct RawAgent {
     pub start_heading_deg: Option<Spanned<f64>>,
 }
 
-/// What a fault does (only killing a process so far).
-#[derive(Deserialize, Debug, Clone, Copy)]
+/// What a fault does.
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub(super) enum RawFaultAction {
     Kill,
+    Freeze,
 }
 
 /// Which process a fault hits.
@@ -130,13 +131,16 @@ pub(super) enum RawRole {
     Sim,
 }
 
-/// One `[[faults]]` entry.
+/// One `[[faults]]` entry. Which keys go together (one time, `signal` only with a kill,
+/// `for_s` only with a freeze) is checked in `validate`, where the error can name the line.
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawFault {
-    pub at_round: u64,
+    pub at_round: Option<Spanned<u64>>,
+    pub at_s: Option<Spanned<f64>>,
     pub action: RawFaultAction,
     pub role: RawRole,
     pub index: Option<Spanned<i64>>,
-    pub signal: Option<super::FaultSignal>,
+    pub signal: Option<Spanned<super::FaultSignal>>,
+    pub for_s: Option<Spanned<f64>>,
 }

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::params::{CoordinatorParams, RestartConfig, RobotParams, SimParams};
-use super::{FaultTarget, Scenario};
+use super::Scenario;
 use crate::grid::{octile, octile_shortest_path_len, CornerCutting};
 
 /// The map part of a [`ScenarioReport`].
@@ -108,22 +108,9 @@ impl ScenarioReport {
                 }
             })
             .collect();
-        let faults = s
-            .faults
-            .iter()
-            .map(|f| {
-                let target = match f.target {
-                    FaultTarget::Agent(i) => format!("agent {i}"),
-                    FaultTarget::Coordinator => "coordinator".into(),
-                    FaultTarget::Sim => "sim".into(),
-                };
-                format!(
-                    "round {}: {:?} {target} with SIG{:?}",
-                    f.at_round, f.action, f.signal
-                )
-                .to_lowercase()
-            })
-            .collect();
+        // As the command line writes them (`--kill agent:3@round:40`), one spelling for
+        // both sources of a fault plan.
+        let faults = s.faults.iter().map(ToString::to_string).collect();
         ScenarioReport {
             name: s.name.clone(),
             source: s.source_name.clone(),

@@ -111,9 +111,10 @@ signal = "TERM"
         -std::f64::consts::FRAC_PI_2
     );
     assert_eq!(s.faults[0].target, FaultTarget::Agent(0));
-    assert_eq!(s.faults[0].signal, FaultSignal::Kill);
+    assert_eq!(s.faults[0].action, FaultAction::Kill(FaultSignal::Kill));
+    assert_eq!(s.faults[0].at, FaultTime::Round(10));
     assert_eq!(s.faults[1].target, FaultTarget::Coordinator);
-    assert_eq!(s.faults[1].signal, FaultSignal::Term);
+    assert_eq!(s.faults[1].action, FaultAction::Kill(FaultSignal::Term));
 
     // A broken map file is reported at its own line, referenced from the scenario.
     std::fs::write(

@@ -6,10 +6,13 @@ use std::collections::HashMap;
 use toml::Spanned;
 
 use super::error::{Loc, ScenarioError};
+use super::fault_arg::{check_at_s, check_for_s};
 use super::lines::Lines;
 use super::params::RobotParams;
 use super::raw::{RawAgent, RawFault, RawFaultAction, RawRole};
-use super::{AgentSpec, FaultAction, FaultSignal, FaultSpec, FaultTarget, MapSpec, Scenario};
+use super::{
+    AgentSpec, FaultAction, FaultSignal, FaultSpec, FaultTarget, FaultTime, MapSpec, Scenario,
+};
 use crate::grid::{reachable_from, Cell, Endpoint, Grid};
 use crate::msg::MAX_AGENTS;
 
@@ -255,14 +258,64 @@ pub(super) fn build_fault(
         (RawRole::Coordinator, None) => FaultTarget::Coordinator,
         (RawRole::Sim, None) => FaultTarget::Sim,
     };
+    let bad = |at: Loc, problem: String| ScenarioError::BadFault {
+        at,
+        fault: i,
+        problem,
+    };
+    let when = match (&f.at_round, &f.at_s) {
+        (Some(r), None) => FaultTime::Round(*r.get_ref()),
+        (None, Some(s)) => {
+            let secs = *s.get_ref();
+            check_at_s(secs).map_err(|p| bad(lines.at(s), format!("`at_s` {p}")))?;
+            FaultTime::Seconds(secs)
+        }
+        (Some(_), Some(s)) => {
+            return Err(bad(
+                lines.at(s),
+                "give one of `at_round` and `at_s`, not both".into(),
+            ))
+        }
+        (None, None) => return Err(bad(at, "needs `at_round` or `at_s`".into())),
+    };
     let action = match f.action {
-        RawFaultAction::Kill => FaultAction::Kill,
+        RawFaultAction::Kill => {
+            if let Some(d) = &f.for_s {
+                return Err(bad(
+                    lines.at(d),
+                    "`for_s` is only meaningful with action = \"freeze\"".into(),
+                ));
+            }
+            FaultAction::Kill(
+                f.signal
+                    .as_ref()
+                    .map_or(FaultSignal::Kill, |s| *s.get_ref()),
+            )
+        }
+        RawFaultAction::Freeze => {
+            if let Some(s) = &f.signal {
+                return Err(bad(
+                    lines.at(s),
+                    "`signal` is only meaningful with action = \"kill\" (a freeze sends \
+                     SIGSTOP, then SIGCONT after `for_s`)"
+                        .into(),
+                ));
+            }
+            let for_s = match &f.for_s {
+                None => None,
+                Some(d) => {
+                    let secs = *d.get_ref();
+                    check_for_s(secs).map_err(|p| bad(lines.at(d), format!("`for_s` {p}")))?;
+                    Some(secs)
+                }
+            };
+            FaultAction::Freeze { for_s }
+        }
     };
     Ok(FaultSpec {
-        at_round: f.at_round,
+        at: when,
         action,
         target,
-        signal: f.signal.unwrap_or(FaultSignal::Kill),
     })
 }
 
@@ -323,6 +376,17 @@ pub(super) fn revalidate(s: &Scenario) -> Result<(), ScenarioError> {
         check_reachable(&s.agents, &s.map, |_| at.clone())?;
     }
     for (i, f) in s.faults.iter().enumerate() {
+        let bad = |problem: String| ScenarioError::BadFault {
+            at: at.clone(),
+            fault: i,
+            problem,
+        };
+        if let FaultTime::Seconds(secs) = f.at {
+            check_at_s(secs).map_err(|p| bad(format!("`at_s` {p}")))?;
+        }
+        if let FaultAction::Freeze { for_s: Some(secs) } = f.action {
+            check_for_s(secs).map_err(|p| bad(format!("`for_s` {p}")))?;
+        }
         if let FaultTarget::Agent(a) = f.target {
             if a >= s.agents.len() {
                 let index = i64::try_from(a).unwrap_or(i64::MAX);

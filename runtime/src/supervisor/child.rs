@@ -357,6 +357,36 @@ impl Child {
         info
     }
 
+    /// Blocks until the child is stopped (by SIGSTOP) or has exited, and says which: `true`
+    /// stopped. A stop cannot be refused, so this returns as soon as the kernel has stopped
+    /// every thread of the child (a thread in an uninterruptible sleep, an `fsync`, say,
+    /// finishes that first). An exit is left unreaped for [`Child::try_reap`]; the stop is
+    /// consumed, so that a later freeze waits for its own.
+    pub fn wait_stopped(&self) -> bool {
+        if self.exit.get().is_some() {
+            return false;
+        }
+        let seen = loop {
+            match waitid(
+                Id::Pid(self.pid),
+                WaitPidFlag::WSTOPPED | WaitPidFlag::WEXITED | WaitPidFlag::WNOWAIT,
+            ) {
+                Err(Errno::EINTR) => continue,
+                other => break other,
+            }
+        };
+        match seen {
+            Ok(WaitStatus::Stopped(..)) => {
+                let _ = waitid(
+                    Id::Pid(self.pid),
+                    WaitPidFlag::WSTOPPED | WaitPidFlag::WNOHANG,
+                );
+                true
+            }
+            _ => false,
+        }
+    }
+
     /// Sends `signal` to the child process only. Does nothing once the child is reaped.
     pub fn signal(&self, signal: Signal) -> Result<(), ChildError> {
         if self.exit.get().is_some() {

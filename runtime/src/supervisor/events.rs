@@ -7,8 +7,9 @@
 //! first round" are differences of two stamps. The consensus log cannot hold these: it must
 //! stay byte-identical between runs.
 //!
-//! Events are rare (per fault and per restart, never per round), so each line is written and
-//! flushed at once; a failed write (a full disk) costs the journal, never the run: it is
+//! Events are rare (per fault and per restart, never per round), so each line is written at
+//! once, in one `write` to the file open in append mode (`hnav kill` appends to a live run's
+//! journal too); a failed write (a full disk) costs the journal, never the run: it is
 //! reported once and the journal stops.
 //!
 //! ```json
@@ -16,8 +17,8 @@
 //! ```
 
 use std::cell::RefCell;
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::fs::{File, OpenOptions};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
@@ -100,9 +101,13 @@ struct Stamped<'e> {
 
 /// The open journal of one run. Recording takes `&self` (the supervisor's slots stay
 /// borrowed by its waiter while events happen).
+///
+/// The file is open in append mode and each line goes out in one `write`, so that lines
+/// `hnav kill` appends to a live run's journal ([`RunEvents::append`]) and the supervisor's
+/// own never overwrite or split each other.
 pub struct RunEvents {
     path: PathBuf,
-    out: RefCell<Option<BufWriter<File>>>,
+    out: RefCell<Option<File>>,
 }
 
 impl RunEvents {
@@ -110,8 +115,21 @@ impl RunEvents {
     /// and the run goes on without it.
     pub fn create(dir: &Path) -> Self {
         let path = dir.join(EVENTS_FILE);
-        let out = match File::create(&path) {
-            Ok(f) => Some(BufWriter::new(f)),
+        let out = File::create(&path).and_then(|_| open_append(&path));
+        Self::from_open(path, out)
+    }
+
+    /// Opens `dir/events.jsonl` to add lines after the ones already there (created if
+    /// missing): another process's view of a live run's journal.
+    pub fn append(dir: &Path) -> Self {
+        let path = dir.join(EVENTS_FILE);
+        let out = open_append(&path);
+        Self::from_open(path, out)
+    }
+
+    fn from_open(path: PathBuf, out: std::io::Result<File>) -> Self {
+        let out = match out {
+            Ok(f) => Some(f),
             Err(e) => {
                 tracing::warn!("no event journal {}: {e}", path.display());
                 None
@@ -131,7 +149,12 @@ impl RunEvents {
         }
     }
 
-    /// Appends `event`, stamped now, and flushes it.
+    /// Whether lines are being written.
+    pub fn is_open(&self) -> bool {
+        self.out.borrow().is_some()
+    }
+
+    /// Appends `event`, stamped now, in one write.
     pub fn record(&self, event: RunEvent) {
         let mut slot = self.out.borrow_mut();
         let Some(out) = slot.as_mut() else {
@@ -141,15 +164,21 @@ impl RunEvents {
             t_ns: monotonic_ns(),
             event: &event,
         };
-        let written = serde_json::to_writer(&mut *out, &stamped)
+        let written = serde_json::to_vec(&stamped)
             .map_err(std::io::Error::from)
-            .and_then(|()| out.write_all(b"\n"))
-            .and_then(|()| out.flush());
+            .and_then(|mut line| {
+                line.push(b'\n');
+                out.write_all(&line)
+            });
         if let Err(e) = written {
             tracing::warn!("event journal {} stopped: {e}", self.path.display());
             *slot = None;
         }
     }
+}
+
+fn open_append(path: &Path) -> std::io::Result<File> {
+    OpenOptions::new().create(true).append(true).open(path)
 }
 
 #[cfg(test)]
@@ -185,6 +214,35 @@ mod tests {
             lines[1]["t_ns"].as_u64().unwrap(),
         );
         assert!(t0 > 0 && t1 >= t0);
+    }
+
+    #[test]
+    fn lines_appended_by_another_writer_are_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        let supervisor = RunEvents::create(dir.path());
+        supervisor.record(RunEvent::Up {
+            node: "sim".into(),
+            pid: 1,
+        });
+        let kill = RunEvents::append(dir.path());
+        kill.record(RunEvent::Signalled {
+            node: "agent-0".into(),
+            pid: 2,
+            signal: "SIGKILL".into(),
+            fault: None,
+            round: 7,
+        });
+        supervisor.record(RunEvent::Exited {
+            node: "agent-0".into(),
+            pid: 2,
+            how: "killed by SIGKILL".into(),
+        });
+        let text = std::fs::read_to_string(dir.path().join(EVENTS_FILE)).unwrap();
+        let events: Vec<String> = text
+            .lines()
+            .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["event"].to_string())
+            .collect();
+        assert_eq!(events, ["\"up\"", "\"signalled\"", "\"exited\""]);
     }
 
     #[test]

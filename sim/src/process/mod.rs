@@ -57,7 +57,7 @@ pub struct SimProcess<'t> {
     state: State,
     /// Skip the wait for the supervisor's `Start` (a restarted process).
     resume: bool,
-    /// The rounds of the scenario's planned faults.
+    /// The lockstep rounds of the run's planned faults (the scenario's and the command line's).
     fault_rounds: Vec<u64>,
     /// How long the handshake waits for `Start`: the scenario's start-up timeout.
     startup_timeout: Duration,
@@ -76,7 +76,11 @@ impl<'t> SimProcess<'t> {
             ports,
             state: State::new(world, scenario.sim.clock, lockstep_deadline),
             resume: false,
-            fault_rounds: scenario.faults.iter().map(|f| f.at_round).collect(),
+            fault_rounds: scenario
+                .faults
+                .iter()
+                .map(|f| f.lockstep_round(&scenario.sim))
+                .collect(),
             startup_timeout: scenario.startup_timeout(),
         })
     }

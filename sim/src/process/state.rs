@@ -25,7 +25,7 @@ pub(crate) struct State {
     /// `sim.lockstep_deadline_ms`, `None` for 0 (wait indefinitely).
     pub(crate) lockstep_deadline: Option<Duration>,
     /// Lockstep with a fault plan: the periods to hold before, ascending (the distinct
-    /// `at_round`s of the scenario's faults; round `r` is committed just before period `r`
+    /// lockstep rounds of the run's faults; round `r` is committed just before period `r`
     /// is stepped).
     holds: VecDeque<u64>,
     /// The `Hold` for the first of `holds` has been sent.

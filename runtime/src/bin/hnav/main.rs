@@ -7,6 +7,7 @@
 //! report could not be written, 2 it is invalid or cannot be read (README, *Command line*).
 
 mod clean_cmd;
+mod kill_cmd;
 mod log_cmd;
 mod ps_cmd;
 mod run_cmd;
@@ -14,7 +15,7 @@ mod run_cmd;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use hnav_runtime::grid::check::check_map;
 use hnav_runtime::scenario::{default_out_dir, Scenario, ScenarioReport};
 
@@ -55,6 +56,8 @@ enum Command {
     Run(run_cmd::RunArgs),
     /// List the live runs on this machine and their processes.
     Ps(ps_cmd::PsArgs),
+    /// Send a signal to one process of a live run (agent:N, coordinator or sim).
+    Kill(kill_cmd::KillArgs),
     /// Remove what dead runs left behind (processes, shared memory, registry entries).
     Clean(clean_cmd::CleanArgs),
     /// Inspect a run's consensus log.
@@ -77,7 +80,11 @@ enum MapCommand {
 }
 
 fn main() -> ExitCode {
-    match Cli::parse().command {
+    // The matches too, not only the parsed arguments: `hnav run` reads the order in which
+    // its --kill, --term and --freeze were given from them.
+    let matches = Cli::command().get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    match cli.command {
         Command::Check {
             scenario,
             out,
@@ -87,7 +94,8 @@ fn main() -> ExitCode {
         Command::Map {
             command: MapCommand::Check { map, scen },
         } => map_check(map, scen),
-        Command::Run(args) => run_cmd::run_command(args),
+        Command::Run(args) => run_cmd::run_command(args, matches.subcommand_matches("run")),
+        Command::Kill(args) => kill_cmd::run(args),
         Command::Ps(args) => ps_cmd::run(args),
         Command::Clean(args) => clean_cmd::run(args),
         Command::Log { command } => log_cmd::run(command),

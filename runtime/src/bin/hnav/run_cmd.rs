@@ -1,8 +1,10 @@
 //! `hnav run SCENARIO [--agents N] [--mode lockstep|realtime] [--seed S] [--out DIR]
-//! [--force]`: the supervisor. The work is in `hnav_runtime::supervisor::run`.
+//! [--force] [--kill|--term|--freeze TARGET@WHEN[+SECONDSs]]...`: the supervisor. The work
+//! is in `hnav_runtime::supervisor::run`; the faults' syntax in
+//! `hnav_runtime::scenario::fault_arg`.
 //!
 //! Exit codes: 0 every robot reached its goal without a collision, 1 the run ended otherwise
-//! (time limit, collisions, stopped), 2 the run could not happen (bad scenario, a process
+//! (time limit, collisions, stopped), 2 the run could not happen (bad scenario or fault, a process
 //! that would not start, a run id or directory held by a live run, a finished run's
 //! directory without `--force`), 3 the run was ended early because it could not go on (the
 //! sim or the coordinator down and not restarted, or no agent left: the summary is still
@@ -13,8 +15,10 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use clap::ArgMatches;
 use hnav_runtime::launch::ProcessArgs;
-use hnav_runtime::scenario::{ClockMode, Scenario};
+use hnav_runtime::scenario::fault_arg::{self, FaultArgError, FaultFlag};
+use hnav_runtime::scenario::{ClockMode, FaultSpec, Scenario};
 use hnav_runtime::supervisor::run::{default_run_dir, new_run_id, run, RunError, RunOptions};
 
 /// The exit code of a run that started but could not go on (a process stopped on a full
@@ -49,17 +53,86 @@ pub struct RunArgs {
     /// Where the process binaries are [default: next to this executable].
     #[arg(long, value_name = "DIR")]
     pub bin_dir: Option<PathBuf>,
+    /// SIGKILL a process at a round or a time after Start, e.g. agent:3@round:40,
+    /// coordinator@2.5s, sim@round:200 (repeatable; after the scenario's [[faults]]).
+    #[arg(long, value_name = "TARGET@WHEN")]
+    pub kill: Vec<String>,
+    /// Like --kill, with SIGTERM.
+    #[arg(long, value_name = "TARGET@WHEN")]
+    pub term: Vec<String>,
+    /// SIGSTOP a process, and SIGCONT it SECONDS later if +SECONDSs is given, e.g.
+    /// agent:5@round:60+3s (repeatable).
+    #[arg(long, value_name = "TARGET@WHEN[+SECONDSs]")]
+    pub freeze: Vec<String>,
 }
 
-pub fn run_command(a: RunArgs) -> ExitCode {
+/// The command line's faults in the order they were written (`matches` says where each
+/// came; without them, every --kill, then every --term, then every --freeze).
+fn cli_faults(a: &RunArgs, matches: Option<&ArgMatches>) -> Vec<(FaultFlag, String)> {
+    let mut faults: Vec<(usize, FaultFlag, String)> = Vec::new();
+    for flag in FaultFlag::ALL {
+        let values = match flag {
+            FaultFlag::Kill => &a.kill,
+            FaultFlag::Term => &a.term,
+            FaultFlag::Freeze => &a.freeze,
+        };
+        let at: Vec<usize> = matches
+            .and_then(|m| m.indices_of(flag.name()))
+            .map(Iterator::collect)
+            .unwrap_or_default();
+        for (i, v) in values.iter().enumerate() {
+            let pos = at.get(i).copied().unwrap_or(usize::MAX);
+            faults.push((pos, flag, v.clone()));
+        }
+    }
+    // Stable: without positions the flags' own order stays.
+    faults.sort_by_key(|f| f.0);
+    faults.into_iter().map(|(_, f, v)| (f, v)).collect()
+}
+
+/// Parses the command line's faults and checks them against `scenario`; the error names the
+/// argument.
+fn parse_faults(
+    written: &[(FaultFlag, String)],
+    scenario: &Scenario,
+) -> Result<Vec<FaultSpec>, FaultArgError> {
+    written
+        .iter()
+        .map(|(flag, value)| {
+            let f = fault_arg::parse(*flag, value)?;
+            fault_arg::check_target(*flag, value, &f, scenario.agents.len())?;
+            Ok(f)
+        })
+        .collect()
+}
+
+pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
     hnav_runtime::logging::init();
-    let name = match Scenario::load(&a.scenario) {
-        Ok(s) => default_run_dir(&s),
+    let written = cli_faults(&a, matches);
+    let mut args = ProcessArgs {
+        run: a.run.unwrap_or_else(|| new_run_id().as_str().to_string()),
+        scenario: a.scenario,
+        agents: a.agents,
+        seed: a.seed,
+        mode: a.mode,
+        dir: None,
+        resume: false,
+        faults: Vec::new(),
+    };
+    // The scenario as the processes will see it (--agents applied), so that a fault's agent
+    // is checked against the run's agents before anything is spawned.
+    let checked = args.scenario().map_err(|e| e.to_string()).and_then(|s| {
+        let faults = parse_faults(&written, &s).map_err(|e| e.to_string())?;
+        Ok((s, faults))
+    });
+    let (name, faults) = match checked {
+        Ok((s, faults)) => (default_run_dir(&s), faults),
         Err(e) => {
             hnav_runtime::errln!("error: {e}");
             return ExitCode::from(2);
         }
     };
+    args.faults = faults;
     let bin_dir = a.bin_dir.or_else(|| {
         std::env::current_exe()
             .ok()
@@ -70,16 +143,9 @@ pub fn run_command(a: RunArgs) -> ExitCode {
         return ExitCode::from(2);
     };
     let dir = a.out.unwrap_or(name);
+    args.dir = Some(dir.clone());
     let opts = RunOptions {
-        args: ProcessArgs {
-            run: a.run.unwrap_or_else(|| new_run_id().as_str().to_string()),
-            scenario: a.scenario,
-            agents: a.agents,
-            seed: a.seed,
-            mode: a.mode,
-            dir: Some(dir.clone()),
-            resume: false,
-        },
+        args,
         bin_dir,
         progress: std::io::stderr().is_terminal(),
         force: a.force,

@@ -209,8 +209,7 @@ fn supervise(
     let lockstep = scenario.sim.clock == ClockMode::Lockstep;
     let mut watch = Watch {
         view: ProgressView::new(show_progress, scenario.agents.len()),
-        faults: FaultSchedule::new(&scenario.faults),
-        lockstep,
+        faults: FaultSchedule::new(&scenario.faults, lockstep, &scenario.sim),
         t0: Instant::now(),
         // In lockstep the coordinator counts the limit in rounds and says when it is reached.
         // A limit too large for a Duration (a valid scenario may say 1e300 s) never ends it.
@@ -219,30 +218,42 @@ fn supervise(
                 .unwrap_or(Duration::MAX)
         }),
     };
-    loop {
-        if let Some(end) = watch.until_change(transport, ports, slots)? {
-            watch.view.finish();
-            return Ok(end);
-        }
-        if let Some(why) = slots.reap_and_restart(transport, &ports.life)? {
-            watch.view.finish();
-            return Ok(End::CannotGoOn(why));
-        }
-        slots.write_record(record);
-    }
+    let end = watch.until_end(transport, ports, slots, record);
+    // A process the plan froze and has not continued yet could not stop politely.
+    watch.faults.thaw_all(slots);
+    watch.view.finish();
+    end
 }
 
 /// The state of the watch between two changes of the set of running processes.
 struct Watch<'s> {
     view: ProgressView,
     faults: FaultSchedule<'s>,
-    lockstep: bool,
     t0: Instant,
     /// The wall-clock limit (realtime only).
     limit: Option<Duration>,
 }
 
 impl Watch<'_> {
+    /// Watches, reaping and restarting whatever dies, until the run ends.
+    fn until_end(
+        &mut self,
+        transport: &Transport,
+        ports: &Ports,
+        slots: &mut Slots,
+        record: &mut RunRecord,
+    ) -> Result<End, RunError> {
+        loop {
+            if let Some(end) = self.until_change(transport, ports, slots)? {
+                return Ok(end);
+            }
+            if let Some(why) = slots.reap_and_restart(transport, &ports.life)? {
+                return Ok(End::CannotGoOn(why));
+            }
+            slots.write_record(record);
+        }
+    }
+
     /// Follows the run until it ends (`Some`) or until a child exits, a restart is due or a
     /// process announces itself (`None`: reap, restart, and watch the new set of children).
     fn until_change(
@@ -263,6 +274,8 @@ impl Watch<'_> {
             if let Some(period) = self.faults.resume_due(slots) {
                 ports.life.publish(Lifecycle::resume(period))?;
             }
+            self.faults.thaw_due(slots, Instant::now());
+            self.faults.fire_due(slots, self.t0.elapsed());
             if let Some(end) = self.on_progress(ports, slots)? {
                 return Ok(Some(end));
             }
@@ -275,10 +288,10 @@ impl Watch<'_> {
             if due.is_some_and(|d| d <= now) {
                 return Ok(None);
             }
-            // The next tick of the progress bar and the fault schedule, sooner if a restart
-            // is due, never past the time limit.
+            // The next tick of the progress bar and the fault schedule, sooner if a restart,
+            // a fault in seconds or the end of a freeze is due, never past the time limit.
             let mut until = now + left.map_or(TICK, |l| TICK.min(l));
-            if let Some(d) = due {
+            for d in due.into_iter().chain(self.faults.next_deadline(self.t0)) {
                 until = until.min(d);
             }
             match waiter.wait(Some(until))? {
@@ -291,7 +304,7 @@ impl Watch<'_> {
     }
 
     /// Shows the coordinator's latest progress and, in realtime, fires the faults due by its
-    /// round; `AllAtGoal` or `TimeLimit` once it reports that it ended the run.
+    /// round (or by the time since `Start`); `AllAtGoal` or `TimeLimit` once it reports that it ended the run.
     fn on_progress(&mut self, ports: &Ports, slots: &Slots) -> Result<Option<End>, RunError> {
         let mut last = None;
         ports.progress.drain_pending(|p| last = Some(*p))?;
@@ -299,9 +312,8 @@ impl Watch<'_> {
             return Ok(None);
         };
         self.view.show(&p);
-        if !self.lockstep {
-            self.faults.fire_due(slots, p.round);
-        }
+        self.faults.on_round(p.round);
+        self.faults.fire_due(slots, self.t0.elapsed());
         Ok(match p.done {
             Progress::ALL_AT_GOAL => Some(End::AllAtGoal),
             Progress::TIME_LIMIT => Some(End::TimeLimit),
