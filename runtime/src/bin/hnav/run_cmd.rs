@@ -54,7 +54,7 @@ pub struct RunArgs {
     #[arg(long, value_name = "DIR")]
     pub bin_dir: Option<PathBuf>,
     /// SIGKILL a process at a round or a time after Start, e.g. agent:3@round:40,
-    /// coordinator@2.5s, sim@round:200 (repeatable; after the scenario's [[faults]]).
+    /// coordinator@2.5s, sim@round:200 (repeatable; after the scenario's `[[faults]]`).
     #[arg(long, value_name = "TARGET@WHEN")]
     pub kill: Vec<String>,
     /// Like --kill, with SIGTERM.
