@@ -368,6 +368,22 @@ fn stop_all_escalates_and_reaps() {
 }
 
 #[test]
+fn a_stopped_child_is_seen_stopped_and_stop_all_ends_it_with_sigterm() {
+    let dir = tempfile::tempdir().unwrap();
+    let frozen = Child::spawn(&sh(dir.path(), "frozen", "echo ready; exec sleep 30")).unwrap();
+    wait_for_line(&frozen.spec().log_file, "ready");
+    frozen.signal(Signal::SIGSTOP).unwrap();
+    assert!(frozen.wait_stopped(), "stopped, not exited");
+    let stopped = stop_all([&frozen], Duration::from_millis(300));
+    assert_eq!(stopped[0].how, StopHow::AfterSigterm, "{stopped:?}");
+    assert_eq!(stopped[0].exit, ExitInfo::Signaled(Signal::SIGTERM));
+    // One that dies instead of stopping is reported as not stopped, and left to be reaped.
+    let dying = Child::spawn(&sh(dir.path(), "dying", "exit 3")).unwrap();
+    assert!(!dying.wait_stopped());
+    assert_eq!(dying.wait(None), Some(ExitInfo::Exited(3)));
+}
+
+#[test]
 fn stop_all_returns_early_when_everything_exits() {
     let dir = tempfile::tempdir().unwrap();
     let a = Child::spawn(&sh(dir.path(), "a", "sleep 0.1")).unwrap();

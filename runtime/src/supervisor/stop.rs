@@ -3,7 +3,8 @@
 //! By the time [`stop_all`] runs, the supervisor has already asked every process to finish
 //! over the run's lifecycle topic, which lets them flush logs and drop their iceoryx2 nodes
 //! cleanly. Whatever is still running after `grace` gets SIGTERM on its whole process group
-//! (iceoryx2 turns that into a termination request, still a clean exit), and after another
+//! (iceoryx2 turns that into a termination request, still a clean exit; a SIGCONT with it
+//! wakes a stopped process to act on it), and after another
 //! `grace` SIGKILL, which cannot be refused. Waiting is blocking on the children's exit
 //! descriptors with `poll(2)`, so the supervisor sleeps until an exit or the deadline.
 //!
@@ -63,6 +64,11 @@ where
                     tracing::debug!(pid = child.pid(), %signal, "escalating stop");
                     if let Err(e) = child.signal_group(signal) {
                         tracing::warn!(error = %e, "stop: signal failed");
+                    }
+                    // A stopped process (`hnav kill --signal STOP`) acts on SIGTERM only
+                    // once continued; to a running one SIGCONT is nothing.
+                    if signal == Signal::SIGTERM {
+                        let _ = child.signal_group(Signal::SIGCONT);
                     }
                 }
             }
