@@ -152,9 +152,26 @@ fn a_realtime_coordinator_kill_in_seconds_ends_with_every_robot_at_goal() {
         "plan-rt",
         &dir,
         &tmp.path().join("runs"),
-        &["--mode", "realtime", "--kill", "coordinator@1.0s"],
+        &[
+            "--mode",
+            "realtime",
+            "--kill",
+            "coordinator@1.0s",
+            "--freeze",
+            "agent:3@0.5s+0.2s",
+        ],
     );
     let ev = events(&dir);
+    // The freeze is continued by a deadline of the supervisor's wait, 0.2 s after the stop.
+    let stamp = |signal: &str| {
+        ev.iter()
+            .find(|e| e["node"] == "agent-3" && e["signal"] == signal && e["fault"] == 1)
+            .and_then(|e| e["t_ns"].as_u64())
+            .unwrap_or_else(|| panic!("agent-3 {signal}: {ev:?}"))
+    };
+    let frozen_ms = (stamp("SIGCONT") - stamp("SIGSTOP")) as f64 / 1e6;
+    println!("agent-3 frozen for {frozen_ms:.1} ms (asked 200 ms)");
+    assert!((200.0..1000.0).contains(&frozen_ms), "{frozen_ms} ms");
     assert!(
         ev.iter().any(|e| e["event"] == "signalled"
             && e["node"] == "coordinator"
