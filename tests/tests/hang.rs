@@ -62,13 +62,16 @@ fn scenario(dir: &Path, mode: &str, agent_hang: Duration) -> PathBuf {
     path
 }
 
+/// When a commit was read, its round, and agents 0 and 1's (verdict, conflict kind).
+type SeenCommit = (u64, u64, [(u8, u8); 2]);
+
 /// What a test's observer thread saw on the run's topics, each stamped with
 /// [`monotonic_ns`] when it was read.
 #[derive(Default)]
 struct Seen {
     /// Commit round, and agent 0's and agent 1's verdict and conflict kind ([`NONE`]: no
     /// decision, the agent asked for nothing).
-    commits: Vec<(u64, u64, [(u8, u8); 2])>,
+    commits: Vec<SeenCommit>,
     /// Robot 0's pose.
     poses: Vec<(u64, Pose)>,
     round: u64,

@@ -117,7 +117,7 @@ impl HangWatch {
             let hang = self.deadline[Self::role_slot(role)];
             let silent = Duration::from_nanos(now_ns.saturating_sub(w.since_ns));
             if silent <= hang {
-                let due = now + (hang - silent);
+                let due = now + hang.saturating_sub(silent);
                 next = Some(next.map_or(due, |n| n.min(due)));
                 continue;
             }
