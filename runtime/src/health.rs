@@ -1,9 +1,11 @@
 //! A process's heartbeat: the sending half of hang detection.
 //!
 //! Every process of a run (agent, coordinator, sim) beats on the `heartbeat` topic
-//! ([`topics::HEARTBEAT`]) from its main loop while it is up, idle waits included: the loop
-//! asks [`Heartbeat::until`] for its wait's deadline, which sends the beat that is due and
-//! returns the earlier of the loop's own deadline and the next beat. A beat therefore proves
+//! ([`topics::HEARTBEAT`]) from its main loop while it is up, idle waits included: every
+//! pass of the loop calls [`Heartbeat::beat`] (a loop that works through a backlog without
+//! waiting still beats), and the loop asks [`Heartbeat::until`] for its wait's deadline,
+//! which sends the beat that is due and returns the earlier of the loop's own deadline and
+//! the next beat. A beat therefore proves
 //! that the loop itself turns; a helper thread would go on beating while the loop is stuck.
 //! The supervisor's half is `supervisor::run::hang`.
 //!

@@ -163,6 +163,7 @@ impl<'t> AgentProcess<'t> {
         let _commit = waiter.attach(&p.commit)?;
         let _life = waiter.attach(p.life.events())?;
         loop {
+            self.heart.beat()?;
             if p.life.drain(|_, _, _| {})?.is_some() {
                 break;
             }

@@ -145,6 +145,8 @@ fn rounds(
     heart: &Heartbeat,
 ) -> Result<EndReason, CoordinatorError> {
     loop {
+        // Every pass beats if due: a backlog of rounds closes back to back without a wait.
+        heart.beat()?;
         // Candidates first, then the supervisor: an event sent before a candidate (an agent's
         // `Restarted` before the round the sim resumed for) is then always heard before that
         // round closes, so it is logged at the same round in every lockstep run.

@@ -159,6 +159,9 @@ fn run_loop(
     // anything came in, as long as nothing does.
     let mut give_up: Option<Instant> = None;
     loop {
+        // Every pass beats if due, not only a wait: a realtime sim catching up on overdue
+        // periods steps them back to back without waiting, and is not hung.
+        heart.beat()?;
         if max_periods.is_some_and(|m| st.period >= m) {
             return Ok(false);
         }
