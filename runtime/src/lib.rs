@@ -19,6 +19,7 @@
 //! | [`supervisor`] | starting, watching, restarting and stopping a run's processes; the registry behind `hnav ps`. It sits on top: no other module uses it |
 //! | [`consensus_log`] | the durable consensus log: record types, segment format, reader, verifier |
 //! | [`clock`] | `CLOCK_MONOTONIC` in nanoseconds: one time base for the supervisor, the processes and observers of a host |
+//! | [`health`] | a process's heartbeat, beaten from its main loop for the supervisor's hang detection |
 //! | [`hash`] | FNV-1a 64 and SplitMix64: digests and seeded random numbers, stable across platforms |
 //! | [`diag`] | printing that never panics: `outln!`/`errln!` and the `tracing` writer drop (and count) a failed write |
 //! | [`file_lock`] | exclusive `flock` locks that name their holder: a run's directory, its run id, its consensus log |
@@ -30,6 +31,7 @@ pub mod diag;
 pub mod file_lock;
 pub mod grid;
 pub mod hash;
+pub mod health;
 pub mod launch;
 pub mod logging;
 pub mod msg;

@@ -12,6 +12,7 @@
 //! | `progress` | [`Progress`](crate::msg::Progress) | coordinator -> supervisor | latest |
 //! | `ready` | [`Lifecycle`](crate::msg::Lifecycle) (`Up`; the sim's `Hold`) | every process -> supervisor | latest, deep buffer |
 //! | `lifecycle` | [`Lifecycle`](crate::msg::Lifecycle) | supervisor -> every process | latest, deep buffer |
+//! | `heartbeat` | [`Heartbeat`](crate::msg::Heartbeat) | every process -> supervisor | latest, depth 1, not notified |
 //!
 //! Why "latest" (overwrite the oldest) for commits and lifecycle events, where every sample
 //! counts: with backpressure a dead subscriber whose buffer is full would stall the publisher
@@ -19,6 +20,12 @@
 //! The buffers are sized so that a live reader never falls that far behind: an agent reads a
 //! commit every round, and there is one round in flight at a time. History 1 hands a
 //! restarted process the last commit (or lifecycle event) at once.
+//!
+//! One `heartbeat` topic for every process rather than one per process: iceoryx2 keeps a
+//! queue per publisher-subscriber connection, so a depth-1 "latest" buffer already holds each
+//! process's own last beat, and the supervisor reads the whole swarm from one subscriber
+//! without a service (and its shared memory) per process. Beats do not notify: the
+//! supervisor reads them at its own deadline, so a beat costs a sample write and wakes nobody.
 
 use crate::transport::{Delivery, Qos};
 
@@ -50,6 +57,9 @@ pub const READY: &str = "ready";
 /// The supervisor's lifecycle events and requests.
 pub const LIFECYCLE: &str = "lifecycle";
 
+/// Every process's heartbeat ([`heartbeat_qos`]).
+pub const HEARTBEAT: &str = "heartbeat";
+
 /// QoS of the per-robot topics and of truth and progress: superseding state.
 pub fn state_qos() -> Qos {
     Qos::latest()
@@ -80,6 +90,20 @@ pub fn lifecycle_qos(agents: usize) -> Qos {
         max_subscribers: n,
         buffer: 2 * n,
         history: 1,
+        delivery: Delivery::LatestOnly,
+    }
+}
+
+/// QoS of the `heartbeat` topic of a swarm of `agents`: every process (twice, while a
+/// restarted one replaces a dead one whose connection is not cleaned up yet) publishes, the
+/// supervisor and an observer read, and only each publisher's last beat matters.
+pub fn heartbeat_qos(agents: usize) -> Qos {
+    let n = agents.max(1) + Qos::EXTRA_NODES;
+    Qos {
+        max_publishers: 2 * n,
+        max_subscribers: 2,
+        buffer: 1,
+        history: 0,
         delivery: Delivery::LatestOnly,
     }
 }

@@ -3,7 +3,8 @@
 //! Inputs: its robot's odometry (`odom/<i>`), the coordinator's commits, the supervisor's
 //! lifecycle events. Outputs: candidates, wheel commands (`wheels/<i>`) and neural-map
 //! snapshots (`map/<i>`, written in place into loaned shared memory). It blocks in one
-//! [`Waiter`](hnav_runtime::transport::Waiter) on the three inputs; there is no timer.
+//! [`Waiter`](hnav_runtime::transport::Waiter) on the three inputs; its one timer is its
+//! heartbeat ([`hnav_runtime::health`]), beaten from that loop.
 //!
 //! Every control period (one odometry reading) the agent updates its dead reckoning, notices
 //! arrival at `next`, and, unless a candidate of its own is still unanswered, publishes the
@@ -29,8 +30,9 @@ mod state;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
+use hnav_runtime::health::Heartbeat;
 use hnav_runtime::launch::{ProcessArgs, StartOutcome};
-use hnav_runtime::msg::StartupPhase;
+use hnav_runtime::msg::{Role, StartupPhase};
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::transport::{Transport, TransportError, Wake};
 
@@ -87,6 +89,7 @@ pub struct AgentProcess<'t> {
     transport: &'t Transport,
     ports: Ports,
     core: Core,
+    heart: Heartbeat,
     startup_timeout: Duration,
 }
 
@@ -106,6 +109,7 @@ impl<'t> AgentProcess<'t> {
             .get(index as usize)
             .ok_or(AgentError::NoSuchAgent { index, agents })?;
         let ports = Ports::open(transport, &scenario.map.grid, index, agents)?;
+        let heart = Heartbeat::open(transport, Role::Agent, index, agents, scenario.heartbeat())?;
         if !args.resume {
             // Only a first start has a supervisor waiting on a bound; a restarted agent
             // builds its map just the same but nobody times it.
@@ -133,6 +137,7 @@ impl<'t> AgentProcess<'t> {
             transport,
             ports,
             core,
+            heart,
         })
     }
 
@@ -158,13 +163,14 @@ impl<'t> AgentProcess<'t> {
         let _commit = waiter.attach(&p.commit)?;
         let _life = waiter.attach(p.life.events())?;
         loop {
+            self.heart.beat()?;
             if p.life.drain(|_, _, _| {})?.is_some() {
                 break;
             }
             core.step(p)?;
-            // No deadline: the agent only ever reacts to its inputs. `TimedOut` cannot happen
-            // without one, and would only mean "look again".
-            match waiter.wait(None)? {
+            // The agent only ever reacts to its inputs; its one deadline is the next beat,
+            // after which `TimedOut` only means "look again".
+            match waiter.wait(self.heart.until(None)?)? {
                 Wake::Data | Wake::TimedOut => {}
                 Wake::Stop => break,
             }

@@ -28,8 +28,9 @@ use std::path::Path;
 use std::time::Duration;
 
 use hnav_runtime::consensus_log::{EndReason, LogError};
+use hnav_runtime::health::Heartbeat;
 use hnav_runtime::launch::StartOutcome;
-use hnav_runtime::msg::MAX_AGENTS;
+use hnav_runtime::msg::{Role, MAX_AGENTS};
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::transport::{Transport, TransportError, Waiter, Wake};
 
@@ -77,6 +78,7 @@ pub struct CoordinatorProcess<'t> {
     transport: &'t Transport,
     ports: Ports,
     state: State,
+    heart: Heartbeat,
     startup_timeout: Duration,
 }
 
@@ -92,8 +94,10 @@ impl<'t> CoordinatorProcess<'t> {
             return Err(CoordinatorError::TooManyAgents(n));
         }
         let ports = Ports::open(transport, n)?;
+        let heart = Heartbeat::open(transport, Role::Coordinator, 0, n, scenario.heartbeat())?;
         let state = State::open(scenario, run_dir)?;
         Ok(CoordinatorProcess {
+            heart,
             startup_timeout: scenario.startup_timeout(),
             transport,
             ports,
@@ -123,7 +127,7 @@ impl<'t> CoordinatorProcess<'t> {
         let waiter = self.transport.waiter()?;
         let _candidates = waiter.attach(&p.candidates)?;
         let _lifecycle = waiter.attach(p.life.events())?;
-        let reason = rounds(p, st, &waiter)?;
+        let reason = rounds(p, st, &waiter, &self.heart)?;
         if !st.ended() {
             st.end(reason)?;
         }
@@ -134,8 +138,15 @@ impl<'t> CoordinatorProcess<'t> {
 
 /// Decides rounds until the supervisor's `Stop` or a termination signal; returns why the run
 /// ends.
-fn rounds(p: &Ports, st: &mut State, waiter: &Waiter) -> Result<EndReason, CoordinatorError> {
+fn rounds(
+    p: &Ports,
+    st: &mut State,
+    waiter: &Waiter,
+    heart: &Heartbeat,
+) -> Result<EndReason, CoordinatorError> {
     loop {
+        // Every pass beats if due: a backlog of rounds closes back to back without a wait.
+        heart.beat()?;
         // Candidates first, then the supervisor: an event sent before a candidate (an agent's
         // `Restarted` before the round the sim resumed for) is then always heard before that
         // round closes, so it is logged at the same round in every lockstep run.
@@ -147,14 +158,15 @@ fn rounds(p: &Ports, st: &mut State, waiter: &Waiter) -> Result<EndReason, Coord
             st.close_round(p)?;
             continue;
         }
-        // Lockstep has no deadline: only candidates and liveness close a round, and the
-        // waiter's own re-check covers a lost wake-up.
+        // Lockstep has no round deadline: only candidates and liveness close a round, and
+        // the waiter's own re-check covers a lost wake-up. The heartbeat's deadline only
+        // bounds the wait; the round deadline is checked on the clock.
         let deadline = st.round_deadline();
         if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
             st.close_round(p)?;
             continue;
         }
-        match waiter.wait(deadline)? {
+        match waiter.wait(heart.until(deadline)?)? {
             // A passed deadline closes the round on the next pass, after one more drain.
             Wake::Data | Wake::TimedOut => {}
             Wake::Stop => return Ok(EndReason::Stopped),

@@ -29,6 +29,7 @@ pub(super) fn parse(
     let coordinator = build_coordinator(raw.coordinator, &lines)?;
     let restart = build_restart(raw.restart);
     let run = build_run(raw.run, &lines)?;
+    let health = super::health::build_health(raw.health, &lines)?;
     if raw.agents.is_empty() {
         return Err(ScenarioError::NoAgents {
             at: Loc::new(source_name, 1),
@@ -67,6 +68,7 @@ pub(super) fn parse(
         coordinator,
         restart,
         run,
+        health,
         agents,
         faults,
         allow_unreachable,

@@ -53,6 +53,12 @@
 //!                                      # 60 s plus the agents' neural-map builds, scaled
 //!                                      # with the map (params::default_startup_timeout_s)
 //!
+//! [health]                             # hang detection (README, *Hangs*); not in the hash
+//! heartbeat_ms = 50                    # every process beats this often, in [1, 60000]
+//! agent_hang_ms = 1000                 # silence before a process is declared hung, in
+//! coordinator_hang_ms = 2000           # [2 * heartbeat_ms, 3600000]; the agents' default
+//! sim_hang_ms = 1000                   # grows with the map (health::default_agent_hang_ms)
+//!
 //! [[agents]]                           # one table per robot, numbered from 0
 //! start = [0, 0]                       # [x, y]: x = column, y = row, origin top-left
 //! goal = [31, 31]
@@ -116,6 +122,7 @@ mod build_params;
 pub mod error;
 pub mod fault_arg;
 mod hash;
+pub mod health;
 mod lines;
 pub mod params;
 mod raw;
@@ -127,6 +134,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 pub use error::{Loc, ScenarioError};
+pub use health::HealthParams;
 pub use params::{
     default_startup_timeout_s, ClockMode, ClockModeError, CoordinatorParams, FsyncPolicy,
     RestartConfig, RestartPolicy, RestartRule, RobotParams, RunParams, SimParams,
@@ -273,6 +281,8 @@ pub struct Scenario {
     pub restart: RestartConfig,
     /// The supervisor's run parameters.
     pub run: RunParams,
+    /// Heartbeats and hang deadlines (`[health]`).
+    pub health: HealthParams,
     /// The robots, numbered from 0.
     pub agents: Vec<AgentSpec>,
     /// The fault plan.
@@ -328,6 +338,24 @@ impl Scenario {
             default_startup_timeout_s(g.width(), g.height(), self.agents.len(), cores)
         });
         std::time::Duration::from_secs_f64(secs)
+    }
+
+    /// How often every process of the run beats (`[health] heartbeat_ms`).
+    pub fn heartbeat(&self) -> std::time::Duration {
+        self.health.heartbeat()
+    }
+
+    /// How long a process of `role` may stay silent before the supervisor declares it hung:
+    /// `[health] <role>_hang_ms`, for agents by default growing with the map
+    /// ([`health::default_agent_hang_ms`]).
+    pub fn hang_deadline(&self, role: crate::msg::Role) -> std::time::Duration {
+        let g = &self.map.grid;
+        health::hang_deadline(
+            &self.health,
+            role,
+            (g.width(), g.height()),
+            self.agents.len(),
+        )
     }
 
     /// A copy with exactly `n` agents: the first `n` if there are enough, otherwise all of

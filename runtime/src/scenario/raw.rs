@@ -23,6 +23,7 @@ pub(super) struct RawScenario {
     pub coordinator: Option<RawCoordinator>,
     pub restart: Option<RawRestart>,
     pub run: Option<RawRun>,
+    pub health: Option<super::health::RawHealth>,
     #[serde(default)]
     pub agents: Vec<Spanned<RawAgent>>,
     #[serde(default)]

@@ -280,6 +280,19 @@ impl<T: Debug + ZeroCopySend + 'static> Sender<T> {
         self.publish(sample.write_payload(value))
     }
 
+    /// [`Sender::send`] without waking the receivers: for state a reader takes at a deadline
+    /// of its own (the heartbeat), where a wake-up per sample would only cost the reader.
+    pub fn send_silently(&self, value: T) -> Result<usize, TransportError> {
+        let sample = self
+            .publisher
+            .loan_uninit()
+            .map_err(|e| self.loan_error(e))?;
+        sample
+            .write_payload(value)
+            .send()
+            .map_err(|e| TransportError::ipc("send sample", self.name.as_str(), e))
+    }
+
     /// Loans a default-initialised chunk, lets `fill` write the payload in place (no copy of a
     /// large message through the stack), publishes it and wakes the receivers.
     pub fn send_in_place(&self, fill: impl FnOnce(&mut T)) -> Result<usize, TransportError>

@@ -28,7 +28,9 @@ mod state;
 
 use std::time::{Duration, Instant};
 
+use hnav_runtime::health::Heartbeat;
 use hnav_runtime::launch::{LifecyclePorts, StartOutcome};
+use hnav_runtime::msg::Role;
 use hnav_runtime::scenario::params::ClockMode;
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::transport::{Transport, Waiter, Wake};
@@ -55,6 +57,7 @@ pub struct SimProcess<'t> {
     transport: &'t Transport,
     ports: Ports,
     state: State,
+    heart: Heartbeat,
     /// Skip the wait for the supervisor's `Start` (a restarted process).
     resume: bool,
     /// The lockstep rounds of the run's planned faults (the scenario's and the command line's).
@@ -69,12 +72,20 @@ impl<'t> SimProcess<'t> {
     pub fn new(transport: &'t Transport, scenario: &Scenario) -> Result<Self, SimError> {
         let world = World::from_scenario(scenario)?;
         let ports = Ports::open(transport, world.robots())?;
+        let heart = Heartbeat::open(
+            transport,
+            Role::Sim,
+            0,
+            world.robots(),
+            scenario.heartbeat(),
+        )?;
         let lockstep_deadline = (scenario.sim.lockstep_deadline_ms > 0)
             .then(|| Duration::from_millis(scenario.sim.lockstep_deadline_ms.into()));
         Ok(SimProcess {
             transport,
             ports,
             state: State::new(world, scenario.sim.clock, lockstep_deadline),
+            heart,
             resume: false,
             fault_rounds: scenario
                 .faults
@@ -126,7 +137,13 @@ impl<'t> SimProcess<'t> {
         }
         let waiter = self.transport.waiter()?;
         let _attached = self.ports.attach(&waiter)?;
-        let signalled = run_loop(&self.ports, &mut self.state, &waiter, max_periods)?;
+        let signalled = run_loop(
+            &self.ports,
+            &mut self.state,
+            &waiter,
+            &self.heart,
+            max_periods,
+        )?;
         Ok(self.state.outcome(signalled))
     }
 }
@@ -137,6 +154,7 @@ fn run_loop(
     ports: &Ports,
     st: &mut State,
     waiter: &Waiter,
+    heart: &Heartbeat,
     max_periods: Option<u64>,
 ) -> Result<bool, SimError> {
     let period_wall = st.period_wall();
@@ -145,6 +163,9 @@ fn run_loop(
     // anything came in, as long as nothing does.
     let mut give_up: Option<Instant> = None;
     loop {
+        // Every pass beats if due, not only a wait: a realtime sim catching up on overdue
+        // periods steps them back to back without waiting, and is not hung.
+        heart.beat()?;
         if max_periods.is_some_and(|m| st.period >= m) {
             return Ok(false);
         }
@@ -181,11 +202,13 @@ fn run_loop(
                 Some(due)
             }
         };
-        match waiter.wait(deadline)? {
+        // The wait also ends at the next heartbeat, so a time-out is the lockstep deadline's
+        // only once that has passed.
+        match waiter.wait(heart.until(deadline)?)? {
             Wake::Data => {}
             Wake::Stop => return Ok(true),
             Wake::TimedOut => {
-                if st.clock == ClockMode::Lockstep && st.lockstep_deadline.is_some() {
+                if st.clock == ClockMode::Lockstep && give_up.is_some_and(|g| Instant::now() >= g) {
                     st.mark_missing_down();
                     give_up = None;
                 }

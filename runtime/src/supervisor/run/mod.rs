@@ -15,7 +15,8 @@
 //!    event), the others told on the lifecycle topic, and it is restarted under its role's
 //!    policy with `--resume` (module `slots`). The progress bar (`progress`) follows the
 //!    coordinator's progress topic; the scenario's planned faults (`faults`) too in realtime,
-//!    and the sim's `Hold` at each fault's round in lockstep.
+//!    and the sim's `Hold` at each fault's round in lockstep. Every process that is up has a
+//!    hang deadline (`hang`): one silent past it is SIGKILLed and takes the same path.
 //! 4. End when the coordinator reports every agent at its goal, or (lockstep) the last round
 //!    of the time limit committed; when the time limit passes on the wall clock (realtime);
 //!    when the run cannot go on (the sim or the coordinator down and not restarted, or no
@@ -26,6 +27,7 @@
 
 mod error;
 mod faults;
+mod hang;
 mod progress;
 mod slots;
 
@@ -46,6 +48,7 @@ use crate::topics;
 use crate::transport::{purge_run, Receiver, RunId, Transport, Wake};
 use error::io;
 use faults::FaultSchedule;
+use hang::HangWatch;
 use progress::ProgressView;
 use slots::Slots;
 
@@ -196,6 +199,8 @@ fn supervise(
     record: &mut RunRecord,
     show_progress: bool,
 ) -> Result<End, RunError> {
+    // Open before any process starts, so that no beat finds the topic missing.
+    let hang = HangWatch::open(transport, scenario)?;
     slots.spawn_all()?;
     slots.write_record(record);
     let children: Vec<&Child> = slots.children().collect();
@@ -210,6 +215,8 @@ fn supervise(
     let mut watch = Watch {
         view: ProgressView::new(show_progress, scenario.agents.len()),
         faults: FaultSchedule::new(&scenario.faults, lockstep, &scenario.sim),
+        hang,
+        round: 0,
         t0: Instant::now(),
         // In lockstep the coordinator counts the limit in rounds and says when it is reached.
         // A limit too large for a Duration (a valid scenario may say 1e300 s) never ends it.
@@ -229,6 +236,9 @@ fn supervise(
 struct Watch<'s> {
     view: ProgressView,
     faults: FaultSchedule<'s>,
+    hang: HangWatch,
+    /// The last committed round the coordinator reported.
+    round: u64,
     t0: Instant,
     /// The wall-clock limit (realtime only).
     limit: Option<Duration>,
@@ -283,18 +293,25 @@ impl Watch<'_> {
             if left.is_some_and(|l| l.is_zero()) {
                 return Ok(Some(End::TimeLimit));
             }
+            self.hang.follow(slots);
+            let hung_due = self.hang.check(slots, self.round)?;
             let now = Instant::now();
             let due = slots.next_restart();
             if due.is_some_and(|d| d <= now) {
                 return Ok(None);
             }
             // The next tick of the progress bar and the fault schedule, sooner if a restart,
-            // a fault in seconds or the end of a freeze is due, never past the time limit.
+            // a hang deadline, a fault in seconds or the end of a freeze is due, never past
+            // the time limit.
             let mut until = now + left.map_or(TICK, |l| TICK.min(l));
-            for d in due.into_iter().chain(self.faults.next_deadline(self.t0)) {
+            let timed = [due, hung_due, self.faults.next_deadline(self.t0)];
+            for d in timed.into_iter().flatten() {
                 until = until.min(d);
             }
-            match waiter.wait(Some(until))? {
+            self.hang.before_wait(until);
+            let wake = waiter.wait(Some(until));
+            self.hang.after_wait();
+            match wake? {
                 Wake::Stop => return Ok(Some(End::Signalled)),
                 // A child's exit, an `Up`, or only a re-check: reap and look again.
                 Wake::Data => return Ok(None),
@@ -312,6 +329,7 @@ impl Watch<'_> {
             return Ok(None);
         };
         self.view.show(&p);
+        self.round = p.round;
         self.faults.on_round(p.round);
         self.faults.fire_due(slots, self.t0.elapsed());
         Ok(match p.done {

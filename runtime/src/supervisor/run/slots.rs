@@ -100,6 +100,15 @@ impl Slots {
         self.slots.iter().filter_map(|s| s.child.as_ref())
     }
 
+    /// Role, index and pid of every process that is up: running, and announced up again if
+    /// it was restarted (what the hang watch holds deadlines for).
+    pub(super) fn up(&self) -> impl Iterator<Item = (Role, u32, u32)> + '_ {
+        self.slots
+            .iter()
+            .filter(|s| !s.announce.get())
+            .filter_map(|s| Some((s.spec.role, s.spec.index, s.child.as_ref()?.pid())))
+    }
+
     /// The current incarnation of `role`/`index`, if it runs.
     pub(super) fn child(&self, role: Role, index: u32) -> Option<&Child> {
         self.slots
