@@ -66,9 +66,7 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         )
     })?;
     let until = match args.for_s {
-        Some(s) if s.is_finite() && s >= 0.0 && s <= 1e6 => {
-            Some(Instant::now() + Duration::from_secs_f64(s))
-        }
+        Some(s) if (0.0..=1e6).contains(&s) => Some(Instant::now() + Duration::from_secs_f64(s)),
         Some(s) => return Err(format!("--for-s {s}: must be within [0, 1000000] s").into()),
         None => None,
     };
@@ -90,7 +88,7 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         if until.is_some_and(|u| Instant::now() >= u) {
             break Ok(());
         }
-        if attack != Attack::Flood || i % FLOOD_BATCH == 0 {
+        if attack != Attack::Flood || i.is_multiple_of(FLOOD_BATCH) {
             // A flood does not wait: the deadline of now only picks up commits and signals.
             let pause = if attack == Attack::Flood {
                 Duration::ZERO
