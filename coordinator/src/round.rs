@@ -17,8 +17,9 @@
 //! the agent in the way.
 
 use hnav_runtime::consensus_log::{LoggedDecision, ReplanRecord, RoundRecord, Tally};
-use hnav_runtime::grid::{Cell, Grid};
+use hnav_runtime::grid::{Cell, Direction, Grid};
 use hnav_runtime::msg::{Candidate, CandidateFlags, Decision, Verdict, NO_CELL};
+use hnav_runtime::rejected::Rejected;
 use hnav_runtime::scenario::Scenario;
 
 use crate::conflict::{AgentMode, AgentRow, Options, Outcome, Resolver};
@@ -37,6 +38,8 @@ pub struct Arbiter {
     waiting: Vec<u32>,
     goals: Vec<Cell>,
     priorities: Vec<f64>,
+    /// Per agent, the priority and speed its candidates carry (the scenario's, as `f32`).
+    claims: Vec<(f32, f32)>,
     replan_after: u32,
     outcomes: Vec<Outcome>,
     decisions: Vec<Decision>,
@@ -72,6 +75,11 @@ impl Arbiter {
                 .iter()
                 .map(|a| a.effective_priority())
                 .collect(),
+            claims: scenario
+                .agents
+                .iter()
+                .map(|a| (a.effective_priority() as f32, a.speed as f32))
+                .collect(),
             replan_after: scenario.coordinator.replan_after_rounds.max(1),
             outcomes: Vec::with_capacity(n),
             decisions: Vec::with_capacity(n),
@@ -91,17 +99,54 @@ impl Arbiter {
         self.rows.len()
     }
 
-    /// Whether a candidate names cells of this grid (and `NO_CELL` only where allowed).
-    pub fn valid(&self, c: &Candidate) -> bool {
-        let n = self.grid.len() as u32;
-        (c.agent as usize) < self.rows.len()
-            && c.current < n
-            && c.next < n
-            && (c.probable < n || c.probable == NO_CELL)
+    /// Checks what a candidate says against what its agent can truthfully say, apart from the
+    /// round (which the caller knows): the agent index, the flag bits and reserved field, the
+    /// priority and speed (exactly the scenario's, as the agent sends them) and the cells (on
+    /// the map; `next` is `current` or a neighbour, `probable` is [`NO_CELL`] or a neighbour
+    /// of `next` or `current`). Returns the first check that fails.
+    pub fn check(&self, c: &Candidate) -> Result<(), Rejected> {
+        let Some(&(priority, speed)) = self.claims.get(c.agent as usize) else {
+            return Err(Rejected::Agent);
+        };
+        if c.flags & !CandidateFlags::ALL != 0 || c.reserved != 0 {
+            return Err(Rejected::Flags);
+        }
+        // Bit equality: NaN never equals itself, and -0.0 is not what any agent sends.
+        if c.priority.to_bits() != priority.to_bits() || c.speed.to_bits() != speed.to_bits() {
+            return Err(Rejected::PrioritySpeed);
+        }
+        let cell = |v: u32| self.grid.cell_at(v as usize);
+        let (Some(current), Some(next)) = (cell(c.current), cell(c.next)) else {
+            return Err(Rejected::Cell);
+        };
+        let step = |a: Cell, b: Cell| Direction::between(a, b).is_some();
+        if next != current && !step(current, next) {
+            return Err(Rejected::Cell);
+        }
+        if c.probable != NO_CELL {
+            match cell(c.probable) {
+                Some(p) if step(next, p) || step(current, p) => {}
+                _ => return Err(Rejected::Cell),
+            }
+        }
+        Ok(())
     }
 
-    /// Decides one round. `candidates[i]` is agent `i`'s candidate (validated with
-    /// [`Arbiter::valid`]) or `None` if it is missing. Returns the decisions for the agents that
+    /// Classifies a candidate when rounds up to `decided` are decided: [`Arbiter::check`],
+    /// then its round, which must be the open one (`decided + 1`).
+    pub fn classify(&self, c: &Candidate, decided: u64) -> Result<(), Rejected> {
+        self.check(c)?;
+        if c.round > decided.saturating_add(1) {
+            Err(Rejected::FutureRound)
+        } else if c.round <= decided {
+            Err(Rejected::PastRound)
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Decides one round. `candidates[i]` is agent `i`'s candidate (checked with
+    /// [`Arbiter::check`]) or `None` if it is missing. Returns the decisions for the agents that
     /// asked for something (in agent order) and the replans made.
     pub fn decide(
         &mut self,
@@ -331,15 +376,105 @@ mod tests {
     }
 
     #[test]
-    fn invalid_candidates_are_recognised() {
+    fn each_hostile_candidate_is_put_in_its_class() {
         let s = scenario(TWO);
         let a = Arbiter::new(&s);
-        let mut c = cand(&s, 0, (1, 1), None);
-        assert!(a.valid(&c));
-        c.agent = 5;
-        assert!(!a.valid(&c));
-        c.agent = 0;
-        c.probable = 24;
-        assert!(!a.valid(&c));
+        let g = &s.map.grid;
+        let at = |x, y| g.index(Cell::new(x, y)) as u32;
+        let good = Candidate {
+            priority: 1.0,
+            speed: 1.0,
+            ..cand(&s, 0, (1, 1), Some((2, 1)))
+        };
+        assert_eq!(a.check(&good), Ok(()));
+        let moving = Candidate {
+            next: at(2, 2),
+            probable: NO_CELL,
+            ..good
+        };
+        assert_eq!(a.check(&moving), Ok(()));
+        let bad: [(Candidate, Rejected); 12] = [
+            (Candidate { agent: 2, ..good }, Rejected::Agent),
+            (
+                Candidate {
+                    agent: u32::MAX,
+                    ..good
+                },
+                Rejected::Agent,
+            ),
+            (
+                Candidate {
+                    flags: 1 << 5,
+                    ..good
+                },
+                Rejected::Flags,
+            ),
+            (
+                Candidate {
+                    reserved: 7,
+                    ..good
+                },
+                Rejected::Flags,
+            ),
+            (
+                Candidate {
+                    priority: f32::NAN,
+                    ..good
+                },
+                Rejected::PrioritySpeed,
+            ),
+            (
+                Candidate {
+                    speed: f32::INFINITY,
+                    ..good
+                },
+                Rejected::PrioritySpeed,
+            ),
+            (
+                Candidate {
+                    priority: -1.0,
+                    ..good
+                },
+                Rejected::PrioritySpeed,
+            ),
+            (
+                Candidate {
+                    priority: 2.0,
+                    ..good
+                },
+                Rejected::PrioritySpeed,
+            ),
+            (
+                Candidate {
+                    current: 24,
+                    ..good
+                },
+                Rejected::Cell,
+            ),
+            (
+                Candidate {
+                    next: at(3, 1),
+                    ..good
+                },
+                Rejected::Cell,
+            ),
+            (
+                Candidate {
+                    probable: at(5, 1),
+                    ..good
+                },
+                Rejected::Cell,
+            ),
+            (
+                Candidate {
+                    probable: 24,
+                    ..good
+                },
+                Rejected::Cell,
+            ),
+        ];
+        for (c, class) in bad {
+            assert_eq!(a.check(&c), Err(class), "{c:?}");
+        }
     }
 }

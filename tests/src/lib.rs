@@ -7,6 +7,8 @@
 //!   test leaves nothing behind in `/dev/shm`;
 //! - the `hnav-test-peer` binary (`src/bin/hnav-test-peer.rs`): small publisher and
 //!   subscriber roles the tests run as separate processes;
+//! - the `hnav-rogue` binary (`src/bin/hnav-rogue.rs`) and [`rogue`], the hostile candidates
+//!   it forges (`tests/rogue.rs`);
 //! - [`pattern`]: the deterministic payloads both sides of a test agree on;
 //! - [`lost_wakeup`]: both halves of the lost-wake-up reproducer (`tests/lost_wakeup.rs`);
 //! - [`tick`]: a discrete-time multi-agent run (neural maps, path constructor, conflict
@@ -17,6 +19,7 @@
 
 pub mod lost_wakeup;
 pub mod pattern;
+pub mod rogue;
 pub mod swarm;
 pub mod tick;
 

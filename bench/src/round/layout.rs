@@ -215,6 +215,10 @@ mod tests {
             let mut blocked = 0;
             for round in 1..=40u64 {
                 let cands: Vec<_> = (0..n).map(|i| Some(l.candidate(i, round))).collect();
+                // A candidate the coordinator drops as hostile would stall the bench's round.
+                for c in cands.iter().flatten() {
+                    assert_eq!(arbiter.classify(c, round - 1), Ok(()), "{c:?}");
+                }
                 let (decisions, replans) = arbiter.decide(round, &cands);
                 assert!(replans.is_empty(), "{n} agents, round {round}");
                 for d in decisions {

@@ -69,7 +69,8 @@ pub struct CoordinatorOutcome {
     pub round: u64,
     /// Whether every agent reached its goal.
     pub all_at_goal: bool,
-    /// Candidates dropped as malformed.
+    /// Candidates dropped as malformed or hostile (every class of
+    /// [`Rejected`](hnav_runtime::rejected::Rejected) together).
     pub dropped: u64,
 }
 
@@ -117,6 +118,7 @@ impl<'t> CoordinatorProcess<'t> {
             if !st.ended() {
                 st.end(EndReason::Stopped)?;
             }
+            st.report_rejections();
             return Ok(st.outcome());
         }
         // A coordinator that died between its last round and the run's end ends it now.
@@ -132,6 +134,7 @@ impl<'t> CoordinatorProcess<'t> {
             st.end(reason)?;
         }
         st.sync()?;
+        st.report_rejections();
         Ok(st.outcome())
     }
 }

@@ -1,7 +1,7 @@
 //! The coordinator's state between wake-ups: the open round's candidates, who is live, the
 //! last decided round and the consensus log it is made durable in.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use hnav_runtime::consensus_log::{
@@ -12,6 +12,7 @@ use hnav_runtime::grid::{reachable_from, Cell, CornerCutting, Grid};
 use hnav_runtime::msg::{
     Candidate, CandidateFlags, Lifecycle, LifecycleEvent, Progress, Role, StopReason,
 };
+use hnav_runtime::rejected::{Rejected, Rejections};
 use hnav_runtime::scenario::{ClockMode, Scenario};
 
 use super::ports::Ports;
@@ -34,7 +35,9 @@ pub(super) struct State {
     round_limit: Option<u64>,
     /// Why the run ended, once the log holds its end.
     end: Option<EndReason>,
-    dropped: u64,
+    /// Candidates dropped, per class; kept in `DIR/rejected.json` across restarts.
+    rejected: Rejections,
+    run_dir: PathBuf,
     restarts: Vec<u32>,
     /// The supervisor's events of one drain, kept so that draining allocates nothing once warm.
     events: Vec<(Role, u32, LifecycleEvent)>,
@@ -99,7 +102,8 @@ impl State {
             round_limit: (scenario.sim.clock == ClockMode::Lockstep)
                 .then(|| scenario.sim.rounds_in(scenario.coordinator.time_limit_s)),
             end: None,
-            dropped: 0,
+            rejected: load_rejections(run_dir),
+            run_dir: run_dir.to_path_buf(),
             restarts: vec![0; n],
             events: Vec::new(),
             walls: scenario.map.grid.clone(),
@@ -135,7 +139,7 @@ impl State {
         CoordinatorOutcome {
             round: self.round,
             all_at_goal: self.ended() && self.arbiter.at_goal() as usize == self.arbiter.agents(),
-            dropped: self.dropped,
+            dropped: self.rejected.total(),
         }
     }
 
@@ -264,36 +268,57 @@ impl State {
     }
 
     /// Takes every candidate in; keeps those for the open round, re-sends the last commit to
-    /// agents asking for a round already decided.
+    /// agents asking for a round already decided, drops (and counts) the rest.
     pub(super) fn collect(&mut self, p: &Ports) -> Result<(), CoordinatorError> {
         let mut resend = false;
         p.candidates.drain_pending(|&c| {
-            if !self.arbiter.valid(&c) {
-                self.dropped += 1;
-                tracing::warn!(
-                    agent = c.agent,
-                    round = c.round,
-                    "malformed candidate dropped"
-                );
+            if let Err(class) = self.arbiter.classify(&c, self.round) {
+                // An agent behind (a restarted one, or one the dead coordinator never
+                // answered): the last commit brings it up to date.
+                resend |= class == Rejected::PastRound && self.round > 0;
+                self.reject(class, &c);
                 return;
             }
-            let i = c.agent as usize;
-            if c.round == self.round + 1 && !self.ended() {
+            if !self.ended() {
+                let i = c.agent as usize;
                 if self.pending.iter().all(Option::is_none) {
                     self.opened = Some(Instant::now());
                 }
                 self.pending[i] = Some(c);
                 self.live[i] = true;
-            } else if c.round <= self.round && self.round > 0 {
-                // An agent behind (a restarted one, or one the dead coordinator never
-                // answered): the last commit brings it up to date.
-                resend = true;
             }
         })?;
         if resend {
             self.resend_last_commit(p)?;
         }
         Ok(())
+    }
+
+    /// Counts a dropped candidate; only the first of its class is logged, so that a flood
+    /// costs no log line and no allocation per message.
+    fn reject(&mut self, class: Rejected, c: &Candidate) {
+        if self.rejected.note(class) {
+            tracing::warn!(
+                class = class.name(),
+                agent = c.agent,
+                round = c.round,
+                "candidate dropped; further ones of this class are only counted"
+            );
+        }
+    }
+
+    /// Logs the totals of dropped candidates (if any) and keeps them in `DIR/rejected.json`
+    /// for the run summary and for a coordinator restarted after this one.
+    pub(super) fn report_rejections(&self) {
+        if self.rejected.total() > 0 {
+            tracing::warn!(counts = %self.rejected, "candidates dropped in this run");
+        }
+        if let Err(e) = self.rejected.store(&self.run_dir) {
+            tracing::warn!(
+                "cannot write {}: {e}",
+                self.run_dir.join(hnav_runtime::rejected::FILE).display()
+            );
+        }
     }
 
     /// Publishes the last logged round's commit again, if there is one.
@@ -415,4 +440,13 @@ impl State {
         })?;
         Ok(())
     }
+}
+
+/// The counts an earlier coordinator of the run left, or none; a file that cannot be read is
+/// reported and counting starts again from zero, since the counts never decide anything.
+fn load_rejections(run_dir: &Path) -> Rejections {
+    Rejections::load(run_dir).unwrap_or_else(|e| {
+        tracing::warn!("{e}; counting dropped candidates from zero");
+        Rejections::default()
+    })
 }

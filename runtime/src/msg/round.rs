@@ -60,6 +60,9 @@ impl CandidateFlags {
     pub const RESTARTED: u32 = 1 << 3;
     /// The neural map reports the goal unreachable.
     pub const NO_PATH: u32 = 1 << 4;
+    /// Every bit an agent may set; a receiver drops a candidate with any other.
+    pub const ALL: u32 =
+        Self::AT_GOAL | Self::STANDING | Self::LOCAL_EXTREMUM | Self::RESTARTED | Self::NO_PATH;
 }
 
 /// What the coordinator decided for one agent in a round.

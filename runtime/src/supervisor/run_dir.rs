@@ -19,9 +19,16 @@ use crate::transport::RunId;
 pub const LOCK_FILE: &str = ".hnav-run.lock";
 
 /// What a run writes into its directory: the consensus log, the agents' checkpoints, the
-/// processes' output, the summary and the event journal. `--force` removes these and nothing
-/// else.
-pub const RUN_OUTPUTS: [&str; 5] = ["log", "agents", "logs", "summary.json", "events.jsonl"];
+/// processes' output, the summary, the event journal and the coordinator's counts of dropped
+/// candidates. `--force` removes these and nothing else.
+pub const RUN_OUTPUTS: [&str; 6] = [
+    "log",
+    "agents",
+    "logs",
+    "summary.json",
+    "events.jsonl",
+    crate::rejected::FILE,
+];
 
 /// Why a run directory cannot be claimed.
 #[derive(Debug, thiserror::Error)]

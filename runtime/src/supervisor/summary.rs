@@ -6,6 +6,7 @@
 //! comes from the sim's ground truth — its true pose lies in its goal cell — not from what the
 //! agents believed.
 
+use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -13,6 +14,7 @@ use serde::Serialize;
 
 use crate::consensus_log::{read_log, LogError, Record, Tally};
 use crate::msg::Truth;
+use crate::rejected::Rejections;
 
 /// One agent's line of the summary.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -56,6 +58,9 @@ pub struct RunSummary {
     /// coordinator down and not restarted, or no agent left); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cannot_go_on: Option<String>,
+    /// Candidates the coordinator dropped as malformed or hostile, per
+    /// [`Rejected`](crate::rejected::Rejected) class (every class, zeros included).
+    pub rejected: BTreeMap<String, u64>,
 }
 
 impl RunSummary {
@@ -67,7 +72,8 @@ impl RunSummary {
     }
 
     /// Builds the summary from the log in `log_dir` and the last ground truth (poses in
-    /// metres, cells `cell_size_m` wide).
+    /// metres, cells `cell_size_m` wide), with the coordinator's counts of dropped candidates
+    /// from the run directory holding `log_dir`.
     pub fn from_log(
         run_id: &str,
         log_dir: &Path,
@@ -127,6 +133,7 @@ impl RunSummary {
             end,
             log: log_dir.to_path_buf(),
             cannot_go_on: None,
+            rejected: read_rejected(log_dir.parent().unwrap_or(Path::new("."))),
         })
     }
 
@@ -170,6 +177,17 @@ impl RunSummary {
         );
         s
     }
+}
+
+/// The coordinator's counts of dropped candidates in `run_dir` (see [`crate::rejected`]);
+/// all zero, with a warning, when its file cannot be read.
+fn read_rejected(run_dir: &Path) -> BTreeMap<String, u64> {
+    Rejections::load(run_dir)
+        .unwrap_or_else(|e| {
+            tracing::warn!("{e}; the summary counts no dropped candidates");
+            Rejections::default()
+        })
+        .to_map()
 }
 
 /// Replaces `path` by a file holding `bytes`, whole or not at all (see
