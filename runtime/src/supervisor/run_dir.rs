@@ -18,10 +18,18 @@ use crate::transport::RunId;
 /// The lock file in the run directory.
 pub const LOCK_FILE: &str = ".hnav-run.lock";
 
-/// What a run writes into its directory: the consensus log, the agents' checkpoints, the
-/// processes' output, the summary and the event journal. `--force` removes these and nothing
-/// else.
-pub const RUN_OUTPUTS: [&str; 5] = ["log", "agents", "logs", "summary.json", "events.jsonl"];
+/// What a run writes into its directory: the consensus log, the agents' and the sim's
+/// checkpoints, the processes' output, the summary and the event journal. `--force` removes
+/// these and nothing else.
+pub const RUN_OUTPUTS: [&str; 7] = [
+    "log",
+    "agents",
+    "sim.ckpt",
+    "sim.ckpt.tmp",
+    "logs",
+    "summary.json",
+    "events.jsonl",
+];
 
 /// Why a run directory cannot be claimed.
 #[derive(Debug, thiserror::Error)]
