@@ -36,21 +36,33 @@ fn kill(round: u64, role: &str) -> String {
 /// The run ended with exit code 4, robot [`LOST`] lost (for `why`) and every other one at its
 /// goal, well before the time limit.
 fn ended_with_the_robot_lost(f: &Finished, why: &str) {
-    assert_eq!(f.status.code(), Some(4), "{}\n{}", f.status, f.swarm.log_tails());
+    assert_eq!(
+        f.status.code(),
+        Some(4),
+        "{}\n{}",
+        f.status,
+        f.swarm.log_tails()
+    );
     let s = f.summary();
     assert_eq!(s["end"], "all-at-goal-or-lost", "{s}");
     let lost = s["lost"].as_array().unwrap();
     assert_eq!(lost.len(), 1, "{s}");
     assert_eq!(lost[0]["id"], LOST as u64, "{s}");
     let said = lost[0]["why"].as_str().unwrap();
-    assert!(said.contains("hnav-agent 4") && said.contains(why), "{said}");
+    assert!(
+        said.contains("hnav-agent 4") && said.contains(why),
+        "{said}"
+    );
     for (i, a) in s["agents"].as_array().unwrap().iter().enumerate() {
         assert_eq!(a["lost"], i == LOST, "{a}");
         assert_eq!(a["reached_goal"], i != LOST, "{a}");
     }
     f.check_log_and_summary();
     let rounds = s["rounds"].as_u64().unwrap();
-    assert!(rounds < 20_000, "{rounds} rounds: the run waited for its time limit");
+    assert!(
+        rounds < 20_000,
+        "{rounds} rounds: the run waited for its time limit"
+    );
 }
 
 #[test]
@@ -62,11 +74,20 @@ fn an_agent_past_its_restart_budget_is_lost_and_the_run_ends_when_the_others_arr
         kill(5, "agent"),
         kill(10, "agent")
     );
-    let scenario = demo(tmp.path(), "budget", &[("time_limit_s = 60", "time_limit_s = 600")], &extra);
+    let scenario = demo(
+        tmp.path(),
+        "budget",
+        &[("time_limit_s = 60", "time_limit_s = 600")],
+        &extra,
+    );
     let f = run("budget", &scenario, tmp.path(), "lockstep", BOUND);
     ended_with_the_robot_lost(&f, "restart limit of 1 reached");
     let agent = |e, n| (Role::Agent, LOST as u32, e, n);
-    let logged: Vec<_> = f.lifecycle().into_iter().map(|l| (l.0, (l.1, l.2, l.3, l.4))).collect();
+    let logged: Vec<_> = f
+        .lifecycle()
+        .into_iter()
+        .map(|l| (l.0, (l.1, l.2, l.3, l.4)))
+        .collect();
     assert_eq!(
         logged,
         vec![
@@ -86,12 +107,26 @@ fn under_on_give_up_stop_an_agent_not_restarted_stops_the_run_at_once() {
         "[restart]\nagent = {{ policy = \"never\" }}\non_give_up = \"stop\"\n\n{}",
         kill(5, "agent")
     );
-    let scenario = demo(tmp.path(), "stop", &[("time_limit_s = 60", "time_limit_s = 600")], &extra);
+    let scenario = demo(
+        tmp.path(),
+        "stop",
+        &[("time_limit_s = 60", "time_limit_s = 600")],
+        &extra,
+    );
     let f = run("giveupstop", &scenario, tmp.path(), "lockstep", BOUND);
-    assert_eq!(f.status.code(), Some(3), "{}\n{}", f.status, f.swarm.log_tails());
+    assert_eq!(
+        f.status.code(),
+        Some(3),
+        "{}\n{}",
+        f.status,
+        f.swarm.log_tails()
+    );
     let s = f.summary();
     let why = s["cannot_go_on"].as_str().unwrap_or_default();
-    assert!(why.contains("hnav-agent 4") && why.contains("on_give_up"), "{s}");
+    assert!(
+        why.contains("hnav-agent 4") && why.contains("on_give_up"),
+        "{s}"
+    );
     assert!(s["rounds"].as_u64().unwrap() < 1000, "{s}");
 }
 
@@ -117,10 +152,14 @@ fn coordinator_and_lost_agent(mode: &str) -> Finished {
         .iter()
         .find(|l| l.1 == Role::Coordinator && l.3 == LifecycleEvent::Restarted)
         .expect("the coordinator's restart is logged");
-    assert_eq!(restarted.4, 1, "the coordinator's restart count is the supervisor's: {life:?}");
+    assert_eq!(
+        restarted.4, 1,
+        "the coordinator's restart count is the supervisor's: {life:?}"
+    );
     for e in [LifecycleEvent::Down, LifecycleEvent::Lost] {
         assert!(
-            life.iter().any(|l| l.1 == Role::Agent && l.2 == LOST as u32 && l.3 == e),
+            life.iter()
+                .any(|l| l.1 == Role::Agent && l.2 == LOST as u32 && l.3 == e),
             "agent {LOST}'s {} is not logged: {life:?}",
             e.name()
         );
@@ -133,7 +172,10 @@ fn a_lockstep_coordinator_killed_with_an_agent_for_good_does_not_deadlock() {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let f = coordinator_and_lost_agent("lockstep");
     let life = f.lifecycle();
-    assert!(life.iter().all(|l| l.0 == 30), "logged at the faults' round: {life:?}");
+    assert!(
+        life.iter().all(|l| l.0 == 30),
+        "logged at the faults' round: {life:?}"
+    );
 }
 
 #[test]

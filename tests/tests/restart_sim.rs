@@ -64,8 +64,15 @@ fn a_killed_lockstep_sim_resumes_and_the_run_decides_what_it_would_have() {
     // The header differs (the fault plan is part of the scenario hash) and the kill run logs
     // the sim's death and restart; every decision is the same.
     let (da, db) = (decisions(&a), decisions(&b));
-    assert_eq!(da.len(), db.len(), "the runs logged different numbers of records");
-    assert!(da == db, "the lockstep run with the sim killed decided differently");
+    assert_eq!(
+        da.len(),
+        db.len(),
+        "the runs logged different numbers of records"
+    );
+    assert!(
+        da == db,
+        "the lockstep run with the sim killed decided differently"
+    );
 }
 
 #[test]
@@ -77,7 +84,14 @@ fn a_killed_realtime_sim_resumes_and_every_robot_arrives() {
     all_at_goal(&f);
     f.check_log_and_summary();
     f.check_odometry_continuous();
-    let sim: Vec<_> = f.lifecycle().into_iter().filter(|l| l.1 == Role::Sim).collect();
+    let sim: Vec<_> = f
+        .lifecycle()
+        .into_iter()
+        .filter(|l| l.1 == Role::Sim)
+        .collect();
     assert_eq!(sim.len(), 2, "{sim:?}");
-    assert_eq!((sim[0].3, sim[1].3, sim[1].4), (LifecycleEvent::Down, LifecycleEvent::Restarted, 1));
+    assert_eq!(
+        (sim[0].3, sim[1].3, sim[1].4),
+        (LifecycleEvent::Down, LifecycleEvent::Restarted, 1)
+    );
 }

@@ -10,8 +10,7 @@ use hnav_runtime::consensus_log::{
 };
 use hnav_runtime::grid::{reachable_from, Cell, CornerCutting, Grid};
 use hnav_runtime::msg::{
-    Candidate, CandidateFlags, Lifecycle, LifecycleEvent, Progress, Role, RosterState,
-    StopReason,
+    Candidate, CandidateFlags, Lifecycle, LifecycleEvent, Progress, Role, RosterState, StopReason,
 };
 use hnav_runtime::scenario::{ClockMode, Scenario};
 
@@ -281,8 +280,7 @@ impl State {
                 }
                 self.log_event(role, l.index, ev, l.restarts)
             }
-            LifecycleEvent::Roster if role == Role::Agent => match RosterState::from_u8(l.reason)
-            {
+            LifecycleEvent::Roster if role == Role::Agent => match RosterState::from_u8(l.reason) {
                 Some(state) => self.reconcile(l.index, state, l.restarts),
                 None => Ok(()),
             },
@@ -501,9 +499,7 @@ impl State {
                     EndReason::AllAtGoal
                     | EndReason::AllAtGoalOrUnreachable
                     | EndReason::AllAtGoalOrLost,
-                ) => {
-                    Progress::ALL_AT_GOAL
-                }
+                ) => Progress::ALL_AT_GOAL,
                 Some(EndReason::TimeLimit) => Progress::TIME_LIMIT,
                 Some(EndReason::Stopped) | None => 0,
             },

@@ -472,7 +472,10 @@ mod tests {
         );
         assert!(start.time_ns > 0);
         let lost = Lifecycle::lost(Role::Agent, 2, 3);
-        assert_eq!(fields(lost), (agent, 2, LifecycleEvent::Lost as u8, 0, 0, 3));
+        assert_eq!(
+            fields(lost),
+            (agent, 2, LifecycleEvent::Lost as u8, 0, 0, 3)
+        );
         let roster = Lifecycle::roster(5, RosterState::Down, 1);
         assert_eq!(
             fields(roster),

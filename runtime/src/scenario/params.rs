@@ -335,7 +335,10 @@ mod tests {
         );
         // 20 rad/s * 21 mm / 16 cm.
         assert!((r.max_speed_cells_s() - 2.625).abs() < 1e-9);
-        assert_eq!(RestartConfig::default().sim.policy, RestartPolicy::OnFailure);
+        assert_eq!(
+            RestartConfig::default().sim.policy,
+            RestartPolicy::OnFailure
+        );
         assert_eq!(SimParams::default().clock, ClockMode::Lockstep);
         assert_eq!(CoordinatorParams::default().fsync, FsyncPolicy::EveryRecord);
     }

@@ -153,7 +153,13 @@ mod tests {
     fn world() -> World {
         let robot = RobotParams::default();
         let start = cell_centre_pose(robot.cell_size_m, Cell::new(1, 1), 0.0);
-        World::new(&robot, &SimParams::default(), Grid::new(6, 4).unwrap(), &[start]).unwrap()
+        World::new(
+            &robot,
+            &SimParams::default(),
+            Grid::new(6, 4).unwrap(),
+            &[start],
+        )
+        .unwrap()
     }
 
     #[test]
@@ -175,7 +181,10 @@ mod tests {
 
         let other = SimCheckpoint::in_dir(dir.path(), 8);
         let err = other.load(&mut world()).unwrap_err().to_string();
-        assert!(err.ends_with("sim.ckpt: written for another scenario"), "{err}");
+        assert!(
+            err.ends_with("sim.ckpt: written for another scenario"),
+            "{err}"
+        );
         let mut bytes = std::fs::read(ck.path()).unwrap();
         bytes[30] ^= 4;
         std::fs::write(ck.path(), &bytes).unwrap();

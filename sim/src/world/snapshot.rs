@@ -46,7 +46,10 @@ struct Words<'b>(&'b [u8]);
 
 impl Words<'_> {
     fn next(&mut self) -> Result<u64, SnapshotError> {
-        let (w, rest) = self.0.split_first_chunk::<8>().ok_or(SnapshotError::Length)?;
+        let (w, rest) = self
+            .0
+            .split_first_chunk::<8>()
+            .ok_or(SnapshotError::Length)?;
         self.0 = rest;
         Ok(u64::from_le_bytes(*w))
     }
@@ -176,7 +179,8 @@ impl World {
         let count = w.count(COLLISION_WORDS)?;
         next.collisions.clear();
         for _ in 0..count {
-            let (time_ns, robot, kind, x, y) = (w.next()?, w.next()?, w.next()?, w.next()?, w.next()?);
+            let (time_ns, robot, kind, x, y) =
+                (w.next()?, w.next()?, w.next()?, w.next()?, w.next()?);
             let hit = match kind {
                 0 => Hit::Robot(x as u32),
                 _ => Hit::Cell(x as i64, y as i64),
@@ -227,7 +231,8 @@ mod tests {
         for _ in 0..n {
             if w.steps() % 10 == 0 {
                 for i in 0..2 {
-                    w.apply_command(i, w.steps() / 10, 8.0, 8.0, w.time_ns()).unwrap();
+                    w.apply_command(i, w.steps() / 10, 8.0, 8.0, w.time_ns())
+                        .unwrap();
                 }
             }
             w.step();

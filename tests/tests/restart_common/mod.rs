@@ -33,7 +33,10 @@ pub fn demo(dir: &Path, name: &str, replace: &[(&str, &str)], extra: &str) -> Pa
 
 /// The demo with every robot at 2 cells/s, so that a realtime run takes seconds, not a
 /// minute.
-pub const FAST: [(&str, &str); 2] = [("speed = 0.5", "speed = 2.0"), ("speed = 1.5", "speed = 2.0")];
+pub const FAST: [(&str, &str); 2] = [
+    ("speed = 0.5", "speed = 2.0"),
+    ("speed = 1.5", "speed = 2.0"),
+];
 
 /// A finished run: the supervisor's exit, its directory, and what the observer saw.
 pub struct Finished {
@@ -90,7 +93,10 @@ impl Finished {
             .iter()
             .filter(|a| a["reached_goal"] == true)
             .count();
-        assert_eq!(at_goal, end.at_goal as usize, "summary {s} vs log end {end:?}");
+        assert_eq!(
+            at_goal, end.at_goal as usize,
+            "summary {s} vs log end {end:?}"
+        );
         assert_eq!(s["end"], end.reason.name(), "{s}");
     }
 
@@ -100,10 +106,19 @@ impl Finished {
     /// back by the whole distance driven).
     pub fn check_odometry_continuous(&self) {
         for (i, seen) in self.odometry.iter().enumerate() {
-            assert!(seen.len() > 10, "robot {i}: only {} readings seen", seen.len());
+            assert!(
+                seen.len() > 10,
+                "robot {i}: only {} readings seen",
+                seen.len()
+            );
             for w in seen.windows(2) {
                 let (a, b) = (w[0], w[1]);
-                assert!(b.period >= a.period, "robot {i}: period {} after {}", b.period, a.period);
+                assert!(
+                    b.period >= a.period,
+                    "robot {i}: period {} after {}",
+                    b.period,
+                    a.period
+                );
                 let gap = (b.period - a.period).max(1) as i64;
                 // 20 rad/s for 10 ms is 1.4 ticks of 42 per revolution.
                 let bound = 2 * gap + 1;
@@ -142,9 +157,11 @@ pub fn run(tag: &str, scenario: &Path, dir: &Path, mode: &str, bound: Duration) 
         &["--mode", mode],
     )
     .expect("hnav run starts");
-    let status = swarm.finish(bound).expect("hnav run ends within its bound");
+    let status = swarm.finish(bound);
     let wall = started.elapsed();
+    // Before anything can fail: the observer's node must be gone for the run's clean-up.
     let odometry = observer.finish();
+    let status = status.expect("hnav run ends within its bound");
     Finished {
         swarm,
         status,
@@ -168,9 +185,15 @@ impl OdometryObserver {
         let (seen2, stop2, run) = (seen.clone(), stop.clone(), run.clone());
         let (ready_tx, ready_rx) = std::sync::mpsc::channel();
         let thread = std::thread::spawn(move || {
-            let t = Transport::builder(&run).node_name("odom-observer").create().unwrap();
+            let t = Transport::builder(&run)
+                .node_name("odom-observer")
+                .create()
+                .unwrap();
             let rx: Vec<_> = (0..robots)
-                .map(|i| t.receiver::<Odometry>(&topics::odometry(i), topics::state_qos()).unwrap())
+                .map(|i| {
+                    t.receiver::<Odometry>(&topics::odometry(i), topics::state_qos())
+                        .unwrap()
+                })
                 .collect();
             let waiter = t.waiter().unwrap();
             let _attached: Vec<_> = rx.iter().map(|r| waiter.attach(r).unwrap()).collect();
@@ -183,7 +206,9 @@ impl OdometryObserver {
                 let _ = waiter.wait(Some(Instant::now() + Duration::from_millis(100)));
             }
         });
-        ready_rx.recv_timeout(Duration::from_secs(30)).expect("observer up");
+        ready_rx
+            .recv_timeout(Duration::from_secs(30))
+            .expect("observer up");
         Self {
             seen,
             stop,
