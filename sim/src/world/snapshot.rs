@@ -83,8 +83,9 @@ fn put_option(out: &mut Vec<u8>, v: Option<u64>) {
 }
 
 impl World {
-    /// Appends the world's dynamic state to `out` (see the [module docs](self)); with `out`
-    /// reused, no allocation once it has grown to the snapshot's size.
+    /// Appends the world's dynamic state to `out`: every value a step reads that the scenario
+    /// does not fix, floats as their bits. With `out` reused, no allocation once it has grown
+    /// to the snapshot's size.
     pub fn write_snapshot(&self, out: &mut Vec<u8>) {
         put(out, MAGIC);
         put(out, self.robots() as u64);
@@ -229,7 +230,7 @@ mod tests {
     /// robot whose command is older than 100 ms).
     fn drive(w: &mut World, n: usize) {
         for _ in 0..n {
-            if w.steps() % 10 == 0 {
+            if w.steps().is_multiple_of(10) {
                 for i in 0..2 {
                     w.apply_command(i, w.steps() / 10, 8.0, 8.0, w.time_ns())
                         .unwrap();

@@ -54,7 +54,7 @@ impl Finished {
     }
 
     pub fn records(&self) -> Vec<Record> {
-        read_log(&self.swarm.dir.join("log")).unwrap().records
+        read_log(self.swarm.dir.join("log")).unwrap().records
     }
 
     /// `(round, role, index, event, restarts)` of every lifecycle record.
