@@ -276,6 +276,13 @@ impl Arbiter {
             .count() as u32
     }
 
+    /// Whether agent `i`'s last candidate said it stands on its goal.
+    pub fn agent_at_goal(&self, i: usize) -> bool {
+        self.flags
+            .get(i)
+            .is_some_and(|f| f & CandidateFlags::AT_GOAL != 0)
+    }
+
     /// The tally of every decision made (and replayed) so far.
     pub fn tally(&self) -> &Tally {
         &self.tally

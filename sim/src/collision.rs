@@ -135,6 +135,30 @@ impl Detector {
         }
     }
 
+    /// Whether robot `i` touched a wall at the last check (a contact in progress is not
+    /// recorded again).
+    pub(crate) fn on_wall(&self, i: usize) -> bool {
+        self.on_wall.get(i).copied().unwrap_or(false)
+    }
+
+    /// Restores [`Detector::on_wall`] of robot `i`.
+    pub(crate) fn set_on_wall(&mut self, i: usize, v: bool) {
+        if let Some(w) = self.on_wall.get_mut(i) {
+            *w = v;
+        }
+    }
+
+    /// The robot pairs in contact at the last check, sorted.
+    pub(crate) fn touching(&self) -> &[(u32, u32)] {
+        &self.touching
+    }
+
+    /// Restores [`Detector::touching`] (sorted here, as the check's binary search needs).
+    pub(crate) fn set_touching(&mut self, mut pairs: Vec<(u32, u32)>) {
+        pairs.sort_unstable();
+        self.touching = pairs;
+    }
+
     /// Whether centre `p` lies in an open cell (see `open`).
     #[inline]
     fn in_open_cell(&self, p: &Point2<f64>) -> bool {

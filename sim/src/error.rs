@@ -45,4 +45,8 @@ pub enum SimError {
     /// or the supervisor never answered the start-up handshake.
     #[error(transparent)]
     Transport(#[from] TransportError),
+    /// The restart checkpoint `DIR/sim.ckpt` could not be written, or a restarted sim could
+    /// not use the one it found.
+    #[error("sim checkpoint {0}")]
+    Checkpoint(#[from] crate::process::CheckpointError),
 }

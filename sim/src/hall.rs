@@ -28,6 +28,16 @@ impl SlipNoise {
         SlipNoise { rng, std }
     }
 
+    /// How far into its stream the generator is (in 32-bit words), for a checkpoint.
+    pub fn word_pos(&self) -> u128 {
+        self.rng.get_word_pos()
+    }
+
+    /// Moves the generator to `pos` of its stream ([`SlipNoise::word_pos`]).
+    pub fn set_word_pos(&mut self, pos: u128) {
+        self.rng.set_word_pos(pos);
+    }
+
     /// The next pair of slip factors `(left, right)`; ground travel is wheel travel times
     /// `1 + factor`. Zero when the standard deviation is zero.
     pub fn draw(&mut self) -> (f64, f64) {

@@ -26,6 +26,10 @@ use hnav_runtime::scenario::params::{RobotParams, SimParams};
 use hnav_runtime::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Translation2};
 
+mod snapshot;
+
+pub use snapshot::SnapshotError;
+
 /// Steps between re-derivations of the heading vectors from the heading angles.
 const RESYNC_STEPS: u64 = 256;
 

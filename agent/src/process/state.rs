@@ -31,6 +31,8 @@ pub(super) struct Core {
     outstanding: Option<u64>,
     last_period: Option<u64>,
     wheel_due: Option<u64>,
+    /// The last wheel command sent, for a restarted sim that asks for it again.
+    last_wheels: Option<WheelCommand>,
     /// A candidate is due for the last odometry reading.
     candidate_due: bool,
     ticks: (i64, i64),
@@ -90,6 +92,7 @@ impl Core {
             outstanding: None,
             last_period: None,
             wheel_due: None,
+            last_wheels: None,
             candidate_due: false,
             ticks,
         })
@@ -170,6 +173,9 @@ impl Core {
                 latest = Some(*o);
             }
         })?;
+        if let Some(o) = latest.filter(|o| Some(o.period) == self.last_period) {
+            return self.on_repeated_odometry(p, o.period);
+        }
         let Some(o) = latest.filter(|o| self.last_period.is_none_or(|p| o.period > p)) else {
             return Ok(());
         };
@@ -192,6 +198,18 @@ impl Core {
         }
         self.candidate_due = true;
         self.wheel_due = Some(o.period + 1);
+        Ok(())
+    }
+
+    /// The reading of a period already folded in, again: a restarted sim resumed from its
+    /// checkpoint publishes its last period once more. It subscribed after this agent sent
+    /// its command for the next period (an iceoryx2 subscriber does not get what was sent
+    /// before it existed), so in lockstep it would wait for that command for ever: send it
+    /// again. The reading itself changes nothing.
+    fn on_repeated_odometry(&mut self, p: &Ports, period: u64) -> Result<(), AgentError> {
+        if let Some(c) = self.last_wheels.filter(|c| c.period == period + 1) {
+            p.wheels.send(c)?;
+        }
         Ok(())
     }
 
@@ -239,13 +257,15 @@ impl Core {
         if let Some(p) = self.last_period {
             self.store_checkpoint(p, pose)?;
         }
-        p.wheels.send(WheelCommand {
+        let command = WheelCommand {
             period,
             agent: self.index,
             flags: 0,
             left_rad_s: l,
             right_rad_s: r,
-        })?;
+        };
+        p.wheels.send(command)?;
+        self.last_wheels = Some(command);
         self.wheel_due = None;
         Ok(())
     }

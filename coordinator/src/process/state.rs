@@ -10,7 +10,7 @@ use hnav_runtime::consensus_log::{
 };
 use hnav_runtime::grid::{reachable_from, Cell, CornerCutting, Grid};
 use hnav_runtime::msg::{
-    Candidate, CandidateFlags, Lifecycle, LifecycleEvent, Progress, Role, StopReason,
+    Candidate, CandidateFlags, Lifecycle, LifecycleEvent, Progress, Role, RosterState, StopReason,
 };
 use hnav_runtime::rejected::{Rejected, Rejections};
 use hnav_runtime::scenario::{ClockMode, Scenario};
@@ -38,9 +38,13 @@ pub(super) struct State {
     /// Candidates dropped, per class; kept in `DIR/rejected.json` across restarts.
     rejected: Rejections,
     run_dir: PathBuf,
+    /// Per agent: its restarts so far, as the supervisor counts them.
     restarts: Vec<u32>,
+    /// Per agent: gone for good (`Lost`); its robot stands for the rest of the run and its
+    /// goal counts as not reached.
+    lost: Vec<bool>,
     /// The supervisor's events of one drain, kept so that draining allocates nothing once warm.
-    events: Vec<(Role, u32, LifecycleEvent)>,
+    events: Vec<Lifecycle>,
     /// The map's walls, for confirming an agent's report of an unreachable goal.
     walls: Grid,
     corners: CornerCutting,
@@ -105,6 +109,7 @@ impl State {
             rejected: load_rejections(run_dir),
             run_dir: run_dir.to_path_buf(),
             restarts: vec![0; n],
+            lost: vec![false; n],
             events: Vec::new(),
             walls: scenario.map.grid.clone(),
             corners: scenario.map.corner_cutting,
@@ -129,7 +134,12 @@ impl State {
             state.replay(r);
         }
         if state.round > 0 {
-            tracing::info!(round = state.round, "resumed from the consensus log");
+            let down = state.live.iter().filter(|l| !**l).count();
+            tracing::info!(
+                round = state.round,
+                agents_down = down,
+                "resumed from the consensus log"
+            );
         }
         Ok(state)
     }
@@ -138,7 +148,7 @@ impl State {
     pub(super) fn outcome(&self) -> CoordinatorOutcome {
         CoordinatorOutcome {
             round: self.round,
-            all_at_goal: self.ended() && self.arbiter.at_goal() as usize == self.arbiter.agents(),
+            all_at_goal: self.ended() && self.at_goal() as usize == self.arbiter.agents(),
             dropped: self.rejected.total(),
         }
     }
@@ -158,8 +168,10 @@ impl State {
             }
             Record::End(e) => self.end = Some(e.reason),
             Record::Lifecycle(l) => {
-                if let Some(r) = self.restarts.get_mut(l.index as usize) {
-                    *r = (*r).max(l.restarts);
+                if let (Some(Role::Agent), Some(ev)) =
+                    (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
+                {
+                    self.agent_event(l.index, ev, l.restarts);
                 }
             }
             Record::Unreachable(u) => {
@@ -171,17 +183,38 @@ impl State {
         }
     }
 
-    /// Agents whose goal is confirmed unreachable.
-    fn unreachable_agents(&self) -> usize {
-        self.unreachable
-            .iter()
-            .filter(|r| **r == Some(true))
-            .count()
+    /// What an agent's lifecycle event (heard or replayed) says of who is live: a `Down`
+    /// agent is not waited for until it is back, a `Lost` one never again.
+    fn agent_event(&mut self, index: u32, ev: LifecycleEvent, restarts: u32) {
+        let i = index as usize;
+        let (Some(live), Some(lost), Some(r)) = (
+            self.live.get_mut(i),
+            self.lost.get_mut(i),
+            self.restarts.get_mut(i),
+        ) else {
+            return;
+        };
+        *r = (*r).max(restarts);
+        match ev {
+            LifecycleEvent::Down => *live = false,
+            LifecycleEvent::Restarted => *live = !*lost,
+            LifecycleEvent::Lost => (*live, *lost) = (false, true),
+            _ => {}
+        }
     }
 
-    /// Whether every agent is at its goal or confirmed unable to reach it.
+    /// Agents at their goal, lost ones not counted (what the end record says).
+    fn at_goal(&self) -> u32 {
+        (0..self.arbiter.agents())
+            .filter(|&i| self.arbiter.agent_at_goal(i) && !self.lost[i])
+            .count() as u32
+    }
+
+    /// Whether every agent is at its goal, confirmed unable to reach it, or lost.
     fn settled(&self) -> bool {
-        self.arbiter.at_goal() as usize + self.unreachable_agents() == self.arbiter.agents()
+        (0..self.arbiter.agents()).all(|i| {
+            self.arbiter.agent_at_goal(i) || self.unreachable[i] == Some(true) || self.lost[i]
+        })
     }
 
     /// Logs, once per agent and before the round's record, a goal its agent reports
@@ -220,50 +253,103 @@ impl State {
         // process, so losing the buffer then costs nothing.
         let mut events = std::mem::take(&mut self.events);
         events.clear();
-        let stop = p.life.drain(|r, i, e| events.push((r, i, e)))?;
-        for &(role, index, ev) in &events {
-            self.on_lifecycle(role, index, ev)?;
+        let stop = p.life.drain_samples(|_, _, l| events.push(*l))?;
+        let ended = self.ended();
+        for l in &events {
+            self.on_lifecycle(l)?;
         }
         self.events = events;
+        // A robot lost while every other one is settled ends the run here, between rounds.
+        self.end_if_over()?;
+        if self.ended() && !ended {
+            self.publish_progress(p)?;
+        }
         Ok(stop.map(|reason| match reason {
             StopReason::TimeLimit => EndReason::TimeLimit,
             StopReason::Requested => EndReason::Stopped,
         }))
     }
 
-    /// A supervisor event: liveness of agents, logged for the record.
-    fn on_lifecycle(
+    /// A supervisor event: liveness of agents, logged for the record with the restart count
+    /// the supervisor gives; a roster entry is reconciled with what the log holds.
+    fn on_lifecycle(&mut self, l: &Lifecycle) -> Result<(), CoordinatorError> {
+        let (Some(role), Some(ev)) = (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
+        else {
+            return Ok(());
+        };
+        match ev {
+            LifecycleEvent::Down | LifecycleEvent::Restarted | LifecycleEvent::Lost => {
+                if role == Role::Agent {
+                    self.agent_event(l.index, ev, l.restarts);
+                }
+                self.log_event(role, l.index, ev, l.restarts)
+            }
+            LifecycleEvent::Roster if role == Role::Agent => match RosterState::from_u8(l.reason) {
+                Some(state) => self.reconcile(l.index, state, l.restarts),
+                None => Ok(()),
+            },
+            _ => Ok(()),
+        }
+    }
+
+    /// A roster entry (sent after this coordinator came up): the records the log misses
+    /// because the agent died, came back or was given up while no coordinator listened are
+    /// logged now, at the current round, and the agent is waited for or not accordingly.
+    fn reconcile(
+        &mut self,
+        index: u32,
+        state: RosterState,
+        restarts: u32,
+    ) -> Result<(), CoordinatorError> {
+        let i = index as usize;
+        let (Some(&live), Some(&lost), Some(&logged)) =
+            (self.live.get(i), self.lost.get(i), self.restarts.get(i))
+        else {
+            return Ok(());
+        };
+        let mut missed: [Option<(LifecycleEvent, u32)>; 2] = [None, None];
+        match state {
+            // Up with restarts the log has not seen: it died and came back meanwhile.
+            RosterState::Up if !lost && (!live || logged < restarts) => {
+                if live {
+                    missed[0] = Some((LifecycleEvent::Down, restarts.saturating_sub(1)));
+                }
+                missed[1] = Some((LifecycleEvent::Restarted, restarts));
+            }
+            RosterState::Down if live => missed[0] = Some((LifecycleEvent::Down, restarts)),
+            RosterState::Lost if !lost => {
+                if live {
+                    missed[0] = Some((LifecycleEvent::Down, restarts));
+                }
+                missed[1] = Some((LifecycleEvent::Lost, restarts));
+            }
+            _ => {}
+        }
+        for (ev, count) in missed.into_iter().flatten() {
+            self.agent_event(index, ev, count);
+            self.log_event(Role::Agent, index, ev, count)?;
+        }
+        Ok(())
+    }
+
+    /// Logs a lifecycle event at the current round, unless the run has ended.
+    fn log_event(
         &mut self,
         role: Role,
         index: u32,
         ev: LifecycleEvent,
+        restarts: u32,
     ) -> Result<(), CoordinatorError> {
-        if !matches!(ev, LifecycleEvent::Down | LifecycleEvent::Restarted) {
+        if self.ended() {
             return Ok(());
         }
-        if role == Role::Agent {
-            if let Some(l) = self.live.get_mut(index as usize) {
-                *l = ev == LifecycleEvent::Restarted;
-            }
-        }
-        if role == Role::Agent && ev == LifecycleEvent::Restarted {
-            if let Some(r) = self.restarts.get_mut(index as usize) {
-                *r += 1;
-            }
-        }
-        if !self.ended() {
-            let restarts = self
-                .restarts
-                .get(index as usize)
-                .copied()
-                .unwrap_or_default();
-            let event = match ev {
-                LifecycleEvent::Restarted => Lifecycle::restarted(role, index, restarts),
-                _ => Lifecycle::down(role, index, restarts),
-            };
-            self.log
-                .append(&Record::Lifecycle(LifecycleRecord::new(self.round, &event)))?;
-        }
+        let event = match ev {
+            LifecycleEvent::Restarted => Lifecycle::restarted(role, index, restarts),
+            LifecycleEvent::Lost => Lifecycle::lost(role, index, restarts),
+            _ => Lifecycle::down(role, index, restarts),
+        };
+        self.log
+            .append(&Record::Lifecycle(LifecycleRecord::new(self.round, &event)))?;
         Ok(())
     }
 
@@ -285,7 +371,9 @@ impl State {
                     self.opened = Some(Instant::now());
                 }
                 self.pending[i] = Some(c);
-                self.live[i] = true;
+                // A candidate shows an agent live, unless the supervisor gave it up (a
+                // sample it sent before it died).
+                self.live[i] = !self.lost[i];
             }
         })?;
         if resend {
@@ -391,8 +479,10 @@ impl State {
         if self.ended() || self.round == 0 {
             return Ok(());
         }
-        if self.arbiter.at_goal() as usize == self.arbiter.agents() {
+        if self.at_goal() as usize == self.arbiter.agents() {
             self.end(EndReason::AllAtGoal)?;
+        } else if self.settled() && self.lost.iter().any(|l| *l) {
+            self.end(EndReason::AllAtGoalOrLost)?;
         } else if self.settled() {
             self.end(EndReason::AllAtGoalOrUnreachable)?;
         } else if self.round_limit.is_some_and(|limit| self.round >= limit) {
@@ -405,7 +495,7 @@ impl State {
     pub(super) fn end(&mut self, reason: EndReason) -> Result<(), CoordinatorError> {
         self.log.append(&Record::End(EndRecord {
             round: self.round,
-            at_goal: self.arbiter.at_goal(),
+            at_goal: self.at_goal(),
             reason,
         }))?;
         self.log.sync()?;
@@ -425,14 +515,16 @@ impl State {
         p.progress.send(Progress {
             round: self.round,
             agents: self.arbiter.agents() as u32,
-            at_goal: self.arbiter.at_goal(),
+            at_goal: self.at_goal(),
             conflicts: t.conflicts(),
             replans: t.replans(),
             done: match self.end {
                 // Nothing is left to decide for the unreachable ones either.
-                Some(EndReason::AllAtGoal | EndReason::AllAtGoalOrUnreachable) => {
-                    Progress::ALL_AT_GOAL
-                }
+                Some(
+                    EndReason::AllAtGoal
+                    | EndReason::AllAtGoalOrUnreachable
+                    | EndReason::AllAtGoalOrLost,
+                ) => Progress::ALL_AT_GOAL,
                 Some(EndReason::TimeLimit) => Progress::TIME_LIMIT,
                 Some(EndReason::Stopped) | None => 0,
             },

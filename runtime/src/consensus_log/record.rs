@@ -252,16 +252,21 @@ pub enum EndReason {
     Stopped,
     /// Every agent is at its goal or has reported its goal unreachable (at least one has).
     AllAtGoalOrUnreachable,
+    /// Every agent is at its goal, unreachable, or lost (its process gone for good: its robot
+    /// stands and its goal counts as not reached); at least one is lost.
+    AllAtGoalOrLost,
 }
 
 impl EndReason {
-    /// Lower-case name (`all-at-goal`, `time-limit`, `stopped`, `all-at-goal-or-unreachable`).
+    /// Lower-case name (`all-at-goal`, `time-limit`, `stopped`, `all-at-goal-or-unreachable`,
+    /// `all-at-goal-or-lost`).
     pub fn name(self) -> &'static str {
         match self {
             Self::AllAtGoal => "all-at-goal",
             Self::TimeLimit => "time-limit",
             Self::Stopped => "stopped",
             Self::AllAtGoalOrUnreachable => "all-at-goal-or-unreachable",
+            Self::AllAtGoalOrLost => "all-at-goal-or-lost",
         }
     }
 }

@@ -104,6 +104,15 @@ pub enum LifecycleEvent {
     /// start-up phase ([`Lifecycle::reason`] holds the [`StartupPhase`], [`Lifecycle::restarts`]
     /// its size), so that a start-up timeout can say what the process was doing.
     Phase = 8,
+    /// Supervisor to all: the process exited and is not restarted (its policy, or its
+    /// restart budget used up); for an agent, its robot stands for the rest of the run.
+    /// [`Lifecycle::restarts`] holds the restarts it had.
+    Lost = 9,
+    /// Supervisor to all, once for every agent, right after the `Restarted` of the sim or
+    /// the coordinator: the agent's state at that moment ([`Lifecycle::reason`] holds a
+    /// [`RosterState`], [`Lifecycle::restarts`] its restarts so far). A process that was down
+    /// missed the events of that time; the roster tells it what they were.
+    Roster = 10,
 }
 
 impl LifecycleEvent {
@@ -118,12 +127,14 @@ impl LifecycleEvent {
             6 => Some(Self::Hold),
             7 => Some(Self::Resume),
             8 => Some(Self::Phase),
+            9 => Some(Self::Lost),
+            10 => Some(Self::Roster),
             _ => None,
         }
     }
 
     /// Lower-case name (`up`, `down`, `restarted`, `start`, `stop`, `hold`, `resume`,
-    /// `phase`), as in `hnav log show`.
+    /// `phase`, `lost`, `roster`), as in `hnav log show`.
     pub fn name(self) -> &'static str {
         match self {
             Self::Up => "up",
@@ -134,6 +145,8 @@ impl LifecycleEvent {
             Self::Hold => "hold",
             Self::Resume => "resume",
             Self::Phase => "phase",
+            Self::Lost => "lost",
+            Self::Roster => "roster",
         }
     }
 }
@@ -163,6 +176,30 @@ impl StartupPhase {
     pub fn describe(self, size: u32) -> String {
         match self {
             Self::BuildingNeuralMap => format!("building its neural map, {size} MiB"),
+        }
+    }
+}
+
+/// An agent's state in a [`LifecycleEvent::Roster`] entry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum RosterState {
+    /// Running and announced (up since its last `Restarted`, or since the start).
+    Up = 1,
+    /// Dead or not yet up again, and to be restarted: its `Restarted` is still to come.
+    Down = 2,
+    /// Gone for good ([`LifecycleEvent::Lost`]).
+    Lost = 3,
+}
+
+impl RosterState {
+    /// Decodes a state byte received from another process.
+    pub fn from_u8(v: u8) -> Option<Self> {
+        match v {
+            1 => Some(Self::Up),
+            2 => Some(Self::Down),
+            3 => Some(Self::Lost),
+            _ => None,
         }
     }
 }
@@ -212,8 +249,8 @@ pub struct Lifecycle {
     pub role: u8,
     /// A [`LifecycleEvent`] as `u8`.
     pub event: u8,
-    /// For `Stop`, a [`StopReason`] as `u8`; for `Phase`, a [`StartupPhase`] as `u8`; zero
-    /// for every other event.
+    /// For `Stop`, a [`StopReason`] as `u8`; for `Phase`, a [`StartupPhase`] as `u8`; for
+    /// `Roster`, a [`RosterState`] as `u8`; zero for every other event.
     pub reason: u8,
     /// Zero.
     pub reserved: u8,
@@ -236,6 +273,19 @@ impl Lifecycle {
     /// `Restarted`: the process runs again, its `restarts`-th incarnation after the first.
     pub fn restarted(role: Role, index: u32, restarts: u32) -> Self {
         Self::about(role, index, LifecycleEvent::Restarted, restarts)
+    }
+
+    /// `Lost`: the process is gone for good, after `restarts` restarts.
+    pub fn lost(role: Role, index: u32, restarts: u32) -> Self {
+        Self::about(role, index, LifecycleEvent::Lost, restarts)
+    }
+
+    /// `Roster`: agent `index` is in `state` now, after `restarts` restarts.
+    pub fn roster(index: u32, state: RosterState, restarts: u32) -> Self {
+        Self {
+            reason: state as u8,
+            ..Self::about(Role::Agent, index, LifecycleEvent::Roster, restarts)
+        }
     }
 
     /// `Start`: every process is up, begin the run.
@@ -344,9 +394,16 @@ mod tests {
             LifecycleEvent::Hold,
             LifecycleEvent::Resume,
             LifecycleEvent::Phase,
+            LifecycleEvent::Lost,
+            LifecycleEvent::Roster,
         ] {
             assert_eq!(LifecycleEvent::from_u8(e as u8), Some(e));
         }
+        for r in [RosterState::Up, RosterState::Down, RosterState::Lost] {
+            assert_eq!(RosterState::from_u8(r as u8), Some(r));
+        }
+        assert_eq!(RosterState::from_u8(0), None);
+        assert_eq!(RosterState::from_u8(4), None);
         let p = StartupPhase::BuildingNeuralMap;
         assert_eq!(StartupPhase::from_u8(p as u8), Some(p));
         assert_eq!(StartupPhase::from_u8(0), None);
@@ -354,10 +411,10 @@ mod tests {
         for s in [StopReason::Requested, StopReason::TimeLimit] {
             assert_eq!(StopReason::from_u8(s as u8), Some(s));
         }
-        assert_eq!(LifecycleEvent::from_u8(9), None);
+        assert_eq!(LifecycleEvent::from_u8(11), None);
         for bad in [0u8, 5, 200, 255] {
             assert_eq!(Role::from_u8(bad), None);
-            assert_eq!(LifecycleEvent::from_u8(bad.max(9)), None);
+            assert_eq!(LifecycleEvent::from_u8(bad.max(11)), None);
             assert_eq!(StopReason::from_u8(bad.max(3)), None);
         }
         assert_eq!(StopReason::from_u8(0), None);
@@ -414,6 +471,16 @@ mod tests {
             (agent, 4, LifecycleEvent::Phase as u8, 1, 0, 430)
         );
         assert!(start.time_ns > 0);
+        let lost = Lifecycle::lost(Role::Agent, 2, 3);
+        assert_eq!(
+            fields(lost),
+            (agent, 2, LifecycleEvent::Lost as u8, 0, 0, 3)
+        );
+        let roster = Lifecycle::roster(5, RosterState::Down, 1);
+        assert_eq!(
+            fields(roster),
+            (agent, 5, LifecycleEvent::Roster as u8, 2, 0, 1)
+        );
     }
 
     /// A period travels whole in a `Hold` or `Resume`, past 32 bits too.

@@ -47,7 +47,7 @@ mod motion;
 mod round;
 
 pub use health::Heartbeat;
-pub use lifecycle::{Lifecycle, LifecycleEvent, Role, StartupPhase, StopReason};
+pub use lifecycle::{Lifecycle, LifecycleEvent, Role, RosterState, StartupPhase, StopReason};
 pub use map::{ActivationKind, MapHeader};
 pub use motion::{Odometry, Pose, Truth, WheelCommand};
 pub use round::{Candidate, CandidateFlags, Commit, ConflictKind, Decision, Progress, Verdict};

@@ -216,6 +216,7 @@ pub(super) fn build_restart(raw: Option<RawRestart>) -> RestartConfig {
         agent: rule(r.agent, d.agent),
         coordinator: rule(r.coordinator, d.coordinator),
         sim: rule(r.sim, d.sim),
+        on_give_up: r.on_give_up.unwrap_or(d.on_give_up),
     }
 }
 

@@ -6,13 +6,16 @@
 //!
 //! * the map: width, height, every cell's MovingAI character, the terrain layer if any, and
 //!   the corner-cutting rule;
-//! * `[robot]`, `[sim]` (including the seed), `[coordinator]` and `[restart]`, every field;
+//! * `[robot]`, `[sim]` (including the seed), `[coordinator]` and `[restart]`, every field
+//!   (the sim's policy codes are arranged so that its default hashes as before it changed,
+//!   see `sim_rule`);
 //! * every agent (start, goal, speed, priority, start heading) in order, and every fault in
 //!   order (the scenario's `[[faults]]`, then the command line's: both change the run). A
 //!   kill at a round keeps the encoding it had before times in seconds and freezes existed.
 //!
 //! * `allow_unreachable`, only when it is `true` (appended last), so that the hash of every
-//!   scenario without the key, and every log written before it existed, stays the same.
+//!   scenario without the key, and every log written before it existed, stays the same;
+//!   likewise `[restart] on_give_up`, only when it is `"stop"`.
 //!
 //! It does **not** cover the scenario `name`, the source file name, or the map file's path
 //! (only the map's content), so renaming or moving files keeps the hash.
@@ -21,7 +24,7 @@
 //! little-endian `u64`, floats as the little-endian bits of the `f64`, booleans and enum
 //! variants as one `u64` code, options as a presence code then the value.
 
-use super::params::{ClockMode, FsyncPolicy, RestartPolicy, RestartRule};
+use super::params::{ClockMode, FsyncPolicy, GiveUpAction, RestartPolicy, RestartRule};
 use super::{FaultAction, FaultSignal, FaultSpec, FaultTarget, FaultTime, Scenario};
 use crate::grid::{CornerCutting, TerrainKind};
 use crate::hash::Fnv1a64;
@@ -60,6 +63,18 @@ fn fault(h: &mut Fnv1a64, f: &FaultSpec) {
         FaultAction::Freeze { for_s: None } => h.u64(0),
         FaultAction::Freeze { for_s: Some(d) } => h.u64(1).f64(d),
     };
+}
+
+/// The sim's rule: its policy codes swap `never` and `on-failure` against [`rule`]'s, because
+/// its default moved from `never` to `on-failure` and the default keeps the code it had. A
+/// scenario that leaves the sim's rule alone keeps its hash, and with it every lockstep log.
+fn sim_rule(h: &mut Fnv1a64, r: &RestartRule) {
+    let policy = match r.policy {
+        RestartPolicy::OnFailure => 0,
+        RestartPolicy::Never => 1,
+        RestartPolicy::Always => 2,
+    };
+    h.u64(policy).u64(r.max_restarts.into()).u64(r.backoff_ms);
 }
 
 /// The hash described in the [module docs](self).
@@ -126,7 +141,7 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
 
     rule(&mut h, &s.restart.agent);
     rule(&mut h, &s.restart.coordinator);
-    rule(&mut h, &s.restart.sim);
+    sim_rule(&mut h, &s.restart.sim);
 
     h.u64(s.agents.len() as u64);
     for a in &s.agents {
@@ -147,6 +162,9 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
     }
     if s.allow_unreachable {
         h.bytes(b"allow_unreachable");
+    }
+    if s.restart.on_give_up == GiveUpAction::Stop {
+        h.bytes(b"on_give_up=stop");
     }
     h.finish()
 }

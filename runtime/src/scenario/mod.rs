@@ -43,10 +43,12 @@
 //! replan_after_rounds = 3
 //! time_limit_s = 120.0                 # lockstep: simulated time, in rounds; realtime: wall clock
 //!
-//! [restart]                            # per role; defaults: agent and coordinator
-//! agent = { policy = "on-failure", max_restarts = 3, backoff_ms = 100 }   # "on-failure",
-//! coordinator = { policy = "on-failure" }                                 # sim "never"
-//! sim = { policy = "never" }           # policies: "never", "on-failure", "always"
+//! [restart]                            # per role; default for each role as shown
+//! agent = { policy = "on-failure", max_restarts = 3, backoff_ms = 100 }
+//! coordinator = { policy = "on-failure" }
+//! sim = { policy = "on-failure" }      # policies: "never", "on-failure", "always"
+//! on_give_up = "stand"                 # an agent not restarted: its robot stands and the run
+//!                                      # ends once the others are settled; "stop": at once
 //!
 //! [run]
 //! startup_timeout_s = 60.0             # how long the processes get to come up; default
@@ -137,7 +139,7 @@ pub use error::{Loc, ScenarioError};
 pub use health::HealthParams;
 pub use params::{
     default_startup_timeout_s, ClockMode, ClockModeError, CoordinatorParams, FsyncPolicy,
-    RestartConfig, RestartPolicy, RestartRule, RobotParams, RunParams, SimParams,
+    GiveUpAction, RestartConfig, RestartPolicy, RestartRule, RobotParams, RunParams, SimParams,
 };
 pub use report::{default_out_dir, ScenarioReport};
 

@@ -283,9 +283,9 @@ impl RestartRule {
     }
 }
 
-/// Restart rules per role (`[restart]`). Agents and the coordinator are restarted on failure
-/// by default (both resume from the consensus log); the simulator is not, because its
-/// ground-truth state cannot be rebuilt, so losing it ends the run.
+/// Restart rules per role (`[restart]`). Every role is restarted on failure by default: an
+/// agent resumes from its checkpoint, the coordinator from the consensus log, the simulator
+/// from its ground-truth checkpoint (`DIR/sim.ckpt`).
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Serialize)]
 pub struct RestartConfig {
     /// Rule for agent processes.
@@ -294,6 +294,20 @@ pub struct RestartConfig {
     pub coordinator: RestartRule,
     /// Rule for the simulator.
     pub sim: RestartRule,
+    /// What an agent gone for good (not restarted) does to the run.
+    pub on_give_up: GiveUpAction,
+}
+
+/// What happens to a run when an agent exits and is not restarted (`[restart] on_give_up`).
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GiveUpAction {
+    /// Its robot stands for the rest of the run (an obstacle to the others, its goal not
+    /// reached); the run ends once every other robot is at its goal or cannot reach it.
+    #[default]
+    Stand,
+    /// The run stops at once, as one that cannot go on.
+    Stop,
 }
 
 impl Default for RestartConfig {
@@ -301,7 +315,8 @@ impl Default for RestartConfig {
         RestartConfig {
             agent: RestartRule::with_policy(RestartPolicy::OnFailure),
             coordinator: RestartRule::with_policy(RestartPolicy::OnFailure),
-            sim: RestartRule::with_policy(RestartPolicy::Never),
+            sim: RestartRule::with_policy(RestartPolicy::OnFailure),
+            on_give_up: GiveUpAction::Stand,
         }
     }
 }
@@ -320,7 +335,10 @@ mod tests {
         );
         // 20 rad/s * 21 mm / 16 cm.
         assert!((r.max_speed_cells_s() - 2.625).abs() < 1e-9);
-        assert_eq!(RestartConfig::default().sim.policy, RestartPolicy::Never);
+        assert_eq!(
+            RestartConfig::default().sim.policy,
+            RestartPolicy::OnFailure
+        );
         assert_eq!(SimParams::default().clock, ClockMode::Lockstep);
         assert_eq!(CoordinatorParams::default().fsync, FsyncPolicy::EveryRecord);
     }

@@ -9,7 +9,7 @@
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::params::{ClockMode, FsyncPolicy, RestartPolicy};
+use super::params::{ClockMode, FsyncPolicy, GiveUpAction, RestartPolicy};
 
 /// Top level.
 #[derive(Deserialize, Debug)]
@@ -93,6 +93,7 @@ pub(super) struct RawRestart {
     pub agent: Option<RawRestartRule>,
     pub coordinator: Option<RawRestartRule>,
     pub sim: Option<RawRestartRule>,
+    pub on_give_up: Option<GiveUpAction>,
 }
 
 /// One role's restart rule.

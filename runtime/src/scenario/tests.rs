@@ -99,7 +99,7 @@ signal = "TERM"
     assert_eq!(
         s.restart.sim,
         RestartRule {
-            policy: RestartPolicy::Never,
+            policy: RestartPolicy::OnFailure,
             max_restarts: 3,
             backoff_ms: 5
         }

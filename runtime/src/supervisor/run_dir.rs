@@ -18,12 +18,14 @@ use crate::transport::RunId;
 /// The lock file in the run directory.
 pub const LOCK_FILE: &str = ".hnav-run.lock";
 
-/// What a run writes into its directory: the consensus log, the agents' checkpoints, the
-/// processes' output, the summary, the event journal and the coordinator's counts of dropped
-/// candidates. `--force` removes these and nothing else.
-pub const RUN_OUTPUTS: [&str; 6] = [
+/// What a run writes into its directory: the consensus log, the agents' and the sim's
+/// checkpoints, the processes' output, the summary, the event journal and the coordinator's
+/// counts of dropped candidates. `--force` removes these and nothing else.
+pub const RUN_OUTPUTS: [&str; 8] = [
     "log",
     "agents",
+    "sim.ckpt",
+    "sim.ckpt.tmp",
     "logs",
     "summary.json",
     "events.jsonl",

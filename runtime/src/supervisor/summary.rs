@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::consensus_log::{read_log, LogError, Record, Tally};
-use crate::msg::Truth;
+use crate::msg::{LifecycleEvent, Role, Truth};
 use crate::rejected::Rejections;
 
 /// One agent's line of the summary.
@@ -33,6 +33,20 @@ pub struct AgentSummary {
     pub replans: u32,
     /// Whether the agent reported its goal unreachable (an unreachable record in the log).
     pub unreachable: bool,
+    /// Whether the agent's process is gone for good (a `lost` record in the log, or the
+    /// supervisor gave it up): its robot stood for the rest of the run and its goal counts
+    /// as not reached, wherever the robot is.
+    pub lost: bool,
+}
+
+/// A robot lost during the run: its agent's process exited and was not restarted.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LostRobot {
+    /// Agent index.
+    pub id: u32,
+    /// Why, as the supervisor saw it (`hnav-agent 2 ended (killed by SIGKILL) and is not
+    /// restarted (restart limit of 1 reached)`).
+    pub why: String,
 }
 
 /// The whole run.
@@ -61,9 +75,27 @@ pub struct RunSummary {
     /// Candidates the coordinator dropped as malformed or hostile, per
     /// [`Rejected`](crate::rejected::Rejected) class (every class, zeros included).
     pub rejected: BTreeMap<String, u64>,
+    /// The robots lost during the run, by index; empty when none was.
+    pub lost: Vec<LostRobot>,
 }
 
 impl RunSummary {
+    /// Marks each of `lost` (index, why) lost: its goal counts as not reached.
+    pub fn mark_lost(&mut self, lost: &[(u32, String)]) {
+        for (id, why) in lost {
+            if let Some(a) = self.agents.get_mut(*id as usize) {
+                a.lost = true;
+            }
+            self.lost.push(LostRobot {
+                id: *id,
+                why: why.clone(),
+            });
+        }
+        for a in self.agents.iter_mut().filter(|a| a.lost) {
+            a.reached_goal = false;
+        }
+    }
+
     /// Whether every robot reached its goal without a collision.
     pub fn success(&self) -> bool {
         self.cannot_go_on.is_none()
@@ -87,6 +119,7 @@ impl RunSummary {
         let mut rounds = 0;
         let mut end = "incomplete".to_string();
         let mut unreachable = Vec::new();
+        let mut lost = Vec::new();
         for r in &contents.records {
             match r {
                 Record::Header(h) => {
@@ -99,6 +132,11 @@ impl RunSummary {
                 }
                 Record::End(e) => end = e.reason.name().to_string(),
                 Record::Unreachable(u) => unreachable.push(u.agent),
+                Record::Lifecycle(l)
+                    if l.role == Role::Agent as u8 && l.event == LifecycleEvent::Lost as u8 =>
+                {
+                    lost.push(l.index);
+                }
                 Record::Lifecycle(_) | Record::Replan(_) => {}
             }
         }
@@ -112,6 +150,7 @@ impl RunSummary {
                 conflicts: t.conflicts,
                 replans: t.replans,
                 unreachable: unreachable.contains(&id),
+                lost: lost.contains(&id),
             })
             .collect();
         if let (Some(t), Some(h)) = (truth, header) {
@@ -120,7 +159,7 @@ impl RunSummary {
                 let (gx, gy) = (entry.goal % width, entry.goal / width);
                 let cx = (pose.x_m / cell_size_m).floor();
                 let cy = (pose.y_m / cell_size_m).floor();
-                a.reached_goal = cx == f64::from(gx) && cy == f64::from(gy);
+                a.reached_goal = !a.lost && cx == f64::from(gx) && cy == f64::from(gy);
             }
         }
         Ok(RunSummary {
@@ -134,6 +173,7 @@ impl RunSummary {
             log: log_dir.to_path_buf(),
             cannot_go_on: None,
             rejected: read_rejected(log_dir.parent().unwrap_or(Path::new("."))),
+            lost: Vec::new(),
         })
     }
 
@@ -154,10 +194,11 @@ impl RunSummary {
     pub fn render(&self) -> String {
         let mut s = String::from("agent  goal  steps  length  conflicts  replans\n");
         for a in &self.agents {
-            let goal = match (a.reached_goal, a.unreachable) {
-                (true, _) => "yes",
-                (false, true) => "unreachable",
-                (false, false) => "NO",
+            let goal = match (a.reached_goal, a.unreachable, a.lost) {
+                (true, _, _) => "yes",
+                (false, _, true) => "lost",
+                (false, true, false) => "unreachable",
+                (false, false, false) => "NO",
             };
             s += &format!(
                 "{:>5}  {:>4}  {:>5}  {:>6.2}  {:>9}  {:>7}\n",

@@ -34,6 +34,9 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         .node_name(&Role::Sim.node_name(0))
         .create()?;
     let mut sim = SimProcess::new(&transport, &scenario)?.resuming(args.common.resume);
+    if let Some(dir) = &args.common.dir {
+        sim = sim.with_checkpoint(dir, &scenario);
+    }
     if !args.standalone {
         let ports = LifecyclePorts::open(&transport, Role::Sim, 0, scenario.agents.len())?;
         sim = sim.with_lifecycle(ports);

@@ -23,9 +23,11 @@
 //! | `ports` | the topics: wheel commands in; odometry, Truth and lifecycle out |
 //! | `state` | the world, who is live and who has sent, and the handlers of each input |
 
+mod checkpoint;
 mod ports;
 mod state;
 
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use hnav_runtime::health::Heartbeat;
@@ -37,6 +39,7 @@ use hnav_runtime::transport::{Transport, Waiter, Wake};
 
 use crate::error::SimError;
 use crate::world::World;
+pub use checkpoint::{CheckpointError, Restored, SimCheckpoint};
 use ports::Ports;
 use state::State;
 
@@ -108,6 +111,13 @@ impl<'t> SimProcess<'t> {
         self
     }
 
+    /// Checkpoints every stepped period to `run_dir/sim.ckpt` (see [`SimCheckpoint`]); a
+    /// restarted sim ([`SimProcess::resuming`]) resumes from it.
+    pub fn with_checkpoint(mut self, run_dir: &Path, scenario: &Scenario) -> Self {
+        self.state.checkpoint = Some(SimCheckpoint::in_dir(run_dir, scenario.scenario_hash()));
+        self
+    }
+
     /// Whether the process was restarted (`--resume`): its handshake then only announces it,
     /// without waiting for a `Start` the supervisor sent long ago.
     pub fn resuming(mut self, resume: bool) -> Self {
@@ -135,6 +145,11 @@ impl<'t> SimProcess<'t> {
                 return Ok(self.state.outcome(true));
             }
         }
+        if self.resume {
+            if let Some(period) = self.state.resume(&self.ports)? {
+                tracing::info!(period, "resumed from the checkpoint");
+            }
+        }
         let waiter = self.transport.waiter()?;
         let _attached = self.ports.attach(&waiter)?;
         let signalled = run_loop(
@@ -158,7 +173,9 @@ fn run_loop(
     max_periods: Option<u64>,
 ) -> Result<bool, SimError> {
     let period_wall = st.period_wall();
-    let started = Instant::now();
+    // Realtime periods are due from the loop's start on, counted from the period it starts
+    // at (a resumed sim's is not 0).
+    let (started, first) = (Instant::now(), st.period);
     // Lockstep: when the robots still missing are given up on. Runs from the last time
     // anything came in, as long as nothing does.
     let mut give_up: Option<Instant> = None;
@@ -194,7 +211,7 @@ fn run_loop(
             }
             ClockMode::Realtime => {
                 // From the start, not from the last step: the schedule does not drift.
-                let due = started + period_wall.mul_f64((st.period + 1) as f64);
+                let due = started + period_wall.mul_f64((st.period + 1 - first) as f64);
                 if Instant::now() >= due {
                     st.advance(ports)?;
                     continue;

@@ -4,9 +4,10 @@
 use std::collections::VecDeque;
 use std::time::Duration;
 
-use hnav_runtime::msg::{LifecycleEvent, Role};
+use hnav_runtime::msg::{LifecycleEvent, Role, RosterState};
 use hnav_runtime::scenario::params::ClockMode;
 
+use super::checkpoint::SimCheckpoint;
 use super::ports::Ports;
 use super::SimOutcome;
 use crate::error::SimError;
@@ -30,6 +31,8 @@ pub(crate) struct State {
     holds: VecDeque<u64>,
     /// The `Hold` for the first of `holds` has been sent.
     hold_sent: bool,
+    /// Where each stepped period is checkpointed for a restart, if the run has a directory.
+    pub(crate) checkpoint: Option<SimCheckpoint>,
 }
 
 /// What a lifecycle drain found.
@@ -54,6 +57,7 @@ impl State {
             lockstep_deadline,
             holds: VecDeque::new(),
             hold_sent: false,
+            checkpoint: None,
         }
     }
 
@@ -69,7 +73,8 @@ impl State {
     /// Whether the current period, ready to be stepped, waits for the supervisor's `Resume`;
     /// the first time, tells it with `Hold`. Fault rounds behind the current period are
     /// dropped; a restarted sim, which starts again at period 0, holds at every fault round
-    /// once more, and the supervisor resumes those already done at once.
+    /// once more (one resumed from its checkpoint, at those from its period on), and the
+    /// supervisor resumes those already done at once.
     pub(crate) fn holding(&mut self, ports: &Ports) -> Result<bool, SimError> {
         while self.holds.front().is_some_and(|&p| p < self.period) {
             self.holds.pop_front();
@@ -101,7 +106,8 @@ impl State {
         }
     }
 
-    /// Applies the supervisor's events. A dead agent's robot brakes and is not waited for, and
+    /// Applies the supervisor's events. A dead or lost agent's robot (also one the roster
+    /// names so) brakes and is not waited for, and
     /// a command it sent for this period is void (the brake overrode it); a restarted one
     /// counts again from its first fresh command (it needs this period's odometry before it
     /// can send one). A `Resume` for the period held at ends the hold.
@@ -128,8 +134,17 @@ impl State {
             else {
                 return;
             };
+            // A restarted sim learns from the roster which agents are down or lost: it must
+            // not wait for their robots.
+            let down = match ev {
+                LifecycleEvent::Roster => matches!(
+                    RosterState::from_u8(sample.reason),
+                    Some(RosterState::Down | RosterState::Lost)
+                ),
+                _ => matches!(ev, LifecycleEvent::Down | LifecycleEvent::Lost),
+            };
             match (role, ev) {
-                (Role::Agent, LifecycleEvent::Down) => {
+                (Role::Agent, _) if down => {
                     *v = false;
                     *h = false;
                     world.brake(index);
@@ -225,20 +240,48 @@ impl State {
         }
     }
 
-    /// Steps one control period and publishes odometry and truth for it.
+    /// Steps one control period, checkpoints it, and publishes odometry and truth for it.
     pub(crate) fn advance(&mut self, ports: &Ports) -> Result<(), SimError> {
         for _ in 0..self.world.steps_per_odometry() {
             self.world.step();
         }
-        for (i, tx) in ports.odom.iter().enumerate() {
-            if let Some(o) = self.world.odometry(i as u32, self.period) {
-                tx.send(o)?;
-            }
+        if let Some(c) = &mut self.checkpoint {
+            c.store(&self.world, self.period + 1)?;
         }
-        let (world, period) = (&self.world, self.period);
-        ports.truth.send_in_place(|t| world.fill_truth(period, t))?;
+        self.publish(ports, self.period)?;
         self.period += 1;
         self.have.iter_mut().for_each(|h| *h = false);
         Ok(())
+    }
+
+    /// Publishes every robot's odometry and the truth of the world as it stands, as the
+    /// reading of `period`.
+    fn publish(&self, ports: &Ports, period: u64) -> Result<(), SimError> {
+        for (i, tx) in ports.odom.iter().enumerate() {
+            if let Some(o) = self.world.odometry(i as u32, period) {
+                tx.send(o)?;
+            }
+        }
+        let world = &self.world;
+        ports.truth.send_in_place(|t| world.fill_truth(period, t))?;
+        Ok(())
+    }
+
+    /// A restarted sim: restores the world and the period counter from the checkpoint, if
+    /// there is one, and publishes the last stepped period's odometry and truth again (its
+    /// predecessor may have died between checkpointing and publishing them). Returns the
+    /// period resumed at.
+    pub(crate) fn resume(&mut self, ports: &Ports) -> Result<Option<u64>, SimError> {
+        let Some(c) = &self.checkpoint else {
+            return Ok(None);
+        };
+        let Some(r) = c.load(&mut self.world)? else {
+            return Ok(None);
+        };
+        self.period = r.period;
+        if let Some(last) = r.period.checked_sub(1) {
+            self.publish(ports, last)?;
+        }
+        Ok(Some(r.period))
     }
 }

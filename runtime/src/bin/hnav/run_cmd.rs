@@ -7,9 +7,10 @@
 //! (time limit, collisions, stopped), 2 the run could not happen (bad scenario or fault, a process
 //! that would not start, a run id or directory held by a live run, a finished run's
 //! directory without `--force`), 3 the run was ended early because it could not go on (the
-//! sim or the coordinator down and not restarted, or no agent left: the summary is still
-//! written; or a process stopped on a full disk: no summary, the message names it and the
-//! directory).
+//! sim or the coordinator down and not restarted, no agent left, or an agent not restarted
+//! under `[restart] on_give_up = "stop"`: the summary is still written; or a process stopped
+//! on a full disk: no summary, the message names it and the directory), 4 the run finished
+//! with robots lost (agents not restarted; the summary's `lost` names them and why).
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -24,6 +25,9 @@ use hnav_runtime::supervisor::run::{default_run_dir, new_run_id, run, RunError, 
 /// The exit code of a run that started but could not go on (a process stopped on a full
 /// disk): neither a finished run (0, 1) nor one that never started (2).
 const EXIT_RUN_BROKEN: u8 = 3;
+/// The exit code of a run that went on without the robots whose agents were not restarted,
+/// and finished.
+const EXIT_ROBOTS_LOST: u8 = 4;
 
 /// `hnav run` arguments.
 #[derive(clap::Args, Debug)]
@@ -158,6 +162,11 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
             if let Some(why) = &summary.cannot_go_on {
                 hnav_runtime::errln!("error: {why}");
                 ExitCode::from(EXIT_RUN_BROKEN)
+            } else if !summary.lost.is_empty() {
+                for l in &summary.lost {
+                    hnav_runtime::errln!("robot {} lost: {}", l.id, l.why);
+                }
+                ExitCode::from(EXIT_ROBOTS_LOST)
             } else if summary.success() {
                 ExitCode::SUCCESS
             } else {

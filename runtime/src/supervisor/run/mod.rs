@@ -125,6 +125,9 @@ fn run_owned(
     let mut record = registry.new_record(&run, &dir);
     let started = Instant::now();
     let mut slots = Slots::new(&opts.args, &opts.bin_dir, &scenario, &dir);
+    // The last ground truth seen: a sample does not outlive its publisher, so a sim that is
+    // down at the end (or gone for good) leaves only what was taken while it ran.
+    let mut truth = None;
     let result = supervise(
         &transport,
         &ports,
@@ -132,10 +135,10 @@ fn run_owned(
         &mut slots,
         &mut record,
         opts.progress,
+        &mut truth,
     );
-    // The last ground truth, taken while the sim still runs (a sample does not outlive its
-    // publisher). After the end of the run nothing moves any more in lockstep.
-    let mut truth = None;
+    // Taken while the sim still runs; after the end of the run nothing moves any more in
+    // lockstep.
     ports.truth.drain(|t| truth = Some(*t))?;
     let reason = match result {
         Ok(End::TimeLimit) => StopReason::TimeLimit,
@@ -164,6 +167,7 @@ fn run_owned(
         scenario.robot.cell_size_m,
         started.elapsed().as_secs_f64(),
     )?;
+    summary.mark_lost(&slots.lost_agents());
     if let End::CannotGoOn(why) = end {
         summary.cannot_go_on = Some(why);
     }
@@ -198,6 +202,7 @@ fn supervise(
     slots: &mut Slots,
     record: &mut RunRecord,
     show_progress: bool,
+    truth: &mut Option<Truth>,
 ) -> Result<End, RunError> {
     // Open before any process starts, so that no beat finds the topic missing.
     let hang = HangWatch::open(transport, scenario)?;
@@ -214,6 +219,7 @@ fn supervise(
     let lockstep = scenario.sim.clock == ClockMode::Lockstep;
     let mut watch = Watch {
         view: ProgressView::new(show_progress, scenario.agents.len()),
+        truth,
         faults: FaultSchedule::new(&scenario.faults, lockstep, &scenario.sim),
         hang,
         round: 0,
@@ -235,6 +241,8 @@ fn supervise(
 /// The state of the watch between two changes of the set of running processes.
 struct Watch<'s> {
     view: ProgressView,
+    /// The latest ground truth taken in.
+    truth: &'s mut Option<Truth>,
     faults: FaultSchedule<'s>,
     hang: HangWatch,
     /// The last committed round the coordinator reported.
@@ -323,6 +331,8 @@ impl Watch<'_> {
     /// Shows the coordinator's latest progress and, in realtime, fires the faults due by its
     /// round (or by the time since `Start`); `AllAtGoal` or `TimeLimit` once it reports that it ended the run.
     fn on_progress(&mut self, ports: &Ports, slots: &Slots) -> Result<Option<End>, RunError> {
+        let truth = &mut *self.truth;
+        ports.truth.drain_pending(|t| *truth = Some(*t))?;
         let mut last = None;
         ports.progress.drain_pending(|p| last = Some(*p))?;
         let Some(p) = last else {

@@ -8,8 +8,8 @@ use std::time::Instant;
 
 use super::error::RunError;
 use crate::launch::ProcessArgs;
-use crate::msg::{Lifecycle, LifecycleEvent, Role};
-use crate::scenario::Scenario;
+use crate::msg::{Lifecycle, LifecycleEvent, Role, RosterState};
+use crate::scenario::{GiveUpAction, Scenario};
 use crate::supervisor::child::{Child, ChildError, ChildSpec, ExitInfo};
 use crate::supervisor::events::{RunEvent, RunEvents};
 use crate::supervisor::registry::RunRecord;
@@ -28,6 +28,8 @@ struct Slot {
     /// the slots stay borrowed by the waiter's attachments on the children's exit descriptors
     /// while `Up`s are taken.
     announce: Cell<bool>,
+    /// Gone for good (not restarted): why, in words.
+    lost: Option<String>,
 }
 
 /// Every process of the run: the sim, the coordinator and one agent per robot, in that order.
@@ -37,6 +39,8 @@ pub(super) struct Slots {
     dir: PathBuf,
     /// `DIR/events.jsonl`: exits, respawns, `Up`s and the faults' signals.
     events: RunEvents,
+    /// What an agent gone for good does to the run.
+    on_give_up: GiveUpAction,
 }
 
 impl Slots {
@@ -68,6 +72,7 @@ impl Slots {
                 tracker: RestartTracker::new(rule),
                 restart_at: None,
                 announce: Cell::new(false),
+                lost: None,
             });
         };
         add(Role::Sim, 0, "hnav-sim");
@@ -79,6 +84,7 @@ impl Slots {
             slots,
             dir: dir.to_path_buf(),
             events: RunEvents::create(dir),
+            on_give_up: scenario.restart.on_give_up,
         }
     }
 
@@ -136,6 +142,32 @@ impl Slots {
             .any(|s| s.spec.role == Role::Agent && (s.child.is_some() || s.restart_at.is_some()))
     }
 
+    /// The agents gone for good and why, by index.
+    pub(super) fn lost_agents(&self) -> Vec<(u32, String)> {
+        self.slots
+            .iter()
+            .filter(|s| s.spec.role == Role::Agent)
+            .filter_map(|s| s.lost.clone().map(|why| (s.spec.index, why)))
+            .collect()
+    }
+
+    /// Tells every process what state each agent is in now (`Roster`), for a sim or a
+    /// coordinator that was down and missed their events.
+    fn publish_roster(&self, life: &SupervisorPorts) -> Result<(), RunError> {
+        for s in self.slots.iter().filter(|s| s.spec.role == Role::Agent) {
+            let restarts = s.tracker.restarts();
+            let (state, restarts) = match (&s.child, s.lost.is_some()) {
+                (_, true) => (RosterState::Lost, restarts),
+                (Some(_), false) if !s.announce.get() => (RosterState::Up, restarts),
+                // Dead, waiting for its restart, or restarted and not up yet: the restart
+                // already counted is still to be announced.
+                _ => (RosterState::Down, restarts.saturating_sub(1)),
+            };
+            life.publish(Lifecycle::roster(s.spec.index, state, restarts))?;
+        }
+        Ok(())
+    }
+
     /// The earliest pending restart.
     pub(super) fn next_restart(&self) -> Option<Instant> {
         self.slots.iter().filter_map(|s| s.restart_at).min()
@@ -191,15 +223,23 @@ impl Slots {
                 }
                 RestartDecision::GiveUp(why) => {
                     tracing::warn!(node = role.node_name(index), %why, "not restarted");
-                    let gone = gone_for_good(role, index, &exit, why);
+                    life.publish(Lifecycle::lost(role, index, s.tracker.restarts()))?;
+                    let ended = not_restarted(role, index, &exit, why);
+                    let gone = format!("{ended}: the run cannot go on");
                     self.events.record(RunEvent::GaveUp {
                         node: role.node_name(index),
                         why: gone.clone(),
                     });
                     match role {
+                        Role::Agent if self.on_give_up == GiveUpAction::Stop => {
+                            core_gone = Some(format!(
+                                "{ended}, and [restart] on_give_up = \"stop\" ends the run"
+                            ));
+                        }
                         Role::Agent => agent_gone = Some(gone),
                         Role::Sim | Role::Coordinator => core_gone = Some(gone),
                     }
+                    s.lost = Some(ended);
                 }
             }
         }
@@ -266,20 +306,22 @@ impl Slots {
                     s.spec.index,
                     s.tracker.restarts(),
                 ))?;
+                if s.spec.role != Role::Agent {
+                    self.publish_roster(life)?;
+                }
             }
         }
         Ok(holds)
     }
 }
 
-/// Why the run cannot go on without `role`/`index`, which ended with `exit` and is not
-/// restarted for `why`.
-fn gone_for_good(role: Role, index: u32, exit: &ExitInfo, why: GiveUpReason) -> String {
+/// That `role`/`index` ended with `exit` and is not restarted for `why`, in words.
+fn not_restarted(role: Role, index: u32, exit: &ExitInfo, why: GiveUpReason) -> String {
     let who = match role {
         Role::Agent => format!("hnav-agent {index}"),
         other => format!("hnav-{}", other.name()),
     };
-    format!("{who} ended ({exit}) and is not restarted ({why}): the run cannot go on")
+    format!("{who} ended ({exit}) and is not restarted ({why})")
 }
 
 /// What a process of `role` writes in the run directory `dir`, for the message of a run that
@@ -295,6 +337,10 @@ fn role_writes(role: Role, index: u32, dir: &Path) -> String {
             dir.join("agents").join(format!("{index}.ckpt")).display(),
             log.display()
         ),
-        Role::Sim => format!("its log {}", log.display()),
+        Role::Sim => format!(
+            "its checkpoint {} or its log {}",
+            dir.join("sim.ckpt").display(),
+            log.display()
+        ),
     }
 }
