@@ -145,6 +145,20 @@ impl Harness {
     }
 }
 
+/// A user-facing message must be words, not a value's `Debug` form (`Variant { field: .. }`,
+/// `Some(..)`), which names Rust types and fields.
+pub(crate) fn check_not_debug(message: &str) {
+    let struct_like = message.split(" { ").skip(1).any(|rest| {
+        rest.split_once(": ").is_some_and(|(field, _)| {
+            !field.is_empty() && field.chars().all(|c| c.is_ascii_lowercase() || c == '_')
+        })
+    });
+    assert!(
+        !struct_like && !message.contains("Some(") && !message.contains("None"),
+        "error message looks like a debug dump: {message}"
+    );
+}
+
 /// The files of a corpus directory, sorted by name (empty if it does not exist).
 pub fn corpus_files(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
     let mut files = Vec::new();

@@ -19,10 +19,7 @@ fn check_message(message: &str) {
         message.contains(SOURCE),
         "error does not name its source: {message}"
     );
-    assert!(
-        !message.contains("Error {") && !message.contains("Some("),
-        "error message looks like a debug dump: {message}"
-    );
+    crate::check_not_debug(message);
 }
 
 /// `read_map`; an accepted map is written and read back to the same grid.
