@@ -84,8 +84,34 @@ pub fn decode_payload(payload: &[u8], stored_crc: u32) -> Result<Record, FramePr
             detail: format!("{} trailing bytes", payload.len() - used),
         }),
         Err(e) => Err(FrameProblem::Undecodable {
-            detail: e.to_string(),
+            detail: describe_decode_error(&e),
         }),
+    }
+}
+
+/// What is wrong with a payload, in words: bincode's own `Display` is its `Debug` form
+/// (`InvalidIntegerType { expected: U32, found: Reserved }`), which `hnav log verify` must not
+/// print.
+fn describe_decode_error(e: &bincode::error::DecodeError) -> String {
+    use bincode::error::DecodeError as E;
+    match e {
+        E::UnexpectedEnd { additional } => {
+            let s = if *additional == 1 { "" } else { "s" };
+            format!("the payload ends {additional} byte{s} early")
+        }
+        E::LimitExceeded => {
+            format!("a length in it exceeds the {MAX_RECORD_LEN} bytes of a record")
+        }
+        E::InvalidIntegerType { .. } => "a malformed integer".into(),
+        E::UnexpectedVariant { found, .. } => format!("unknown variant {found}"),
+        E::Utf8 { .. } => "a text field is not UTF-8".into(),
+        E::InvalidBooleanValue(v) => format!("a boolean of value {v}"),
+        E::OutsideUsizeRange(v) => format!("a length of {v}, too large for this machine"),
+        // Serde's own wording, e.g. "invalid value: integer `9`, expected variant index
+        // 0 <= i < 6" for an unknown record kind.
+        E::OtherString(s) => s.clone(),
+        E::Other(s) => (*s).into(),
+        _ => "not a record of this format".into(),
     }
 }
 
@@ -112,6 +138,21 @@ mod tests {
             decode_payload(&buf[9..], crc ^ 1),
             Err(FrameProblem::BadChecksum { .. })
         ));
+    }
+
+    /// Found by the `record` fuzz target: the detail was bincode's `Debug` form.
+    #[test]
+    fn an_undecodable_payload_is_described_in_words() {
+        let detail = |payload: &[u8]| match decode_payload(payload, crc32c::crc32c(payload)) {
+            Err(FrameProblem::Undecodable { detail }) => detail,
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(detail(&[4]), "the payload ends 1 byte early");
+        assert_eq!(detail(&[1, 0xFF]), "a malformed integer");
+        assert_eq!(
+            detail(&[9]),
+            "invalid value: integer `9`, expected variant index 0 <= i < 6"
+        );
     }
 
     #[test]
