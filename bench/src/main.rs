@@ -77,13 +77,13 @@ fn chaos(args: ChaosCli) -> Result<()> {
         only: args.only,
         bin_dir,
     };
-    let report = run_campaign(&config, |line| hnav_runtime::outln!("{line}"))
-        .map_err(anyhow::Error::msg)?;
+    let report =
+        run_campaign(&config, |line| hnav_runtime::outln!("{line}")).map_err(anyhow::Error::msg)?;
     hnav_runtime::out!("{}", report.render());
-    if report.passed() {
-        Ok(())
-    } else {
-        anyhow::bail!("{} of the campaign's runs failed", report.failures().len())
+    match report.failures().len() {
+        _ if report.passed() => Ok(()),
+        0 => anyhow::bail!("no run of the campaign ran (every plan was skipped)"),
+        n => anyhow::bail!("{n} of the campaign's runs failed"),
     }
 }
 

@@ -22,7 +22,10 @@ fn every_run_of_the_chaos_campaign_finishes_with_nothing_lost_or_left() {
         runs: QUICK_RUNS,
         seed,
         only: None,
-        bin_dir: hnav.parent().expect("binaries live in a directory").to_path_buf(),
+        bin_dir: hnav
+            .parent()
+            .expect("binaries live in a directory")
+            .to_path_buf(),
     };
     let report = run_campaign(&config, |line| println!("{line}")).expect("the campaign runs");
     println!("{}", report.render());

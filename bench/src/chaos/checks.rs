@@ -141,11 +141,12 @@ pub fn check_summary(summary: &serde_json::Value) -> Result<(usize, usize), Stri
     let agents = summary["agents"]
         .as_array()
         .ok_or("summary.json has no agents")?;
-    let reachable: Vec<&serde_json::Value> = agents
+    let reachable: Vec<&serde_json::Value> =
+        agents.iter().filter(|a| a["unreachable"] != true).collect();
+    let at_goal = reachable
         .iter()
-        .filter(|a| a["unreachable"] != true)
-        .collect();
-    let at_goal = reachable.iter().filter(|a| a["reached_goal"] == true).count();
+        .filter(|a| a["reached_goal"] == true)
+        .count();
     let collisions = summary["collisions"].as_u64().unwrap_or(u64::MAX);
     let mut wrong = Vec::new();
     if at_goal < reachable.len() {
@@ -186,10 +187,8 @@ pub fn alive_of_run(pids: &[u32], run_id: &str) -> Vec<u32> {
     pids.iter()
         .copied()
         .filter(|pid| {
-            std::fs::read(format!("/proc/{pid}/cmdline")).is_ok_and(|c| {
-                c.split(|&b| b == 0)
-                    .any(|arg| arg == run_id.as_bytes())
-            })
+            std::fs::read(format!("/proc/{pid}/cmdline"))
+                .is_ok_and(|c| c.split(|&b| b == 0).any(|arg| arg == run_id.as_bytes()))
         })
         .collect()
 }
@@ -217,15 +216,34 @@ mod tests {
     #[test]
     fn each_way_of_losing_or_repeating_a_commit_fails() {
         let cases: [(&[(u64, u64)], &str); 6] = [
-            (&[(1, 10), (3, 30)], "round 2 was never received (round 3 came after 1)"),
-            (&[(1, 10), (2, 21), (3, 30)], "the commit of round 2 differs from the log's"),
-            (&[(1, 10), (2, 20), (2, 22)], "round 2 was committed twice, differently"),
-            (&[(1, 10), (2, 20), (1, 10)], "round 1 was received again after round 2"),
-            (&[(1, 10), (2, 20), (3, 30), (4, 40)], "round 4 was received but is not in the log"),
+            (
+                &[(1, 10), (3, 30)],
+                "round 2 was never received (round 3 came after 1)",
+            ),
+            (
+                &[(1, 10), (2, 21), (3, 30)],
+                "the commit of round 2 differs from the log's",
+            ),
+            (
+                &[(1, 10), (2, 20), (2, 22)],
+                "round 2 was committed twice, differently",
+            ),
+            (
+                &[(1, 10), (2, 20), (1, 10)],
+                "round 1 was received again after round 2",
+            ),
+            (
+                &[(1, 10), (2, 20), (3, 30), (4, 40)],
+                "round 4 was received but is not in the log",
+            ),
             (&[(1, 10)], "rounds 2..=3 of the log were never received"),
         ];
         for (seen, want) in cases {
-            assert_eq!(check_commits(seen, &log(3)), Err(want.to_string()), "{seen:?}");
+            assert_eq!(
+                check_commits(seen, &log(3)),
+                Err(want.to_string()),
+                "{seen:?}"
+            );
         }
     }
 

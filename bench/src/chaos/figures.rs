@@ -17,6 +17,8 @@ pub struct Figure {
     hist: Histogram<u64>,
     /// Start events without a matching end.
     pub unmatched: usize,
+    /// The largest sample's run and process (`plan 12 agent-3`), to look it up.
+    pub worst: Option<(u64, String)>,
 }
 
 impl Figure {
@@ -27,14 +29,18 @@ impl Figure {
             // Microseconds up to an hour, 3 significant digits: the bounds cannot be wrong.
             hist: Histogram::new_with_bounds(1, 3_600_000_000, 3).expect("valid bounds"),
             unmatched: 0,
+            worst: None,
         }
     }
 
-    fn add_ns(&mut self, from: u64, to: Option<u64>) {
+    fn add_ns(&mut self, from: u64, to: Option<u64>, what: impl FnOnce() -> String) {
         match to {
             Some(to) => {
                 let us = (to.saturating_sub(from) / 1000).max(1);
                 self.hist.saturating_record(us);
+                if self.worst.as_ref().is_none_or(|w| us > w.0) {
+                    self.worst = Some((us, what()));
+                }
             }
             None => self.unmatched += 1,
         }
@@ -101,9 +107,10 @@ fn parse_node(node: &str) -> Option<(Role, u32)> {
 }
 
 impl Figures {
-    /// Adds one run's events and observations.
-    pub fn add_run(&mut self, events: &[EventLine], seen: &Observed) {
+    /// Adds one run's events and observations; `run` names the run (`plan 12`).
+    pub fn add_run(&mut self, run: &str, events: &[EventLine], seen: &Observed) {
         for e in events {
+            let what = || format!("{run} {}", e.node);
             let Some((role, index)) = parse_node(&e.node) else {
                 continue;
             };
@@ -118,27 +125,28 @@ impl Figures {
                                 && (l.role, l.index) == (role, index)
                         })
                         .map(|l| l.t_ns);
-                    self.kill_to_down.add_ns(e.t_ns, down);
+                    self.kill_to_down.add_ns(e.t_ns, down, what);
                 }
                 ("signalled", Some("SIGSTOP")) => {
                     let hung = events
                         .iter()
                         .find(|h| h.event == "hung" && h.node == e.node && h.t_ns >= e.t_ns)
                         .map(|h| h.t_ns);
-                    self.freeze_to_hung.add_ns(e.t_ns, hung);
+                    self.freeze_to_hung.add_ns(e.t_ns, hung, what);
                 }
                 ("hung", _) => {
                     if let Some(ms) = e.silent_ms {
-                        self.hang_silence.add_ns(0, Some(ms * 1_000_000));
+                        self.hang_silence.add_ns(0, Some(ms * 1_000_000), what);
                     }
                 }
-                ("spawned", _) => self.add_respawn(role, index, e.t_ns, seen),
+                ("spawned", _) => self.add_respawn(role, index, e.t_ns, seen, what()),
                 _ => {}
             }
         }
     }
 
-    fn add_respawn(&mut self, role: Role, index: u32, spawned: u64, seen: &Observed) {
+    fn add_respawn(&mut self, role: Role, index: u32, spawned: u64, seen: &Observed, what: String) {
+        let what = move || what;
         match role {
             Role::Agent => {
                 let first = seen
@@ -146,7 +154,7 @@ impl Figures {
                     .iter()
                     .find(|&&(t, a)| t > spawned && a == index)
                     .map(|c| c.0);
-                self.agent_back.add_ns(spawned, first);
+                self.agent_back.add_ns(spawned, first, what);
             }
             Role::Coordinator => {
                 // A resend of the last logged round is not a decision; its first new round is.
@@ -162,11 +170,11 @@ impl Figures {
                     .iter()
                     .find(|c| c.t_ns > spawned && c.round > before)
                     .map(|c| c.t_ns);
-                self.coordinator_back.add_ns(spawned, first);
+                self.coordinator_back.add_ns(spawned, first, what);
             }
             Role::Sim => {
                 let first = seen.truths.iter().copied().find(|&t| t > spawned);
-                self.sim_back.add_ns(spawned, first);
+                self.sim_back.add_ns(spawned, first, what);
             }
         }
     }
@@ -186,8 +194,8 @@ impl Figures {
     /// The figures as a table: samples, p50, p99, max, unmatched, the aim.
     pub fn render(&self) -> String {
         let mut out = format!(
-            "{:<38} {:>5} {:>9} {:>9} {:>9} {:>9}  aim\n",
-            "figure", "n", "p50 ms", "p99 ms", "max ms", "unmatched"
+            "{:<38} {:>5} {:>9} {:>9} {:>9} {:>9}  {:<20} max at\n",
+            "figure", "n", "p50 ms", "p99 ms", "max ms", "unmatched", "aim"
         );
         for f in self.all() {
             if f.is_empty() {
@@ -197,14 +205,15 @@ impl Figures {
                 );
             } else {
                 out += &format!(
-                    "{:<38} {:>5} {:>9.2} {:>9.2} {:>9.2} {:>9}  {}\n",
+                    "{:<38} {:>5} {:>9.2} {:>9.2} {:>9.2} {:>9}  {:<20} {}\n",
                     f.name,
                     f.len(),
                     f.quantile_ms(0.5),
                     f.quantile_ms(0.99),
                     f.max_ms(),
                     f.unmatched,
-                    f.aim
+                    f.aim,
+                    f.worst.as_ref().map_or("", |w| w.1.as_str())
                 );
             }
         }
@@ -239,33 +248,46 @@ mod tests {
             event(300_000_000, "spawned", "coordinator", None),
         ];
         let seen = Observed {
-            lifecycle: vec![
-                SeenLifecycle {
-                    t_ns: 3_000_000,
-                    event: LifecycleEvent::Down,
-                    role: Role::Agent,
-                    index: 2,
-                },
-            ],
+            lifecycle: vec![SeenLifecycle {
+                t_ns: 3_000_000,
+                event: LifecycleEvent::Down,
+                role: Role::Agent,
+                index: 2,
+            }],
             // Agent 1's candidate does not count for agent 2.
             candidates: vec![(102_000_000, 1), (121_000_000, 2)],
             commits: vec![
-                SeenCommit { t_ns: 150_000_000, round: 40, digest: 0 },
-                SeenCommit { t_ns: 310_000_000, round: 40, digest: 0 },
-                SeenCommit { t_ns: 350_000_000, round: 41, digest: 0 },
+                SeenCommit {
+                    t_ns: 150_000_000,
+                    round: 40,
+                    digest: 0,
+                },
+                SeenCommit {
+                    t_ns: 310_000_000,
+                    round: 40,
+                    digest: 0,
+                },
+                SeenCommit {
+                    t_ns: 350_000_000,
+                    round: 41,
+                    digest: 0,
+                },
             ],
             ..Observed::default()
         };
         let mut f = Figures::default();
-        f.add_run(&events, &seen);
+        f.add_run("plan 7", &events, &seen);
         assert_eq!(f.kill_to_down.len(), 1);
-        assert_eq!(f.kill_to_down.quantile_ms(0.5), 2.0);
+        // The histogram keeps 3 significant digits.
+        let near = |got: f64, want: f64| (got - want).abs() < want / 100.0;
+        assert!(near(f.kill_to_down.quantile_ms(0.5), 2.0));
         // The coordinator's Down never arrived.
         assert_eq!(f.kill_to_down.unmatched, 1);
-        assert_eq!(f.agent_back.quantile_ms(0.5), 20.0);
+        assert!(near(f.agent_back.quantile_ms(0.5), 20.0));
         // The resend of round 40 at 310 ms is skipped: round 41 at 350 ms is its first.
-        assert!((f.coordinator_back.quantile_ms(0.5) - 50.0).abs() < 0.1);
+        assert!(near(f.coordinator_back.quantile_ms(0.5), 50.0));
         assert!(f.sim_back.is_empty() && f.freeze_to_hung.is_empty());
+        assert_eq!(f.agent_back.worst, Some((20_000, "plan 7 agent-2".into())));
         assert!(f.render().contains("SIGKILL -> Down received"));
     }
 }

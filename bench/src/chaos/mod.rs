@@ -129,16 +129,18 @@ impl CampaignReport {
 /// that is not restarted ends the run by design.
 pub fn needs(plan: &Plan) -> Option<String> {
     match plan.class {
-        Class::FreezeAgent => Scenario::from_str(
-            &plan.scenario(CHAOS_SCENARIO),
-            "chaos.toml",
-            Path::new("."),
-        )
-        .err()
-        .map(|e| format!("needs freeze faults in [[faults]] (action = \"freeze\"; here: {e})")),
-        Class::SimKill => (RestartConfig::default().sim.policy == RestartPolicy::Never).then(|| {
-            "needs sim restarts (the sim's default restart policy is still never)".to_string()
-        }),
+        Class::FreezeAgent => {
+            Scenario::from_str(&plan.scenario(CHAOS_SCENARIO), "chaos.toml", Path::new("."))
+                .err()
+                .map(|e| {
+                    format!("needs freeze faults in [[faults]] (action = \"freeze\"; here: {e})")
+                })
+        }
+        Class::SimKill => {
+            (RestartConfig::default().sim.policy == RestartPolicy::Never).then(|| {
+                "needs sim restarts (the sim's default restart policy is still never)".to_string()
+            })
+        }
         _ => None,
     }
 }
@@ -170,7 +172,11 @@ pub fn run_campaign(
             Some(why) => RunOutcome::skipped(p, why),
             None => run_plan(&setup, p),
         };
-        figures.add_run(&outcome.events, &outcome.seen);
+        figures.add_run(
+            &format!("plan {}", p.number),
+            &outcome.events,
+            &outcome.seen,
+        );
         progress(&progress_line(&outcome, i + 1, plans.len()));
         outcomes.push(outcome);
     }

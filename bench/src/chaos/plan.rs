@@ -186,7 +186,10 @@ pub struct Plan {
 impl Plan {
     /// The scenario `base` with this plan's faults appended.
     pub fn scenario(&self, base: &str) -> String {
-        let mut text = format!("{base}\n# chaos plan {} (seed {})\n", self.number, self.seed);
+        let mut text = format!(
+            "{base}\n# chaos plan {} (seed {})\n",
+            self.number, self.seed
+        );
         for f in &self.faults {
             text.push('\n');
             text.push_str(&f.to_toml());
@@ -241,7 +244,12 @@ pub fn class_counts(runs: usize) -> Vec<(Class, usize)> {
     let total: usize = Class::ALL.iter().map(|c| c.quick_share()).sum();
     let mut counts: Vec<(Class, usize)> = Class::ALL
         .iter()
-        .map(|&c| (c, (runs * c.quick_share() / total).max(usize::from(runs >= 5))))
+        .map(|&c| {
+            (
+                c,
+                (runs * c.quick_share() / total).max(usize::from(runs >= 5)),
+            )
+        })
         .collect();
     // Rounding down leaves runs over; the largest class takes them (or gives back).
     let sum: usize = counts.iter().map(|c| c.1).sum();
@@ -256,7 +264,7 @@ pub fn generate(seed: u64, runs: usize, space: &PlanSpace) -> Vec<Plan> {
     for (class, n) in class_counts(runs) {
         for k in 0..n {
             let number = plans.len();
-            let mode = if k % 2 == 0 {
+            let mode = if k.is_multiple_of(2) {
                 Mode::Lockstep
             } else {
                 Mode::Realtime
@@ -276,8 +284,7 @@ pub fn generate(seed: u64, runs: usize, space: &PlanSpace) -> Vec<Plan> {
 
 /// The seed of plan `number` of a campaign seeded `seed`.
 fn plan_seed(seed: u64, number: usize) -> u64 {
-    hnav_runtime::hash::SplitMix64::new(seed ^ (number as u64).wrapping_mul(0x9e37_79b9))
-        .next_u64()
+    hnav_runtime::hash::SplitMix64::new(seed ^ (number as u64).wrapping_mul(0x9e37_79b9)).next_u64()
 }
 
 /// The faults of the `k`-th plan of `class`.
@@ -301,7 +308,7 @@ fn draw(class: Class, k: usize, seed: u64, space: &PlanSpace) -> Vec<Fault> {
         Class::SimKill => vec![kill(Target::Sim, round(&mut rng))],
         Class::FreezeAgent => {
             // Alternating, so a class of any size has both sides of the deadline.
-            let for_s = if k % 2 == 0 {
+            let for_s = if k.is_multiple_of(2) {
                 space.freeze_short_s
             } else {
                 space.freeze_long_s
@@ -418,7 +425,9 @@ mod tests {
             action: Action::Freeze { for_s: 3.0 },
         };
         assert_eq!(freeze.to_string(), "--freeze agent:5@round:60+3s");
-        assert!(freeze.to_toml().contains("action = \"freeze\"\nfor_s = 3\n"));
+        assert!(freeze
+            .to_toml()
+            .contains("action = \"freeze\"\nfor_s = 3\n"));
         let coord = Fault {
             target: Target::Coordinator,
             at_round: 7,

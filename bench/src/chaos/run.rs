@@ -203,9 +203,9 @@ fn observe(
             }
             if wake == Wake::TimedOut && Instant::now() >= deadline {
                 let _ = child.signal_group(Signal::SIGKILL);
-                outcome
-                    .failures
-                    .push(format!("the run did not end within {RUN_TIMEOUT:?} (killed)"));
+                outcome.failures.push(format!(
+                    "the run did not end within {RUN_TIMEOUT:?} (killed)"
+                ));
                 break;
             }
         }
