@@ -135,29 +135,35 @@ pub fn verify_log(hnav: &Path, dir: &Path) -> Result<(), String> {
     ))
 }
 
+/// Robots at goal and robots whose goal is reachable (not reported unreachable), from
+/// `summary.json`.
+pub fn goal_counts(summary: &serde_json::Value) -> (usize, usize) {
+    let agents = summary["agents"].as_array().map_or(&[][..], Vec::as_slice);
+    let reachable = agents.iter().filter(|a| a["unreachable"] != true);
+    let at_goal = reachable
+        .clone()
+        .filter(|a| a["reached_goal"] == true)
+        .count();
+    (at_goal, reachable.count())
+}
+
 /// The summary's verdict on the robots: every robot whose goal is reachable at it, and no
-/// collision. Returns `(at goal, reachable)` when it holds.
-pub fn check_summary(summary: &serde_json::Value) -> Result<(usize, usize), String> {
+/// collision.
+pub fn check_summary(summary: &serde_json::Value) -> Result<(), String> {
     let agents = summary["agents"]
         .as_array()
         .ok_or("summary.json has no agents")?;
-    let reachable: Vec<&serde_json::Value> =
-        agents.iter().filter(|a| a["unreachable"] != true).collect();
-    let at_goal = reachable
-        .iter()
-        .filter(|a| a["reached_goal"] == true)
-        .count();
+    let (at_goal, reachable) = goal_counts(summary);
     let collisions = summary["collisions"].as_u64().unwrap_or(u64::MAX);
     let mut wrong = Vec::new();
-    if at_goal < reachable.len() {
-        let missing: Vec<String> = reachable
+    if at_goal < reachable {
+        let missing: Vec<String> = agents
             .iter()
-            .filter(|a| a["reached_goal"] != true)
+            .filter(|a| a["unreachable"] != true && a["reached_goal"] != true)
             .map(|a| a["id"].to_string())
             .collect();
         wrong.push(format!(
-            "{at_goal} of {} robots at goal (not: {})",
-            reachable.len(),
+            "{at_goal} of {reachable} robots at goal (not: {})",
             missing.join(", ")
         ));
     }
@@ -165,7 +171,7 @@ pub fn check_summary(summary: &serde_json::Value) -> Result<(usize, usize), Stri
         wrong.push(format!("{collisions} collisions"));
     }
     if wrong.is_empty() {
-        Ok((at_goal, reachable.len()))
+        Ok(())
     } else {
         Err(format!("{} (end: {})", wrong.join(", "), summary["end"]))
     }
@@ -252,13 +258,15 @@ mod tests {
         let ok = serde_json::json!({"agents": [
             {"id": 0, "reached_goal": true, "unreachable": false},
             {"id": 1, "reached_goal": false, "unreachable": true}], "collisions": 0, "end": "all-at-goal"});
-        assert_eq!(check_summary(&ok), Ok((1, 1)));
+        assert_eq!(check_summary(&ok), Ok(()));
+        assert_eq!(goal_counts(&ok), (1, 1));
         let bad = serde_json::json!({"agents": [
             {"id": 0, "reached_goal": false, "unreachable": false}], "collisions": 2, "end": "time-limit"});
         assert_eq!(
             check_summary(&bad),
             Err("0 of 1 robots at goal (not: 0), 2 collisions (end: \"time-limit\")".into())
         );
+        assert_eq!(goal_counts(&bad), (0, 1));
     }
 
     #[test]
