@@ -5,6 +5,7 @@
 //!
 //! | module | subcommand | what it measures |
 //! |---|---|---|
+//! | [`chaos`] | `hnav-bench chaos [--runs N] [--seed S] [--quick] [--only N]` | a seeded campaign of runs with agents, the coordinator or the sim killed or frozen: per-run checks (at goal, no collision, log verifies, every commit seen once, nothing left behind), a table per class and mode, detection and recovery latencies |
 //! | [`latency`] | `hnav-bench latency [--quick] --out DIR` | one-way and round-trip latency of raw iceoryx2, the HNAV transport, a Unix domain socket and TCP loopback, in a two-thread ping-pong |
 //! | [`neural_map`] | `hnav-bench neural-map [--quick]` | neuron updates per second and time per map for 20x20 to 1024x1024, tanh against linear, and plan queries |
 //! | [`sim`] | `hnav-bench sim [--robots 1,64,1024] [--seconds S] [--json]` | robot-steps per second of the physics stepper |
@@ -16,6 +17,7 @@
 //! (`date,language,platform,name,size_bytes,avg_us,p50_us,p90_us,p99_us,n`), so they can be
 //! plotted next to other frameworks' numbers.
 
+pub mod chaos;
 pub mod latency;
 pub mod neural_map;
 pub mod plan;

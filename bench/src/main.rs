@@ -42,6 +42,49 @@ enum Command {
     /// Decision-round latency (all candidates in -> commit at every agent) against a real
     /// hnav-coordinator for 1..128 agents; with --faults, SIGKILL -> Down and rejoin latency.
     Round(hnav_bench::round::RoundArgs),
+    /// Chaos campaign: seeded runs of a small swarm with agents, the coordinator or the sim
+    /// killed or frozen; checks every run and prints a table and the recovery figures.
+    Chaos(ChaosCli),
+}
+
+#[derive(Debug, Args)]
+struct ChaosCli {
+    /// Runs in all, split 30:10:5:5:5 over the classes [default: 110, or 55 with --quick].
+    #[arg(long, value_name = "N")]
+    runs: Option<usize>,
+    /// The campaign's seed (every plan is drawn from it).
+    #[arg(long, default_value_t = 12)]
+    seed: u64,
+    /// The campaign the test runs: 55 runs.
+    #[arg(long)]
+    quick: bool,
+    /// Run only plan N of the campaign (numbered from 0, as the failures name them).
+    #[arg(long, value_name = "N")]
+    only: Option<usize>,
+}
+
+fn chaos(args: ChaosCli) -> Result<()> {
+    use hnav_bench::chaos::{run_campaign, CampaignConfig, FULL_RUNS, QUICK_RUNS};
+    let exe = std::env::current_exe()?;
+    let bin_dir = exe
+        .parent()
+        .ok_or_else(|| anyhow::anyhow!("{} has no directory", exe.display()))?
+        .to_path_buf();
+    let default_runs = if args.quick { QUICK_RUNS } else { FULL_RUNS };
+    let config = CampaignConfig {
+        runs: args.runs.unwrap_or(default_runs),
+        seed: args.seed,
+        only: args.only,
+        bin_dir,
+    };
+    let report =
+        run_campaign(&config, |line| hnav_runtime::outln!("{line}")).map_err(anyhow::Error::msg)?;
+    hnav_runtime::out!("{}", report.render());
+    match report.failures().len() {
+        _ if report.passed() => Ok(()),
+        0 => anyhow::bail!("no run of the campaign ran (every plan was skipped)"),
+        n => anyhow::bail!("{n} of the campaign's runs failed"),
+    }
 }
 
 #[derive(Debug, Args)]
@@ -228,6 +271,7 @@ fn main() -> std::process::ExitCode {
             Ok(())
         }
         Command::Round(args) => hnav_bench::round::main(args),
+        Command::Chaos(args) => chaos(args),
     };
     match outcome {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -1,0 +1,37 @@
+//! The chaos campaign the issue asks for, as a test: 55 seeded runs of the chaos swarm
+//! (`scenarios/chaos.toml`) — 30 killing 1–3 random agents at random rounds, 10 killing the
+//! coordinator, 5 freezing an agent, 5 killing the sim, 5 killing two agents and the
+//! coordinator at once — split over lockstep and realtime. Every run must finish with every
+//! robot at goal, no collision, a log that verifies, every commit seen once, and nothing
+//! left behind; the table and the figures are printed at the end (`--nocapture`).
+//!
+//! The same code as `hnav-bench chaos --quick` (`hnav_bench::chaos`). In its own test binary
+//! because it SIGKILLs and SIGSTOPs processes. `HNAV_CHAOS_SEED` draws another campaign.
+
+use hnav_bench::chaos::{run_campaign, CampaignConfig, QUICK_RUNS};
+use hnav_tests::swarm::workspace_bin;
+
+#[test]
+fn every_run_of_the_chaos_campaign_finishes_with_nothing_lost_or_left() {
+    let seed = std::env::var("HNAV_CHAOS_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(12);
+    let hnav = workspace_bin("hnav");
+    let config = CampaignConfig {
+        runs: QUICK_RUNS,
+        seed,
+        only: None,
+        bin_dir: hnav
+            .parent()
+            .expect("binaries live in a directory")
+            .to_path_buf(),
+    };
+    let report = run_campaign(&config, |line| println!("{line}")).expect("the campaign runs");
+    println!("{}", report.render());
+    assert!(
+        report.passed(),
+        "chaos campaign (seed {seed}) failed:\n{}",
+        report.failures().join("\n")
+    );
+}
