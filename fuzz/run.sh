@@ -6,7 +6,7 @@
 # crashes. Findings land in target/fuzz/TARGET/default/{crashes,queue}; minimise a crash with
 # `cargo afl tmin -i CRASH -o fuzz/corpus/TARGET/crash-NAME -- target/fuzz/afl/release/hnav-fuzz-afl TARGET`
 # and commit it: the CI-sized campaign (`cargo test -p hnav-fuzz`) replays it from then on.
-# `FUZZ_BUILD_ONLY=1 fuzz/run.sh` only builds the harness (what .ci/run does).
+# `FUZZ_BUILD_ONLY=1 fuzz/run.sh` only builds the harness.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD

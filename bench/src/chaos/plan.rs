@@ -466,6 +466,6 @@ mod tests {
         )
         .unwrap();
         assert_eq!(s.faults.len(), 2);
-        assert_eq!(s.faults[0].at_round, 30);
+        assert_eq!(s.faults[0].at, hnav_runtime::scenario::FaultTime::Round(30));
     }
 }
