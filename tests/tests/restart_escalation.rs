@@ -156,14 +156,15 @@ fn coordinator_and_lost_agent(mode: &str) -> Finished {
         restarted.4, 1,
         "the coordinator's restart count is the supervisor's: {life:?}"
     );
-    for e in [LifecycleEvent::Down, LifecycleEvent::Lost] {
-        assert!(
-            life.iter()
-                .any(|l| l.1 == Role::Agent && l.2 == LOST as u32 && l.3 == e),
-            "agent {LOST}'s {} is not logged: {life:?}",
-            e.name()
-        );
-    }
+    // `Lost` must be logged. Its `Down` only if the coordinator saw it before it was killed
+    // itself: the agent and the coordinator die at the same round, and in realtime the
+    // coordinator can die first; its successor then learns the agent's state from the
+    // supervisor's roster, which says `Lost` (a lost agent is down).
+    assert!(
+        life.iter()
+            .any(|l| l.1 == Role::Agent && l.2 == LOST as u32 && l.3 == LifecycleEvent::Lost),
+        "agent {LOST}'s lost is not logged: {life:?}"
+    );
     f
 }
 
