@@ -259,3 +259,28 @@ pub fn hnav_output(
         stderr: err.join().unwrap_or_default(),
     })
 }
+
+/// The lifecycle records of the log in `dir`: (round, role, index, event).
+pub fn lifecycle_records(
+    dir: &std::path::Path,
+) -> Vec<(
+    u64,
+    Option<hnav_runtime::msg::Role>,
+    u32,
+    Option<hnav_runtime::msg::LifecycleEvent>,
+)> {
+    hnav_runtime::consensus_log::read_log(dir)
+        .unwrap()
+        .records
+        .iter()
+        .filter_map(|r| match r {
+            hnav_runtime::consensus_log::Record::Lifecycle(l) => Some((
+                l.round,
+                hnav_runtime::msg::Role::from_u8(l.role),
+                l.index,
+                hnav_runtime::msg::LifecycleEvent::from_u8(l.event),
+            )),
+            _ => None,
+        })
+        .collect()
+}

@@ -10,9 +10,8 @@ use std::path::Path;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use hnav_runtime::consensus_log::{read_log, Record};
 use hnav_runtime::msg::{LifecycleEvent, Role};
-use hnav_tests::swarm::{hnav_output, repo_root, verify_log, SwarmRun};
+use hnav_tests::swarm::{hnav_output, lifecycle_records, repo_root, verify_log, SwarmRun};
 use hnav_tests::TestRun;
 
 const RUN_TIMEOUT: Duration = Duration::from_secs(300);
@@ -53,24 +52,6 @@ fn assert_finished_well(swarm: &SwarmRun, status: std::process::ExitStatus) {
     assert_eq!(s["collisions"], 0, "{s}");
     let (ok, report) = verify_log(&swarm.dir.join("log"));
     assert!(ok, "log does not verify:\n{report}");
-}
-
-/// The lifecycle records of the log in `dir`: (round, role, index, event).
-fn lifecycle_records(dir: &Path) -> Vec<(u64, Option<Role>, u32, Option<LifecycleEvent>)> {
-    read_log(dir)
-        .unwrap()
-        .records
-        .iter()
-        .filter_map(|r| match r {
-            Record::Lifecycle(l) => Some((
-                l.round,
-                Role::from_u8(l.role),
-                l.index,
-                LifecycleEvent::from_u8(l.event),
-            )),
-            _ => None,
-        })
-        .collect()
 }
 
 /// Runs the demo with `extra` arguments into `dir` and checks that it finished well.

@@ -7,9 +7,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use hnav_runtime::consensus_log::{read_log, Record};
 use hnav_runtime::msg::{LifecycleEvent, Role};
-use hnav_tests::swarm::{repo_root, verify_log, SwarmRun};
+use hnav_tests::swarm::{lifecycle_records, repo_root, verify_log, SwarmRun};
 use hnav_tests::TestRun;
 
 const RUN_TIMEOUT: Duration = Duration::from_secs(300);
@@ -35,24 +34,6 @@ fn run(tag: &str, scenario: &Path, dir: &Path, registry: &Path) -> Vec<u8> {
     let (ok, report) = verify_log(&dir.join("log"));
     assert!(ok, "log does not verify:\n{report}");
     std::fs::read(dir.join("log/seg-00000000.hlog")).unwrap()
-}
-
-/// The lifecycle records of the log in `dir`: (round, role, index, event).
-fn lifecycle_records(dir: &Path) -> Vec<(u64, Option<Role>, u32, Option<LifecycleEvent>)> {
-    read_log(dir)
-        .unwrap()
-        .records
-        .iter()
-        .filter_map(|r| match r {
-            Record::Lifecycle(l) => Some((
-                l.round,
-                Role::from_u8(l.role),
-                l.index,
-                LifecycleEvent::from_u8(l.event),
-            )),
-            _ => None,
-        })
-        .collect()
 }
 
 #[test]
