@@ -211,3 +211,56 @@ pub fn agreement(summary: &serde_json::Value, log: &LogNumbers) -> String {
         wrong.join("; ")
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hnav_runtime::consensus_log::LoggedDecision;
+    use hnav_runtime::msg::{Verdict, NO_CELL};
+
+    fn log() -> LogNumbers {
+        let mut tally = Tally::new([0, 9], 10);
+        for (agent, verdict, cell) in [(0, Verdict::Accept, 11), (1, Verdict::Hold, NO_CELL)] {
+            tally.fold(&LoggedDecision {
+                agent,
+                verdict: verdict as u8,
+                refused: 0,
+                kind: 0,
+                cell,
+                waypoint: NO_CELL,
+            });
+        }
+        LogNumbers {
+            tally,
+            rounds: 40,
+            end: Some((40, 1, EndReason::TimeLimit)),
+            makespan_rounds: None,
+        }
+    }
+
+    fn summary() -> serde_json::Value {
+        serde_json::json!({"rounds": 40, "end": "time-limit", "agents": [
+            {"id": 0, "reached_goal": true, "steps": 1, "length": std::f64::consts::SQRT_2, "conflicts": 0, "replans": 0},
+            {"id": 1, "reached_goal": false, "steps": 0, "length": 0.0, "conflicts": 1, "replans": 0}]})
+    }
+
+    #[test]
+    fn a_summary_that_is_the_log_agrees() {
+        assert_eq!(agreement(&summary(), &log()), "ok");
+    }
+
+    #[test]
+    fn every_difference_between_summary_and_log_is_named() {
+        let mut s = summary();
+        s["agents"][1]["conflicts"] = 2.into();
+        s["rounds"] = 41.into();
+        s["end"] = "all-at-goal".into();
+        s["agents"][1]["reached_goal"] = true.into();
+        assert_eq!(
+            agreement(&s, &log()),
+            "agent 1: summary 0 steps 0.0 long, 2 conflicts, 0 replans; log 0 steps 0.000 long, \
+             1 conflicts, 0 replans; summary 41 rounds, log 40; summary ends \"all-at-goal\", \
+             log time-limit; summary 2 robots at goal, log's end record 1"
+        );
+    }
+}
