@@ -115,11 +115,18 @@ fn mapf(args: MapfCli) -> Result<()> {
         out: args.out,
         bin_dir: hnav_bench::swarm_run::bin_dir().map_err(anyhow::Error::msg)?,
     };
-    let rows = mapf::run_benchmark(&config, |line| hnav_runtime::errln!("{line}"))
-        .map_err(anyhow::Error::msg)?;
-    if args.json {
-        hnav_runtime::out!("{}", report::render_json(&rows));
-    } else {
+    let json = args.json;
+    let rows = mapf::run_benchmark(
+        &config,
+        |line| hnav_runtime::errln!("{line}"),
+        |row| {
+            if json {
+                hnav_runtime::out!("{}", report::render_json(std::slice::from_ref(row)));
+            }
+        },
+    )
+    .map_err(anyhow::Error::msg)?;
+    if !json {
         hnav_runtime::out!("{}", report::render_table(&rows));
     }
     Ok(())

@@ -42,9 +42,11 @@ fn parsed(rows: &[Row]) -> Vec<Row> {
 #[test]
 fn the_quick_instances_end_with_every_robot_at_goal_and_a_short_limit_does_not() {
     let out = tempfile::tempdir().unwrap();
-    let rows = run_benchmark(&config(out.path(), QUICK_AGENTS.to_vec(), None), |l| {
-        println!("{l}")
-    })
+    let rows = run_benchmark(
+        &config(out.path(), QUICK_AGENTS.to_vec(), None),
+        |l| println!("{l}"),
+        |_| {},
+    )
     .expect("the quick benchmark runs");
     let rows = parsed(&rows);
     assert_eq!(rows.len(), QUICK_AGENTS.len());
@@ -60,8 +62,12 @@ fn the_quick_instances_end_with_every_robot_at_goal_and_a_short_limit_does_not()
 
     // 2 s of simulated time (200 rounds) is far too short for 8 robots whose solo trips
     // take 10-40 s: the run ends on its limit, robots away from their goals.
-    let rows = run_benchmark(&config(out.path(), vec![8], Some(2.0)), |l| println!("{l}"))
-        .expect("the short benchmark runs");
+    let rows = run_benchmark(
+        &config(out.path(), vec![8], Some(2.0)),
+        |l| println!("{l}"),
+        |_| {},
+    )
+    .expect("the short benchmark runs");
     let [r] = &parsed(&rows)[..] else {
         panic!("one row: {rows:?}")
     };

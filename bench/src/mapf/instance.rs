@@ -135,6 +135,14 @@ pub struct RunSettings {
 /// the benchmark measures the rules, not hang detection.
 pub const HANG_MS: u32 = 30_000;
 
+/// `[run] startup_timeout_s` of a benchmark run of `agents`: 60 s plus 2 s an agent. The
+/// default (60 s plus the neural-map builds, a few ms on these maps) was too short for 200
+/// debug-build processes opening their ports on two loaded cores; every process of a run
+/// waits for the supervisor's `Start`, so a slow start costs nothing but its own time.
+pub fn startup_timeout_s(agents: usize) -> f64 {
+    60.0 + 2.0 * agents as f64
+}
+
 impl Instance<'_> {
     /// Agents in it.
     pub fn agents(&self) -> usize {
@@ -187,6 +195,11 @@ impl Instance<'_> {
         if let Some(rules) = &settings.rules {
             let _ = writeln!(out, "rules = {rules:?}");
         }
+        let _ = writeln!(
+            out,
+            "\n[run]\nstartup_timeout_s = {:?}",
+            startup_timeout_s(self.agents())
+        );
         let _ = writeln!(
             out,
             "\n[health]\nagent_hang_ms = {HANG_MS}\ncoordinator_hang_ms = {HANG_MS}\nsim_hang_ms = {HANG_MS}"

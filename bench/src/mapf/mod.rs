@@ -93,12 +93,14 @@ fn rules_setting(rules: &str) -> Result<Option<String>, String> {
     }
 }
 
-/// Runs every size under every rules, calling `progress` with a line after each run;
-/// returns the rows in that order. Stops at the first error (bad input, a run that left no
-/// summary or an unreadable log).
+/// Runs every size under every rules, calling `progress` with a line and `on_row` with the
+/// row after each run (so that a script reading JSON lines has every finished run even if a
+/// later one fails); returns the rows in that order. Stops at the first error (bad input, a
+/// run that left no summary or an unreadable log).
 pub fn run_benchmark(
     config: &MapfConfig,
     mut progress: impl FnMut(&str),
+    mut on_row: impl FnMut(&Row),
 ) -> Result<Vec<Row>, String> {
     let benchmark = Benchmark::load(&config.map, &config.scen).map_err(|e| e.to_string())?;
     let instances = config
@@ -147,6 +149,7 @@ pub fn run_benchmark(
                 row.end,
                 dir.display()
             ));
+            on_row(&row);
             rows.push(row);
         }
     }
