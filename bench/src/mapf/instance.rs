@@ -63,7 +63,7 @@ impl Benchmark {
         if let Some(e) = validate_scen(&grid, &file).into_iter().next() {
             return Err(e.into());
         }
-        let map = std::path::absolute(map).unwrap_or_else(|_| map.to_path_buf());
+        let map = std::fs::canonicalize(map).unwrap_or_else(|_| map.to_path_buf());
         Ok(Benchmark {
             map,
             grid,

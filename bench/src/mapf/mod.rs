@@ -69,27 +69,33 @@ pub struct MapfConfig {
 /// The rules of the dissertation, the ones a runtime without a `rules` key runs.
 pub const DISSERTATION: &str = "dissertation";
 
-/// Whether the linked runtime's scenarios have the `[coordinator] rules` key (probed by
-/// parsing one, like the chaos campaign's `needs`): `Err` with the parser's word if not.
-fn rules_key() -> Result<(), String> {
-    let text =
-        "name = \"probe\"\n[map]\nrows = [\"..\"]\n[coordinator]\nrules = \"dissertation\"\n\
-                [[agents]]\nstart = [0, 0]\ngoal = [1, 0]\n";
-    Scenario::from_str(text, "probe.toml", Path::new("."))
+/// Parses a one-agent scenario with `[coordinator] rules = RULES` with the linked runtime
+/// (the same source as the `hnav` beside it, as the chaos campaign probes its faults).
+fn probe_rules(rules: &str) -> Result<(), String> {
+    let text = format!(
+        "name = \"probe\"\n[map]\nrows = [\"..\"]\n[coordinator]\nrules = {rules:?}\n\
+         [[agents]]\nstart = [0, 0]\ngoal = [1, 0]\n"
+    );
+    Scenario::from_str(&text, "probe.toml", Path::new("."))
         .map(drop)
         .map_err(|e| e.to_string())
 }
 
-/// The `rules` key to write for `rules`: `None` (no key) for the dissertation's rules on a
-/// runtime without the key; an error for any other rules there.
+/// The `rules` key to write for `rules`: the name itself where the runtime takes it; `None`
+/// (no key) for the dissertation's rules on a runtime without the key; an error, in the
+/// parser's words, for rules it does not know.
 fn rules_setting(rules: &str) -> Result<Option<String>, String> {
-    match rules_key() {
-        Ok(()) => Ok(Some(rules.to_string())),
-        Err(_) if rules == DISSERTATION => Ok(None),
-        Err(e) => Err(format!(
+    let Err(e) = probe_rules(rules) else {
+        return Ok(Some(rules.to_string()));
+    };
+    let has_key = probe_rules(DISSERTATION).is_ok();
+    match (has_key, rules == DISSERTATION) {
+        (false, true) => Ok(None),
+        (false, false) => Err(format!(
             "rules {rules:?} cannot run: this build's scenarios have no [coordinator] rules \
              key, so only the dissertation's rules exist ({e})"
         )),
+        (true, _) => Err(format!("rules {rules:?} cannot run: {e}")),
     }
 }
 
@@ -154,4 +160,21 @@ pub fn run_benchmark(
         }
     }
     Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_dissertation_rules_always_run_and_unknown_rules_never() {
+        // With or without the key in this build, the dissertation's rules can be written.
+        let setting = rules_setting(DISSERTATION).unwrap();
+        assert!(setting.is_none() || setting.as_deref() == Some(DISSERTATION));
+        let err = rules_setting("no-such-rules").unwrap_err();
+        assert!(
+            err.starts_with("rules \"no-such-rules\" cannot run: "),
+            "{err}"
+        );
+    }
 }
