@@ -45,6 +45,91 @@ enum Command {
     /// Chaos campaign: seeded runs of a small swarm with agents, the coordinator or the sim
     /// killed or frozen; checks every run and prints a table and the recovery figures.
     Chaos(ChaosCli),
+    /// MAPF benchmark: the first N entries of a MovingAI .scen run by a whole swarm
+    /// (lockstep), per N and rules: robots at goal, collisions, makespan, sum of lengths
+    /// against the .scen's lower bound, conflicts, replans, wall time, memory.
+    Mapf(MapfCli),
+}
+
+#[derive(Debug, Args)]
+struct MapfCli {
+    /// The MovingAI .map file.
+    #[arg(long, value_name = "FILE", required_unless_present = "quick")]
+    map: Option<PathBuf>,
+    /// Its .scen file; instance N is its first N entries.
+    #[arg(long, value_name = "FILE", required_unless_present = "quick")]
+    scen: Option<PathBuf>,
+    /// Instance sizes [default: 50,100,150,200,250; with --quick 8,16].
+    #[arg(long, value_delimiter = ',', value_name = "N")]
+    agents: Vec<usize>,
+    /// Coordinator rules, each run at every size (the scenario's [coordinator] rules).
+    #[arg(long, value_delimiter = ',', default_value = "dissertation")]
+    rules: Vec<String>,
+    /// lockstep (the same log every time) or realtime.
+    #[arg(long, default_value = "lockstep", value_parser = ["lockstep", "realtime"])]
+    mode: String,
+    /// The scenarios' time limit, simulated seconds in lockstep [default: 10 s per cell of
+    /// the longest optimal path, at least 600 s].
+    #[arg(long, value_name = "S")]
+    time_limit_s: Option<f64>,
+    /// Wall-clock cap of each run, start-up included; a run past it is stopped.
+    #[arg(long, value_name = "S", default_value_t = 1800.0)]
+    wall_limit_s: f64,
+    /// One JSON object per run instead of the table.
+    #[arg(long)]
+    json: bool,
+    /// Where each run gets its directory (<map>-<rules>-<N>/, replaced by the next run).
+    #[arg(long, value_name = "DIR", default_value = "target/hnav-out/mapf")]
+    out: PathBuf,
+    /// A tiny instance: N = 8, 16 on maps/random-32-32-10 unless --map/--scen/--agents say
+    /// otherwise.
+    #[arg(long)]
+    quick: bool,
+}
+
+fn mapf(args: MapfCli) -> Result<()> {
+    use hnav_bench::mapf::{self, report, MapfConfig};
+    let (quick_map, quick_scen) = mapf::quick_files();
+    let agents = match (args.agents.is_empty(), args.quick) {
+        (false, _) => args.agents,
+        (true, true) => mapf::QUICK_AGENTS.to_vec(),
+        (true, false) => vec![50, 100, 150, 200, 250],
+    };
+    if !(args.wall_limit_s > 0.0 && args.wall_limit_s.is_finite()) {
+        anyhow::bail!("--wall-limit-s must be a positive number of seconds");
+    }
+    if args
+        .time_limit_s
+        .is_some_and(|t| !(t > 0.0 && t.is_finite()))
+    {
+        anyhow::bail!("--time-limit-s must be a positive number of seconds");
+    }
+    let config = MapfConfig {
+        map: args.map.unwrap_or(quick_map),
+        scen: args.scen.unwrap_or(quick_scen),
+        agents,
+        rules: args.rules,
+        mode: args.mode,
+        time_limit_s: args.time_limit_s,
+        wall_limit: std::time::Duration::from_secs_f64(args.wall_limit_s),
+        out: args.out,
+        bin_dir: hnav_bench::swarm_run::bin_dir().map_err(anyhow::Error::msg)?,
+    };
+    let json = args.json;
+    let rows = mapf::run_benchmark(
+        &config,
+        |line| hnav_runtime::errln!("{line}"),
+        |row| {
+            if json {
+                hnav_runtime::out!("{}", report::render_json(std::slice::from_ref(row)));
+            }
+        },
+    )
+    .map_err(anyhow::Error::msg)?;
+    if !json {
+        hnav_runtime::out!("{}", report::render_table(&rows));
+    }
+    Ok(())
 }
 
 #[derive(Debug, Args)]
@@ -65,11 +150,7 @@ struct ChaosCli {
 
 fn chaos(args: ChaosCli) -> Result<()> {
     use hnav_bench::chaos::{run_campaign, CampaignConfig, FULL_RUNS, QUICK_RUNS};
-    let exe = std::env::current_exe()?;
-    let bin_dir = exe
-        .parent()
-        .ok_or_else(|| anyhow::anyhow!("{} has no directory", exe.display()))?
-        .to_path_buf();
+    let bin_dir = hnav_bench::swarm_run::bin_dir().map_err(anyhow::Error::msg)?;
     let default_runs = if args.quick { QUICK_RUNS } else { FULL_RUNS };
     let config = CampaignConfig {
         runs: args.runs.unwrap_or(default_runs),
@@ -272,6 +353,7 @@ fn main() -> std::process::ExitCode {
         }
         Command::Round(args) => hnav_bench::round::main(args),
         Command::Chaos(args) => chaos(args),
+        Command::Mapf(args) => mapf(args),
     };
     match outcome {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -24,16 +24,21 @@ fn files_with_ext(ext: &str) -> Vec<PathBuf> {
     files
 }
 
-/// The two shipped scenario files with their maps and expected entry counts.
+/// The shipped scenario files with their maps and expected entry counts: MovingAI's two and
+/// the warehouse's generated one (`hnav map scen`, see maps/README.md).
 fn scen_pairs() -> Vec<(Grid, ScenFile, usize)> {
-    [("random-32-32-10", 461), ("random-32-32-20", 409)]
-        .into_iter()
-        .map(|(name, count)| {
-            let grid = read_map_file(maps_dir().join(format!("{name}.map"))).unwrap();
-            let scen = read_scen_file(maps_dir().join(format!("{name}-random-1.scen"))).unwrap();
-            (grid, scen, count)
-        })
-        .collect()
+    [
+        ("random-32-32-10", 461),
+        ("random-32-32-20", 409),
+        ("warehouse-10-20-10-2-1", 500),
+    ]
+    .into_iter()
+    .map(|(name, count)| {
+        let grid = read_map_file(maps_dir().join(format!("{name}.map"))).unwrap();
+        let scen = read_scen_file(maps_dir().join(format!("{name}-random-1.scen"))).unwrap();
+        (grid, scen, count)
+    })
+    .collect()
 }
 
 #[test]
@@ -87,7 +92,7 @@ fn every_map_round_trips_byte_exactly() {
 #[test]
 fn every_scen_round_trips_byte_exactly() {
     let scens = files_with_ext("scen");
-    assert_eq!(scens.len(), 2, "{scens:?}");
+    assert_eq!(scens.len(), 3, "{scens:?}");
     for path in scens {
         let original = std::fs::read_to_string(&path).unwrap();
         let scen = read_scen(&original, "x.scen").unwrap();
@@ -117,7 +122,7 @@ fn octile_oracle_matches_every_optimal_length() {
             checked += 1;
         }
     }
-    assert_eq!(checked, 461 + 409);
+    assert_eq!(checked, 461 + 409 + 500);
 }
 
 #[test]
@@ -142,7 +147,11 @@ fn corner_cutting_would_break_the_optimal_lengths() {
 
 #[test]
 fn map_check_reports_ok_for_shipped_pairs() {
-    for name in ["random-32-32-10", "random-32-32-20"] {
+    for name in [
+        "random-32-32-10",
+        "random-32-32-20",
+        "warehouse-10-20-10-2-1",
+    ] {
         let map = maps_dir().join(format!("{name}.map"));
         let scen = maps_dir().join(format!("{name}-random-1.scen"));
         let c = check_map(&map, Some(&scen)).unwrap();
@@ -157,4 +166,16 @@ fn map_check_reports_ok_for_shipped_pairs() {
     .unwrap();
     assert!(!c.is_ok());
     assert_eq!(c.warnings.len(), 1);
+}
+
+#[test]
+fn the_warehouse_scen_is_what_its_command_generates() {
+    // maps/README.md: `hnav map scen maps/warehouse-10-20-10-2-1.map --agents 500 --seed 1`.
+    let grid = read_map_file(maps_dir().join("warehouse-10-20-10-2-1.map")).unwrap();
+    let generated =
+        hnav_runtime::grid::scen_gen::generate_scen(&grid, "warehouse-10-20-10-2-1.map", 500, 1)
+            .unwrap();
+    let shipped =
+        std::fs::read_to_string(maps_dir().join("warehouse-10-20-10-2-1-random-1.scen")).unwrap();
+    assert_eq!(write_scen(&generated), shipped);
 }

@@ -1,6 +1,6 @@
 //! What every chaos run must show, each check returning what it found wrong in words.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::Deserialize;
 
@@ -116,77 +116,6 @@ pub fn logged_commits(log_dir: &Path) -> Result<Vec<(u64, u64)>, String> {
         .collect())
 }
 
-/// `hnav log verify DIR`: `Ok` when it exits 0, else its output.
-pub fn verify_log(hnav: &Path, dir: &Path) -> Result<(), String> {
-    let out = std::process::Command::new(hnav)
-        .args(["log", "verify"])
-        .arg(dir)
-        .output()
-        .map_err(|e| format!("cannot run {} log verify: {e}", hnav.display()))?;
-    if out.status.success() {
-        return Ok(());
-    }
-    Err(format!(
-        "hnav log verify {} ({}): {}{}",
-        dir.display(),
-        out.status,
-        String::from_utf8_lossy(&out.stdout).trim(),
-        String::from_utf8_lossy(&out.stderr).trim()
-    ))
-}
-
-/// Robots at goal and robots whose goal is reachable (not reported unreachable), from
-/// `summary.json`.
-pub fn goal_counts(summary: &serde_json::Value) -> (usize, usize) {
-    let agents = summary["agents"].as_array().map_or(&[][..], Vec::as_slice);
-    let reachable = agents.iter().filter(|a| a["unreachable"] != true);
-    let at_goal = reachable
-        .clone()
-        .filter(|a| a["reached_goal"] == true)
-        .count();
-    (at_goal, reachable.count())
-}
-
-/// The summary's verdict on the robots: every robot whose goal is reachable at it, and no
-/// collision.
-pub fn check_summary(summary: &serde_json::Value) -> Result<(), String> {
-    let agents = summary["agents"]
-        .as_array()
-        .ok_or("summary.json has no agents")?;
-    let (at_goal, reachable) = goal_counts(summary);
-    let collisions = summary["collisions"].as_u64().unwrap_or(u64::MAX);
-    let mut wrong = Vec::new();
-    if at_goal < reachable {
-        let missing: Vec<String> = agents
-            .iter()
-            .filter(|a| a["unreachable"] != true && a["reached_goal"] != true)
-            .map(|a| a["id"].to_string())
-            .collect();
-        wrong.push(format!(
-            "{at_goal} of {reachable} robots at goal (not: {})",
-            missing.join(", ")
-        ));
-    }
-    if collisions != 0 {
-        wrong.push(format!("{collisions} collisions"));
-    }
-    if wrong.is_empty() {
-        Ok(())
-    } else {
-        Err(format!("{} (end: {})", wrong.join(", "), summary["end"]))
-    }
-}
-
-/// The run's files in `/dev/shm` and under iceoryx2's root directory. Only the run's own
-/// (its prefix): other runs on the machine come and go meanwhile, so a whole-directory
-/// comparison would blame them on this one.
-pub fn run_files(run: &hnav_runtime::transport::RunId) -> Vec<PathBuf> {
-    let mut files = hnav_runtime::transport::run_shm_files(run);
-    files.extend(hnav_runtime::transport::run_iceoryx2_files(run));
-    files.sort();
-    files
-}
-
 /// The processes of `pids` that still run as part of the run (their command line names the
 /// run id, so a pid reused by an unrelated process is not taken for one of the run's).
 pub fn alive_of_run(pids: &[u32], run_id: &str) -> Vec<u32> {
@@ -251,22 +180,6 @@ mod tests {
                 "{seen:?}"
             );
         }
-    }
-
-    #[test]
-    fn the_summary_check_names_what_is_wrong() {
-        let ok = serde_json::json!({"agents": [
-            {"id": 0, "reached_goal": true, "unreachable": false},
-            {"id": 1, "reached_goal": false, "unreachable": true}], "collisions": 0, "end": "all-at-goal"});
-        assert_eq!(check_summary(&ok), Ok(()));
-        assert_eq!(goal_counts(&ok), (1, 1));
-        let bad = serde_json::json!({"agents": [
-            {"id": 0, "reached_goal": false, "unreachable": false}], "collisions": 2, "end": "time-limit"});
-        assert_eq!(
-            check_summary(&bad),
-            Err("0 of 1 robots at goal (not: 0), 2 collisions (end: \"time-limit\")".into())
-        );
-        assert_eq!(goal_counts(&bad), (0, 1));
     }
 
     #[test]

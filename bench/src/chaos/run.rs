@@ -4,7 +4,6 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use hnav_runtime::msg::Role;
 use hnav_runtime::supervisor::child::{Child, ChildSpec, ExitInfo, Signal};
 use hnav_runtime::supervisor::registry::RunRegistry;
 use hnav_runtime::transport::{purge_run, RunId, Wake};
@@ -12,6 +11,7 @@ use hnav_runtime::transport::{purge_run, RunId, Wake};
 use super::checks::{self, CommitCount, EventLine};
 use super::observer::{Observed, Observer};
 use super::plan::Plan;
+use crate::swarm_run::{self, hnav_run_spec, run_files};
 
 /// The longest a run may take, start-up included: the chaos scenario's time limit (20 s)
 /// is far below it, so only a run whose supervisor hangs meets it.
@@ -109,7 +109,7 @@ pub fn run_plan(setup: &RunSetup<'_>, plan: &Plan) -> RunOutcome {
     }
     outcome.wall = started.elapsed();
     // The checks saw what was left; nothing of a failed run may stay on the machine.
-    if !checks::run_files(&run).is_empty() {
+    if !run_files(&run).is_empty() {
         let _ = purge_run(&run);
     }
     if outcome.failures.is_empty() {
@@ -129,25 +129,22 @@ fn execute(
     let scenario = dir.join("scenario.toml");
     std::fs::write(&scenario, plan.scenario(setup.base_scenario))
         .map_err(|e| format!("{}: {e}", scenario.display()))?;
-    let before = checks::run_files(run);
+    let before = run_files(run);
     if !before.is_empty() {
         return Err(format!("files of a fresh run id already exist: {before:?}"));
     }
     let out = dir.join("out");
     let registry = dir.join("runs");
     let hnav = setup.bin_dir.join("hnav");
-    // `ChildSpec` names a process of a run; the supervisor has no role of its own, and the
-    // role only names the process in a warning.
-    let spec = ChildSpec::new(Role::Sim, 0, &hnav, dir.join("hnav-run.log"))
-        .arg("run")
-        .arg(&scenario)
-        .arg("--run")
-        .arg(run.as_str())
-        .arg("--out")
-        .arg(&out)
-        .arg("--mode")
-        .arg(plan.mode.name())
-        .env("HNAV_RUNS_DIR", &registry);
+    let spec = hnav_run_spec(
+        &hnav,
+        &scenario,
+        run,
+        &out,
+        plan.mode.name(),
+        &registry,
+        dir.join("hnav-run.log"),
+    );
     let (child, pids) = observe(run, setup.agents, &spec, &registry, outcome)?;
     let exit = match child.wait(Some(EXIT_TIMEOUT)) {
         Some(exit) => exit,
@@ -231,21 +228,18 @@ fn check_run(
     if exit != ExitInfo::Exited(0) {
         fail.push(format!("hnav run ended with {exit}, not exit code 0"));
     }
-    match std::fs::read_to_string(out.join("summary.json"))
-        .map_err(|e| format!("summary.json: {e}"))
-        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).map_err(|e| e.to_string()))
-    {
+    match swarm_run::read_summary(out) {
         Ok(summary) => {
             outcome.collisions = summary["collisions"].as_u64().unwrap_or(0);
-            outcome.at_goal = checks::goal_counts(&summary);
-            if let Err(e) = checks::check_summary(&summary) {
+            outcome.at_goal = swarm_run::goal_counts(&summary);
+            if let Err(e) = swarm_run::check_summary(&summary) {
                 fail.push(e);
             }
         }
         Err(e) => fail.push(e),
     }
     let hnav = setup.bin_dir.join("hnav");
-    match checks::verify_log(&hnav, out) {
+    match swarm_run::verify_log(&hnav, out) {
         Ok(()) => outcome.verified = true,
         Err(e) => fail.push(e),
     }
@@ -274,7 +268,7 @@ fn check_run(
             fail.push(format!("fault {i} ({f}) never fired"));
         }
     }
-    let left = checks::run_files(run);
+    let left = run_files(run);
     outcome.leaked_files = left.len();
     if !left.is_empty() {
         fail.push(format!("left behind: {left:?}"));

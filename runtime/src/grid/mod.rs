@@ -10,6 +10,7 @@
 //! | [`terrain`] | [`Terrain`], an optional elevation or cost layer |
 //! | [`movingai`] | `.map` reader/writer |
 //! | [`scen`] | `.scen` reader/writer and validation against a map |
+//! | [`scen_gen`] | seeded random `.scen` files for maps that have none (`hnav map scen`) |
 //! | [`shortest`] | octile shortest paths (the "free oracle") and reachability |
 //! | [`check`] | the `hnav map check` report |
 //! | [`error`] | [`GridError`], every variant naming file and line |
@@ -34,6 +35,7 @@ pub mod geometry;
 pub mod movingai;
 pub mod neighbours;
 pub mod scen;
+pub mod scen_gen;
 pub mod shortest;
 pub mod terrain;
 pub mod tile;
@@ -43,7 +45,7 @@ pub use error::{Dimension, Endpoint, GridError};
 pub use movingai::{read_map, read_map_file, read_map_rows, write_map, write_map_file};
 pub use neighbours::{CornerCutting, Direction, Neighbours};
 pub use scen::{read_scen, read_scen_file, validate_scen, write_scen, ScenEntry, ScenFile};
-pub use shortest::{octile_shortest_path, octile_shortest_path_len, reachable_from};
+pub use shortest::{components, octile_shortest_path, octile_shortest_path_len, reachable_from};
 pub use terrain::{Terrain, TerrainKind};
 pub use tile::Tile;
 

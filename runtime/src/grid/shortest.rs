@@ -5,7 +5,8 @@
 //! planner: `.scen` optimal lengths, scenario sanity (`hnav check`), and tests of the real
 //! planners. With [`CornerCutting::Forbidden`] its lengths equal the MovingAI optimal lengths.
 //!
-//! Also [`reachable_from`], a BFS flood used to place random agents in connected cells.
+//! Also [`reachable_from`], a BFS flood used to place random agents in connected cells, and
+//! [`components`], the connected components it finds.
 
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, VecDeque};
@@ -141,6 +142,25 @@ pub fn reachable_from(grid: &Grid, start: Cell, rule: CornerCutting) -> Vec<bool
         }
     }
     seen
+}
+
+/// Connected-component label of every free cell under `rule` (`u32::MAX` for blocked
+/// cells), numbered from 0 in row-major order of each component's first cell.
+pub fn components(grid: &Grid, rule: CornerCutting) -> Vec<u32> {
+    let mut label = vec![u32::MAX; grid.len()];
+    let mut next = 0u32;
+    for cell in grid.passable_cells() {
+        if label[grid.index(cell)] != u32::MAX {
+            continue;
+        }
+        for (i, reached) in reachable_from(grid, cell, rule).into_iter().enumerate() {
+            if reached {
+                label[i] = next;
+            }
+        }
+        next += 1;
+    }
+    label
 }
 
 #[cfg(test)]

@@ -10,27 +10,9 @@ use std::collections::HashSet;
 
 use super::error::{Loc, ScenarioError};
 use super::{AgentSpec, FaultTarget, Scenario};
-use crate::grid::{reachable_from, Cell, Grid};
+use crate::grid::{components, Cell};
 use crate::hash::SplitMix64;
 use crate::msg::MAX_AGENTS;
-
-/// Connected-component label of every free cell (`u32::MAX` for blocked cells).
-fn components(grid: &Grid, rule: crate::grid::CornerCutting) -> Vec<u32> {
-    let mut label = vec![u32::MAX; grid.len()];
-    let mut next = 0u32;
-    for cell in grid.passable_cells() {
-        if label[grid.index(cell)] != u32::MAX {
-            continue;
-        }
-        for (i, reached) in reachable_from(grid, cell, rule).into_iter().enumerate() {
-            if reached {
-                label[i] = next;
-            }
-        }
-        next += 1;
-    }
-    label
-}
 
 /// See [`Scenario::with_agent_count`].
 pub(super) fn with_agent_count(

@@ -77,6 +77,18 @@ enum MapCommand {
         #[arg(long)]
         scen: Option<PathBuf>,
     },
+    /// Write a seeded random MovingAI .scen for a map to stdout: distinct starts and goals
+    /// in its largest connected component, optimal lengths without corner cutting.
+    Scen {
+        /// The .map file.
+        map: PathBuf,
+        /// Entries to write (the largest N-agent instance it holds).
+        #[arg(long, value_name = "N")]
+        agents: usize,
+        /// Seed of the random starts and goals.
+        #[arg(long, value_name = "S", default_value_t = 1)]
+        seed: u64,
+    },
 }
 
 fn main() -> ExitCode {
@@ -94,6 +106,9 @@ fn main() -> ExitCode {
         Command::Map {
             command: MapCommand::Check { map, scen },
         } => map_check(map, scen),
+        Command::Map {
+            command: MapCommand::Scen { map, agents, seed },
+        } => map_scen(map, agents, seed),
         Command::Run(args) => run_cmd::run_command(args, matches.subcommand_matches("run")),
         Command::Kill(args) => kill_cmd::run(args),
         Command::Ps(args) => ps_cmd::run(args),
@@ -146,6 +161,27 @@ fn map_check(map: PathBuf, scen: Option<PathBuf>) -> ExitCode {
             } else {
                 ExitCode::from(1)
             }
+        }
+        Err(e) => {
+            hnav_runtime::errln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn map_scen(map: PathBuf, agents: usize, seed: u64) -> ExitCode {
+    use hnav_runtime::grid::{read_map_file, scen_gen::generate_scen, write_scen};
+    let name = map
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let generated = read_map_file(&map)
+        .map_err(|e| e.to_string())
+        .and_then(|grid| generate_scen(&grid, &name, agents, seed).map_err(|e| e.to_string()));
+    match generated {
+        Ok(scen) => {
+            hnav_runtime::out!("{}", write_scen(&scen));
+            ExitCode::SUCCESS
         }
         Err(e) => {
             hnav_runtime::errln!("error: {e}");

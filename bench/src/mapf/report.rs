@@ -1,0 +1,183 @@
+//! A row per instance run, printed as a markdown table or as JSON lines.
+
+use std::fmt::Write as _;
+
+use hnav_runtime::scenario::SimParams;
+use serde::{Deserialize, Serialize};
+
+use super::instance::{Instance, RunSettings};
+use super::memory::RunMemory;
+
+/// What one run of one instance showed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    /// The map file.
+    pub map: String,
+    /// The `.scen` file.
+    pub scen: String,
+    /// Agents (the first N entries).
+    pub agents: usize,
+    /// The coordinator's rules.
+    pub rules: String,
+    /// `lockstep` or `realtime`.
+    pub mode: String,
+    /// The scenario's time limit (simulated seconds in lockstep).
+    pub time_limit_s: f64,
+    /// Robots whose true pose ended in their goal cell (`summary.json`).
+    pub at_goal: usize,
+    /// Collisions on ground truth (`summary.json`).
+    pub collisions: u64,
+    /// The last round of the log.
+    pub rounds: u64,
+    /// The round in which the last robot was at its goal (the log's end record of an
+    /// all-at-goal run); `None` when not every robot got there.
+    pub makespan_rounds: Option<u64>,
+    /// [`Row::makespan_rounds`] in simulated seconds.
+    pub makespan_s: Option<f64>,
+    /// Sum over the agents of their accepted moves' octile length (the log).
+    pub length_sum: f64,
+    /// Sum of the `.scen`'s optimal lengths: the lower bound.
+    pub optimal_sum: f64,
+    /// `length_sum / optimal_sum`.
+    pub length_ratio: f64,
+    /// Refused or held requests (the log).
+    pub conflicts: u32,
+    /// Global replans (the log).
+    pub replans: u32,
+    /// Wall time of `hnav run`, start-up included.
+    pub wall_s: f64,
+    /// How the run ended (`summary.json`'s `end`).
+    pub end: String,
+    /// How `hnav run` exited.
+    pub exit: String,
+    /// Whether the benchmark's wall-clock cap stopped the run.
+    pub wall_capped: bool,
+    /// Whether `hnav log verify` passed.
+    pub log_verified: bool,
+    /// `ok` when the summary's numbers are the log's, else what differs.
+    pub agreement: String,
+    /// The processes' memory.
+    pub memory: RunMemory,
+}
+
+impl Row {
+    /// A row for `instance` with nothing measured yet but its memory.
+    pub fn new(instance: &Instance<'_>, settings: &RunSettings, memory: RunMemory) -> Self {
+        Row {
+            map: instance.benchmark.map.display().to_string(),
+            scen: instance.benchmark.scen.clone(),
+            agents: instance.agents(),
+            rules: settings
+                .rules
+                .clone()
+                .unwrap_or_else(|| "dissertation".into()),
+            mode: settings.mode.clone(),
+            time_limit_s: settings.time_limit_s,
+            at_goal: 0,
+            collisions: 0,
+            rounds: 0,
+            makespan_rounds: None,
+            makespan_s: None,
+            length_sum: 0.0,
+            optimal_sum: instance.optimal_sum(),
+            length_ratio: 0.0,
+            conflicts: 0,
+            replans: 0,
+            wall_s: 0.0,
+            end: String::new(),
+            exit: String::new(),
+            wall_capped: false,
+            log_verified: false,
+            agreement: String::new(),
+            memory,
+        }
+    }
+
+    /// Fills the derived numbers: the ratio and the makespan in seconds (the scenarios run
+    /// at the default control period).
+    pub fn derive(&mut self) {
+        self.length_ratio = if self.optimal_sum > 0.0 {
+            self.length_sum / self.optimal_sum
+        } else {
+            0.0
+        };
+        let period = SimParams::default().control_period_s();
+        self.makespan_s = self.makespan_rounds.map(|r| r as f64 * period);
+    }
+
+    /// Every robot at its goal, no collision, an intact log that agrees with the summary.
+    pub fn solved(&self) -> bool {
+        self.at_goal == self.agents
+            && self.collisions == 0
+            && self.log_verified
+            && self.agreement == "ok"
+    }
+}
+
+fn mib(kib: u64) -> String {
+    format!("{:.1}", kib as f64 / 1024.0)
+}
+
+/// The rows as a markdown table, then a line per row whose summary and log disagree or
+/// whose log does not verify.
+pub fn render_table(rows: &[Row]) -> String {
+    let mut out = String::new();
+    out += "| N | rules | at goal | collisions | makespan (rounds) | sum of lengths | lower bound | ratio | conflicts | replans | wall s | end | sim MiB | coordinator MiB | agent MiB | PSS sum MiB |\n";
+    out += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for r in rows {
+        let makespan = r
+            .makespan_rounds
+            .map_or_else(|| "-".to_string(), |m| m.to_string());
+        let end = if r.wall_capped {
+            format!("{} (wall cap)", r.end)
+        } else {
+            r.end.clone()
+        };
+        let _ = writeln!(
+            out,
+            "| {} | {} | {}/{} | {} | {} | {:.1} | {:.1} | {:.3} | {} | {} | {:.1} | {} | {} | {} | {} | {} |",
+            r.agents,
+            r.rules,
+            r.at_goal,
+            r.agents,
+            r.collisions,
+            makespan,
+            r.length_sum,
+            r.optimal_sum,
+            r.length_ratio,
+            r.conflicts,
+            r.replans,
+            r.wall_s,
+            end,
+            mib(r.memory.sim.hwm_kib),
+            mib(r.memory.coordinator.hwm_kib),
+            mib(r.memory.agent.hwm_kib),
+            mib(r.memory.pss_sum_kib),
+        );
+    }
+    for r in rows {
+        if !r.log_verified {
+            let _ = writeln!(
+                out,
+                "N = {} ({}): the log does not verify",
+                r.agents, r.rules
+            );
+        }
+        if r.agreement != "ok" {
+            let _ = writeln!(
+                out,
+                "N = {} ({}): summary and log disagree: {}",
+                r.agents, r.rules, r.agreement
+            );
+        }
+    }
+    out += "memory: peak RSS (VmHWM) of the sim, the coordinator and the largest agent; PSS sum: the largest sum over all processes at one sample (shared memory counted once)\n";
+    out
+}
+
+/// The rows as JSON lines, one object per row.
+pub fn render_json(rows: &[Row]) -> String {
+    rows.iter()
+        .map(|r| serde_json::to_string(r).unwrap_or_default() + "\n")
+        .collect()
+}
