@@ -71,6 +71,7 @@
 //! agent) with generation stamps instead of clearing per-cell tables, and allocates nothing
 //! (the caller's `out` keeps its capacity).
 
+pub mod pibt;
 mod resolve;
 #[cfg(test)]
 mod tests;
@@ -78,6 +79,7 @@ mod tests;
 use hnav_runtime::grid::{Cell, CornerCutting, Direction, Grid};
 use hnav_runtime::msg::{ConflictKind, Decision, Verdict, NO_CELL};
 
+pub use pibt::Pibt;
 pub use resolve::Resolver;
 
 /// Whether an agent takes part in the round.
