@@ -130,8 +130,9 @@ proptest! {
     /// measured: PIBT is a one-step greedy rule, and incomplete.
     /// - "All at their goals at once" is not PIBT's promise: two agents whose goals are
     ///   neighbours in a narrow place can take turns pushing each other off their goals, for
-    ///   ever. The rotating tie break and the hand-over of rank to a cornered agent (see the
-    ///   module docs) halved such instances, from about 40 % to 20 % of the dense ones.
+    ///   ever. With the rotating tie break and the hand-over of rank to a cornered agent (see
+    ///   the module docs) one run had all agents home at once in 58 of 68 instances, without
+    ///   the hand-over in 42 of 58.
     /// - PIBT's reachability (every agent on its goal at some time) holds for the agent of
     ///   highest priority when it moves into the cell vacated in the same step. Robots that
     ///   hold a cell until they have left it cannot: the pusher waits, the chain of pushes is
