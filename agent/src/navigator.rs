@@ -6,8 +6,12 @@
 //!   one step from `current` with the directions the coordinator refused last round masked
 //!   out; while driving to `next` it asks for nothing (the coordinator still hears from it:
 //!   every live agent sends one candidate per round, which doubles as its heartbeat).
-//! - **Accept**: `next <- probable`; the wheel controller drives there and the agent sets
-//!   `current <- next` on arrival, which frees the old cell for others.
+//! - **Accept**: `next <- cell`; the wheel controller drives there and the agent sets
+//!   `current <- next` on arrival, which frees the old cell for others. The cell is usually
+//!   the probable step; under `[coordinator] rules = "pibt"` it may be another neighbour
+//!   ([`ConflictKind::Pushed`], [`ConflictKind::Redirected`]), also from the goal. The agent
+//!   then forgets the cells it has left, so the climb starts afresh from the new cell: a
+//!   robot pushed off its goal, whose goal is a left (negated) cell, climbs straight back.
 //! - **Block**: the refused directions are masked for the next candidate (the dissertation's
 //!   `grad_d = -1` "virtual obstacle", §3.3.2). A block by a standing or finished agent (type
 //!   d) also makes that cell an obstacle of the map, as the dissertation prescribes, so the
@@ -225,6 +229,13 @@ impl Navigator {
                 let dir = cell.and_then(|c| Direction::between(self.current, c));
                 if let (Some(c), Some(dir), false) = (cell, dir, self.is_moving()) {
                     self.walker.advance(dir);
+                    let chosen = matches!(
+                        ConflictKind::from_u8(d.kind),
+                        Some(ConflictKind::Pushed | ConflictKind::Redirected)
+                    );
+                    if chosen {
+                        self.walker.forget_visited();
+                    }
                     self.next = c;
                     applied.accepted = true;
                 }
@@ -394,5 +405,45 @@ mod tests {
             assert_eq!(n.apply(&d).unwrap(), Applied::default());
         }
         assert!(!n.is_moving());
+    }
+
+    #[test]
+    fn an_agent_pushed_off_its_goal_climbs_back() {
+        let grid = Grid::new(6, 3).unwrap();
+        let goal = Cell::new(3, 1);
+        let mut n = nav(&grid, Cell::new(1, 1), goal);
+        let mut round = 0;
+        while !n.at_goal() {
+            let c = n.candidate(round);
+            n.apply(&accept(&n, &c)).unwrap();
+            n.arrived().unwrap();
+            round += 1;
+        }
+        // Two pushes away from the goal, then the agent climbs back on its own.
+        for to in [Cell::new(3, 2), Cell::new(4, 2)] {
+            let c = n.candidate(round);
+            assert_eq!(c.probable == NO_CELL, n.at_goal(), "asks only off the goal");
+            let pushed = Decision {
+                verdict: Verdict::Accept as u8,
+                kind: ConflictKind::Pushed as u8,
+                cell: grid.index(to) as u32,
+                ..Decision::default()
+            };
+            assert!(n.apply(&pushed).unwrap().accepted);
+            n.arrived().unwrap();
+            assert_eq!(n.current(), to);
+            round += 1;
+        }
+        let mut back = 0;
+        while !n.at_goal() {
+            let c = n.candidate(round);
+            assert_ne!(c.probable, NO_CELL, "stuck at {:?}", n.current());
+            assert_eq!(c.flags & CandidateFlags::LOCAL_EXTREMUM, 0);
+            n.apply(&accept(&n, &c)).unwrap();
+            n.arrived().unwrap();
+            round += 1;
+            back += 1;
+            assert!(back <= 2, "not the shortest way back: at {:?}", n.current());
+        }
     }
 }

@@ -398,6 +398,12 @@ impl Walker {
         (constructor.choose(&g), g)
     }
 
+    /// Forgets every cell left so far (a new climb from where the walker stands), without
+    /// allocating.
+    pub fn forget_visited(&mut self) {
+        self.left.fill(0);
+    }
+
     /// Makes the move `d`: the current cell becomes "left" and the walker steps. Returns the
     /// new cell. The move is not checked against the map (the coordinator has done that).
     pub fn advance(&mut self, d: Direction) -> Cell {

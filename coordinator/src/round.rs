@@ -15,24 +15,36 @@
 //! leads straight there. When that vertex is the goal itself (the goal is in sight and the
 //! agent is stuck anyway) the waypoint is A*'s cell a few steps ahead, which steers it around
 //! the agent in the way.
+//!
+//! **Rules.** `[coordinator] rules` picks the round: the dissertation's [`Resolver`] with the
+//! hybrid replanning above (`dissertation`), or [`Pibt`] (`pibt`), which may move an agent
+//! other than it asked, also one that asked for nothing; such a decision is published only
+//! when the agent moves. PIBT needs no replanning (its priorities rise until an agent gets
+//! through), so none is made in that mode.
 
 use hnav_runtime::consensus_log::{LoggedDecision, ReplanRecord, RoundRecord, Tally};
 use hnav_runtime::grid::{Cell, Direction, Grid};
 use hnav_runtime::msg::{Candidate, CandidateFlags, Decision, Verdict, NO_CELL};
 use hnav_runtime::rejected::Rejected;
-use hnav_runtime::scenario::Scenario;
+use hnav_runtime::scenario::{Rules, Scenario};
 
-use crate::conflict::{AgentMode, AgentRow, Options, Outcome, Resolver};
+use crate::conflict::{AgentMode, AgentRow, Options, Outcome, Pibt, Resolver};
 use crate::planner::{AStar, LazyTheta, Planner, PlannerConfig};
 
 /// How many A* steps ahead the fallback waypoint lies.
 const FALLBACK_STEPS: usize = 4;
 
+/// The round of `[coordinator] rules`.
+enum Round {
+    Dissertation(Resolver),
+    Pibt(Box<Pibt>),
+}
+
 /// The coordinator's round logic; see the [module docs](self).
 pub struct Arbiter {
     grid: Grid,
     scratch: Grid,
-    resolver: Resolver,
+    round: Round,
     rows: Vec<AgentRow>,
     flags: Vec<u32>,
     waiting: Vec<u32>,
@@ -59,9 +71,14 @@ impl Arbiter {
             ..Options::default()
         };
         let config = PlannerConfig::new(scenario.map.corner_cutting);
+        let goals: Vec<Cell> = scenario.agents.iter().map(|a| a.goal).collect();
+        let round = match scenario.coordinator.rules {
+            Rules::Dissertation => Round::Dissertation(Resolver::new(&grid, n, options)),
+            Rules::Pibt => Round::Pibt(Box::new(Pibt::new(&grid, &goals, options))),
+        };
         Arbiter {
             scratch: grid.clone(),
-            resolver: Resolver::new(&grid, n, options),
+            round,
             rows: scenario
                 .agents
                 .iter()
@@ -69,7 +86,7 @@ impl Arbiter {
                 .collect(),
             flags: vec![0; n],
             waiting: vec![0; n],
-            goals: scenario.agents.iter().map(|a| a.goal).collect(),
+            goals,
             priorities: scenario
                 .agents
                 .iter()
@@ -179,14 +196,24 @@ impl Arbiter {
             }
             row.priority = self.priorities[i];
         }
-        self.resolver.resolve(&self.rows, &mut self.outcomes);
+        let replanning = match &mut self.round {
+            Round::Dissertation(r) => {
+                r.resolve(&self.rows, &mut self.outcomes);
+                true
+            }
+            Round::Pibt(p) => {
+                p.resolve(&self.rows, &mut self.outcomes);
+                false
+            }
+        };
         for i in 0..self.rows.len() {
             let row = self.rows[i];
             let o = self.outcomes[i];
-            let stuck = self.flags[i] & CandidateFlags::LOCAL_EXTREMUM != 0
+            let stuck = replanning
+                && self.flags[i] & CandidateFlags::LOCAL_EXTREMUM != 0
                 && row.mode == AgentMode::Active
                 && row.is_at_rest();
-            if row.probable.is_none() && !stuck {
+            if row.probable.is_none() && !stuck && !o.accepted() {
                 continue;
             }
             let mut d = o.decision(i as u32, &self.grid);
@@ -203,7 +230,7 @@ impl Arbiter {
                         .map_or(NO_CELL, |c| c as u32);
                 }
             }
-            if stuck || self.waiting[i] >= self.replan_after {
+            if replanning && (stuck || self.waiting[i] >= self.replan_after) {
                 if let Some(r) = self.replan(round, i) {
                     d = Decision {
                         agent: i as u32,
@@ -483,5 +510,60 @@ mod tests {
         for (c, class) in bad {
             assert_eq!(a.check(&c), Err(class), "{c:?}");
         }
+    }
+
+    #[test]
+    fn pibt_moves_an_agent_that_asked_nothing_and_replans_nobody() {
+        let s = scenario(
+            r#"
+            name = "t"
+            [map]
+            rows = ["........", "........", "........"]
+            [coordinator]
+            rules = "pibt"
+            replan_after_rounds = 2
+            [[agents]]
+            start = [0, 1]
+            goal = [7, 1]
+            [[agents]]
+            start = [1, 1]
+            goal = [1, 1]
+        "#,
+        );
+        let mut a = Arbiter::new(&s);
+        let g = &s.map.grid;
+        let c0 = cand(&s, 0, (0, 1), Some((1, 1)));
+        let c1 = Candidate {
+            flags: CandidateFlags::AT_GOAL | CandidateFlags::STANDING,
+            ..cand(&s, 1, (1, 1), None)
+        };
+        let (d, r) = a.decide(1, &[Some(c0), Some(c1)]);
+        assert!(r.is_empty(), "no replans in pibt mode");
+        // Agent 0 pushes agent 1 off its goal and waits for the cell.
+        assert_eq!(d.len(), 2, "{d:?}");
+        assert_eq!(d[0].verdict, Verdict::Hold as u8);
+        assert_eq!(d[0].kind, ConflictKind::Reserved as u8);
+        assert_eq!(d[1].verdict, Verdict::Accept as u8);
+        assert_eq!(d[1].kind, ConflictKind::Pushed as u8);
+        let to = g.cell_at(d[1].cell as usize).unwrap();
+        assert!(Direction::between(Cell::new(1, 1), to).is_some());
+        assert_ne!(to, Cell::new(0, 1));
+        let cell = d[1].cell;
+        // Agent 0 keeps waiting while agent 1 drives out, past replan_after_rounds = 2, and
+        // is never replanned; agent 1, driving, gets no decision.
+        for round in 2..=4 {
+            let moving = Candidate {
+                next: cell,
+                flags: 0,
+                ..c1
+            };
+            let (d, r) = a.decide(round, &[Some(c0), Some(moving)]);
+            assert!(r.is_empty(), "no replans in pibt mode");
+            assert_eq!(d.len(), 1, "{d:?}");
+            assert_eq!(d[0].verdict, Verdict::Hold as u8);
+        }
+        // A push is a step, a hold a conflict.
+        assert_eq!(a.tally().agents()[1].steps, 1, "{:?}", a.tally());
+        assert_eq!(a.tally().agents()[0].conflicts, 4);
     }
 }

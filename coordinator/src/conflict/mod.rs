@@ -3,6 +3,8 @@
 //!
 //! A pure function of the round's rows, with no I/O: the coordinator process calls
 //! [`Resolver::resolve`] once per decision round, tests call it from a discrete-time loop.
+//! [`Pibt`] is the other round (`[coordinator] rules = "pibt"`, priority inheritance; see
+//! [`pibt`]) over the same rows and outcomes, with the same invariants.
 //!
 //! # The model, and why it is this one
 //!
@@ -71,6 +73,7 @@
 //! agent) with generation stamps instead of clearing per-cell tables, and allocates nothing
 //! (the caller's `out` keeps its capacity).
 
+pub mod pibt;
 mod resolve;
 #[cfg(test)]
 mod tests;
@@ -78,6 +81,7 @@ mod tests;
 use hnav_runtime::grid::{Cell, CornerCutting, Direction, Grid};
 use hnav_runtime::msg::{ConflictKind, Decision, Verdict, NO_CELL};
 
+pub use pibt::Pibt;
 pub use resolve::Resolver;
 
 /// Whether an agent takes part in the round.

@@ -69,7 +69,7 @@ impl Default for Request {
 
 /// Priorities compared with `0.0 == -0.0` and NaN ordered by `total_cmp` (deterministic
 /// whatever the caller sends).
-fn cmp_priority(a: f64, b: f64) -> Ordering {
+pub(super) fn cmp_priority(a: f64, b: f64) -> Ordering {
     if a == b {
         Ordering::Equal
     } else {

@@ -113,7 +113,12 @@ fn decision(s: &mut String, d: &LoggedDecision, width: u32) {
     let kind = ConflictKind::from_u8(d.kind)
         .map_or_else(|| format!("kind{}", d.kind), |k| k.name().into());
     match Verdict::from_u8(d.verdict) {
-        Some(Verdict::Accept) => _ = write!(s, "accept a{}->{}", d.agent, cell(d.cell, width)),
+        Some(Verdict::Accept) => {
+            let _ = write!(s, "accept a{}->{}", d.agent, cell(d.cell, width));
+            if d.kind != ConflictKind::None as u8 {
+                let _ = write!(s, " {kind}");
+            }
+        }
         Some(Verdict::Block) => {
             let _ = write!(s, "block a{} {kind}", d.agent);
             if d.refused != 0 {

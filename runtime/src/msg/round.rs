@@ -123,6 +123,12 @@ pub enum ConflictKind {
     Reserved = 6,
     /// Not a legal move at all: not a neighbour, off the grid, or a blocked cell.
     Invalid = 7,
+    /// `[coordinator] rules = "pibt"`, on an accept: the agent is moved out of the way of a
+    /// higher-priority agent (priority inheritance), whatever it asked for.
+    Pushed = 8,
+    /// `[coordinator] rules = "pibt"`, on an accept: the coordinator chose another step than
+    /// the agent asked for (its cell was taken, or it asked for none), by distance to its goal.
+    Redirected = 9,
 }
 
 impl ConflictKind {
@@ -137,6 +143,8 @@ impl ConflictKind {
             5 => Some(Self::CornerCut),
             6 => Some(Self::Reserved),
             7 => Some(Self::Invalid),
+            8 => Some(Self::Pushed),
+            9 => Some(Self::Redirected),
             _ => None,
         }
     }
@@ -152,6 +160,8 @@ impl ConflictKind {
             Self::CornerCut => "corner-cut",
             Self::Reserved => "reserved",
             Self::Invalid => "invalid",
+            Self::Pushed => "pushed",
+            Self::Redirected => "redirected",
         }
     }
 }
@@ -167,7 +177,9 @@ pub struct Decision {
     pub verdict: u8,
     /// Refused directions, bit `d` for direction index `d` (0 = N, clockwise to 7 = NW).
     pub refused: u8,
-    /// Why a move was refused or held: a [`ConflictKind`] as `u8` (0 when accepted).
+    /// Why a move was refused or held: a [`ConflictKind`] as `u8`; 0 when accepted as asked,
+    /// [`ConflictKind::Pushed`] or [`ConflictKind::Redirected`] on an accept the coordinator
+    /// chose.
     pub kind: u8,
     /// Zero.
     pub reserved: u8,
@@ -319,10 +331,10 @@ mod tests {
         ] {
             assert_eq!(Verdict::from_u8(v as u8), Some(v));
         }
-        for k in 0..=7u8 {
+        for k in 0..=9u8 {
             assert_eq!(ConflictKind::from_u8(k).map(|k| k as u8), Some(k));
         }
-        assert_eq!(ConflictKind::from_u8(8), None);
+        assert_eq!(ConflictKind::from_u8(10), None);
         for bad in [0u8, 5, 200, 255] {
             assert_eq!(Verdict::from_u8(bad), None);
         }

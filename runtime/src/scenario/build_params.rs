@@ -198,6 +198,7 @@ pub(super) fn build_coordinator(
             &none,
             lines,
         )?,
+        rules: c.rules.unwrap_or(d.rules),
     })
 }
 

@@ -24,7 +24,7 @@
 //! little-endian `u64`, floats as the little-endian bits of the `f64`, booleans and enum
 //! variants as one `u64` code, options as a presence code then the value.
 
-use super::params::{ClockMode, FsyncPolicy, GiveUpAction, RestartPolicy, RestartRule};
+use super::params::{ClockMode, FsyncPolicy, GiveUpAction, RestartPolicy, RestartRule, Rules};
 use super::{FaultAction, FaultSignal, FaultSpec, FaultTarget, FaultTime, Scenario};
 use crate::grid::{CornerCutting, TerrainKind};
 use crate::hash::Fnv1a64;
@@ -138,6 +138,14 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
         FsyncPolicy::None => 2,
     });
     h.u64(c.replan_after_rounds.into()).f64(c.time_limit_s);
+    // Hashed only off its default, so that every scenario written before the option (and
+    // the golden logs, which carry the hash) keeps its hash.
+    if c.rules != Rules::Dissertation {
+        h.u64(match c.rules {
+            Rules::Dissertation => 0,
+            Rules::Pibt => 1,
+        });
+    }
 
     rule(&mut h, &s.restart.agent);
     rule(&mut h, &s.restart.coordinator);

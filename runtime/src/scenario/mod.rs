@@ -42,6 +42,7 @@
 //! fsync = "every-record"               # or "batched", "none"
 //! replan_after_rounds = 3
 //! time_limit_s = 120.0                 # lockstep: simulated time, in rounds; realtime: wall clock
+//! rules = "dissertation"               # or "pibt": priority inheritance (README, *Dense swarms*)
 //!
 //! [restart]                            # per role; default for each role as shown
 //! agent = { policy = "on-failure", max_restarts = 3, backoff_ms = 100 }
@@ -139,7 +140,8 @@ pub use error::{Loc, ScenarioError};
 pub use health::HealthParams;
 pub use params::{
     default_startup_timeout_s, ClockMode, ClockModeError, CoordinatorParams, FsyncPolicy,
-    GiveUpAction, RestartConfig, RestartPolicy, RestartRule, RobotParams, RunParams, SimParams,
+    GiveUpAction, RestartConfig, RestartPolicy, RestartRule, RobotParams, Rules, RunParams,
+    SimParams,
 };
 pub use report::{default_out_dir, ScenarioReport};
 

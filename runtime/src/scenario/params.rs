@@ -188,6 +188,29 @@ pub enum FsyncPolicy {
     None,
 }
 
+/// The rules of the decision round (`[coordinator] rules`).
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Rules {
+    /// The dissertation's conflict types (a)-(d) with priority `1 / speed` and hybrid
+    /// replanning: the reproduction mode.
+    #[default]
+    Dissertation,
+    /// Priority inheritance with backtracking (PIBT, Okumura et al.): the coordinator may move
+    /// an agent out of a higher-priority agent's way, and priorities rise with waiting.
+    Pibt,
+}
+
+impl Rules {
+    /// The name used in scenario files: `"dissertation"` or `"pibt"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Rules::Dissertation => "dissertation",
+            Rules::Pibt => "pibt",
+        }
+    }
+}
+
 /// Coordinator parameters (`[coordinator]`).
 #[derive(Clone, PartialEq, Debug, Serialize)]
 pub struct CoordinatorParams {
@@ -200,6 +223,8 @@ pub struct CoordinatorParams {
     /// Limit of the whole run in seconds: wall-clock in realtime; in lockstep seconds of
     /// simulated time, counted in rounds ([`SimParams::rounds_in`]).
     pub time_limit_s: f64,
+    /// The rules of the decision round.
+    pub rules: Rules,
 }
 
 impl Default for CoordinatorParams {
@@ -209,6 +234,7 @@ impl Default for CoordinatorParams {
             fsync: FsyncPolicy::EveryRecord,
             replan_after_rounds: 3,
             time_limit_s: 120.0,
+            rules: Rules::Dissertation,
         }
     }
 }

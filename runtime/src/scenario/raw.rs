@@ -9,7 +9,7 @@
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::params::{ClockMode, FsyncPolicy, GiveUpAction, RestartPolicy};
+use super::params::{ClockMode, FsyncPolicy, GiveUpAction, RestartPolicy, Rules};
 
 /// Top level.
 #[derive(Deserialize, Debug)]
@@ -77,6 +77,7 @@ pub(super) struct RawCoordinator {
     pub fsync: Option<FsyncPolicy>,
     pub replan_after_rounds: Option<Spanned<u32>>,
     pub time_limit_s: Option<Spanned<f64>>,
+    pub rules: Option<Rules>,
 }
 
 /// `[run]`.

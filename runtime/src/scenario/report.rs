@@ -159,12 +159,13 @@ impl ScenarioReport {
         );
         let _ = writeln!(
             o,
-            "run       {} clock, step {} ms, seed {}, round deadline {} ms, time limit {} s",
+            "run       {} clock, step {} ms, seed {}, round deadline {} ms, time limit {} s, rules {}",
             format!("{:?}", self.sim.clock).to_lowercase(),
             self.sim.step_ms,
             self.sim.seed,
             self.coordinator.round_deadline_ms,
-            self.coordinator.time_limit_s
+            self.coordinator.time_limit_s,
+            self.coordinator.rules.name()
         );
         let _ = writeln!(o, "agents    {}", self.agents.len());
         let _ = writeln!(

@@ -169,3 +169,24 @@ fn validate_refuses_unreachable_goals_and_too_many_agents() {
         "{e}"
     );
 }
+
+#[test]
+fn rules_count_in_the_hash_only_off_the_default_and_a_bad_name_is_a_located_error() {
+    let a = parse(BASE).unwrap();
+    assert_eq!(a.coordinator.rules, Rules::Dissertation);
+    let with = |rules: &str| format!("{BASE}\n[coordinator]\nrules = \"{rules}\"\n");
+    let b = parse(&with("dissertation")).unwrap();
+    assert_eq!(a.scenario_hash(), b.scenario_hash(), "the default");
+    let c = parse(&with("pibt")).unwrap();
+    assert_eq!(c.coordinator.rules, Rules::Pibt);
+    assert_ne!(a.scenario_hash(), c.scenario_hash());
+    let text = with("fifo");
+    let e = parse(&text).unwrap_err();
+    let line = text.lines().position(|l| l.starts_with("rules")).unwrap() + 1;
+    assert_eq!(e.line(), Some(line), "{e}");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("fifo") && msg.contains("`dissertation`") && msg.contains("`pibt`"),
+        "{msg}"
+    );
+}
