@@ -11,6 +11,7 @@ as it arrives (`commit R: a0 accept [x,y], a1 hold, ...`), the ground truth ever
 """
 
 import argparse
+import ctypes
 import math
 import os
 import sys
@@ -103,7 +104,7 @@ def main() -> int:
     while seen < a.commits:
         for s in commits.drain():
             c = s.payload().contents
-            decisions = ", ".join(describe(d, width) for d in c.decided())
+            decisions = ", ".join(describe(d, width) for d in c.decided()) or "no decisions"
             print(f"commit {c.round}: {decisions}")
             first = c.round if first is None else first
             last = c.round
@@ -140,7 +141,9 @@ def newest_map(topic, current):
     """The newest snapshot on `topic` as (header, values), or `current` if none came."""
     for s in topic.drain():
         header = msg.MapHeader.from_buffer_copy(bytes(s.user_header().contents))
-        current = (header, s.payload().as_memory_view().tolist())
+        values = s.payload()
+        # Copied out: the sample's chunk goes back to the agent when `s` is dropped.
+        current = (header, list((ctypes.c_float * values.len()).from_address(values.as_ptr())))
     return current
 
 
