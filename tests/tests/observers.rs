@@ -172,12 +172,26 @@ fn services_lists_the_topics_with_their_publishers_and_subscribers() {
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
     assert_eq!(v["run_id"], id.as_str());
     let topics = v["topics"].as_array().unwrap();
-    let names: Vec<&str> = topics.iter().map(|t| t["topic"].as_str().unwrap()).collect();
+    let names: Vec<&str> = topics
+        .iter()
+        .map(|t| t["topic"].as_str().unwrap())
+        .collect();
     assert_eq!(
         names,
         [
-            "candidates", "commit", "heartbeat", "lifecycle", "map/0", "map/1", "odom/0",
-            "odom/1", "progress", "ready", "truth", "wheels/0", "wheels/1"
+            "candidates",
+            "commit",
+            "heartbeat",
+            "lifecycle",
+            "map/0",
+            "map/1",
+            "odom/0",
+            "odom/1",
+            "progress",
+            "ready",
+            "truth",
+            "wheels/0",
+            "wheels/1"
         ],
         "{json}"
     );
@@ -187,26 +201,57 @@ fn services_lists_the_topics_with_their_publishers_and_subscribers() {
     assert_eq!(node_names(&commit["publishers"]), ["coordinator"], "{json}");
     let readers = node_names(&commit["subscribers"]);
     for n in ["agent-0", "agent-1", "services-test"] {
-        assert!(readers.iter().any(|r| r == n), "{n} not a commit subscriber: {json}");
+        assert!(
+            readers.iter().any(|r| r == n),
+            "{n} not a commit subscriber: {json}"
+        );
     }
-    assert!(commit["publishers"][0]["pid"].as_i64().unwrap() > 0, "{json}");
+    assert!(
+        commit["publishers"][0]["pid"].as_i64().unwrap() > 0,
+        "{json}"
+    );
     let map = topic("map/1");
-    assert_eq!((map["payload"].as_str(), map["user_header"].as_str()), (Some("[f32]"), Some("hnav::MapHeader")));
+    assert_eq!(
+        (map["payload"].as_str(), map["user_header"].as_str()),
+        (Some("[f32]"), Some("hnav::MapHeader"))
+    );
     assert_eq!(node_names(&map["publishers"]), ["agent-1"], "{json}");
     // The truth reaches the supervisor; the sim reads every robot's wheels.
-    assert_eq!(node_names(&topic("truth")["subscribers"]), ["supervisor"], "{json}");
-    assert_eq!(node_names(&topic("wheels/0")["subscribers"]), ["sim"], "{json}");
+    assert_eq!(
+        node_names(&topic("truth")["subscribers"]),
+        ["supervisor"],
+        "{json}"
+    );
+    assert_eq!(
+        node_names(&topic("wheels/0")["subscribers"]),
+        ["sim"],
+        "{json}"
+    );
     let mut writers = node_names(&topic("candidates")["publishers"]);
     writers.sort();
     assert_eq!(writers, ["agent-0", "agent-1"], "{json}");
     assert!(
-        text.contains(&format!("hnav/{id}/commit  [hnav::Commit]  history 1, buffer 64, latest")),
+        text.contains(&format!(
+            "hnav/{id}/commit  [hnav::Commit]  history 1, buffer 64, latest"
+        )),
         "{text}"
     );
-    assert!(text.contains("  publishers 1/2: coordinator (pid "), "{text}");
+    assert!(
+        text.contains("  publishers 1/2: coordinator (pid "),
+        "{text}"
+    );
 
     // Once the run is over its id names no live run.
-    let out = hnav_output(&["services".into(), id.clone()], &registry, Duration::from_secs(30)).unwrap();
+    let out = hnav_output(
+        &["services".into(), id.clone()],
+        &registry,
+        Duration::from_secs(30),
+    )
+    .unwrap();
     assert_eq!(out.status.code(), Some(2), "{}", out.stdout);
-    assert!(out.stderr.contains(&format!("no live run `{id}`")), "{}", out.stderr);
+    assert!(
+        out.stderr.contains(&format!("no live run `{id}`")),
+        "{}",
+        out.stderr
+    );
 }

@@ -69,7 +69,10 @@ fn ctypes_mirrors_match_the_rust_layout_table() {
     let report = String::from_utf8_lossy(&test.stderr);
     eprintln!("{report}");
     assert!(test.status.success(), "the layout test failed:\n{report}");
-    assert!(report.contains("Ran 4 tests"), "not every layout test ran:\n{report}");
+    assert!(
+        report.contains("Ran 4 tests"),
+        "not every layout test ran:\n{report}"
+    );
 }
 
 #[test]
@@ -112,14 +115,22 @@ fn the_python_example_watches_a_live_run() {
     assert!(status.success(), "the example failed ({status}):\n{text}");
 
     let commits: Vec<&String> = lines.iter().filter(|l| l.starts_with("commit ")).collect();
-    assert!(commits.len() >= 100, "{} commits printed:\n{text}", commits.len());
+    assert!(
+        commits.len() >= 100,
+        "{} commits printed:\n{text}",
+        commits.len()
+    );
     assert_eq!(commits.len(), COMMITS);
     // The first round decides every robot's first move; each decision names its agent.
     assert!(
-        commits.iter().any(|l| (0..6).all(|a| l.contains(&format!("a{a} accept [")))),
+        commits
+            .iter()
+            .any(|l| (0..6).all(|a| l.contains(&format!("a{a} accept [")))),
         "no commit with a move of every agent:\n{text}"
     );
-    assert!(lines.iter().any(|l| l.starts_with("truth period ") && l.contains("r5 (")));
+    assert!(lines
+        .iter()
+        .any(|l| l.starts_with("truth period ") && l.contains("r5 (")));
     // The demo's map is 12 x 12: the header says so and 12 rows of 12 cells follow.
     let at = lines
         .iter()

@@ -97,27 +97,96 @@ macro_rules! layout {
 /// The layout table of every payload and topic.
 pub fn layouts() -> Layouts {
     let types = vec![
-        layout!(Candidate { round: u64, agent: u32, current: u32, next: u32, probable: u32,
-            priority: f32, speed: f32, flags: u32, reserved: u32 }),
-        layout!(Decision { agent: u32, verdict: u8, refused: u8, kind: u8, reserved: u8,
-            cell: u32, waypoint: u32 }),
-        layout!(Commit { round: u64, count: u32, reserved: u32,
-            decisions: [Decision; MAX_AGENTS] }),
-        layout!(Progress { round: u64, agents: u32, at_goal: u32, conflicts: u32,
-            replans: u32, done: u8, reserved: [u8; 7] }),
-        layout!(WheelCommand { period: u64, agent: u32, flags: u32, left_rad_s: f64,
-            right_rad_s: f64 }),
-        layout!(Odometry { sim_time_ns: u64, period: u64, agent: u32, reserved: u32,
-            ticks_left: i64, ticks_right: i64 }),
-        layout!(Pose { x_m: f64, y_m: f64, theta_rad: f64 }),
-        layout!(Truth { sim_time_ns: u64, period: u64, robots: u32, collisions: u32,
-            poses: [Pose; MAX_AGENTS] }),
-        layout!(Lifecycle { time_ns: u64, pid: u32, index: u32, role: u8, event: u8,
-            reason: u8, reserved: u8, restarts: u32 }),
-        layout!(Heartbeat { t_ns: u64, seq: u64, pid: u32, index: u32, role: u8,
-            reserved: [u8; 7] }),
-        layout!(MapHeader { round: u64, agent: u32, width: u32, height: u32, iterations: u32,
-            target: u32, activation: u8, reserved: [u8; 3] }),
+        layout!(Candidate {
+            round: u64,
+            agent: u32,
+            current: u32,
+            next: u32,
+            probable: u32,
+            priority: f32,
+            speed: f32,
+            flags: u32,
+            reserved: u32
+        }),
+        layout!(Decision {
+            agent: u32,
+            verdict: u8,
+            refused: u8,
+            kind: u8,
+            reserved: u8,
+            cell: u32,
+            waypoint: u32
+        }),
+        layout!(Commit {
+            round: u64,
+            count: u32,
+            reserved: u32,
+            decisions: [Decision; MAX_AGENTS]
+        }),
+        layout!(Progress {
+            round: u64,
+            agents: u32,
+            at_goal: u32,
+            conflicts: u32,
+            replans: u32,
+            done: u8,
+            reserved: [u8; 7]
+        }),
+        layout!(WheelCommand {
+            period: u64,
+            agent: u32,
+            flags: u32,
+            left_rad_s: f64,
+            right_rad_s: f64
+        }),
+        layout!(Odometry {
+            sim_time_ns: u64,
+            period: u64,
+            agent: u32,
+            reserved: u32,
+            ticks_left: i64,
+            ticks_right: i64
+        }),
+        layout!(Pose {
+            x_m: f64,
+            y_m: f64,
+            theta_rad: f64
+        }),
+        layout!(Truth {
+            sim_time_ns: u64,
+            period: u64,
+            robots: u32,
+            collisions: u32,
+            poses: [Pose; MAX_AGENTS]
+        }),
+        layout!(Lifecycle {
+            time_ns: u64,
+            pid: u32,
+            index: u32,
+            role: u8,
+            event: u8,
+            reason: u8,
+            reserved: u8,
+            restarts: u32
+        }),
+        layout!(Heartbeat {
+            t_ns: u64,
+            seq: u64,
+            pid: u32,
+            index: u32,
+            role: u8,
+            reserved: [u8; 7]
+        }),
+        layout!(MapHeader {
+            round: u64,
+            agent: u32,
+            width: u32,
+            height: u32,
+            iterations: u32,
+            target: u32,
+            activation: u8,
+            reserved: [u8; 3]
+        }),
     ];
     let fixed = |topic, payload| TopicLayout {
         topic,
@@ -196,7 +265,11 @@ mod tests {
         for t in layouts().types {
             let mut end = 0;
             for f in &t.fields {
-                assert_eq!(f.offset, end, "{}.{} does not follow the field before", t.name, f.name);
+                assert_eq!(
+                    f.offset, end,
+                    "{}.{} does not follow the field before",
+                    t.name, f.name
+                );
                 end = f.offset + f.size;
             }
             assert_eq!(end, t.size, "{}: fields end at {end} of {}", t.name, t.size);

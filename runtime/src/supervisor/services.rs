@@ -96,7 +96,8 @@ pub fn services(registry: &RunRegistry, run: &str) -> Result<ServicesReport, Ser
     config.global.node.cleanup_dead_nodes_on_creation = false;
     config.global.node.cleanup_dead_nodes_on_destruction = false;
     config.global.service.cleanup_dead_nodes_on_open = false;
-    let name = NodeName::new(NODE_NAME).map_err(|e| TransportError::ipc("name node", NODE_NAME, e))?;
+    let name =
+        NodeName::new(NODE_NAME).map_err(|e| TransportError::ipc("name node", NODE_NAME, e))?;
     let node = NodeBuilder::new()
         .config(&config)
         .name(&name)
@@ -133,13 +134,25 @@ pub fn services(registry: &RunRegistry, run: &str) -> Result<ServicesReport, Ser
         };
         let named = |ids: Vec<u128>| -> Vec<Endpoint> {
             ids.into_iter()
-                .map(|n| nodes.get(&n).cloned().unwrap_or(Endpoint { node: String::new(), pid: None }))
+                .map(|n| {
+                    nodes.get(&n).cloned().unwrap_or(Endpoint {
+                        node: String::new(),
+                        pid: None,
+                    })
+                })
                 .collect()
         };
         topics.push(TopicStatus {
-            topic: service.strip_prefix(&prefix).unwrap_or(&service).to_string(),
+            topic: service
+                .strip_prefix(&prefix)
+                .unwrap_or(&service)
+                .to_string(),
             service,
-            payload: if slice { format!("[{element}]") } else { element },
+            payload: if slice {
+                format!("[{element}]")
+            } else {
+                element
+            },
             user_header: (header != "()").then_some(header),
             history: ps.history_size(),
             buffer: ps.subscriber_max_buffer_size(),
@@ -232,7 +245,16 @@ fn open_ports(
             })*
         };
     }
-    fixed!(Candidate, Commit, Progress, WheelCommand, Odometry, Truth, Lifecycle, Heartbeat);
+    fixed!(
+        Candidate,
+        Commit,
+        Progress,
+        WheelCommand,
+        Odometry,
+        Truth,
+        Lifecycle,
+        Heartbeat
+    );
     if slice && element == type_name::<f32>() && header == type_name::<MapHeader>() {
         return Some(ports_of!(node, name, [f32], MapHeader));
     }
@@ -291,7 +313,11 @@ impl ServicesReport {
 }
 
 fn describe(e: &Endpoint) -> String {
-    let name = if e.node.is_empty() { "(unnamed)" } else { &e.node };
+    let name = if e.node.is_empty() {
+        "(unnamed)"
+    } else {
+        &e.node
+    };
     match e.pid {
         Some(pid) => format!("{name} (pid {pid})"),
         None => name.to_string(),
@@ -313,7 +339,10 @@ mod tests {
     fn an_unknown_run_is_named() {
         let tmp = tempfile::tempdir().unwrap();
         let e = services(&RunRegistry::at(tmp.path()), "no-such-run").unwrap_err();
-        assert!(e.to_string().starts_with("no live run `no-such-run`"), "{e}");
+        assert!(
+            e.to_string().starts_with("no live run `no-such-run`"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -337,13 +366,25 @@ mod tests {
                 overflow: true,
                 max_publishers: 2,
                 max_subscribers: 6,
-                publishers: vec![Endpoint { node: "coordinator".into(), pid: Some(7) }],
-                subscribers: vec![Endpoint { node: "agent-0".into(), pid: Some(8) }],
+                publishers: vec![Endpoint {
+                    node: "coordinator".into(),
+                    pid: Some(7),
+                }],
+                subscribers: vec![Endpoint {
+                    node: "agent-0".into(),
+                    pid: Some(8),
+                }],
             }],
         };
         let text = r.render();
-        assert!(text.contains("hnav/r/commit  [hnav::Commit]  history 1, buffer 64, latest"), "{text}");
-        assert!(text.contains("publishers 1/2: coordinator (pid 7)"), "{text}");
+        assert!(
+            text.contains("hnav/r/commit  [hnav::Commit]  history 1, buffer 64, latest"),
+            "{text}"
+        );
+        assert!(
+            text.contains("publishers 1/2: coordinator (pid 7)"),
+            "{text}"
+        );
         assert!(text.contains("subscribers 1/6: agent-0 (pid 8)"), "{text}");
     }
 }
