@@ -8,7 +8,7 @@
 //! | `truth` | [`Truth`](crate::msg::Truth) | sim -> supervisor, viewers | latest |
 //! | `candidates` | [`Candidate`](crate::msg::Candidate) | agents -> coordinator | reliable |
 //! | `commit` | [`Commit`](crate::msg::Commit) | coordinator -> agents | latest, deep buffer |
-//! | `map/<i>` | `[f32]` + [`MapHeader`](crate::msg::MapHeader) | agent i -> coordinator, viewers | latest |
+//! | `map/<i>` | `[f32]` + [`MapHeader`](crate::msg::MapHeader) | agent i -> viewers (`hnav services` lists who) | latest |
 //! | `progress` | [`Progress`](crate::msg::Progress) | coordinator -> supervisor | latest |
 //! | `ready` | [`Lifecycle`](crate::msg::Lifecycle) (`Up`; the sim's `Hold`) | every process -> supervisor | latest, deep buffer |
 //! | `lifecycle` | [`Lifecycle`](crate::msg::Lifecycle) | supervisor -> every process | latest, deep buffer |
@@ -19,7 +19,10 @@
 //! until the supervisor cleans the dead node up, and a stalled coordinator stalls the swarm.
 //! The buffers are sized so that a live reader never falls that far behind: an agent reads a
 //! commit every round, and there is one round in flight at a time. History 1 hands a
-//! restarted process the last commit (or lifecycle event) at once.
+//! restarted process the last commit (or lifecycle event) at once. The same history hands a
+//! viewer that subscribes to `map/<i>` late the agent's last snapshot at once: iceoryx2
+//! delivers history when the publisher updates its connections, and the agent does that on
+//! every pass of its loop, not only when it publishes a rebuilt map.
 //!
 //! One `heartbeat` topic for every process rather than one per process: iceoryx2 keeps a
 //! queue per publisher-subscriber connection, so a depth-1 "latest" buffer already holds each

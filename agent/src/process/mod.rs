@@ -168,6 +168,13 @@ impl<'t> AgentProcess<'t> {
                 break;
             }
             core.step(p)?;
+            // iceoryx2 hands a publisher's history (the last snapshot) to a new subscriber
+            // only when the publisher updates its connections, which a send does; the map is
+            // sent only when it is rebuilt, so without this a viewer that joins late would
+            // wait for the next rebuild. A counter compare unless someone joined.
+            if let Err(e) = p.map.update_connections() {
+                tracing::warn!("neural-map viewers not connected: {e}");
+            }
             // The agent only ever reacts to its inputs; its one deadline is the next beat,
             // after which `TimedOut` only means "look again".
             match waiter.wait(self.heart.until(None)?)? {

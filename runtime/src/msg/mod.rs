@@ -39,8 +39,10 @@
 //! | `lifecycle` | the supervisor's protocol: [`Role`] and its names, [`LifecycleEvent`], [`StopReason`], [`StartupPhase`], [`Lifecycle`] and its constructors |
 //! | `map` | the neural-map snapshot: [`MapHeader`], [`ActivationKind`] |
 //! | `health` | a process's proof of life: [`Heartbeat`] |
+//! | [`layout`] | the table of every payload's size, alignment and field offsets, for clients in other languages (`hnav layout --json`) |
 
 mod health;
+pub mod layout;
 mod lifecycle;
 mod map;
 mod motion;

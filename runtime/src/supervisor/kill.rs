@@ -20,35 +20,18 @@ use nix::unistd::Pid;
 
 use super::child::Signal;
 use super::events::{RunEvent, RunEvents};
-use super::registry::{process_alive, RegistryError, RunRegistry};
+use super::registry::{process_alive, LiveRunError, RunRegistry};
 use crate::consensus_log::reader::LogReader;
 use crate::msg::Role;
 use crate::scenario::fault_arg::target_arg;
 use crate::scenario::FaultTarget;
-use crate::transport::{RunId, TransportError};
 
 /// Why `hnav kill` sent nothing.
 #[derive(Debug, thiserror::Error)]
 pub enum KillError {
-    /// The run id is not a valid one.
+    /// The run is not a live one.
     #[error(transparent)]
-    RunId(#[from] TransportError),
-    /// The registry has no such run.
-    #[error("no live run `{run}` in the run registry {} (`hnav ps` lists the live runs)", dir.display())]
-    UnknownRun {
-        /// The run id.
-        run: String,
-        /// The registry directory.
-        dir: PathBuf,
-    },
-    /// The run's supervisor is gone.
-    #[error("run `{run}` is dead: its supervisor (pid {pid}) is gone (`hnav clean {run}` removes what it left)")]
-    DeadRun {
-        /// The run id.
-        run: String,
-        /// The supervisor's pid.
-        pid: u32,
-    },
+    Live(#[from] LiveRunError),
     /// The run has no such process.
     #[error("run `{run}` has no {target} ({has})")]
     UnknownTarget {
@@ -69,9 +52,6 @@ pub enum KillError {
         /// Its last recorded pid.
         pid: u32,
     },
-    /// The registry could not be read.
-    #[error(transparent)]
-    Registry(#[from] RegistryError),
     /// `kill(2)` refused.
     #[error("cannot send {signal} to {target} (pid {pid}) of run `{run}`: {source}")]
     Signal {
@@ -111,17 +91,7 @@ pub fn kill(
     target: FaultTarget,
     signal: Signal,
 ) -> Result<Killed, KillError> {
-    let id = RunId::new(run)?;
-    let record = registry.find(&id)?.ok_or_else(|| KillError::UnknownRun {
-        run: run.into(),
-        dir: registry.dir().to_path_buf(),
-    })?;
-    if !record.supervisor_alive() {
-        return Err(KillError::DeadRun {
-            run: run.into(),
-            pid: record.supervisor_pid,
-        });
-    }
+    let (_, record) = registry.find_live(run)?;
     let (role, index) = match target {
         FaultTarget::Agent(i) => (Role::Agent, u32::try_from(i).unwrap_or(u32::MAX)),
         FaultTarget::Coordinator => (Role::Coordinator, 0),
@@ -205,6 +175,7 @@ fn last_round(dir: &Path) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::transport::RunId;
 
     /// A registry in `tmp` holding one run `id` whose supervisor is this process, with a
     /// coordinator and two agents; agent 1 is `live` (a process that runs), the others have

@@ -22,6 +22,7 @@
 //! | [`summary`] | the run summary (`summary.json`): per-agent steps, length, conflicts, replans from the consensus log; goals and collisions from ground truth |
 //! | [`kill`] | `hnav kill`: a signal to one process of a live run found in the registry, recorded in its journal |
 //! | [`ps`] | what `hnav ps` shows: each registered process as running, exited or dead, as JSON or a table |
+//! | [`services`] | what `hnav services RUN` shows: a live run's topics with their publishers and subscribers |
 
 pub mod child;
 pub mod clean;
@@ -33,6 +34,7 @@ pub mod registry;
 pub mod restart;
 pub mod run;
 pub mod run_dir;
+pub mod services;
 pub mod startup;
 pub mod stop;
 pub mod summary;

@@ -65,6 +65,33 @@ pub enum RegistryError {
     },
 }
 
+/// Why a run asked for by id (`hnav kill RUN`, `hnav services RUN`) is not a live one.
+#[derive(Debug, thiserror::Error)]
+pub enum LiveRunError {
+    /// The run id is not a valid one.
+    #[error(transparent)]
+    RunId(#[from] crate::transport::TransportError),
+    /// The registry has no such run.
+    #[error("no live run `{run}` in the run registry {} (`hnav ps` lists the live runs)", dir.display())]
+    UnknownRun {
+        /// The run id.
+        run: String,
+        /// The registry directory.
+        dir: PathBuf,
+    },
+    /// The run's supervisor is gone.
+    #[error("run `{run}` is dead: its supervisor (pid {pid}) is gone (`hnav clean {run}` removes what it left)")]
+    DeadRun {
+        /// The run id.
+        run: String,
+        /// The supervisor's pid.
+        pid: u32,
+    },
+    /// The registry could not be read.
+    #[error(transparent)]
+    Registry(#[from] RegistryError),
+}
+
 /// Where run records live.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct RunRegistry {
@@ -154,6 +181,22 @@ impl RunRegistry {
             }
             Err(e) => Err(e),
         }
+    }
+
+    /// The record of the live run `run`: known to the registry and its supervisor alive.
+    pub fn find_live(&self, run: &str) -> Result<(RunId, RunRecord), LiveRunError> {
+        let id = RunId::new(run)?;
+        let record = self.find(&id)?.ok_or_else(|| LiveRunError::UnknownRun {
+            run: run.into(),
+            dir: self.dir.clone(),
+        })?;
+        if !record.supervisor_alive() {
+            return Err(LiveRunError::DeadRun {
+                run: run.into(),
+                pid: record.supervisor_pid,
+            });
+        }
+        Ok((id, record))
     }
 
     /// Claims `run` for this process (a supervisor starting it in `dir`, or `hnav clean`

@@ -11,6 +11,7 @@ mod kill_cmd;
 mod log_cmd;
 mod ps_cmd;
 mod run_cmd;
+mod services_cmd;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -58,12 +59,22 @@ enum Command {
     Ps(ps_cmd::PsArgs),
     /// Send a signal to one process of a live run (agent:N, coordinator or sim).
     Kill(kill_cmd::KillArgs),
+    /// List a live run's topics with their publishers and subscribers.
+    Services(services_cmd::ServicesArgs),
     /// Remove what dead runs left behind (processes, shared memory, registry entries).
     Clean(clean_cmd::CleanArgs),
     /// Inspect a run's consensus log.
     Log {
         #[command(subcommand)]
         command: log_cmd::LogCommand,
+    },
+    /// Print every payload's size, alignment and field offsets (for clients in other
+    /// languages; the Python client's layout test reads it).
+    #[command(hide = true)]
+    Layout {
+        /// As JSON.
+        #[arg(long)]
+        json: bool,
     },
 }
 
@@ -113,7 +124,17 @@ fn main() -> ExitCode {
         Command::Kill(args) => kill_cmd::run(args),
         Command::Ps(args) => ps_cmd::run(args),
         Command::Clean(args) => clean_cmd::run(args),
+        Command::Services(args) => services_cmd::run(args),
         Command::Log { command } => log_cmd::run(command),
+        Command::Layout { json } => {
+            let table = hnav_runtime::msg::layout::layouts();
+            if json {
+                hnav_runtime::outln!("{}", table.to_json());
+            } else {
+                hnav_runtime::out!("{}", table.render());
+            }
+            ExitCode::SUCCESS
+        }
     }
 }
 

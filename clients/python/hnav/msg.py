@@ -1,0 +1,254 @@
+"""ctypes mirrors of every payload in runtime/src/msg/, byte for byte.
+
+Each class has the field names, order and C types of its Rust `#[repr(C)]` struct and the
+iceoryx2 type name the Rust side gives it (`#[type_name("hnav::...")]`), so a service opened
+with it matches the one the run created. `hnav layout --json` prints the Rust table; the
+layout test (tests/test_layout.py) compares every size, alignment and offset with these.
+
+Enumerations travel as plain integers; the constants below name their values.
+"""
+
+import ctypes
+
+# The length of the arrays in Commit and Truth (msg::MAX_AGENTS).
+MAX_AGENTS = 256
+# "No cell" in a cell field (msg::NO_CELL).
+NO_CELL = 0xFFFFFFFF
+
+
+class _Payload(ctypes.Structure):
+    """A payload with an iceoryx2 type name: `hnav::<class name>`."""
+
+    @classmethod
+    def type_name(cls) -> str:
+        """The system-wide type name the Rust side registers the service with."""
+        return f"hnav::{cls.__name__}"
+
+
+class Candidate(_Payload):
+    """One agent's request for a round (`round.rs`)."""
+
+    _fields_ = [
+        ("round", ctypes.c_uint64),
+        ("agent", ctypes.c_uint32),
+        ("current", ctypes.c_uint32),
+        ("next", ctypes.c_uint32),
+        ("probable", ctypes.c_uint32),
+        ("priority", ctypes.c_float),
+        ("speed", ctypes.c_float),
+        ("flags", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+    ]
+
+
+class CandidateFlags:
+    """Bits of `Candidate.flags`."""
+
+    AT_GOAL = 1 << 0
+    STANDING = 1 << 1
+    LOCAL_EXTREMUM = 1 << 2
+    RESTARTED = 1 << 3
+    NO_PATH = 1 << 4
+
+
+class Verdict:
+    """Values of `Decision.verdict`."""
+
+    ACCEPT = 1
+    BLOCK = 2
+    HOLD = 3
+    REPLAN = 4
+    NAMES = {1: "accept", 2: "block", 3: "hold", 4: "replan"}
+
+
+class ConflictKind:
+    """Values of `Decision.kind`."""
+
+    NAMES = {
+        0: "none",
+        1: "crossing",
+        2: "head-on",
+        3: "combined",
+        4: "stable-cell",
+        5: "corner-cut",
+        6: "reserved",
+        7: "invalid",
+    }
+
+
+class Decision(_Payload):
+    """What the coordinator decided for one agent in a round."""
+
+    _fields_ = [
+        ("agent", ctypes.c_uint32),
+        ("verdict", ctypes.c_uint8),
+        ("refused", ctypes.c_uint8),
+        ("kind", ctypes.c_uint8),
+        ("reserved", ctypes.c_uint8),
+        ("cell", ctypes.c_uint32),
+        ("waypoint", ctypes.c_uint32),
+    ]
+
+
+class Commit(_Payload):
+    """One decided round: `count` decisions, the rest of the array unused."""
+
+    _fields_ = [
+        ("round", ctypes.c_uint64),
+        ("count", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+        ("decisions", Decision * MAX_AGENTS),
+    ]
+
+    def decided(self):
+        """The decisions in use."""
+        return self.decisions[: min(self.count, MAX_AGENTS)]
+
+
+class Progress(_Payload):
+    """The coordinator's running tally."""
+
+    _fields_ = [
+        ("round", ctypes.c_uint64),
+        ("agents", ctypes.c_uint32),
+        ("at_goal", ctypes.c_uint32),
+        ("conflicts", ctypes.c_uint32),
+        ("replans", ctypes.c_uint32),
+        ("done", ctypes.c_uint8),
+        ("reserved", ctypes.c_uint8 * 7),
+    ]
+
+
+class WheelCommand(_Payload):
+    """An agent's wheel speeds for one period (`motion.rs`)."""
+
+    _fields_ = [
+        ("period", ctypes.c_uint64),
+        ("agent", ctypes.c_uint32),
+        ("flags", ctypes.c_uint32),
+        ("left_rad_s", ctypes.c_double),
+        ("right_rad_s", ctypes.c_double),
+    ]
+
+
+class Odometry(_Payload):
+    """One robot's Hall-sensor ticks at the end of a period."""
+
+    _fields_ = [
+        ("sim_time_ns", ctypes.c_uint64),
+        ("period", ctypes.c_uint64),
+        ("agent", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+        ("ticks_left", ctypes.c_int64),
+        ("ticks_right", ctypes.c_int64),
+    ]
+
+
+class Pose(_Payload):
+    """A planar pose in metres and radians (x right, y down the map's rows)."""
+
+    _fields_ = [
+        ("x_m", ctypes.c_double),
+        ("y_m", ctypes.c_double),
+        ("theta_rad", ctypes.c_double),
+    ]
+
+
+class Truth(_Payload):
+    """The sim's ground truth: `robots` poses and the collisions so far."""
+
+    _fields_ = [
+        ("sim_time_ns", ctypes.c_uint64),
+        ("period", ctypes.c_uint64),
+        ("robots", ctypes.c_uint32),
+        ("collisions", ctypes.c_uint32),
+        ("poses", Pose * MAX_AGENTS),
+    ]
+
+
+class Role:
+    """Values of a `role` byte."""
+
+    NAMES = {1: "sim", 2: "coordinator", 3: "agent"}
+
+
+class LifecycleEvent:
+    """Values of `Lifecycle.event`."""
+
+    NAMES = {
+        1: "up",
+        2: "down",
+        3: "restarted",
+        4: "start",
+        5: "stop",
+        6: "hold",
+        7: "resume",
+        8: "phase",
+        9: "lost",
+        10: "roster",
+    }
+
+
+class Lifecycle(_Payload):
+    """The supervisor's protocol (`lifecycle.rs`)."""
+
+    _fields_ = [
+        ("time_ns", ctypes.c_uint64),
+        ("pid", ctypes.c_uint32),
+        ("index", ctypes.c_uint32),
+        ("role", ctypes.c_uint8),
+        ("event", ctypes.c_uint8),
+        ("reason", ctypes.c_uint8),
+        ("reserved", ctypes.c_uint8),
+        ("restarts", ctypes.c_uint32),
+    ]
+
+
+class Heartbeat(_Payload):
+    """A process's proof of life (`health.rs`)."""
+
+    _fields_ = [
+        ("t_ns", ctypes.c_uint64),
+        ("seq", ctypes.c_uint64),
+        ("pid", ctypes.c_uint32),
+        ("index", ctypes.c_uint32),
+        ("role", ctypes.c_uint8),
+        ("reserved", ctypes.c_uint8 * 7),
+    ]
+
+
+class ActivationKind:
+    """Values of `MapHeader.activation`."""
+
+    NAMES = {1: "linear", 2: "tanh"}
+
+
+class MapHeader(_Payload):
+    """The user header of a neural-map snapshot (a slice of f32, one value per cell, row-major)."""
+
+    _fields_ = [
+        ("round", ctypes.c_uint64),
+        ("agent", ctypes.c_uint32),
+        ("width", ctypes.c_uint32),
+        ("height", ctypes.c_uint32),
+        ("iterations", ctypes.c_uint32),
+        ("target", ctypes.c_uint32),
+        ("activation", ctypes.c_uint8),
+        ("reserved", ctypes.c_uint8 * 3),
+    ]
+
+
+# Every payload mirror, for the layout test.
+PAYLOADS = [
+    Candidate,
+    Decision,
+    Commit,
+    Progress,
+    WheelCommand,
+    Odometry,
+    Pose,
+    Truth,
+    Lifecycle,
+    Heartbeat,
+    MapHeader,
+]

@@ -1,0 +1,148 @@
+//! The Python client (`clients/python/`) against the Rust side: its `ctypes` mirrors match the
+//! layout table of `hnav layout --json` field by field, and its example joins a live run by
+//! its id and prints commits, ground truth and an agent's neural map.
+//!
+//! The Python is the virtual environment's with the pinned `iceoryx2` package: `$HNAV_PYTHON`,
+//! else `target/py-venv/bin/python` (made by the README's command). Without either the tests
+//! skip, saying so, unless `HNAV_REQUIRE_PYTHON` is set (CI sets it): then they fail.
+
+use std::path::PathBuf;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use hnav_tests::swarm::{repo_root, workspace_bin, SwarmRun};
+use hnav_tests::TestRun;
+use nix::sys::signal::Signal;
+
+/// Bound on stopping the demo run.
+const RUN_TIMEOUT: Duration = Duration::from_secs(120);
+/// Bound on the Python example, joining included.
+const WATCH_TIMEOUT: Duration = Duration::from_secs(90);
+/// Commits the example is asked to print.
+const COMMITS: usize = 150;
+
+/// The virtual environment's Python, or `None` (with the reason printed) when the test
+/// should skip.
+fn python() -> Option<PathBuf> {
+    let explicit = std::env::var_os("HNAV_PYTHON").map(PathBuf::from);
+    let path = explicit
+        .clone()
+        .unwrap_or_else(|| repo_root().join("target/py-venv/bin/python"));
+    if path.exists() {
+        return Some(path);
+    }
+    let why = format!(
+        "no Python virtual environment at {} ({}); make it with `python3 -m venv target/py-venv \
+         && target/py-venv/bin/pip install -r clients/python/requirements.txt`",
+        path.display(),
+        if explicit.is_some() {
+            "$HNAV_PYTHON"
+        } else {
+            "the default; or set $HNAV_PYTHON"
+        }
+    );
+    if std::env::var_os("HNAV_REQUIRE_PYTHON").is_some() {
+        panic!("HNAV_REQUIRE_PYTHON is set but there is {why}");
+    }
+    eprintln!("SKIPPED: {why}");
+    None
+}
+
+#[test]
+fn ctypes_mirrors_match_the_rust_layout_table() {
+    let Some(python) = python() else { return };
+    let out = Command::new(workspace_bin("hnav"))
+        .args(["layout", "--json"])
+        .output()
+        .expect("hnav layout runs");
+    assert!(out.status.success(), "hnav layout --json failed");
+    let dir = tempfile::tempdir().unwrap();
+    let table = dir.path().join("layout.json");
+    std::fs::write(&table, &out.stdout).unwrap();
+    let client = repo_root().join("clients/python");
+    let test = Command::new(&python)
+        .args(["-m", "unittest", "discover", "-v", "-s", "tests"])
+        .current_dir(&client)
+        .env("HNAV_LAYOUT_JSON", &table)
+        .output()
+        .expect("python runs");
+    let report = String::from_utf8_lossy(&test.stderr);
+    eprintln!("{report}");
+    assert!(test.status.success(), "the layout test failed:\n{report}");
+    assert!(
+        report.contains("Ran 4 tests"),
+        "not every layout test ran:\n{report}"
+    );
+}
+
+#[test]
+fn the_python_example_watches_a_live_run() {
+    let Some(python) = python() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let mut run = TestRun::new("pywatch");
+    let mut swarm = SwarmRun::start(
+        &mut run,
+        &repo_root().join("scenarios/demo.toml"),
+        &tmp.path().join("out"),
+        &tmp.path().join("runs"),
+        &["--mode", "lockstep"],
+    )
+    .expect("hnav run starts");
+    let example = repo_root().join("clients/python/examples/watch_run.py");
+    let args = vec![
+        example.display().to_string(),
+        run.run.as_str().to_string(),
+        "--agent".into(),
+        "2".into(),
+        "--commits".into(),
+        COMMITS.to_string(),
+    ];
+    let mut watcher = run
+        .spawn_exact(&python.display().to_string(), &args)
+        .expect("the example starts");
+    let deadline = Instant::now() + WATCH_TIMEOUT;
+    let mut lines = Vec::new();
+    while let Ok(line) = watcher.next_line(deadline.saturating_duration_since(Instant::now())) {
+        lines.push(line);
+    }
+    let status = watcher
+        .wait_exit(deadline.saturating_duration_since(Instant::now()))
+        .expect("the example exits");
+    // The rest of the run is not the test's business (and takes minutes on a loaded machine).
+    swarm.peer.signal(Signal::SIGTERM).unwrap();
+    swarm.finish(RUN_TIMEOUT).expect("hnav run stops");
+    let text = lines.join("\n");
+    assert!(status.success(), "the example failed ({status}):\n{text}");
+
+    let commits: Vec<&String> = lines.iter().filter(|l| l.starts_with("commit ")).collect();
+    assert!(
+        commits.len() >= 100,
+        "{} commits printed:\n{text}",
+        commits.len()
+    );
+    assert_eq!(commits.len(), COMMITS);
+    // The first round decides every robot's first move; each decision names its agent.
+    assert!(
+        commits
+            .iter()
+            .any(|l| (0..6).all(|a| l.contains(&format!("a{a} accept [")))),
+        "no commit with a move of every agent:\n{text}"
+    );
+    assert!(lines
+        .iter()
+        .any(|l| l.starts_with("truth period ") && l.contains("r5 (")));
+    // The demo's map is 12 x 12: the header says so and 12 rows of 12 cells follow.
+    let at = lines
+        .iter()
+        .position(|l| l.starts_with("map agent 2 round "))
+        .unwrap_or_else(|| panic!("no neural map printed:\n{text}"));
+    assert!(lines[at].contains(": 12 x 12,"), "{}", lines[at]);
+    let rows: Vec<&String> = lines[at + 1..]
+        .iter()
+        .take_while(|l| l.starts_with("  |"))
+        .collect();
+    assert_eq!(rows.len(), 12, "{text}");
+    assert!(rows.iter().all(|r| r.chars().count() == 12 + 4), "{text}");
+    // The map's pillars are blocked cells: '@' where demo.toml has them ([2,2]).
+    assert_eq!(rows[2].chars().nth(3 + 2), Some('@'), "{text}");
+}
