@@ -61,6 +61,11 @@
 //! coordinator_hang_ms = 2000           # [2 * heartbeat_ms, 3600000]; the agents' default
 //! sim_hang_ms = 1000                   # grows with the map (health::default_agent_hang_ms)
 //!
+//! [record]                             # the run's recording (README, *Recording and
+//! trajectory_hz = 20                   # report*); not in the hash. Pose samples per
+//! max_mb = 64                          # simulated second (0: every truth message), the
+//! maps = true                          # cap of each file in MiB, neural-map snapshots
+//!
 //! [[agents]]                           # one table per robot, numbered from 0
 //! start = [0, 0]                       # [x, y]: x = column, y = row, origin top-left
 //! goal = [31, 31]
@@ -128,6 +133,7 @@ pub mod health;
 mod lines;
 pub mod params;
 mod raw;
+pub mod record;
 pub mod report;
 mod validate;
 
@@ -137,6 +143,7 @@ use serde::{Deserialize, Serialize};
 
 pub use error::{Loc, ScenarioError};
 pub use health::HealthParams;
+pub use record::RecordParams;
 pub use params::{
     default_startup_timeout_s, ClockMode, ClockModeError, CoordinatorParams, FsyncPolicy,
     GiveUpAction, RestartConfig, RestartPolicy, RestartRule, RobotParams, RunParams, SimParams,
@@ -285,6 +292,8 @@ pub struct Scenario {
     pub run: RunParams,
     /// Heartbeats and hang deadlines (`[health]`).
     pub health: HealthParams,
+    /// What the recorder keeps (`[record]`).
+    pub record: RecordParams,
     /// The robots, numbered from 0.
     pub agents: Vec<AgentSpec>,
     /// The fault plan.

@@ -10,6 +10,7 @@ mod clean_cmd;
 mod kill_cmd;
 mod log_cmd;
 mod ps_cmd;
+mod report_cmd;
 mod run_cmd;
 
 use std::path::PathBuf;
@@ -60,6 +61,8 @@ enum Command {
     Kill(kill_cmd::KillArgs),
     /// Remove what dead runs left behind (processes, shared memory, registry entries).
     Clean(clean_cmd::CleanArgs),
+    /// Draw a finished run's report (DIR/report.svg) again, with the neural maps of --agents.
+    Report(report_cmd::ReportArgs),
     /// Inspect a run's consensus log.
     Log {
         #[command(subcommand)]
@@ -98,6 +101,7 @@ fn main() -> ExitCode {
         Command::Kill(args) => kill_cmd::run(args),
         Command::Ps(args) => ps_cmd::run(args),
         Command::Clean(args) => clean_cmd::run(args),
+        Command::Report(args) => report_cmd::run(args),
         Command::Log { command } => log_cmd::run(command),
     }
 }
