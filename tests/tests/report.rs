@@ -79,13 +79,20 @@ fn check_recording(dir: &Path, scenario: &Scenario, summary: &serde_json::Value)
     assert_eq!((h.robots, h.rate_hz, h.truncated), (6, 20, false));
     let (samples, torn) = r.read_all().unwrap();
     assert_eq!(torn, 0);
-    let truth = samples.iter().filter(|s| s.source == PoseSource::Truth).count() as u64;
+    let truth = samples
+        .iter()
+        .filter(|s| s.source == PoseSource::Truth)
+        .count() as u64;
     let estimates = samples.len() as u64 - truth;
     let rounds = summary["rounds"].as_u64().unwrap();
     let sim_s = rounds as f64 * scenario.sim.control_period_s();
     let expected = (sim_s * 20.0).floor() as u64 * 6;
     let recorded = &summary["recording"];
-    assert_eq!(recorded["truth_samples"].as_u64(), Some(truth), "{recorded}");
+    assert_eq!(
+        recorded["truth_samples"].as_u64(),
+        Some(truth),
+        "{recorded}"
+    );
     assert_eq!(recorded["estimate_samples"].as_u64(), Some(estimates));
     let missed = recorded["missed"].as_u64().unwrap();
     // Every boundary is sampled unless the recorder lost truth messages (counted).
@@ -105,7 +112,8 @@ fn check_recording(dir: &Path, scenario: &Scenario, summary: &serde_json::Value)
     assert_eq!(recorded["map_snapshots"].as_u64(), Some(maps.len() as u64));
     for a in 0..6 {
         assert!(
-            maps.iter().any(|m| m.header.agent == a && m.values.len() == 144),
+            maps.iter()
+                .any(|m| m.header.agent == a && m.values.len() == 144),
             "no 12 x 12 snapshot of agent {a}"
         );
     }
@@ -142,12 +150,19 @@ fn check_report(dir: &Path, scenario: &Scenario, summary: &serde_json::Value) {
         cells_on(&doc, &layout.map),
         scenario.map.grid.blocked_count() + robots
     );
-    assert_eq!(cells_on(&doc, &layout.heatmaps[0]), 144, "agent 0's heatmap");
+    assert_eq!(
+        cells_on(&doc, &layout.heatmaps[0]),
+        144,
+        "agent 0's heatmap"
+    );
     let texts: Vec<&str> = elements(&doc, "text")
         .iter()
         .filter_map(|t| t.text())
         .collect();
-    assert!(texts.iter().any(|t| t.starts_with("agent 0 neural map")), "{texts:?}");
+    assert!(
+        texts.iter().any(|t| t.starts_with("agent 0 neural map")),
+        "{texts:?}"
+    );
     for i in 0..robots {
         assert!(texts.contains(&format!("robot {i}").as_str()), "{texts:?}");
     }

@@ -94,8 +94,10 @@ impl RunData {
         if trajectories.exists() {
             cell_size = Some(data.read_trajectories(&trajectories)?);
         } else {
-            data.notes
-                .push(format!("{}: absent, no trajectories", trajectories.display()));
+            data.notes.push(format!(
+                "{}: absent, no trajectories",
+                trajectories.display()
+            ));
         }
         let summary = dir.join("summary.json");
         let times = data.read_summary(&summary)?;
@@ -271,12 +273,16 @@ impl RunData {
         }
         for (k, poses) in at.iter().enumerate() {
             self.collision_marks
-                .extend(involved(poses).into_iter().map(|(robot, x, y)| CollisionMark {
-                    robot,
-                    x,
-                    y,
-                    t_ns: times[k],
-                }));
+                .extend(
+                    involved(poses)
+                        .into_iter()
+                        .map(|(robot, x, y)| CollisionMark {
+                            robot,
+                            x,
+                            y,
+                            t_ns: times[k],
+                        }),
+                );
         }
         Ok(())
     }
@@ -288,7 +294,9 @@ impl RunData {
         while let Some(s) = r.next_snapshot()? {
             for (slot, a) in last.iter_mut().zip(agents) {
                 if s.header.agent == *a
-                    && slot.as_ref().is_none_or(|o| s.header.round >= o.header.round)
+                    && slot
+                        .as_ref()
+                        .is_none_or(|o| s.header.round >= o.header.round)
                 {
                     *slot = Some(s.clone());
                 }

@@ -110,7 +110,10 @@ fn draw_map(root: &Area<'_>, data: &RunData, map: &Panel) -> DrawResult {
     caption(root, map, "map: committed cells, true trajectories".into())?;
     for (i, _) in data.blocked.iter().enumerate().filter(|(_, b)| **b) {
         let (c, r) = (i as u32 % map.cols.max(1), i as u32 / map.cols.max(1));
-        root.draw(&Rectangle::new(map.cell_rect(c, r), style::OBSTACLE.filled()))?;
+        root.draw(&Rectangle::new(
+            map.cell_rect(c, r),
+            style::OBSTACLE.filled(),
+        ))?;
     }
     frame(root, map)?;
     let s = Sizes::of(map.cell);
@@ -177,18 +180,23 @@ fn draw_heatmap(
     snap: &crate::recording::MapSnapshot,
 ) -> DrawResult {
     let scale = LogScale::of(&snap.values);
-    let range = scale.map_or_else(
-        || "no positive activation".to_string(),
-        |s| format!("log10 from {:.1} to {:.1}", s.lo, s.hi),
-    );
     caption(
         root,
         panel,
         format!(
-            "agent {} neural map, round {} ({range})",
+            "agent {} neural map, round {}",
             snap.header.agent, snap.header.round
         ),
     )?;
+    let range = scale.map_or_else(
+        || "no positive activation".to_string(),
+        |s| format!("log10 activation {:.1} to {:.1}", s.lo, s.hi),
+    );
+    root.draw(&Text::new(
+        range,
+        (panel.x, panel.bottom() + 4),
+        ("sans-serif", 13).into_font(),
+    ))?;
     let cols = panel.cols.max(1);
     for (i, v) in snap.values.iter().enumerate() {
         let (c, r) = (i as u32 % cols, i as u32 / cols);

@@ -20,6 +20,8 @@ pub const GAP: i32 = 30;
 pub const LEGEND_LINE: i32 = 20;
 /// One legend column.
 pub const LEGEND_COLUMN: i32 = 170;
+/// Room for a heatmap's caption and scale line, which may be wider than a small map.
+pub const CAPTION_WIDTH: i32 = 230;
 /// Marker kinds in the legend after the robots (start, goal, committed cell, conflict,
 /// replan, collision).
 pub const LEGEND_MARKERS: usize = 6;
@@ -127,13 +129,16 @@ impl Layout {
             .collect();
         let bottom = heatmaps
             .iter()
-            .map(Panel::bottom)
+            .map(|p| p.bottom() + CAPTION_PX)
             .fold(map.bottom(), i32::max);
+        let captions = heatmaps.last().map_or(0, |p| p.x + CAPTION_WIDTH);
         let legend = (MARGIN, bottom + GAP);
         let entries = robots + LEGEND_MARKERS;
         let legend_rows = entries.min(8).max(1);
         let columns = entries.div_ceil(legend_rows) as i32;
-        let right = (x - GAP).max(MARGIN + columns * LEGEND_COLUMN);
+        let right = (x - GAP)
+            .max(captions)
+            .max(MARGIN + columns * LEGEND_COLUMN);
         Layout {
             width: (right + MARGIN) as u32,
             height: (legend.1 + legend_rows as i32 * LEGEND_LINE + MARGIN) as u32,

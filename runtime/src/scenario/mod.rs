@@ -143,11 +143,11 @@ use serde::{Deserialize, Serialize};
 
 pub use error::{Loc, ScenarioError};
 pub use health::HealthParams;
-pub use record::RecordParams;
 pub use params::{
     default_startup_timeout_s, ClockMode, ClockModeError, CoordinatorParams, FsyncPolicy,
     GiveUpAction, RestartConfig, RestartPolicy, RestartRule, RobotParams, RunParams, SimParams,
 };
+pub use record::RecordParams;
 pub use report::{default_out_dir, ScenarioReport};
 
 use crate::grid::{Cell, CornerCutting, Grid};

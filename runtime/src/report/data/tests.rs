@@ -51,8 +51,14 @@ fn write_log(dir: &Path) {
     }))
     .unwrap();
     let rounds = [
-        vec![decision(0, Verdict::Accept, 1), decision(1, Verdict::Accept, 10)],
-        vec![decision(0, Verdict::Block, NO_CELL), decision(1, Verdict::Hold, NO_CELL)],
+        vec![
+            decision(0, Verdict::Accept, 1),
+            decision(1, Verdict::Accept, 10),
+        ],
+        vec![
+            decision(0, Verdict::Block, NO_CELL),
+            decision(1, Verdict::Hold, NO_CELL),
+        ],
         vec![decision(0, Verdict::Replan, NO_CELL)],
         vec![decision(0, Verdict::Accept, 2)],
     ];
@@ -97,8 +103,8 @@ fn write_recording(dir: &Path) {
         height: 3,
         truncated: false,
     };
-    let mut w = TrajectoryWriter::create(&rec.join(recording::TRAJECTORIES), header, u64::MAX)
-        .unwrap();
+    let mut w =
+        TrajectoryWriter::create(&rec.join(recording::TRAJECTORIES), header, u64::MAX).unwrap();
     for k in 0..3u64 {
         let t = k * 50_000_000;
         w.push(&truth(t, 0, 0.25 + 0.5 * k as f32, 0.25)).unwrap();
@@ -144,8 +150,11 @@ fn the_log_gives_committed_cells_and_marks_at_the_agents_cell() {
     assert_eq!(d.goals, vec![(3, 0), (0, 2)]);
     assert_eq!(d.committed, vec![vec![(1, 0), (2, 0)], vec![(2, 2)]]);
     // Both refused/held decisions, where each agent stood after round 1's moves.
-    let conflicts: Vec<(u32, CellXy, u64)> =
-        d.conflicts.iter().map(|m| (m.agent, m.cell, m.round)).collect();
+    let conflicts: Vec<(u32, CellXy, u64)> = d
+        .conflicts
+        .iter()
+        .map(|m| (m.agent, m.cell, m.round))
+        .collect();
     assert_eq!(conflicts, vec![(0, (1, 0), 2), (1, (2, 2), 2)]);
     assert_eq!(
         d.replans,
@@ -189,10 +198,7 @@ fn robots_far_apart_at_a_collision_are_all_marked() {
     assert_eq!(involved(&poses).len(), 3);
     let poses = [(0, 0.0, 0.0), (1, 5.0, 0.0), (2, 5.5, 0.5)];
     assert_eq!(
-        involved(&poses)
-            .iter()
-            .map(|p| p.0)
-            .collect::<Vec<_>>(),
+        involved(&poses).iter().map(|p| p.0).collect::<Vec<_>>(),
         vec![1, 2]
     );
 }
@@ -228,7 +234,10 @@ fn a_map_copy_of_another_size_is_refused() {
     let grid = Grid::new(5, 5).unwrap();
     std::fs::write(dir.path().join(MAP_FILE), write_map(&grid)).unwrap();
     let e = RunData::load(dir.path(), &[]).unwrap_err().to_string();
-    assert!(e.ends_with("map.map: a 5 x 5 map, the log's run is 4 x 3"), "{e}");
+    assert!(
+        e.ends_with("map.map: a 5 x 5 map, the log's run is 4 x 3"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -161,9 +161,7 @@ mod tests {
     #[test]
     fn truth_is_sampled_at_each_boundary_of_simulated_time() {
         let mut s = TruthSampler::new(20);
-        let taken: Vec<u64> = (0..21)
-            .filter(|p| s.take(p * PERIOD, *p, 0))
-            .collect();
+        let taken: Vec<u64> = (0..21).filter(|p| s.take(p * PERIOD, *p, 0)).collect();
         // 20 Hz over 10 ms periods: every fifth.
         assert_eq!(taken, vec![0, 5, 10, 15, 20]);
         assert_eq!(s.missed, 0);
