@@ -155,9 +155,11 @@ fn check_report(dir: &Path, scenario: &Scenario, summary: &serde_json::Value) {
         144,
         "agent 0's heatmap"
     );
+    // plotters puts a text's content on a line of its own.
     let texts: Vec<&str> = elements(&doc, "text")
         .iter()
         .filter_map(|t| t.text())
+        .map(str::trim)
         .collect();
     assert!(
         texts.iter().any(|t| t.starts_with("agent 0 neural map")),
