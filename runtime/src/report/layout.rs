@@ -134,7 +134,7 @@ impl Layout {
         let captions = heatmaps.last().map_or(0, |p| p.x + CAPTION_WIDTH);
         let legend = (MARGIN, bottom + GAP);
         let entries = robots + LEGEND_MARKERS;
-        let legend_rows = entries.min(8).max(1);
+        let legend_rows = entries.clamp(1, 8);
         let columns = entries.div_ceil(legend_rows) as i32;
         let right = (x - GAP)
             .max(captions)
