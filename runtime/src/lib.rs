@@ -13,6 +13,7 @@
 //! | [`scenario`] | the TOML description of a run, validated with file/line errors |
 //! | [`msg`] | `#[repr(C)]` zero-copy payloads (Candidate, Commit, WheelCommand, ...) and their layouts |
 //! | [`topics`] | the run's service names and their QoS, defined once for every process |
+//! | [`report`] | the run report `DIR/report.svg` (plotters, SVG): map, committed cells, true trajectories, conflicts, replans, collisions, neural-map heatmaps |
 //! | [`rejected`] | the classes of hostile or malformed messages a receiver drops, and their counts for the run summary |
 //! | [`plan`] | [`PlanResult`](plan::PlanResult), the answer to one planning query, whichever planner gave it |
 //! | [`launch`] | the command line every process of a run shares, and the start-up handshake with the supervisor |
@@ -40,6 +41,7 @@ pub mod msg;
 pub mod plan;
 pub mod recording;
 pub mod rejected;
+pub mod report;
 pub mod scenario;
 pub mod supervisor;
 pub mod topics;

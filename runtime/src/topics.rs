@@ -5,7 +5,8 @@
 //! |---|---|---|---|
 //! | `wheels/<i>` | [`WheelCommand`](crate::msg::WheelCommand) | agent i -> sim | latest |
 //! | `odom/<i>` | [`Odometry`](crate::msg::Odometry) | sim -> agent i | latest |
-//! | `truth` | [`Truth`](crate::msg::Truth) | sim -> supervisor, viewers | latest |
+//! | `truth` | [`Truth`](crate::msg::Truth) | sim -> supervisor, recorder, viewers | latest, deep buffer ([`truth_qos`]) |
+//! | `estimate` | [`Estimate`](crate::msg::Estimate) | every agent -> recorder, viewers | latest, depth 1, not notified ([`estimate_qos`]) |
 //! | `candidates` | [`Candidate`](crate::msg::Candidate) | agents -> coordinator | reliable |
 //! | `commit` | [`Commit`](crate::msg::Commit) | coordinator -> agents | latest, deep buffer |
 //! | `map/<i>` | `[f32]` + [`MapHeader`](crate::msg::MapHeader) | agent i -> viewers (`hnav services` lists who) | latest |
@@ -60,12 +61,38 @@ pub const READY: &str = "ready";
 /// The supervisor's lifecycle events and requests.
 pub const LIFECYCLE: &str = "lifecycle";
 
+/// Every agent's dead-reckoned pose ([`estimate_qos`]).
+pub const ESTIMATE: &str = "estimate";
+
 /// Every process's heartbeat ([`heartbeat_qos`]).
 pub const HEARTBEAT: &str = "heartbeat";
 
 /// QoS of the per-robot topics and of truth and progress: superseding state.
 pub fn state_qos() -> Qos {
     Qos::latest()
+}
+
+/// QoS of the `truth` topic: superseding state like [`state_qos`], with a subscriber buffer
+/// deep enough for the supervisor's recorder, which samples truth by simulated time and so
+/// needs every message near a sampling boundary. A lockstep run publishes a truth message per
+/// control period at 10-20x real time (about 2000 a second on the demo), so 128 messages
+/// bridge some 60 ms in which the recorder thread is not scheduled; gaps beyond that are
+/// counted as missed, never waited for. One more subscriber than [`state_qos`]: the
+/// recorder, beside the supervisor's own and a viewer's. Openers with [`state_qos`] still
+/// fit (iceoryx2 only requires at least what they ask for); the supervisor creates the
+/// service before any process starts.
+pub fn truth_qos() -> Qos {
+    Qos {
+        max_subscribers: Qos::EXTRA_NODES + 1,
+        ..state_qos().with_buffer(128)
+    }
+}
+
+/// QoS of the `estimate` topic of a swarm of `agents`: like [`heartbeat_qos`], every agent
+/// (twice, while a restarted one replaces a dead one) publishes and only each one's latest
+/// pose matters; the recorder and a viewer read at a pace of their own.
+pub fn estimate_qos(agents: usize) -> Qos {
+    heartbeat_qos(agents)
 }
 
 /// QoS of the candidate stream of a swarm of `agents`.

@@ -97,7 +97,9 @@ fn drive(mut guard: RunGuard, file: &std::path::Path, agents: usize) -> (u64, Tr
     let odom: Vec<_> = (0..2)
         .map(|i| t.receiver::<Odometry>(&topics::odometry(i), q).unwrap())
         .collect();
-    let truth = t.receiver::<Truth>(topics::TRUTH, q).unwrap();
+    let truth = t
+        .receiver::<Truth>(topics::TRUTH, topics::truth_qos())
+        .unwrap();
     let send = |period: u64| {
         for (i, tx) in wheels.iter().enumerate() {
             let k = i as f64;

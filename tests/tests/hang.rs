@@ -99,7 +99,7 @@ impl Observer {
                 .receiver::<Commit>(topics::COMMIT, topics::commit_qos(2))
                 .unwrap();
             let truth = t
-                .receiver::<Truth>(topics::TRUTH, topics::state_qos())
+                .receiver::<Truth>(topics::TRUTH, topics::truth_qos())
                 .unwrap();
             let progress = t
                 .receiver::<Progress>(topics::PROGRESS, topics::state_qos())

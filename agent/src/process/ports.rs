@@ -2,18 +2,19 @@
 
 use hnav_runtime::grid::Grid;
 use hnav_runtime::launch::LifecyclePorts;
-use hnav_runtime::msg::{Candidate, Commit, MapHeader, Odometry, Role, WheelCommand};
+use hnav_runtime::msg::{Candidate, Commit, Estimate, MapHeader, Odometry, Role, WheelCommand};
 use hnav_runtime::topics;
 use hnav_runtime::transport::{Receiver, Sender, SliceSender, Transport, TransportError};
 
 /// The topics of agent `index`: its odometry and the commits in, its wheel commands,
-/// candidates and neural-map snapshots out, and its side of the lifecycle protocol.
+/// candidates, neural-map snapshots and dead-reckoned poses out, and its side of the lifecycle protocol.
 pub(super) struct Ports {
     pub(super) odom: Receiver<Odometry>,
     pub(super) commit: Receiver<Commit>,
     pub(super) wheels: Sender<WheelCommand>,
     pub(super) candidates: Sender<Candidate>,
     pub(super) map: SliceSender<f32, MapHeader>,
+    pub(super) estimate: Sender<Estimate>,
     pub(super) life: LifecyclePorts,
 }
 
@@ -33,6 +34,7 @@ impl Ports {
             wheels: transport.sender(&topics::wheels(i), topics::state_qos())?,
             candidates: transport.sender(topics::CANDIDATES, topics::candidates_qos(agents))?,
             map: transport.slice_sender(&topics::map(i), grid.len(), topics::state_qos())?,
+            estimate: transport.sender(topics::ESTIMATE, topics::estimate_qos(agents))?,
             life: LifecyclePorts::open(transport, Role::Agent, index, agents)?,
         })
     }

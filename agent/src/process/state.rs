@@ -6,7 +6,7 @@
 use hnav_runtime::diag::is_no_space_io;
 use hnav_runtime::grid::geometry::{cell_centre_m, cell_centre_pose, cell_index};
 use hnav_runtime::grid::Cell;
-use hnav_runtime::msg::{MapHeader, Odometry, Pose, WheelCommand};
+use hnav_runtime::msg::{Estimate, MapHeader, Odometry, Pose, WheelCommand};
 use hnav_runtime::scenario::{AgentSpec, ClockMode, Scenario};
 
 use super::checkpoint::{Checkpoint, CheckpointFile};
@@ -190,6 +190,13 @@ impl Core {
         self.last_period = Some(o.period);
         self.ticks = (o.ticks_left, o.ticks_right);
         let pose = self.dr.update(o.ticks_left, o.ticks_right);
+        // Silent: the recorder and viewers take the latest at their own pace.
+        p.estimate.send_silently(Estimate {
+            sim_time_ns: o.sim_time_ns,
+            agent: self.index,
+            reserved: 0,
+            pose,
+        })?;
         if self.nav.is_moving() {
             let (x, y) = cell_centre_m(self.cell_size_m, self.nav.next());
             if self.ctl.arrived(pose, x, y) && self.nav.arrived()? {

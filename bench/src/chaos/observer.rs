@@ -105,7 +105,7 @@ impl Observer {
             commit: transport.receiver(topics::COMMIT, topics::commit_qos(agents))?,
             life: transport.receiver(topics::LIFECYCLE, topics::lifecycle_qos(agents))?,
             candidates: transport.receiver(topics::CANDIDATES, topics::candidates_qos(agents))?,
-            truth: transport.receiver(topics::TRUTH, topics::state_qos())?,
+            truth: transport.receiver(topics::TRUTH, topics::truth_qos())?,
             transport,
         })
     }

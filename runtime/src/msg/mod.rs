@@ -24,6 +24,7 @@
 //! | [`Odometry`] | 40 | 8 | 0 sim_time_ns u64, 8 period u64, 16 agent u32, 20 reserved u32, 24 ticks_left i64, 32 ticks_right i64 |
 //! | [`Pose`] | 24 | 8 | 0 x_m f64, 8 y_m f64, 16 theta_rad f64 |
 //! | [`Truth`] | 24 + 24·[`MAX_AGENTS`] = 6168 | 8 | 0 sim_time_ns u64, 8 period u64, 16 robots u32, 20 collisions u32, 24 poses [Pose; 256] |
+//! | [`Estimate`] | 40 | 8 | 0 sim_time_ns u64, 8 agent u32, 12 reserved u32, 16 pose Pose |
 //! | [`Lifecycle`] | 24 | 8 | 0 time_ns u64, 8 pid u32, 12 index u32, 16 role u8, 17 event u8, 18 reason u8, 19 reserved u8, 20 restarts u32 |
 //! | [`Progress`] | 32 | 8 | 0 round u64, 8 agents u32, 12 at_goal u32, 16 conflicts u32, 20 replans u32, 24 done u8, 25 reserved [u8; 7] |
 //! | [`Heartbeat`] | 32 | 8 | 0 t_ns u64, 8 seq u64, 16 pid u32, 20 index u32, 24 role u8, 25 reserved [u8; 7] |
@@ -35,7 +36,7 @@
 //! | module | payloads |
 //! |---|---|
 //! | `round` | the decision round: [`Candidate`], [`Decision`], [`Commit`], [`Progress`] |
-//! | `motion` | wheels and ground truth: [`WheelCommand`], [`Odometry`], [`Pose`], [`Truth`] |
+//! | `motion` | wheels, ground truth and estimates: [`WheelCommand`], [`Odometry`], [`Pose`], [`Truth`], [`Estimate`] |
 //! | `lifecycle` | the supervisor's protocol: [`Role`] and its names, [`LifecycleEvent`], [`StopReason`], [`StartupPhase`], [`Lifecycle`] and its constructors |
 //! | `map` | the neural-map snapshot: [`MapHeader`], [`ActivationKind`] |
 //! | `health` | a process's proof of life: [`Heartbeat`] |
@@ -51,7 +52,7 @@ mod round;
 pub use health::Heartbeat;
 pub use lifecycle::{Lifecycle, LifecycleEvent, Role, RosterState, StartupPhase, StopReason};
 pub use map::{ActivationKind, MapHeader};
-pub use motion::{Odometry, Pose, Truth, WheelCommand};
+pub use motion::{Estimate, Odometry, Pose, Truth, WheelCommand};
 pub use round::{Candidate, CandidateFlags, Commit, ConflictKind, Decision, Progress, Verdict};
 
 /// The largest swarm one [`Commit`] or [`Truth`] sample can describe.

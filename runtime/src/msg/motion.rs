@@ -83,6 +83,23 @@ impl Default for Truth {
     }
 }
 
+/// An agent's dead-reckoned pose: where it believes its robot is, published at most once
+/// per control period (`estimate` topic) for the recorder and viewers; nothing in the swarm
+/// decides by it.
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[repr(C)]
+#[type_name("hnav::Estimate")]
+pub struct Estimate {
+    /// Simulated time of the odometry reading the pose folds in, ns since the start of the run.
+    pub sim_time_ns: u64,
+    /// Agent (robot) index.
+    pub agent: u32,
+    /// Zero.
+    pub reserved: u32,
+    /// The estimated pose.
+    pub pose: Pose,
+}
+
 impl Truth {
     /// The valid poses (`robots` clamped to [`MAX_AGENTS`]).
     pub fn poses(&self) -> &[Pose] {
@@ -128,6 +145,16 @@ mod tests {
         assert_eq!(offset_of!(Truth, robots), 16);
         assert_eq!(offset_of!(Truth, collisions), 20);
         assert_eq!(offset_of!(Truth, poses), 24);
+    }
+
+    #[test]
+    fn estimate_layout() {
+        assert_eq!(size_of::<Estimate>(), 40);
+        assert_eq!(align_of::<Estimate>(), 8);
+        assert_eq!(offset_of!(Estimate, sim_time_ns), 0);
+        assert_eq!(offset_of!(Estimate, agent), 8);
+        assert_eq!(offset_of!(Estimate, reserved), 12);
+        assert_eq!(offset_of!(Estimate, pose), 16);
     }
 
     #[test]

@@ -30,6 +30,7 @@ pub(super) fn parse(
     let restart = build_restart(raw.restart);
     let run = build_run(raw.run, &lines)?;
     let health = super::health::build_health(raw.health, &lines)?;
+    let record = super::record::build_record(raw.record, &lines)?;
     if raw.agents.is_empty() {
         return Err(ScenarioError::NoAgents {
             at: Loc::new(source_name, 1),
@@ -69,6 +70,7 @@ pub(super) fn parse(
         restart,
         run,
         health,
+        record,
         agents,
         faults,
         allow_unreachable,

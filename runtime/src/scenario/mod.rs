@@ -62,6 +62,11 @@
 //! coordinator_hang_ms = 2000           # [2 * heartbeat_ms, 3600000]; the agents' default
 //! sim_hang_ms = 1000                   # grows with the map (health::default_agent_hang_ms)
 //!
+//! [record]                             # the run's recording (README, *Recording and
+//! trajectory_hz = 20                   # report*); not in the hash. Pose samples per
+//! max_mb = 64                          # simulated second (0: every truth message), the
+//! maps = true                          # cap of each file in MiB, neural-map snapshots
+//!
 //! [[agents]]                           # one table per robot, numbered from 0
 //! start = [0, 0]                       # [x, y]: x = column, y = row, origin top-left
 //! goal = [31, 31]
@@ -129,6 +134,7 @@ pub mod health;
 mod lines;
 pub mod params;
 mod raw;
+pub mod record;
 pub mod report;
 mod validate;
 
@@ -143,6 +149,7 @@ pub use params::{
     GiveUpAction, RestartConfig, RestartPolicy, RestartRule, RobotParams, Rules, RunParams,
     SimParams,
 };
+pub use record::RecordParams;
 pub use report::{default_out_dir, ScenarioReport};
 
 use crate::grid::{Cell, CornerCutting, Grid};
@@ -287,6 +294,8 @@ pub struct Scenario {
     pub run: RunParams,
     /// Heartbeats and hang deadlines (`[health]`).
     pub health: HealthParams,
+    /// What the recorder keeps (`[record]`).
+    pub record: RecordParams,
     /// The robots, numbered from 0.
     pub agents: Vec<AgentSpec>,
     /// The fault plan.

@@ -24,6 +24,7 @@ pub(super) struct RawScenario {
     pub restart: Option<RawRestart>,
     pub run: Option<RawRun>,
     pub health: Option<super::health::RawHealth>,
+    pub record: Option<super::record::RawRecord>,
     #[serde(default)]
     pub agents: Vec<Spanned<RawAgent>>,
     #[serde(default)]

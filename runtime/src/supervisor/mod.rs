@@ -19,6 +19,7 @@
 //! | [`registry`] | the on-disk list of live runs and their processes that `hnav ps` reads |
 //! | [`startup`] | the supervisor's half of the lifecycle protocol: the start-up handshake and the events it publishes |
 //! | [`run`] | `hnav run`: spawn, start-up handshake, watch and restart, faults, stop, summary |
+//! | [`recorder`] | the recorder thread: ground truth, estimates and neural maps into `DIR/recording/` by simulated time |
 //! | [`summary`] | the run summary (`summary.json`): per-agent steps, length, conflicts, replans from the consensus log; goals and collisions from ground truth |
 //! | [`kill`] | `hnav kill`: a signal to one process of a live run found in the registry, recorded in its journal |
 //! | [`ps`] | what `hnav ps` shows: each registered process as running, exited or dead, as JSON or a table |
@@ -30,6 +31,7 @@ pub mod events;
 pub mod exit_fd;
 pub mod kill;
 pub mod ps;
+pub mod recorder;
 pub mod registry;
 pub mod restart;
 pub mod run;

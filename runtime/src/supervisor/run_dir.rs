@@ -19,9 +19,10 @@ use crate::transport::RunId;
 pub const LOCK_FILE: &str = ".hnav-run.lock";
 
 /// What a run writes into its directory: the consensus log, the agents' and the sim's
-/// checkpoints, the processes' output, the summary, the event journal and the coordinator's
-/// counts of dropped candidates. `--force` removes these and nothing else.
-pub const RUN_OUTPUTS: [&str; 8] = [
+/// checkpoints, the processes' output, the summary, the event journal, the coordinator's
+/// counts of dropped candidates, the recording, the copy of the map and the report.
+/// `--force` removes these and nothing else.
+pub const RUN_OUTPUTS: [&str; 11] = [
     "log",
     "agents",
     "sim.ckpt",
@@ -30,6 +31,9 @@ pub const RUN_OUTPUTS: [&str; 8] = [
     "summary.json",
     "events.jsonl",
     crate::rejected::FILE,
+    crate::recording::DIR,
+    crate::report::MAP_FILE,
+    crate::report::FILE,
 ];
 
 /// Why a run directory cannot be claimed.

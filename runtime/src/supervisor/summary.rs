@@ -77,6 +77,12 @@ pub struct RunSummary {
     pub rejected: BTreeMap<String, u64>,
     /// The robots lost during the run, by index; empty when none was.
     pub lost: Vec<LostRobot>,
+    /// What the recorder wrote into `DIR/recording/`; absent with `hnav run --no-record`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub recording: Option<super::recorder::RecordingSummary>,
+    /// Why `DIR/report.svg` could not be drawn, if it could not (the run still counts).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub report_error: Option<String>,
 }
 
 impl RunSummary {
@@ -174,6 +180,8 @@ impl RunSummary {
             cannot_go_on: None,
             rejected: read_rejected(log_dir.parent().unwrap_or(Path::new("."))),
             lost: Vec::new(),
+            recording: None,
+            report_error: None,
         })
     }
 

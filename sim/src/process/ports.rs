@@ -32,7 +32,7 @@ impl Ports {
         Ok(Self {
             wheels,
             odom,
-            truth: transport.sender(topics::TRUTH, q)?,
+            truth: transport.sender(topics::TRUTH, topics::truth_qos())?,
             life: None,
         })
     }

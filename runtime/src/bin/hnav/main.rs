@@ -10,6 +10,7 @@ mod clean_cmd;
 mod kill_cmd;
 mod log_cmd;
 mod ps_cmd;
+mod report_cmd;
 mod run_cmd;
 mod services_cmd;
 
@@ -63,6 +64,8 @@ enum Command {
     Services(services_cmd::ServicesArgs),
     /// Remove what dead runs left behind (processes, shared memory, registry entries).
     Clean(clean_cmd::CleanArgs),
+    /// Draw a finished run's report (DIR/report.svg) again, with the neural maps of --agents.
+    Report(report_cmd::ReportArgs),
     /// Inspect a run's consensus log.
     Log {
         #[command(subcommand)]
@@ -125,6 +128,7 @@ fn main() -> ExitCode {
         Command::Ps(args) => ps_cmd::run(args),
         Command::Clean(args) => clean_cmd::run(args),
         Command::Services(args) => services_cmd::run(args),
+        Command::Report(args) => report_cmd::run(args),
         Command::Log { command } => log_cmd::run(command),
         Command::Layout { json } => {
             let table = hnav_runtime::msg::layout::layouts();

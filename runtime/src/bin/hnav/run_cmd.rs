@@ -1,5 +1,5 @@
 //! `hnav run SCENARIO [--agents N] [--mode lockstep|realtime] [--seed S] [--out DIR]
-//! [--force] [--kill|--term|--freeze TARGET@WHEN[+SECONDSs]]...`: the supervisor. The work
+//! [--force] [--no-record] [--kill|--term|--freeze TARGET@WHEN[+SECONDSs]]...`: the supervisor. The work
 //! is in `hnav_runtime::supervisor::run`; the faults' syntax in
 //! `hnav_runtime::scenario::fault_arg`.
 //!
@@ -54,6 +54,10 @@ pub struct RunArgs {
     /// and summary.json; nothing else there is touched).
     #[arg(long)]
     pub force: bool,
+    /// Write no recording (DIR/recording/: trajectories and neural maps); the report is then
+    /// drawn without trajectories.
+    #[arg(long)]
+    pub no_record: bool,
     /// Where the process binaries are [default: next to this executable].
     #[arg(long, value_name = "DIR")]
     pub bin_dir: Option<PathBuf>,
@@ -153,12 +157,17 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
         bin_dir,
         progress: std::io::stderr().is_terminal(),
         force: a.force,
+        record: !a.no_record,
     };
     match run(&opts) {
         Ok(summary) => {
             hnav_runtime::out!("{}", summary.render());
             hnav_runtime::outln!("summary   {}", dir.join("summary.json").display());
             hnav_runtime::outln!("log       {}", summary.log.display());
+            if summary.report_error.is_none() {
+                let report = dir.join(hnav_runtime::report::FILE);
+                hnav_runtime::outln!("report    {}", report.display());
+            }
             if let Some(why) = &summary.cannot_go_on {
                 hnav_runtime::errln!("error: {why}");
                 ExitCode::from(EXIT_RUN_BROKEN)

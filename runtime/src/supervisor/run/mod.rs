@@ -24,6 +24,12 @@
 //!    with its [`StopReason`], give the children a grace period, then SIGTERM and SIGKILL
 //!    their process groups; remove the run's shared memory; write `DIR/summary.json` from
 //!    the consensus log and the last ground truth.
+//! 5. Record and draw: unless `--no-record`, the recorder thread ([`super::recorder`]) writes
+//!    `DIR/recording/` from the run's first truth message until just before `Stop`, and its
+//!    counts go into the summary; after the summary, `DIR/report.svg` is drawn
+//!    ([`crate::report`]) from the log, the recording and the copy of the run's map that
+//!    step 1 wrote (`DIR/map.map`). A report that cannot be drawn is a warning on stderr and
+//!    the summary's `report_error`, never a failed run.
 
 mod error;
 mod faults;
@@ -36,6 +42,7 @@ use std::time::{Duration, Instant};
 
 use super::child::Child;
 use super::clean::clean_dead_runs;
+use super::recorder::{Recorder, RecordingSummary};
 use super::registry::{RunRecord, RunRegistry};
 use super::run_dir::RunDir;
 use super::startup::{Startup, SupervisorPorts};
@@ -71,6 +78,8 @@ pub struct RunOptions {
     pub progress: bool,
     /// Replace the outputs of a finished run in the run directory (`--force`).
     pub force: bool,
+    /// Record trajectories and neural maps into `DIR/recording/` (off: `--no-record`).
+    pub record: bool,
 }
 
 struct Ports {
@@ -111,7 +120,7 @@ fn run_owned(
     dir: PathBuf,
     registry: &RunRegistry,
 ) -> Result<RunSummary, RunError> {
-    prepare_dir(&dir)?;
+    prepare_dir(&dir, &scenario)?;
     let transport = Transport::builder(&run)
         .node_name("supervisor")
         .handle_signals(true)
@@ -120,8 +129,21 @@ fn run_owned(
     let ports = Ports {
         life: SupervisorPorts::open(&transport, n)?,
         progress: transport.receiver(topics::PROGRESS, topics::state_qos())?,
-        truth: transport.receiver(topics::TRUTH, topics::state_qos())?,
+        truth: transport.receiver(topics::TRUTH, topics::truth_qos())?,
     };
+    // Started before any process, so the recording begins with the first truth message.
+    let recorder = opts
+        .record
+        .then(|| Recorder::start(&run, &scenario, &dir))
+        .map(|r| {
+            r.map_err(|e| {
+                tracing::warn!("no recording: {e}");
+                RecordingSummary {
+                    error: Some(e.to_string()),
+                    ..RecordingSummary::default()
+                }
+            })
+        });
     let mut record = registry.new_record(&run, &dir);
     let started = Instant::now();
     let mut slots = Slots::new(&opts.args, &opts.bin_dir, &scenario, &dir);
@@ -140,6 +162,7 @@ fn run_owned(
     // Taken while the sim still runs; after the end of the run nothing moves any more in
     // lockstep.
     ports.truth.drain(|t| truth = Some(*t))?;
+    let recording = recorder.map(|r| r.map_or_else(|failed| failed, Recorder::finish));
     let reason = match result {
         Ok(End::TimeLimit) => StopReason::TimeLimit,
         _ => StopReason::Requested,
@@ -171,15 +194,26 @@ fn run_owned(
     if let End::CannotGoOn(why) = end {
         summary.cannot_go_on = Some(why);
     }
+    summary.recording = recording;
     summary.write_json(&dir).map_err(io(&dir))?;
+    if let Err(e) = crate::report::write_report(&dir, &crate::report::ReportOptions::default()) {
+        crate::errln!("warning: {e}");
+        summary.report_error = Some(e.to_string());
+        summary.write_json(&dir).map_err(io(&dir))?;
+    }
     Ok(summary)
 }
 
 /// Creates the directory of the processes' logs; [`RunDir::claim`] has removed (with
 /// `--force`) or refused whatever an earlier run left.
-fn prepare_dir(dir: &Path) -> Result<(), RunError> {
+/// Also keeps a copy of the run's map (`DIR/map.map`, MovingAI format) for the report: the
+/// log's header has the agents' cells and the map's size but not its obstacles, and the
+/// scenario may have named a file that changes or goes.
+fn prepare_dir(dir: &Path, scenario: &Scenario) -> Result<(), RunError> {
     let logs = dir.join("logs");
     std::fs::create_dir_all(&logs).map_err(io(&logs))?;
+    let map = dir.join(crate::report::MAP_FILE);
+    std::fs::write(&map, crate::grid::write_map(&scenario.map.grid)).map_err(io(&map))?;
     Ok(())
 }
 
