@@ -20,7 +20,7 @@ use nix::unistd::Pid;
 
 use super::child::Signal;
 use super::events::{RunEvent, RunEvents};
-use super::registry::{process_alive, RegistryError, RunRegistry};
+use super::registry::{process_alive, RegistryError, RunRecord, RunRegistry};
 use crate::consensus_log::reader::LogReader;
 use crate::msg::Role;
 use crate::scenario::fault_arg::target_arg;
@@ -111,17 +111,7 @@ pub fn kill(
     target: FaultTarget,
     signal: Signal,
 ) -> Result<Killed, KillError> {
-    let id = RunId::new(run)?;
-    let record = registry.find(&id)?.ok_or_else(|| KillError::UnknownRun {
-        run: run.into(),
-        dir: registry.dir().to_path_buf(),
-    })?;
-    if !record.supervisor_alive() {
-        return Err(KillError::DeadRun {
-            run: run.into(),
-            pid: record.supervisor_pid,
-        });
-    }
+    let record = live_run(registry, run)?;
     let (role, index) = match target {
         FaultTarget::Agent(i) => (Role::Agent, u32::try_from(i).unwrap_or(u32::MAX)),
         FaultTarget::Coordinator => (Role::Coordinator, 0),
@@ -187,6 +177,24 @@ pub fn kill(
         round,
         journal: record.dir.join(super::events::EVENTS_FILE),
     })
+}
+
+/// The record of the live run `run` of `registry`: refused when the id is not valid, the
+/// registry does not know it or its supervisor is gone. `hnav kill` and `hnav top` look runs
+/// up through it.
+pub fn live_run(registry: &RunRegistry, run: &str) -> Result<RunRecord, KillError> {
+    let id = RunId::new(run)?;
+    let record = registry.find(&id)?.ok_or_else(|| KillError::UnknownRun {
+        run: run.into(),
+        dir: registry.dir().to_path_buf(),
+    })?;
+    if !record.supervisor_alive() {
+        return Err(KillError::DeadRun {
+            run: run.into(),
+            pid: record.supervisor_pid,
+        });
+    }
+    Ok(record)
 }
 
 /// The last round of the consensus log in `dir` (0 if it has none or cannot be read: the

@@ -11,6 +11,7 @@ mod kill_cmd;
 mod log_cmd;
 mod ps_cmd;
 mod run_cmd;
+mod top;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -60,6 +61,8 @@ enum Command {
     Kill(kill_cmd::KillArgs),
     /// Remove what dead runs left behind (processes, shared memory, registry entries).
     Clean(clean_cmd::CleanArgs),
+    /// Watch a live run in the terminal: its map, robots, agents' states and processes.
+    Top(top::TopArgs),
     /// Inspect a run's consensus log.
     Log {
         #[command(subcommand)]
@@ -99,6 +102,7 @@ fn main() -> ExitCode {
         Command::Ps(args) => ps_cmd::run(args),
         Command::Clean(args) => clean_cmd::run(args),
         Command::Log { command } => log_cmd::run(command),
+        Command::Top(args) => top::run(args),
     }
 }
 
