@@ -41,9 +41,9 @@ pub struct RunInfo {
     pub mode: String,
     /// The map.
     pub grid: Grid,
-    /// Each agent's start cell (row-major id).
+    /// Each agent's start cell (0-based row-major index, as in the messages).
     pub starts: Vec<u32>,
-    /// Each agent's goal cell (row-major id).
+    /// Each agent's goal cell (0-based row-major index).
     pub goals: Vec<u32>,
     /// Side of a cell in metres, to place ground-truth poses.
     pub cell_size_m: f64,
@@ -53,7 +53,8 @@ impl RunInfo {
     /// The picture of `scenario` run as `run_id`.
     pub fn of(run_id: &str, scenario: &Scenario) -> RunInfo {
         let grid = scenario.map.grid.clone();
-        let id = |c| grid.cell_id(c);
+        // Messages name cells by their 0-based row-major index, not the 1-based cell id.
+        let id = |c| u32::try_from(grid.index(c)).unwrap_or(crate::msg::NO_CELL);
         RunInfo {
             run_id: run_id.to_string(),
             mode: scenario.sim.clock.to_string(),
@@ -64,7 +65,7 @@ impl RunInfo {
         }
     }
 
-    /// The cell id of a ground-truth pose, if it is on the map.
+    /// The cell (0-based row-major index) of a ground-truth pose, if it is on the map.
     pub fn cell_of(&self, pose: &Pose) -> Option<u32> {
         let (x, y) = (
             (pose.x_m / self.cell_size_m).floor(),

@@ -213,7 +213,7 @@ fn state_style(s: AgentState) -> Style {
 }
 
 fn cell_text(grid: &Grid, id: Option<u32>) -> String {
-    match id.and_then(|i| grid.cell_from_id(i)) {
+    match id.and_then(|i| grid.cell_at(i as usize)) {
         Some(c) => format!("({},{})", c.x, c.y),
         None => "(off map)".to_string(),
     }
