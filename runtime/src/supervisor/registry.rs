@@ -297,7 +297,9 @@ impl RunRecord {
     /// Records the processes' shared command line ([`RunRecord::process_args`]).
     pub fn set_process_args(&mut self, args: &ProcessArgs) {
         let mut args = args.clone();
-        let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        fn absolute(p: &Path) -> PathBuf {
+            std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf())
+        }
         args.scenario = absolute(&args.scenario);
         args.dir = args.dir.as_deref().map(absolute);
         self.process_args = args

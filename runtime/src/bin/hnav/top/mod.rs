@@ -111,15 +111,14 @@ fn show(
     let mut next_frame = Instant::now();
     loop {
         let now = Instant::now();
-        match &mut feed {
-            Some(f) => {
-                if f.wait((now + DRAIN).min(next_frame))? == Waited::Stop {
-                    return Ok(Left::Signal);
-                }
-            }
+        let waited = match &mut feed {
+            Some(f) => f.wait((now + DRAIN).min(next_frame))?,
             // iceoryx2's handler still turns SIGINT/SIGTERM into this flag.
-            None if SignalHandler::termination_requested() => return Ok(Left::Signal),
-            None => {}
+            None if SignalHandler::termination_requested() => Waited::Stop,
+            None => Waited::Ready,
+        };
+        if waited == Waited::Stop {
+            return Ok(Left::Signal);
         }
         // Blocking on the keys only once the feed is gone: until then the feed's wait sleeps.
         let live = feed.is_some();
