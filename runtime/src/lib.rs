@@ -18,8 +18,9 @@
 //! | [`plan`] | [`PlanResult`](plan::PlanResult), the answer to one planning query, whichever planner gave it |
 //! | [`launch`] | the command line every process of a run shares, and the start-up handshake with the supervisor |
 //! | [`transport`] | run-scoped iceoryx2 services: publisher+notifier, subscriber+listener, the one [`Waiter`](transport::Waiter) every process blocks in |
-//! | [`supervisor`] | starting, watching, restarting and stopping a run's processes; the registry behind `hnav ps`. It sits on top: no other module uses it |
+//! | [`supervisor`] | starting, watching, restarting and stopping a run's processes; the registry behind `hnav ps`. It sits on top: only `monitor` uses it |
 //! | [`recording`] | a run's recording on disk: pose samples (truth and estimate) and neural-map snapshots, for the report, the MCAP export and replay |
+//! | [`monitor`] | the live view behind `hnav top`: a feed of a run's updates, the view's state, its ratatui drawing |
 //! | [`consensus_log`] | the durable consensus log: record types, segment format, reader, verifier |
 //! | [`clock`] | `CLOCK_MONOTONIC` in nanoseconds: one time base for the supervisor, the processes and observers of a host |
 //! | [`health`] | a process's heartbeat, beaten from its main loop for the supervisor's hang detection |
@@ -37,6 +38,7 @@ pub mod hash;
 pub mod health;
 pub mod launch;
 pub mod logging;
+pub mod monitor;
 pub mod msg;
 pub mod plan;
 pub mod recording;

@@ -25,6 +25,12 @@
 //! delivers history when the publisher updates its connections, and the agent does that on
 //! every pass of its loop, not only when it publishes a rebuilt map.
 //!
+//! Observers (`hnav top`, a test, a benchmark's observer) take a subscriber slot of each
+//! topic they read. Besides them, `truth` and `progress` have one subscriber (the
+//! supervisor), `commit` one per agent and `lifecycle` one per agent plus the sim and the
+//! coordinator, so every topic keeps a free slot with one viewer in
+//! (`a_viewer_leaves_a_slot_for_one_more_observer`).
+//!
 //! One `heartbeat` topic for every process rather than one per process: iceoryx2 keeps a
 //! queue per publisher-subscriber connection, so a depth-1 "latest" buffer already holds each
 //! process's own last beat, and the supervisor reads the whole swarm from one subscriber
@@ -147,6 +153,16 @@ mod tests {
         assert_ne!(wheels(1), wheels(2));
         assert_ne!(wheels(1), odometry(1));
         assert_ne!(map(3), odometry(3));
+    }
+
+    #[test]
+    fn a_viewer_leaves_a_slot_for_one_more_observer() {
+        let (viewer, another) = (1, 1);
+        for agents in [1, 6, 64, 256] {
+            assert!(state_qos().max_subscribers >= 1 + viewer + another);
+            assert!(commit_qos(agents).max_subscribers >= agents + viewer + another);
+            assert!(lifecycle_qos(agents).max_subscribers >= agents + 2 + viewer + another);
+        }
     }
 
     #[test]

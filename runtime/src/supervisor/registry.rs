@@ -28,6 +28,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use serde::{Deserialize, Serialize};
 
 use crate::file_lock::{try_lock, FileLock, TryLock};
+use crate::launch::ProcessArgs;
 use crate::msg::Role;
 use crate::transport::RunId;
 
@@ -132,6 +133,7 @@ impl RunRegistry {
             supervisor_start_ticks: process_start_ticks(supervisor_pid),
             started_unix_ms,
             processes: Vec::new(),
+            process_args: Vec::new(),
             file: self.dir.join(format!("{}.json", run.as_str())),
         }
     }
@@ -273,6 +275,11 @@ pub struct RunRecord {
     pub started_unix_ms: u64,
     /// The run's processes, one entry per role and index.
     pub processes: Vec<ProcessRecord>,
+    /// The command line the run's processes share ([`ProcessArgs::to_args`]) with the scenario
+    /// and the run directory absolute, so that a viewer started elsewhere (`hnav top`) loads
+    /// the same scenario; empty in records of supervisors that predate it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub process_args: Vec<String>,
     #[serde(skip)]
     file: PathBuf,
 }
@@ -328,6 +335,38 @@ impl RunRecord {
             Some(p) => *p = new,
             None => self.processes.push(new),
         }
+    }
+
+    /// Records the processes' shared command line ([`RunRecord::process_args`]).
+    pub fn set_process_args(&mut self, args: &ProcessArgs) {
+        let mut args = args.clone();
+        fn absolute(p: &Path) -> PathBuf {
+            std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf())
+        }
+        args.scenario = absolute(&args.scenario);
+        args.dir = args.dir.as_deref().map(absolute);
+        self.process_args = args
+            .to_args()
+            .into_iter()
+            .map(|a| a.to_string_lossy().into_owned())
+            .collect();
+    }
+
+    /// The processes' shared command line, parsed back; `None` when the record has none or it
+    /// does not parse (a record of another version).
+    pub fn parsed_process_args(&self) -> Option<ProcessArgs> {
+        #[derive(clap::Parser)]
+        struct Line {
+            #[command(flatten)]
+            args: ProcessArgs,
+        }
+        if self.process_args.is_empty() {
+            return None;
+        }
+        let argv = std::iter::once("hnav").chain(self.process_args.iter().map(String::as_str));
+        <Line as clap::Parser>::try_parse_from(argv)
+            .ok()
+            .map(|l| l.args)
     }
 
     /// Writes the record atomically (temporary file, then rename), creating the directory.
@@ -415,11 +454,31 @@ pub fn process_alive(pid: u32, start_ticks: Option<u64>) -> bool {
 
 /// When `pid` started, in clock ticks since boot: field 22 of `/proc/<pid>/stat`.
 pub fn process_start_ticks(pid: u32) -> Option<u64> {
-    // The command name (field 2) is parenthesised and may itself hold spaces or ')'.
+    stat_field(pid, 22)
+}
+
+/// The CPU time `pid` has used so far, user and system, in clock ticks: fields 14 and 15
+/// of `/proc/<pid>/stat`. `hnav top` turns two readings into a CPU share.
+pub fn process_cpu_ticks(pid: u32) -> Option<u64> {
     let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
-    let after_name = &stat[stat.rfind(')')? + 1..];
-    // Field 3 (the state) is the first after the name, so field 22 is the 20th.
-    after_name.split_whitespace().nth(19)?.parse().ok()
+    let fields = fields_after_name(&stat)?;
+    let mut fields = fields.skip(11);
+    let user: u64 = fields.next()?.parse().ok()?;
+    let system: u64 = fields.next()?.parse().ok()?;
+    Some(user + system)
+}
+
+/// Field `n` (1-based, as `proc(5)` numbers them; `n >= 3`) of `/proc/<pid>/stat`.
+fn stat_field(pid: u32, n: usize) -> Option<u64> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    let field = fields_after_name(&stat)?.nth(n - 3)?.parse().ok();
+    field
+}
+
+/// The fields of a `/proc/<pid>/stat` line from field 3 (the state) on.
+fn fields_after_name(stat: &str) -> Option<impl Iterator<Item = &str>> {
+    // The command name (field 2) is parenthesised and may itself hold spaces or ')'.
+    Some(stat[stat.rfind(')')? + 1..].split_whitespace())
 }
 
 /// Reads the state letter of `/proc/<pid>/stat` (after the parenthesised command name).
@@ -444,5 +503,47 @@ mod tests {
         assert!(process_alive(me, Some(ticks)));
         assert!(process_alive(me, None));
         assert!(!process_alive(me, Some(ticks + 1)), "a reused pid");
+    }
+
+    #[test]
+    fn cpu_ticks_grow_while_this_process_computes() {
+        let me = std::process::id();
+        let before = process_cpu_ticks(me).expect("/proc names our CPU time");
+        let spin_until = std::time::Instant::now() + std::time::Duration::from_secs(5);
+        let mut x = 0u64;
+        while process_cpu_ticks(me).unwrap() < before + 2 && std::time::Instant::now() < spin_until
+        {
+            for i in 0..100_000u64 {
+                x = std::hint::black_box(x.wrapping_mul(31).wrapping_add(i));
+            }
+        }
+        assert!(
+            process_cpu_ticks(me).unwrap() >= before + 2,
+            "no CPU time counted in 5 s of computing"
+        );
+    }
+
+    #[test]
+    fn process_args_come_back_absolute() {
+        let registry = RunRegistry::at("/nonexistent");
+        let run = RunId::new("args-1").unwrap();
+        let mut record = registry.new_record(&run, "out");
+        assert_eq!(record.parsed_process_args(), None);
+        let args = ProcessArgs {
+            run: "args-1".into(),
+            scenario: "scenarios/demo.toml".into(),
+            agents: Some(3),
+            seed: Some(7),
+            mode: None,
+            dir: Some("out".into()),
+            resume: false,
+            faults: Vec::new(),
+        };
+        record.set_process_args(&args);
+        let back = record.parsed_process_args().unwrap();
+        let cwd = std::env::current_dir().unwrap();
+        assert_eq!(back.scenario, cwd.join("scenarios/demo.toml"));
+        assert_eq!(back.dir, Some(cwd.join("out")));
+        assert_eq!((back.agents, back.seed), (Some(3), Some(7)));
     }
 }

@@ -13,6 +13,7 @@ mod ps_cmd;
 mod report_cmd;
 mod run_cmd;
 mod services_cmd;
+mod top;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -66,6 +67,8 @@ enum Command {
     Clean(clean_cmd::CleanArgs),
     /// Draw a finished run's report (DIR/report.svg) again, with the neural maps of --agents.
     Report(report_cmd::ReportArgs),
+    /// Watch a live run in the terminal: its map, robots, agents' states and processes.
+    Top(top::TopArgs),
     /// Inspect a run's consensus log.
     Log {
         #[command(subcommand)]
@@ -139,6 +142,7 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
+        Command::Top(args) => top::run(args),
     }
 }
 

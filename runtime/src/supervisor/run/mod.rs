@@ -145,6 +145,7 @@ fn run_owned(
             })
         });
     let mut record = registry.new_record(&run, &dir);
+    record.set_process_args(&opts.args);
     let started = Instant::now();
     let mut slots = Slots::new(&opts.args, &opts.bin_dir, &scenario, &dir);
     // The last ground truth seen: a sample does not outlive its publisher, so a sim that is
