@@ -22,6 +22,7 @@
 //! | [`summary`] | the run summary (`summary.json`): per-agent steps, length, conflicts, replans from the consensus log; goals and collisions from ground truth |
 //! | [`kill`] | `hnav kill`: a signal to one process of a live run found in the registry, recorded in its journal |
 //! | [`ps`] | what `hnav ps` shows: each registered process as running, exited or dead, as JSON or a table |
+//! | [`replay`] | `hnav log replay`: a lockstep run started again from its invocation, its log compared with the original's |
 
 pub mod child;
 pub mod clean;
@@ -30,6 +31,7 @@ pub mod exit_fd;
 pub mod kill;
 pub mod ps;
 pub mod registry;
+pub mod replay;
 pub mod restart;
 pub mod run;
 pub mod run_dir;

@@ -20,8 +20,9 @@ pub const LOCK_FILE: &str = ".hnav-run.lock";
 
 /// What a run writes into its directory: the consensus log, the agents' and the sim's
 /// checkpoints, the processes' output, the summary, the event journal and the coordinator's
-/// counts of dropped candidates. `--force` removes these and nothing else.
-pub const RUN_OUTPUTS: [&str; 8] = [
+/// counts of dropped candidates, and how the run was started (for `hnav log replay`).
+/// `--force` removes these and nothing else.
+pub const RUN_OUTPUTS: [&str; 9] = [
     "log",
     "agents",
     "sim.ckpt",
@@ -30,6 +31,7 @@ pub const RUN_OUTPUTS: [&str; 8] = [
     "summary.json",
     "events.jsonl",
     crate::rejected::FILE,
+    crate::invocation::FILE,
 ];
 
 /// Why a run directory cannot be claimed.

@@ -9,6 +9,8 @@
 mod clean_cmd;
 mod kill_cmd;
 mod log_cmd;
+mod log_export_cmd;
+mod log_replay_cmd;
 mod ps_cmd;
 mod run_cmd;
 
@@ -60,7 +62,7 @@ enum Command {
     Kill(kill_cmd::KillArgs),
     /// Remove what dead runs left behind (processes, shared memory, registry entries).
     Clean(clean_cmd::CleanArgs),
-    /// Inspect a run's consensus log.
+    /// Inspect a run's consensus log, replay a lockstep run, export a run to MCAP.
     Log {
         #[command(subcommand)]
         command: log_cmd::LogCommand,
