@@ -22,6 +22,8 @@
 //! | [`recording`] | a run's recording on disk: pose samples (truth and estimate) and neural-map snapshots, for the report, the MCAP export and replay |
 //! | [`monitor`] | the live view behind `hnav top`: a feed of a run's updates, the view's state, its ratatui drawing |
 //! | [`consensus_log`] | the durable consensus log: record types, segment format, reader, verifier |
+//! | [`invocation`] | `DIR/invocation.json`: the scenario file and command-line overrides a run was started with, for replay and export |
+//! | [`export`] | `hnav log export`: a run's log and recording as an MCAP file for Foxglove Studio |
 //! | [`clock`] | `CLOCK_MONOTONIC` in nanoseconds: one time base for the supervisor, the processes and observers of a host |
 //! | [`health`] | a process's heartbeat, beaten from its main loop for the supervisor's hang detection |
 //! | [`hash`] | FNV-1a 64 and SplitMix64: digests and seeded random numbers, stable across platforms |
@@ -32,10 +34,12 @@
 pub mod clock;
 pub mod consensus_log;
 pub mod diag;
+pub mod export;
 pub mod file_lock;
 pub mod grid;
 pub mod hash;
 pub mod health;
+pub mod invocation;
 pub mod launch;
 pub mod logging;
 pub mod monitor;

@@ -181,6 +181,7 @@ fn services_lists_the_topics_with_their_publishers_and_subscribers() {
         [
             "candidates",
             "commit",
+            "estimate",
             "heartbeat",
             "lifecycle",
             "map/0",
@@ -216,12 +217,10 @@ fn services_lists_the_topics_with_their_publishers_and_subscribers() {
         (Some("[f32]"), Some("hnav::MapHeader"))
     );
     assert_eq!(node_names(&map["publishers"]), ["agent-1"], "{json}");
-    // The truth reaches the supervisor; the sim reads every robot's wheels.
-    assert_eq!(
-        node_names(&topic("truth")["subscribers"]),
-        ["supervisor"],
-        "{json}"
-    );
+    // The truth reaches the supervisor and its recorder; the sim reads every robot's wheels.
+    let mut truth_readers = node_names(&topic("truth")["subscribers"]);
+    truth_readers.sort();
+    assert_eq!(truth_readers, ["recorder", "supervisor"], "{json}");
     assert_eq!(
         node_names(&topic("wheels/0")["subscribers"]),
         ["sim"],

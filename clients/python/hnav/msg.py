@@ -166,6 +166,17 @@ class Truth(_Payload):
     ]
 
 
+class Estimate(_Payload):
+    """An agent's dead-reckoned pose, once per control period (`estimate` topic)."""
+
+    _fields_ = [
+        ("sim_time_ns", ctypes.c_uint64),
+        ("agent", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+        ("pose", Pose),
+    ]
+
+
 class Role:
     """Values of a `role` byte."""
 
@@ -248,6 +259,7 @@ PAYLOADS = [
     Odometry,
     Pose,
     Truth,
+    Estimate,
     Lifecycle,
     Heartbeat,
     MapHeader,

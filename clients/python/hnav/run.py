@@ -35,6 +35,7 @@ TOPICS = {
     "ready": (msg.Lifecycle, None),
     "lifecycle": (msg.Lifecycle, None),
     "heartbeat": (msg.Heartbeat, None),
+    "estimate": (msg.Estimate, None),
 }
 
 _RUN_ID = re.compile(r"^[A-Za-z0-9_-]{1,48}$")

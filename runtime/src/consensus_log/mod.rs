@@ -31,8 +31,10 @@
 //! | [`verify`](mod@verify) | [`verify()`]: a [`VerifyReport`] on whether a log is intact |
 //! | [`show`] | one-line text and JSON renderings of records |
 //! | [`tally`] | [`Tally`]: per-agent steps, octile length, conflicts and replans of the decisions |
+//! | [`compare`](mod@compare) | [`compare()`]: two logs record by record, the first [`Divergence`] in words (`hnav log replay`) |
 //! | [`error`] | [`LogError`], [`FrameProblem`] |
 
+pub mod compare;
 pub mod error;
 pub mod frame;
 pub mod reader;
@@ -43,6 +45,7 @@ pub mod tally;
 pub mod verify;
 pub mod writer;
 
+pub use compare::{compare, Comparison, Divergence};
 pub use error::{FrameProblem, LogError};
 pub use frame::{encode_frame, FRAME_HEADER_LEN, MAGIC, MAX_RECORD_LEN};
 pub use reader::{read_log, LogContents, LogReader, RecordPos, TornTail};

@@ -109,6 +109,14 @@ pub fn describe(record: &Record, width: u32) -> String {
     s
 }
 
+/// One decision in words, as [`describe`] prints it in a round (`accept a1->[3, 4]`,
+/// `block a2 crossing (N,NE)`, `hold a0`, `replan a3 via [5, 5]`).
+pub fn describe_decision(d: &LoggedDecision, width: u32) -> String {
+    let mut s = String::new();
+    decision(&mut s, d, width);
+    s
+}
+
 fn decision(s: &mut String, d: &LoggedDecision, width: u32) {
     let kind = ConflictKind::from_u8(d.kind)
         .map_or_else(|| format!("kind{}", d.kind), |k| k.name().into());

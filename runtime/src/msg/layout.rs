@@ -11,8 +11,8 @@ use iceoryx2::prelude::ZeroCopySend;
 use serde::Serialize;
 
 use super::{
-    Candidate, Commit, Decision, Heartbeat, Lifecycle, MapHeader, Odometry, Pose, Progress, Truth,
-    WheelCommand, MAX_AGENTS,
+    Candidate, Commit, Decision, Estimate, Heartbeat, Lifecycle, MapHeader, Odometry, Pose,
+    Progress, Truth, WheelCommand, MAX_AGENTS,
 };
 use crate::topics;
 
@@ -159,6 +159,12 @@ pub fn layouts() -> Layouts {
             collisions: u32,
             poses: [Pose; MAX_AGENTS]
         }),
+        layout!(Estimate {
+            sim_time_ns: u64,
+            agent: u32,
+            reserved: u32,
+            pose: Pose
+        }),
         layout!(Lifecycle {
             time_ns: u64,
             pid: u32,
@@ -210,6 +216,7 @@ pub fn layouts() -> Layouts {
         fixed(topics::READY, type_name_of::<Lifecycle>()),
         fixed(topics::LIFECYCLE, type_name_of::<Lifecycle>()),
         fixed(topics::HEARTBEAT, type_name_of::<Heartbeat>()),
+        fixed(topics::ESTIMATE, type_name_of::<Estimate>()),
     ];
     Layouts {
         max_agents: MAX_AGENTS,

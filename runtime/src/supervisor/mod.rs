@@ -24,6 +24,7 @@
 //! | [`kill`] | `hnav kill`: a signal to one process of a live run found in the registry, recorded in its journal |
 //! | [`ps`] | what `hnav ps` shows: each registered process as running, exited or dead, as JSON or a table |
 //! | [`services`] | what `hnav services RUN` shows: a live run's topics with their publishers and subscribers |
+//! | [`replay`] | `hnav log replay`: a lockstep run started again from its invocation, its log compared with the original's |
 
 pub mod child;
 pub mod clean;
@@ -33,6 +34,7 @@ pub mod kill;
 pub mod ps;
 pub mod recorder;
 pub mod registry;
+pub mod replay;
 pub mod restart;
 pub mod run;
 pub mod run_dir;

@@ -20,9 +20,9 @@ pub const LOCK_FILE: &str = ".hnav-run.lock";
 
 /// What a run writes into its directory: the consensus log, the agents' and the sim's
 /// checkpoints, the processes' output, the summary, the event journal, the coordinator's
-/// counts of dropped candidates, the recording, the copy of the map and the report.
-/// `--force` removes these and nothing else.
-pub const RUN_OUTPUTS: [&str; 11] = [
+/// counts of dropped candidates, the recording, the copy of the map, the report and how the
+/// run was started (for `hnav log replay`). `--force` removes these and nothing else.
+pub const RUN_OUTPUTS: [&str; 12] = [
     "log",
     "agents",
     "sim.ckpt",
@@ -34,6 +34,7 @@ pub const RUN_OUTPUTS: [&str; 11] = [
     crate::recording::DIR,
     crate::report::MAP_FILE,
     crate::report::FILE,
+    crate::invocation::FILE,
 ];
 
 /// Why a run directory cannot be claimed.

@@ -26,7 +26,8 @@ use serde::Serialize;
 
 use super::registry::{LiveRunError, RunRegistry};
 use crate::msg::{
-    Candidate, Commit, Heartbeat, Lifecycle, MapHeader, Odometry, Progress, Truth, WheelCommand,
+    Candidate, Commit, Estimate, Heartbeat, Lifecycle, MapHeader, Odometry, Progress, Truth,
+    WheelCommand,
 };
 use crate::transport::{run_config, Ipc, TransportError};
 
@@ -253,7 +254,8 @@ fn open_ports(
         Odometry,
         Truth,
         Lifecycle,
-        Heartbeat
+        Heartbeat,
+        Estimate
     );
     if slice && element == type_name::<f32>() && header == type_name::<MapHeader>() {
         return Some(ports_of!(node, name, [f32], MapHeader));

@@ -1,10 +1,12 @@
-//! `hnav log verify|show DIR`: inspect a run's consensus log (never modifies it). DIR is the
+//! `hnav log verify|show|replay|export DIR`: inspect a run's consensus log (never modifies it). DIR is the
 //! log directory or the run directory holding it in `log/`.
 //!
 //! Exit codes of `verify`: 0 intact, 1 not intact (torn tail, corruption, order problems),
 //! 2 the directory cannot be read as a log at all (missing, unreadable, no segments).
 //! `show`: 0 every complete record printed (a torn tail is noted on stderr), 1 reading stopped
 //! at corruption (records before it are printed), 2 unreadable as for `verify`.
+//! `replay` (`log_replay_cmd`): 0 identical, 1 diverged, 2 not a replayable run.
+//! `export` (`log_export_cmd`): 0 written, 1 the output cannot be written, 2 unreadable input.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -32,6 +34,14 @@ pub enum LogCommand {
         #[arg(long)]
         json: bool,
     },
+    /// Run a lockstep run again from its scenario and seed and check that every round
+    /// decides as logged: exit 0 identical, 1 diverged (the first divergence is printed), 2
+    /// not a replayable run (realtime, no invocation.json, the scenario changed).
+    Replay(crate::log_replay_cmd::ReplayArgs),
+    /// Write the run as an MCAP file for Foxglove Studio: poses, committed cells, decisions,
+    /// replans and neural maps as JSON channels. Exit 0 written, 1 the file cannot be
+    /// written, 2 the run cannot be read.
+    Export(crate::log_export_cmd::ExportArgs),
 }
 
 /// Runs a `hnav log` subcommand.
@@ -39,6 +49,8 @@ pub fn run(cmd: LogCommand) -> ExitCode {
     match cmd {
         LogCommand::Verify { dir } => verify_cmd(&log_dir(&dir)),
         LogCommand::Show { dir, json } => show_cmd(&log_dir(&dir), json),
+        LogCommand::Replay(args) => crate::log_replay_cmd::run(args),
+        LogCommand::Export(args) => crate::log_export_cmd::run(args),
     }
 }
 

@@ -9,6 +9,8 @@
 mod clean_cmd;
 mod kill_cmd;
 mod log_cmd;
+mod log_export_cmd;
+mod log_replay_cmd;
 mod ps_cmd;
 mod report_cmd;
 mod run_cmd;
@@ -69,7 +71,7 @@ enum Command {
     Report(report_cmd::ReportArgs),
     /// Watch a live run in the terminal: its map, robots, agents' states and processes.
     Top(top::TopArgs),
-    /// Inspect a run's consensus log.
+    /// Inspect a run's consensus log, replay a lockstep run, export a run to MCAP.
     Log {
         #[command(subcommand)]
         command: log_cmd::LogCommand,

@@ -48,6 +48,7 @@ use super::run_dir::RunDir;
 use super::startup::{Startup, SupervisorPorts};
 use super::stop::stop_all;
 use super::summary::RunSummary;
+use crate::invocation::Invocation;
 use crate::launch::ProcessArgs;
 use crate::msg::{Lifecycle, Progress, StopReason, Truth};
 use crate::scenario::{ClockMode, Scenario};
@@ -121,6 +122,9 @@ fn run_owned(
     registry: &RunRegistry,
 ) -> Result<RunSummary, RunError> {
     prepare_dir(&dir, &scenario)?;
+    Invocation::new(&opts.args, &scenario)
+        .write(&dir)
+        .map_err(io(&dir))?;
     let transport = Transport::builder(&run)
         .node_name("supervisor")
         .handle_signals(true)

@@ -1,0 +1,80 @@
+//! `hnav log replay DIR [--bin-dir DIR] [--run ID]`: a lockstep run started again, its log compared with
+//! the run's. The work is in `hnav_runtime::supervisor::replay`.
+//!
+//! Exit codes: 0 every record identical, 1 the replay diverged (the first divergence is
+//! printed: round, agent, both decisions), 2 the run cannot be replayed (realtime, no
+//! `invocation.json`, a scenario whose hash is not the log's, an unreadable log) or the
+//! replay could not run.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use hnav_runtime::consensus_log::Comparison;
+use hnav_runtime::supervisor::replay::{replay, ReplayOptions};
+use hnav_runtime::transport::RunId;
+
+/// `hnav log replay` arguments.
+#[derive(clap::Args, Debug)]
+pub struct ReplayArgs {
+    /// The run directory (holding log/ and invocation.json), or its log/.
+    pub dir: PathBuf,
+    /// Where the process binaries are [default: next to this executable].
+    #[arg(long, value_name = "DIR")]
+    pub bin_dir: Option<PathBuf>,
+    /// The replay's run id (letters, digits, '-', '_') [default: a fresh unique one]. Tests
+    /// pass their own so they can clean its shared memory up whatever happens.
+    #[arg(long, value_name = "ID")]
+    pub run: Option<String>,
+}
+
+/// Runs `hnav log replay`.
+pub fn run(a: ReplayArgs) -> ExitCode {
+    hnav_runtime::logging::init();
+    let bin_dir = a.bin_dir.or_else(|| {
+        std::env::current_exe()
+            .ok()
+            .and_then(|p| p.parent().map(PathBuf::from))
+    });
+    let Some(bin_dir) = bin_dir else {
+        hnav_runtime::errln!("error: cannot locate the process binaries; pass --bin-dir");
+        return ExitCode::from(2);
+    };
+    let run = match a.run.as_deref().map(RunId::new).transpose() {
+        Ok(run) => run,
+        Err(e) => {
+            hnav_runtime::errln!("error: --run: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let opts = ReplayOptions {
+        dir: a.dir,
+        bin_dir,
+        progress: std::io::stderr().is_terminal(),
+        run,
+    };
+    match replay(&opts) {
+        Ok(r) => match r.comparison {
+            Comparison::Identical {
+                rounds,
+                cut_short_at,
+            } => {
+                hnav_runtime::outln!("{rounds} rounds replayed, identical");
+                if let Some(round) = cut_short_at {
+                    hnav_runtime::outln!(
+                        "(the logged run was cut short after round {round}; compared that far)"
+                    );
+                }
+                ExitCode::SUCCESS
+            }
+            Comparison::Diverged(d) => {
+                hnav_runtime::outln!("first divergence: {d}");
+                ExitCode::from(1)
+            }
+        },
+        Err(e) => {
+            hnav_runtime::errln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,159 @@
+//! The JSON schemas of the exported channels (schema encoding `jsonschema`).
+//!
+//! Poses and grids use Foxglove's well-known schemas by name and shape
+//! (`foxglove.PoseInFrame`, `foxglove.Grid`, as in Foxglove's `schemas/jsonschema/`), so
+//! Foxglove Studio's 3D panel draws them without configuration; the log-derived channels
+//! have schemas of their own (`hnav.*`), which the Raw Messages and Plot panels read.
+
+use serde_json::{json, Value};
+
+/// `foxglove.PoseInFrame`.
+pub const POSE_IN_FRAME: &str = "foxglove.PoseInFrame";
+/// `foxglove.Grid`.
+pub const GRID: &str = "foxglove.Grid";
+/// One round's committed cells.
+pub const COMMITTED_CELLS: &str = "hnav.CommittedCells";
+/// One decision of one round.
+pub const DECISION: &str = "hnav.Decision";
+/// One global replan.
+pub const REPLAN: &str = "hnav.Replan";
+
+fn time() -> Value {
+    json!({
+        "type": "object",
+        "title": "time",
+        "properties": {
+            "sec": {"type": "integer", "minimum": 0},
+            "nsec": {"type": "integer", "minimum": 0, "maximum": 999_999_999}
+        },
+        "description": "Simulated time since the run's Start"
+    })
+}
+
+fn pose() -> Value {
+    let number = json!({"type": "number"});
+    json!({
+        "title": "foxglove.Pose",
+        "type": "object",
+        "properties": {
+            "position": {
+                "title": "foxglove.Vector3",
+                "type": "object",
+                "properties": {"x": number, "y": number, "z": number},
+                "required": ["x", "y", "z"]
+            },
+            "orientation": {
+                "title": "foxglove.Quaternion",
+                "type": "object",
+                "properties": {"x": number, "y": number, "z": number, "w": number},
+                "required": ["x", "y", "z", "w"]
+            }
+        },
+        "required": ["position", "orientation"]
+    })
+}
+
+/// A cell as `[x, y]` (column, row), or `null`.
+fn cell() -> Value {
+    json!({
+        "type": ["array", "null"],
+        "items": {"type": "integer", "minimum": 0},
+        "minItems": 2,
+        "maxItems": 2,
+        "description": "[x, y]: 0-based column and row, origin top-left"
+    })
+}
+
+/// The schema named `name`, as bytes for the MCAP schema record.
+pub fn schema(name: &str) -> Vec<u8> {
+    let body = match name {
+        POSE_IN_FRAME => json!({
+            "title": POSE_IN_FRAME,
+            "description": "A timestamped pose for an object or reference frame in 3D space",
+            "type": "object",
+            "properties": {
+                "timestamp": time(),
+                "frame_id": {"type": "string"},
+                "pose": pose()
+            }
+        }),
+        GRID => json!({
+            "title": GRID,
+            "description": "A 2D grid of data",
+            "type": "object",
+            "properties": {
+                "timestamp": time(),
+                "frame_id": {"type": "string"},
+                "pose": pose(),
+                "column_count": {"type": "integer", "minimum": 0},
+                "cell_size": {
+                    "title": "foxglove.Vector2",
+                    "type": "object",
+                    "properties": {"x": {"type": "number"}, "y": {"type": "number"}},
+                    "required": ["x", "y"]
+                },
+                "row_stride": {"type": "integer", "minimum": 0},
+                "cell_stride": {"type": "integer", "minimum": 0},
+                "fields": {
+                    "type": "array",
+                    "items": {
+                        "title": "foxglove.PackedElementField",
+                        "type": "object",
+                        "properties": {
+                            "name": {"type": "string"},
+                            "offset": {"type": "integer", "minimum": 0},
+                            "type": {"title": "foxglove.NumericType", "type": "integer"}
+                        }
+                    }
+                },
+                "data": {"type": "string", "contentEncoding": "base64"}
+            }
+        }),
+        COMMITTED_CELLS => json!({
+            "title": COMMITTED_CELLS,
+            "description": "The cells one round's commit gave the agents (accepted moves and replans with a cell)",
+            "type": "object",
+            "properties": {
+                "timestamp": time(),
+                "round": {"type": "integer"},
+                "cells": {
+                    "type": "array",
+                    "items": {
+                        "type": "object",
+                        "properties": {"agent": {"type": "integer"}, "cell": cell()}
+                    }
+                }
+            }
+        }),
+        DECISION => json!({
+            "title": DECISION,
+            "description": "One agent's decision in one round, as the consensus log holds it",
+            "type": "object",
+            "properties": {
+                "timestamp": time(),
+                "round": {"type": "integer"},
+                "agent": {"type": "integer"},
+                "verdict": {"enum": ["accept", "block", "hold", "replan"]},
+                "kind": {"type": "string", "description": "the conflict kind (none, crossing, head-on, ...)"},
+                "refused": {"type": "array", "items": {"enum": ["N", "NE", "E", "SE", "S", "SW", "W", "NW"]}},
+                "cell": cell(),
+                "waypoint": cell()
+            }
+        }),
+        REPLAN => json!({
+            "title": REPLAN,
+            "description": "A global replan of one agent's route",
+            "type": "object",
+            "properties": {
+                "timestamp": time(),
+                "round": {"type": "integer"},
+                "agent": {"type": "integer"},
+                "planner": {"type": "string"},
+                "found": {"type": "boolean"},
+                "waypoints": {"type": "array", "items": cell()}
+            }
+        }),
+        other => json!({"title": other, "type": "object"}),
+    };
+    serde_json::to_vec(&body).unwrap_or_default()
+}
