@@ -118,15 +118,19 @@ fn a_full_disk_ends_the_run_at_once_with_a_named_cause_and_a_verifiable_log() {
         "hnav run's exit code; its stderr:\n{stderr}"
     );
     // Whichever writer meets the full disk first ends the run: the coordinator appending to
-    // the consensus log, or the sim writing its checkpoint (every period since the sim is
-    // restartable).
+    // the consensus log, the sim writing its checkpoint (every period since the sim is
+    // restartable), or an agent writing its checkpoint or its output (which one comes first
+    // moves with what else the run writes, e.g. its recording).
     let coordinator = stderr
         .contains("no space left on device: coordinator stopped writing the consensus log in")
         && stderr.contains("mnt/run/log");
     let sim = stderr.contains("no space left on device: sim stopped writing its checkpoint")
         && stderr.contains("mnt/run/sim.ckpt");
+    let agent = stderr.contains("no space left on device: agent-")
+        && stderr.contains("stopped writing its checkpoint")
+        && stderr.contains("mnt/run/agents/");
     assert!(
-        coordinator || sim,
+        coordinator || sim || agent,
         "the supervisor names the process, what it wrote and where:\n{stderr}"
     );
     assert!(
