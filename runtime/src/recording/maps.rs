@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 
 use crate::msg::MapHeader;
 
-use super::{io, RecordingError, Written};
+use super::{io, read_up_to, RecordingError, Written};
 
 const MAGIC: &[u8; 7] = b"HNAVMAP";
 const VERSION: u8 = 1;
@@ -209,20 +209,6 @@ impl MapReader {
         })
     }
 
-    /// Reads up to `buf.len()` bytes; fewer only at the end of the file.
-    fn fill(&mut self, buf: &mut [u8]) -> Result<usize, RecordingError> {
-        let mut have = 0;
-        while have < buf.len() {
-            match self.input.read(&mut buf[have..]) {
-                Ok(0) => break,
-                Ok(n) => have += n,
-                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-                Err(e) => return Err(io(&self.path)(e)),
-            }
-        }
-        Ok(have)
-    }
-
     fn corrupt(&self, problem: String) -> RecordingError {
         RecordingError::Corrupt {
             path: self.path.clone(),
@@ -235,7 +221,7 @@ impl MapReader {
     /// a torn tail: it reads as the end, and [`MapReader::torn_tail`] tells its length.
     pub fn next_snapshot(&mut self) -> Result<Option<MapSnapshot>, RecordingError> {
         let mut frame = [0u8; 8];
-        let have = self.fill(&mut frame)?;
+        let have = read_up_to(&mut self.input, &mut frame, &self.path)?;
         if have < 8 {
             self.torn = have as u64;
             return Ok(None);
@@ -250,7 +236,7 @@ impl MapReader {
         }
         let mut body = std::mem::take(&mut self.body);
         body.resize(len, 0);
-        let have = self.fill(&mut body)?;
+        let have = read_up_to(&mut self.input, &mut body, &self.path)?;
         if have < len {
             self.torn = 8 + have as u64;
             return Ok(None);

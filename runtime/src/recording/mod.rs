@@ -89,6 +89,25 @@ pub struct Written {
     pub bytes: u64,
 }
 
+/// Reads up to `buf.len()` bytes, fewer only at the end of the file: both readers tell a torn
+/// tail from the end by how many bytes came.
+fn read_up_to(
+    input: &mut impl std::io::Read,
+    buf: &mut [u8],
+    path: &std::path::Path,
+) -> Result<usize, RecordingError> {
+    let mut have = 0;
+    while have < buf.len() {
+        match input.read(&mut buf[have..]) {
+            Ok(0) => break,
+            Ok(n) => have += n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(io(path)(e)),
+        }
+    }
+    Ok(have)
+}
+
 fn io(path: &std::path::Path) -> impl FnOnce(std::io::Error) -> RecordingError + '_ {
     move |source| RecordingError::Io {
         path: path.to_path_buf(),

@@ -39,7 +39,7 @@ use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
-use super::{io, RecordingError, Written};
+use super::{io, read_up_to, RecordingError, Written};
 
 const MAGIC: &[u8; 7] = b"HNAVTRJ";
 const VERSION: u8 = 1;
@@ -297,15 +297,7 @@ impl TrajectoryReader {
     /// [`TrajectoryReader::torn_tail`] tells its length.
     pub fn next_sample(&mut self) -> Result<Option<PoseSample>, RecordingError> {
         let mut b = [0u8; SAMPLE_LEN];
-        let mut have = 0;
-        while have < SAMPLE_LEN {
-            match self.input.read(&mut b[have..]) {
-                Ok(0) => break,
-                Ok(n) => have += n,
-                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-                Err(e) => return Err(io(&self.path)(e)),
-            }
-        }
+        let have = read_up_to(&mut self.input, &mut b, &self.path)?;
         if have < SAMPLE_LEN {
             self.torn = have as u64;
             return Ok(None);
