@@ -31,13 +31,7 @@ pub struct ReplayArgs {
 /// Runs `hnav log replay`.
 pub fn run(a: ReplayArgs) -> ExitCode {
     hnav_runtime::logging::init();
-    let bin_dir = a.bin_dir.or_else(|| {
-        std::env::current_exe()
-            .ok()
-            .and_then(|p| p.parent().map(PathBuf::from))
-    });
-    let Some(bin_dir) = bin_dir else {
-        hnav_runtime::errln!("error: cannot locate the process binaries; pass --bin-dir");
+    let Some(bin_dir) = crate::run_cmd::bin_dir(a.bin_dir) else {
         return ExitCode::from(2);
     };
     let run = match a.run.as_deref().map(RunId::new).transpose() {

@@ -141,13 +141,7 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
         }
     };
     args.faults = faults;
-    let bin_dir = a.bin_dir.or_else(|| {
-        std::env::current_exe()
-            .ok()
-            .and_then(|p| p.parent().map(PathBuf::from))
-    });
-    let Some(bin_dir) = bin_dir else {
-        hnav_runtime::errln!("error: cannot locate the process binaries; pass --bin-dir");
+    let Some(bin_dir) = bin_dir(a.bin_dir) else {
         return ExitCode::from(2);
     };
     let dir = a.out.unwrap_or(name);
@@ -191,4 +185,18 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// The directory of the process binaries: `--bin-dir`, else this executable's. `None` (said
+/// on stderr) when neither is known.
+pub fn bin_dir(given: Option<PathBuf>) -> Option<PathBuf> {
+    let dir = given.or_else(|| {
+        std::env::current_exe()
+            .ok()
+            .and_then(|p| p.parent().map(PathBuf::from))
+    });
+    if dir.is_none() {
+        hnav_runtime::errln!("error: cannot locate the process binaries; pass --bin-dir");
+    }
+    dir
 }
