@@ -6,6 +6,7 @@
 //! | module | subcommand | what it measures |
 //! |---|---|---|
 //! | [`chaos`] | `hnav-bench chaos [--runs N] [--seed S] [--quick] [--only N]` | a seeded campaign of runs with agents, the coordinator or the sim killed or frozen: per-run checks (at goal, no collision, log verifies, every commit seen once, nothing left behind), a table per class and mode, detection and recovery latencies |
+//! | [`experiment`] | `hnav-bench experiment <name> [--quick] [--json] [--seed S]` | the seeds' experiments, ours beside the paper's tables with intervals |
 //! | [`latency`] | `hnav-bench latency [--quick] --out DIR` | one-way and round-trip latency of raw iceoryx2, the HNAV transport, a Unix domain socket and TCP loopback, in a two-thread ping-pong |
 //! | [`mapf`] | `hnav-bench mapf --map FILE --scen FILE [--agents 50,100] [--rules dissertation,pibt] [--json] [--out DIR] [--quick]` | the first-N-entries MAPF instances of a MovingAI `.scen` run by whole swarms: robots at goal, collisions, makespan, sum of lengths against the lower bound, conflicts, replans, wall time, the processes' memory |
 //! | [`neural_map`] | `hnav-bench neural-map [--quick]` | neuron updates per second and time per map for 20x20 to 1024x1024, tanh against linear, and plan queries |
@@ -19,6 +20,7 @@
 //! plotted next to other frameworks' numbers.
 
 pub mod chaos;
+pub mod experiment;
 pub mod latency;
 pub mod mapf;
 pub mod neural_map;

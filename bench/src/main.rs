@@ -49,6 +49,45 @@ enum Command {
     /// (lockstep), per N and rules: robots at goal, collisions, makespan, sum of lengths
     /// against the .scen's lower bound, conflicts, replans, wall time, memory.
     Mapf(MapfCli),
+    /// The seeds' experiments, ours beside the paper's tables (`hnav-bench experiment list`
+    /// names them).
+    Experiment(ExperimentCli),
+}
+
+#[derive(Debug, Args)]
+struct ExperimentCli {
+    /// The experiment's name, or `list`.
+    name: String,
+    /// The reduced variant (under 30 s), as the tests run it.
+    #[arg(long)]
+    quick: bool,
+    /// Print the figures as JSON instead of markdown.
+    #[arg(long)]
+    json: bool,
+    /// Seed of the experiment's random stream.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+fn experiment(args: ExperimentCli) -> Result<()> {
+    use hnav_bench::experiment::{self, Options, EXPERIMENTS};
+    if args.name == "list" {
+        for e in EXPERIMENTS {
+            println!("{:<16} {}", e.name, e.about);
+        }
+        return Ok(());
+    }
+    let options = Options {
+        quick: args.quick,
+        seed: args.seed,
+    };
+    let report = experiment::run(&args.name, options)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", report.markdown);
+    }
+    Ok(())
 }
 
 #[derive(Debug, Args)]
@@ -354,6 +393,7 @@ fn main() -> std::process::ExitCode {
         Command::Round(args) => hnav_bench::round::main(args),
         Command::Chaos(args) => chaos(args),
         Command::Mapf(args) => mapf(args),
+        Command::Experiment(args) => experiment(args),
     };
     match outcome {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -1,0 +1,67 @@
+//! `hnav-bench experiment <name>`: the seeds' experiments, each printing a markdown table of
+//! our figures beside the paper's, with the differences explained in the linked docs.
+//!
+//! Every experiment is deterministic for a seed (`--seed`, one seeded ChaCha stream per
+//! experiment), finishes in at most five minutes on two cores, and has a `--quick` variant
+//! (under 30 s) that a test runs. `--json` prints the same figures as one JSON document.
+//!
+//! | module | experiment | what |
+//! |---|---|---|
+//! | [`stats`] | — | the intervals the tables print: Wilson for rates, bootstrap for means |
+
+use serde::Serialize;
+
+pub mod stats;
+
+/// One experiment: its command-line name, a line for `--help`, and the function that runs it.
+pub struct Experiment {
+    /// The name after `hnav-bench experiment`.
+    pub name: &'static str,
+    /// What it reproduces.
+    pub about: &'static str,
+    /// Runs it.
+    pub run: fn(Options) -> anyhow::Result<Report>,
+}
+
+/// Every experiment, in the order `--help` lists them. A new experiment is one row here and
+/// one module.
+pub const EXPERIMENTS: &[Experiment] = &[];
+
+/// What every experiment is run with.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub struct Options {
+    /// The reduced variant (under 30 s): fewer runs per setting, same code paths.
+    pub quick: bool,
+    /// Seed of the experiment's random stream.
+    pub seed: u64,
+}
+
+/// What an experiment produced: the markdown table(s) for a reader and the same figures for a
+/// program.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// The experiment's name, as on the command line.
+    pub name: &'static str,
+    /// The options it ran with.
+    pub quick: bool,
+    /// The seed it ran with.
+    pub seed: u64,
+    /// Markdown: tables of ours beside the paper's, and a line on each difference.
+    pub markdown: String,
+    /// The figures behind the tables.
+    pub data: serde_json::Value,
+}
+
+/// Runs the experiment called `name`; an unknown name is an error that lists the known ones.
+pub fn run(name: &str, options: Options) -> anyhow::Result<Report> {
+    match EXPERIMENTS.iter().find(|e| e.name == name) {
+        Some(e) => (e.run)(options),
+        None => {
+            let known: Vec<&str> = EXPERIMENTS.iter().map(|e| e.name).collect();
+            anyhow::bail!(
+                "no experiment called {name:?}; the experiments are: {}",
+                known.join(", ")
+            )
+        }
+    }
+}
