@@ -128,6 +128,7 @@ fn recording(dir: &Path, poses: u64, maps: u64) {
         width: WIDTH,
         height: HEIGHT,
         truncated: false,
+        control_period_us: 10_000,
     };
     let mut t =
         TrajectoryWriter::create(&rec.join(recording::TRAJECTORIES), header, 1 << 20).unwrap();

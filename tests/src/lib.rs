@@ -12,7 +12,8 @@
 //! - [`pattern`]: the deterministic payloads both sides of a test agree on;
 //! - [`lost_wakeup`]: both halves of the lost-wake-up reproducer (`tests/lost_wakeup.rs`);
 //! - [`tick`]: a discrete-time multi-agent run (neural maps, path constructor, conflict
-//!   resolver) for the papers' conflict experiments.
+//!   resolver) for the papers' conflict experiments;
+//! - [`tmux`]: a terminal of a test's own for full-screen programs (`hnav top`, playback).
 //!
 //! Tests that SIGKILL processes live in their own test binaries (`tests/*_kill.rs`).
 //! Tests that send other signals do too (`tests/waiter_signals.rs`).
@@ -22,6 +23,7 @@ pub mod pattern;
 pub mod rogue;
 pub mod swarm;
 pub mod tick;
+pub mod tmux;
 
 use std::io::{BufRead, BufReader};
 use std::process::{Command, ExitStatus, Stdio};

@@ -12,6 +12,7 @@ use hnav_runtime::monitor::state::ViewState;
 use hnav_runtime::monitor::view::{self, Hints};
 use hnav_runtime::supervisor::registry::RunRegistry;
 use hnav_tests::swarm::{hnav_output, repo_root, SwarmRun};
+use hnav_tests::tmux::Tmux;
 use hnav_tests::TestRun;
 use ratatui::backend::TestBackend;
 use ratatui::Terminal;
@@ -152,69 +153,19 @@ fn top_without_a_live_run_says_so_and_exits_2() {
     );
 }
 
-/// A tmux server of its own (`tmux -L NAME`), killed with every session in it when dropped,
-/// also when the test fails.
-struct Tmux {
-    socket: String,
-}
-
-impl Tmux {
-    fn cmd(&self, args: &[&str]) -> std::process::Output {
-        std::process::Command::new("tmux")
-            .args(["-L", &self.socket])
-            .args(args)
-            .output()
-            .expect("tmux runs")
-    }
-
-    /// The pane's screen as text.
-    fn capture(&self) -> String {
-        String::from_utf8_lossy(&self.cmd(&["capture-pane", "-p", "-t", "top"]).stdout).into()
-    }
-
-    /// Waits up to `timeout` for the screen to satisfy `ok`; returns the last capture.
-    fn wait_for(&self, timeout: Duration, ok: impl Fn(&str) -> bool) -> Result<String, String> {
-        let deadline = Instant::now() + timeout;
-        loop {
-            let screen = self.capture();
-            if ok(&screen) {
-                return Ok(screen);
-            }
-            if Instant::now() >= deadline {
-                return Err(screen);
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
-    }
-}
-
-impl Drop for Tmux {
-    fn drop(&mut self) {
-        self.cmd(&["kill-server"]);
-    }
-}
-
 #[test]
 fn top_in_tmux_shows_the_run_until_q_and_gives_the_terminal_back() {
-    if std::process::Command::new("tmux")
-        .arg("-V")
-        .output()
-        .is_err()
-    {
-        eprintln!("SKIPPED: tmux is not installed (`.ci/run` installs it)");
-        return;
-    }
     let tmp = tempfile::tempdir().unwrap();
     let registry = tmp.path().join("runs");
     let mut run = TestRun::new("toptmux");
+    let Some(tmux) = Tmux::new(run.run.as_str()) else {
+        return;
+    };
     let scenario = repo_root().join("scenarios/demo.toml");
     let mut swarm =
         SwarmRun::start(&mut run, &scenario, &tmp.path().join("out"), &registry, &[]).unwrap();
     let id = run.run.as_str().to_string();
     hnav_tests::swarm::wait_for_ps(&registry, &id, Duration::from_secs(60), |_| true).unwrap();
-    let tmux = Tmux {
-        socket: format!("hnav-{id}"),
-    };
     let hnav = hnav_tests::swarm::workspace_bin("hnav");
     // The shell stays after `hnav top` has left, showing its exit status, until the server
     // is killed.
@@ -223,17 +174,7 @@ fn top_in_tmux_shows_the_run_until_q_and_gives_the_terminal_back() {
         registry.display(),
         hnav.display()
     );
-    let started = tmux.cmd(&[
-        "new-session",
-        "-d",
-        "-s",
-        "top",
-        "-x",
-        "120",
-        "-y",
-        "40",
-        &command,
-    ]);
+    let started = tmux.start(WIDTH, HEIGHT, &command);
     assert!(started.status.success(), "{started:?}");
     let labels: Vec<String> = (0..6).map(|i| agent_label(i).to_string()).collect();
     let ended = tmux

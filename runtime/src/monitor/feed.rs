@@ -128,6 +128,18 @@ pub enum FeedError {
         /// The hash in the run's log header.
         logged: u64,
     },
+    /// A run directory that cannot be played back (its log, map or summary), or a speed out
+    /// of range.
+    #[error("{}: {problem}", path.display())]
+    Playback {
+        /// The run directory, or the file at fault.
+        path: PathBuf,
+        /// What is wrong.
+        problem: String,
+    },
+    /// The recording's trajectories could not be read.
+    #[error(transparent)]
+    Recording(#[from] crate::recording::RecordingError),
     /// The run's topics could not be opened or read.
     #[error("run `{run}`: {source}")]
     Transport {

@@ -15,17 +15,17 @@
 //! decisions) and [`view::draw`] renders it with ratatui into any backend, the terminal or
 //! ratatui's `TestBackend`. Nothing past the feed knows where the data came from.
 //!
-//! The one feed today is [`LiveFeed`](live::LiveFeed), a subscriber of a live run like any
-//! other client. A playback of a recorded run would be a second implementation that reads
-//! the recorded trajectories and the consensus log and yields the same updates at a chosen
-//! speed (`Truth` for poses, `Commit`s rebuilt from the log's round records with
-//! [`RoundRecord::commit`](crate::consensus_log::record::RoundRecord::commit), `Ended` at the
-//! log's end record); the state and the view stay as they are.
+//! Two feeds implement it: [`LiveFeed`](live::LiveFeed), a subscriber of a live run like any
+//! other client (`hnav top`), and [`PlaybackFeed`](playback::PlaybackFeed), a finished run's
+//! recording and consensus log yielded at a chosen speed (`hnav log replay DIR --speed X`):
+//! `Truth` from the recorded poses, `Commit`s rebuilt from the log's round records, `Ended`
+//! at the log's end record. The state and the view do not know which one they are fed by.
 //!
 //! | module | what it holds |
 //! |---|---|
 //! | [`feed`] | the [`Feed`](feed::Feed) trait, its [`Update`](feed::Update)s and errors |
 //! | [`live`] | the live feed: the run found in the registry, its topics read without back-pressure |
+//! | [`playback`] | the playback feed: a run directory's recording and log, paced by simulated time / speed |
 //! | [`health`] | process-health rows: pid, state and restarts from the registry, CPU from `/proc` |
 //! | [`state`] | the view's state and the per-agent state machine (decision -> moving / held / ...) |
 //! | [`map`] | the map scaled to the terminal, robots and goals on it |
@@ -35,5 +35,6 @@ pub mod feed;
 pub mod health;
 pub mod live;
 pub mod map;
+pub mod playback;
 pub mod state;
 pub mod view;

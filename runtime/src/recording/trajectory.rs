@@ -17,14 +17,15 @@
 //!  14  reserved      u16                  20 theta_rad  f32
 //!  16  cell_size_m   f32
 //!  20  width, height u32, u32 (cells)
-//!  28  reserved      u32
+//!  28  control period u32, microseconds
+//!        (0 = not recorded)
 //! ```
 //!
 //! ```
 //! use hnav_runtime::recording::{PoseSample, PoseSource, TrajectoryHeader, TrajectoryReader, TrajectoryWriter};
 //! let dir = tempfile::tempdir().unwrap();
 //! let path = dir.path().join("trajectories.bin");
-//! let header = TrajectoryHeader { robots: 2, rate_hz: 20, cell_size_m: 0.16, width: 12, height: 12, truncated: false };
+//! let header = TrajectoryHeader { robots: 2, rate_hz: 20, cell_size_m: 0.16, width: 12, height: 12, truncated: false, control_period_us: 10_000 };
 //! let mut w = TrajectoryWriter::create(&path, header, 1 << 20).unwrap();
 //! let s = PoseSample { t_ns: 50_000_000, robot: 1, source: PoseSource::Truth, x_m: 0.24, y_m: 0.4, theta_rad: 1.57 };
 //! assert!(w.push(&s).unwrap());
@@ -87,6 +88,10 @@ pub struct TrajectoryHeader {
     pub height: u32,
     /// Whether the size cap was reached and later samples dropped.
     pub truncated: bool,
+    /// The run's control period in microseconds (one odometry period, one lockstep round), so
+    /// a playback can place each round's decisions in simulated time; 0 when not recorded.
+    /// It took a field that earlier writers of version 1 left zero, hence no version bump.
+    pub control_period_us: u32,
 }
 
 impl TrajectoryHeader {
@@ -101,6 +106,7 @@ impl TrajectoryHeader {
         b[16..20].copy_from_slice(&self.cell_size_m.to_le_bytes());
         b[20..24].copy_from_slice(&self.width.to_le_bytes());
         b[24..28].copy_from_slice(&self.height.to_le_bytes());
+        b[28..32].copy_from_slice(&self.control_period_us.to_le_bytes());
         b
     }
 
@@ -128,6 +134,7 @@ impl TrajectoryHeader {
             cell_size_m: f32::from_bits(u32_at(16)),
             width: u32_at(20),
             height: u32_at(24),
+            control_period_us: u32_at(28),
         })
     }
 }
@@ -340,6 +347,7 @@ mod tests {
             width: 32,
             height: 32,
             truncated: false,
+            control_period_us: 10_000,
         }
     }
 

@@ -1,16 +1,22 @@
 //! `hnav log replay DIR [--bin-dir DIR] [--run ID]`: a lockstep run started again, its log compared with
 //! the run's. The work is in `hnav_runtime::supervisor::replay`.
+//! `hnav log replay DIR --speed X [--exit-on-end]`: the run's recording played back into the
+//! `hnav top` view at X times real time (any clock mode; nothing is re-run). The work is in
+//! `hnav_runtime::monitor::playback`.
 //!
 //! Exit codes: 0 every record identical, 1 the replay diverged (the first divergence is
 //! printed: round, agent, both decisions), 2 the run cannot be replayed (realtime, no
 //! `invocation.json`, a scenario whose hash is not the log's, an unreadable log) or the
-//! replay could not run.
+//! replay could not run. With `--speed`, those of `hnav top`: 0 left, 1 the recording failed
+//! while it played, 2 it cannot be played (no recording, an unreadable log or map, standard
+//! output not a terminal).
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use hnav_runtime::consensus_log::Comparison;
+use hnav_runtime::monitor::playback::PlaybackFeed;
 use hnav_runtime::supervisor::replay::{replay, ReplayOptions};
 use hnav_runtime::transport::RunId;
 
@@ -26,11 +32,29 @@ pub struct ReplayArgs {
     /// pass their own so they can clean its shared memory up whatever happens.
     #[arg(long, value_name = "ID")]
     pub run: Option<String>,
+    /// Instead of re-running: play the run's recording back into the `hnav top` view at this
+    /// many times real time (0.01 to 10000; simulated time, so a lockstep run plays at the
+    /// speed its robots drove).
+    #[arg(long, value_name = "X", conflicts_with_all = ["bin_dir", "run"])]
+    pub speed: Option<f64>,
+    /// With --speed: leave the view as soon as the playback ends.
+    #[arg(long, requires = "speed")]
+    pub exit_on_end: bool,
 }
 
 /// Runs `hnav log replay`.
 pub fn run(a: ReplayArgs) -> ExitCode {
     hnav_runtime::logging::init();
+    if let Some(speed) = a.speed {
+        let dir = hnav_runtime::supervisor::replay::run_dir_of(&a.dir);
+        return match PlaybackFeed::open(&dir, speed) {
+            Ok(feed) => crate::top::view(feed, a.exit_on_end),
+            Err(e) => {
+                hnav_runtime::errln!("error: {e}");
+                ExitCode::from(2)
+            }
+        };
+    }
     let Some(bin_dir) = crate::run_cmd::bin_dir(a.bin_dir) else {
         return ExitCode::from(2);
     };

@@ -102,6 +102,7 @@ fn write_recording(dir: &Path) {
         width: W,
         height: 3,
         truncated: false,
+        control_period_us: 10_000,
     };
     let mut w =
         TrajectoryWriter::create(&rec.join(recording::TRAJECTORIES), header, u64::MAX).unwrap();

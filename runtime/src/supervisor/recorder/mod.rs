@@ -212,6 +212,7 @@ impl Files {
             width: g.width(),
             height: g.height(),
             truncated: false,
+            control_period_us: (scenario.sim.control_period_s() * 1e6).round() as u32,
         };
         let max_bytes = scenario.record.max_bytes();
         let trajectories =

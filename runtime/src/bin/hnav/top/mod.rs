@@ -1,7 +1,9 @@
-//! `hnav top [RUN] [--exit-on-end]`: the live view of a run in the terminal.
+//! `hnav top [RUN] [--exit-on-end]`: the live view of a run in the terminal; [`view`] also
+//! shows a recorded run played back (`hnav log replay DIR --speed X`).
 //!
 //! The library's `monitor` module does the work: a feed (`LiveFeed`, a subscriber of the
-//! run like any other client) folded into a `ViewState` and drawn by `monitor::view`. This
+//! run like any other client, or `PlaybackFeed`, a run directory's recording) folded into a
+//! `ViewState` and drawn by `monitor::view`. This
 //! module owns what only a terminal has: the [`terminal::TerminalGuard`] and the keys
 //! ([`input`]), and the loop between them.
 //!
@@ -54,13 +56,18 @@ enum Left {
 
 /// Shows the run until it is left; see the module docs for the exit codes.
 pub fn run(args: TopArgs) -> ExitCode {
-    let feed = match LiveFeed::open(&RunRegistry::default_location(), args.run.as_deref()) {
-        Ok(f) => f,
+    match LiveFeed::open(&RunRegistry::default_location(), args.run.as_deref()) {
+        Ok(feed) => view(feed, args.exit_on_end),
         Err(e) => {
             hnav_runtime::errln!("error: {e}");
-            return ExitCode::from(2);
+            ExitCode::from(2)
         }
-    };
+    }
+}
+
+/// Shows what `feed` yields until the viewer is left: the live view of `hnav top` and the
+/// playback of `hnav log replay --speed`. Exit codes as in the module docs.
+pub fn view(feed: impl Feed, exit_on_end: bool) -> ExitCode {
     let mut state = ViewState::new(feed.info().clone());
     let mut guard = match TerminalGuard::enter() {
         Ok(g) => g,
@@ -69,7 +76,7 @@ pub fn run(args: TopArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let result = show(&mut guard, Some(feed), &mut state, args.exit_on_end);
+    let result = show(&mut guard, Some(feed), &mut state, exit_on_end);
     drop(guard);
     let run = &state.info.run_id;
     let at_goal = format!("{}/{} at goal", state.at_goal(), state.agents.len());
@@ -101,9 +108,9 @@ enum ShowError {
 
 /// The loop: sleep in the feed, keys, drain, draw (module docs). The feed is dropped as soon
 /// as the run has ended, so a viewer left open holds nothing of the run.
-fn show(
+fn show<F: Feed>(
     guard: &mut TerminalGuard,
-    mut feed: Option<LiveFeed>,
+    mut feed: Option<F>,
     state: &mut ViewState,
     exit_on_end: bool,
 ) -> Result<Left, ShowError> {
