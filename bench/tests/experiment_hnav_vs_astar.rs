@@ -54,7 +54,10 @@ fn json(seed: &str) -> Value {
 fn quick_json_has_the_tables_figures_and_is_deterministic() {
     let a = json("7");
     assert_eq!(a["name"], "hnav-vs-astar");
-    assert_eq!((a["quick"].as_bool(), a["seed"].as_u64()), (Some(true), Some(7)));
+    assert_eq!(
+        (a["quick"].as_bool(), a["seed"].as_u64()),
+        (Some(true), Some(7))
+    );
     let data = &a["data"];
     let planners = data["planners"].as_array().unwrap();
     assert_eq!(planners.len(), 5);
@@ -69,7 +72,9 @@ fn quick_json_has_the_tables_figures_and_is_deterministic() {
     for t in tasks {
         let ps = t["planners"].as_array().unwrap();
         assert_eq!(ps.len(), 5);
-        assert!(ps.iter().all(|p| p["found"] == true && p["steps"].as_u64() > Some(0)));
+        assert!(ps
+            .iter()
+            .all(|p| p["found"] == true && p["steps"].as_u64() > Some(0)));
         // Figures only: a timing in them would make the determinism check below flaky.
         assert!(ps.iter().all(|p| p.get("median_us").is_none()));
     }
@@ -86,7 +91,10 @@ fn quick_json_has_the_tables_figures_and_is_deterministic() {
     assert!(timings[0]["planners"][0]["median_us"].as_f64().is_some());
 
     let b = json("7");
-    assert_eq!(a["data"]["figures"], b["data"]["figures"], "same seed, same figures");
+    assert_eq!(
+        a["data"]["figures"], b["data"]["figures"],
+        "same seed, same figures"
+    );
     let c = json("8");
     let lines = |v: &Value| v["data"]["figures"]["movingai"][0]["entries"].clone();
     assert_ne!(lines(&a), lines(&c), "another seed samples other entries");

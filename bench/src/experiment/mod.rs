@@ -29,7 +29,8 @@ pub struct Experiment {
 /// one module.
 pub const EXPERIMENTS: &[Experiment] = &[Experiment {
     name: hnav_vs_astar::NAME,
-    about: "Tables 3-8/3-9: HNAV against A* (time, steps), tanh/linear, partial/full; MovingAI samples",
+    about:
+        "Tables 3-8/3-9: HNAV against A* (time, steps), tanh/linear, partial/full; MovingAI samples",
     run: hnav_vs_astar::run,
 }];
 

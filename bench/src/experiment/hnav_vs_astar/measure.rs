@@ -218,7 +218,10 @@ mod tests {
             assert_eq!(f.steps, 5, "{f:?}");
             assert!((f.length - (2.0 + 3.0 * std::f64::consts::SQRT_2)).abs() < 1e-9);
         }
-        assert!(m.timings.iter().all(|t| t.repetitions == 2 && t.min_us > 0.0));
+        assert!(m
+            .timings
+            .iter()
+            .all(|t| t.repetitions == 2 && t.min_us > 0.0));
         assert_eq!(m.figures[HNAV_TANH_FULL].planner, "hnav tanh full");
     }
 }

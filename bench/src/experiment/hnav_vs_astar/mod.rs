@@ -48,8 +48,8 @@ impl Size {
             }
         } else {
             Size {
-                task_repetitions: 2001,
-                entries_per_file: 50,
+                task_repetitions: 5001,
+                entries_per_file: 100,
                 entry_repetitions: 15,
             }
         }
@@ -74,11 +74,7 @@ pub fn run(options: Options) -> Result<Report> {
         let measured = measure::measure(&task.grid, e.start, e.goal, size.task_repetitions)?;
         task_results.push(TaskResult { task, measured });
     }
-    let scen = movingai::run(
-        size.entries_per_file,
-        size.entry_repetitions,
-        options.seed,
-    )?;
+    let scen = movingai::run(size.entries_per_file, size.entry_repetitions, options.seed)?;
     Ok(Report {
         name: NAME,
         quick: options.quick,

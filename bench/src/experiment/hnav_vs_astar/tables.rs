@@ -48,8 +48,14 @@ fn table_3_8(s: &mut String, tasks: &[TaskResult], size: Size) {
     let (mut paper_sum, mut ours_sum) = ((0.0, 0.0), (0.0, 0.0));
     for r in tasks {
         let p = &r.task.paper;
-        let (a, h) = (&r.measured.timings[ASTAR], &r.measured.timings[HNAV_LINEAR_PARTIAL]);
-        let (fa, fh) = (&r.measured.figures[ASTAR], &r.measured.figures[HNAV_LINEAR_PARTIAL]);
+        let (a, h) = (
+            &r.measured.timings[ASTAR],
+            &r.measured.timings[HNAV_LINEAR_PARTIAL],
+        );
+        let (fa, fh) = (
+            &r.measured.figures[ASTAR],
+            &r.measured.figures[HNAV_LINEAR_PARTIAL],
+        );
         paper_sum = (paper_sum.0 + p.astar_ms, paper_sum.1 + p.hnav_ms);
         ours_sum = (ours_sum.0 + a.median_us, ours_sum.1 + h.median_us);
         let same = match (fa.steps == p.astar_steps, fh.steps == p.hnav_steps) {
@@ -130,10 +136,7 @@ fn table_3_9(s: &mut String, tasks: &[TaskResult]) {
             per_sweep(HNAV_TANH_FULL) / per_sweep(HNAV_LINEAR_FULL),
         );
     }
-    let _ = writeln!(
-        s,
-        "| paper | | | 1.3-3 | 1.3-3 | up to 2.5 | 1.5-2.5 |\n"
-    );
+    let _ = writeln!(s, "| paper | | | 1.3-3 | 1.3-3 | up to 2.5 | 1.5-2.5 |\n");
 }
 
 fn movingai(s: &mut String, scen: &[ScenResult], size: Size) {
@@ -170,7 +173,28 @@ fn movingai(s: &mut String, scen: &[ScenResult], size: Size) {
             );
         }
     }
-    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "\nTable 3-9's ratios on these samples (mean sweeps; median times over the entries):\n"
+    );
+    let _ = writeln!(
+        s,
+        "| scen | full/partial sweeps (linear) | full/partial time (linear) | tanh/linear time (partial) | tanh/linear time (full) |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|");
+    for r in scen {
+        let (it, t) = (&r.mean_iterations, |k: usize| r.median_time_us(k));
+        let _ = writeln!(
+            s,
+            "| `{}` | {:.2} | {:.2} | {:.2} | {:.2} |",
+            r.scen,
+            it[HNAV_LINEAR_FULL] / it[HNAV_LINEAR_PARTIAL],
+            t(HNAV_LINEAR_FULL) / t(HNAV_LINEAR_PARTIAL),
+            t(HNAV_TANH_PARTIAL) / t(HNAV_LINEAR_PARTIAL),
+            t(HNAV_TANH_FULL) / t(HNAV_LINEAR_FULL),
+        );
+    }
+    let _ = writeln!(s, "| paper | 1.3-3 | 1.3-3 | up to 2.5 | up to 2.5 |\n");
 }
 
 /// The JSON document: `figures` (deterministic for a seed) and `timings` (this run's).

@@ -177,7 +177,11 @@ mod tests {
     fn scen_lengths_are_optimal_and_variants_agree_on_steps() {
         for t in load().unwrap() {
             let (_, a) = steps(&t, VARIANTS[ASTAR]);
-            assert!((a - t.entry.optimal_length).abs() < 1e-6, "task {}", t.number);
+            assert!(
+                (a - t.entry.optimal_length).abs() < 1e-6,
+                "task {}",
+                t.number
+            );
             let first = steps(&t, VARIANTS[HNAV_LINEAR_PARTIAL]);
             for v in &VARIANTS[HNAV_LINEAR_PARTIAL..] {
                 let s = steps(&t, *v);
