@@ -7,10 +7,12 @@
 //!
 //! | module | experiment | what |
 //! |---|---|---|
+//! | [`pso`] | `pso` | seed 003's Tables 1 and 2: the original swarm against the modified one |
 //! | [`stats`] | — | the intervals the tables print: Wilson for rates, bootstrap for means |
 
 use serde::Serialize;
 
+pub mod pso;
 pub mod stats;
 
 /// One experiment: its command-line name, a line for `--help`, and the function that runs it.
@@ -25,7 +27,11 @@ pub struct Experiment {
 
 /// Every experiment, in the order `--help` lists them. A new experiment is one row here and
 /// one module.
-pub const EXPERIMENTS: &[Experiment] = &[];
+pub const EXPERIMENTS: &[Experiment] = &[Experiment {
+    name: "pso",
+    about: "seed 003, Tables 1-2: original PSO (r_max 1/2/4) vs modified (n_lm 5/7/10)",
+    run: pso::run,
+}];
 
 /// What every experiment is run with.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
