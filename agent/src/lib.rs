@@ -17,6 +17,7 @@
 //! | [`controller`] | the wheel controller that drives the robot to the centre of the committed cell |
 //! | [`odometry`] | §D.2 dead reckoning from Hall ticks: [`odometry::DeadReckoning`], a pure function of the tick stream |
 //! | [`process`] | the `hnav-agent` process: ports, the round loop in lockstep and realtime, map snapshots, the restart checkpoint |
+//! | [`pso`] | seed 003's particle swarm with virtual obstacles at swarm-detected local minima, a [`route::RoutePlanner`] |
 //! | [`route`] | [`route::RoutePlanner`]: the seeds' planners that answer with a whole route (PSO, GA) |
 //! | [`plan`] | [`plan_query`]: one start-goal query, answered with a JSON-ready [`PlanResult`](hnav_runtime::plan::PlanResult) |
 //! | [`error`] | [`Error`]: bad cells and bad options, never a panic |
@@ -39,6 +40,7 @@ pub mod odometry;
 pub mod path_constructor;
 pub mod plan;
 pub mod process;
+pub mod pso;
 pub mod route;
 
 pub use error::{Error, Role};

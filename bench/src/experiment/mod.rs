@@ -7,12 +7,14 @@
 //!
 //! | module | experiment | what |
 //! |---|---|---|
-//! | [`stats`] | — | the intervals the tables print: Wilson for rates, bootstrap for means |
 //! | [`hnav_vs_astar`] | `hnav-vs-astar` | dissertation Tables 3-8/3-9: HNAV against A* on four 20x20 tasks, tanh against linear, partial against full activation; then MovingAI scenario samples |
+//! | [`pso`] | `pso` | seed 003's Tables 1 and 2: the original swarm against the modified one |
+//! | [`stats`] | — | the intervals the tables print: Wilson for rates, bootstrap for means |
 
 use serde::Serialize;
 
 pub mod hnav_vs_astar;
+pub mod pso;
 pub mod stats;
 
 /// One experiment: its command-line name, a line for `--help`, and the function that runs it.
@@ -27,12 +29,18 @@ pub struct Experiment {
 
 /// Every experiment, in the order `--help` lists them. A new experiment is one row here and
 /// one module.
-pub const EXPERIMENTS: &[Experiment] = &[Experiment {
-    name: hnav_vs_astar::NAME,
-    about:
-        "Tables 3-8/3-9: HNAV against A* (time, steps), tanh/linear, partial/full; MovingAI samples",
-    run: hnav_vs_astar::run,
-}];
+pub const EXPERIMENTS: &[Experiment] = &[
+    Experiment {
+        name: hnav_vs_astar::NAME,
+        about: "Tables 3-8/3-9: HNAV against A* (time, steps), tanh/linear, partial/full; MovingAI samples",
+        run: hnav_vs_astar::run,
+    },
+    Experiment {
+        name: "pso",
+        about: "seed 003, Tables 1-2: original PSO (r_max 1/2/4) vs modified (n_lm 5/7/10)",
+        run: pso::run,
+    },
+];
 
 /// What every experiment is run with.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
