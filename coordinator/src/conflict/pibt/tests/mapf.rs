@@ -49,28 +49,3 @@ fn mapf_table() {
         }
     }
 }
-
-#[test]
-#[ignore = "debug"]
-fn mapf_debug() {
-    let var = |k: &str| std::env::var(k).unwrap();
-    let map = var("MAP");
-    let grid = read_map_file(maps_dir().join(format!("{map}.map"))).unwrap();
-    let scen = read_scen_file(maps_dir().join(format!("{map}-random-1.scen"))).unwrap();
-    let n: usize = var("N").parse().unwrap();
-    let watch: Vec<usize> = var("W").split(',').map(|x| x.parse().unwrap()).collect();
-    let (starts, goals): (Vec<Cell>, Vec<Cell>) =
-        scen.entries[..n].iter().map(|e| (e.start, e.goal)).unzip();
-    let mut w = World::new(grid, &starts, &goals);
-    for _ in 0..3000 {
-        w.step().unwrap();
-    }
-    for r in 0..12 {
-        w.step().unwrap();
-        for &i in &watch {
-            let o = w.out[i];
-            eprintln!("r{r} a{i} at {} next {} goal {} waited {} {:?} {:?} {:?} {:?}", w.rows[i].current, w.rows[i].next, w.goals[i], w.pibt.waited(i), o.verdict, o.kind, o.cell, o.other);
-        }
-    }
-    eprintln!("{}", w.picture());
-}
