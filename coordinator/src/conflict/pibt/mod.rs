@@ -75,6 +75,12 @@ use super::resolve::cmp_priority;
 use super::{side_cells, AgentMode, AgentRow, Options, Outcome};
 use distance::{can_step, Distances};
 
+/// A distance as the leading part of a preference key: above the 36 bits of the tie breaks
+/// (distances beyond 2^27 - 1, far beyond any map's, and unreachable ones share the top).
+fn rank(distance: u32) -> u64 {
+    u64::from(distance.min((1 << 27) - 1)) << 36
+}
+
 /// "No agent" in the per-cell table.
 const NOBODY: u32 = u32::MAX;
 
@@ -316,14 +322,23 @@ impl Pibt {
 
     /// Agent `i`'s options, best first: `(cell, key)` with staying included; see the module
     /// docs.
-    fn preferences(&self, i: usize, row: &AgentRow) -> ([Cell; 9], usize) {
+    fn preferences(&self, i: usize, row: &AgentRow, parent: Option<u32>) -> ([Cell; 9], usize) {
         let from = row.current;
+        // A pushed agent prefers, among equally good cells, the one farthest from its
+        // pusher's goal: it makes way rather than stepping onto the pusher's path, where the
+        // pusher would push it again (two agents in each other's goal pockets did so for ever).
+        let out_of_way = |to: Cell| -> u64 {
+            parent.map_or(0, |p| {
+                let d = self.distances.get(p as usize, to);
+                u64::from(u32::MAX - d.min(u32::MAX - 1))
+            })
+        };
         // Ties between equally distant neighbours rotate with the round and the agent: a
         // fixed order lets two agents push each other off their goals in turn for ever, and
         // PIBT breaks such ties at random; this is deterministic.
         let salt = (self.stamp as usize).wrapping_add(i) % 8;
         let mut keyed = [(u64::MAX, from); 9];
-        keyed[0] = (u64::from(self.distances.get(i, from)) << 4, from);
+        keyed[0] = (rank(self.distances.get(i, from)), from);
         let mut len = 1;
         for d in Direction::ALL {
             let step = can_step(
@@ -338,7 +353,10 @@ impl Pibt {
             let key = if row.probable == Some(to) && row.mode == AgentMode::Active {
                 0
             } else {
-                (u64::from(self.distances.get(i, to)) << 4) + 1 + ((d.index() + salt) % 8) as u64
+                rank(self.distances.get(i, to))
+                    + (out_of_way(to) << 4)
+                    + 1
+                    + ((d.index() + salt) % 8) as u64
             };
             keyed[len] = (key, to);
             len += 1;
@@ -385,7 +403,7 @@ impl Pibt {
     fn attempt(&mut self, i: usize, parent: Option<u32>, rows: &[AgentRow]) -> Step {
         self.state[i] = State::InChain;
         let row = &rows[i];
-        let (prefs, len) = self.preferences(i, row);
+        let (prefs, len) = self.preferences(i, row, parent);
         let mut last_resort = NOBODY;
         let mut resort_cell = row.current;
         let mut failed_push = NOBODY;

@@ -7,6 +7,7 @@ use super::distance::can_step;
 use super::Pibt;
 use crate::conflict::{AgentMode, AgentRow, Options, Outcome};
 
+mod mapf;
 mod props;
 
 fn c(x: u32, y: u32) -> Cell {

@@ -1,0 +1,51 @@
+//! The MAPF benchmark instances (MovingAI maps and `.scen` files in `maps/`) in the
+//! discrete-time [`World`]: the fast model of `hnav-bench mapf`, without processes.
+
+use std::path::PathBuf;
+
+use hnav_runtime::grid::{read_map_file, read_scen_file, Cell};
+
+use super::World;
+
+fn maps_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../maps")
+}
+
+/// Runs the first `n` entries of `scen` on `map` for at most `limit` rounds; the rounds until
+/// all were home at once, or the agents away at the end.
+fn run(map: &str, scen: &str, n: usize, limit: u64) -> Result<u64, Vec<usize>> {
+    let grid = read_map_file(maps_dir().join(map)).unwrap();
+    let scen = read_scen_file(maps_dir().join(scen)).unwrap();
+    let (starts, goals): (Vec<Cell>, Vec<Cell>) =
+        scen.entries[..n].iter().map(|e| (e.start, e.goal)).unzip();
+    let mut w = World::new(grid, &starts, &goals);
+    w.run(limit).map_err(|_| {
+        (0..n)
+            .filter(|&i| w.rows[i].current != w.goals[i] || !w.rows[i].is_at_rest())
+            .collect()
+    })
+}
+
+/// Prints the table of the three benchmark maps (`cargo test -p hnav-coordinator mapf_table
+/// -- --ignored --nocapture`).
+#[test]
+#[ignore = "a measurement: prints the sim-only table"]
+fn mapf_table() {
+    let sets = [
+        ("random-32-32-10.map", "random-32-32-10-random-1.scen", 250),
+        ("random-32-32-20.map", "random-32-32-20-random-1.scen", 200),
+        (
+            "warehouse-10-20-10-2-1.map",
+            "warehouse-10-20-10-2-1-random-1.scen",
+            200,
+        ),
+    ];
+    for (map, scen, max) in sets {
+        for n in [50, 100, 150, 200, 250].into_iter().filter(|&n| n <= max) {
+            match run(map, scen, n, 20_000) {
+                Ok(r) => eprintln!("{map} N={n}: all home at round {r}"),
+                Err(away) => eprintln!("{map} N={n}: {} away: {away:?}", away.len()),
+            }
+        }
+    }
+}
