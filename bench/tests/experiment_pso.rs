@@ -1,0 +1,75 @@
+//! `hnav-bench experiment pso --quick` through the binary: the report's shape (both tables'
+//! six settings beside the paper's figures, intervals that bracket their estimates) and the
+//! same JSON twice for one seed, another for another seed. Nothing here is a timing.
+
+use std::process::Command;
+
+use serde_json::Value;
+
+fn json(seed: &str) -> Value {
+    let out = Command::new(env!("CARGO_BIN_EXE_hnav-bench"))
+        .args(["experiment", "pso", "--quick", "--json", "--seed", seed])
+        .output()
+        .expect("hnav-bench runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON document")
+}
+
+#[test]
+fn quick_json_has_both_tables_and_is_deterministic() {
+    let a = json("3");
+    assert_eq!(a["name"], "pso");
+    assert_eq!(
+        (a["quick"].as_bool(), a["seed"].as_u64()),
+        (Some(true), Some(3))
+    );
+    let data = &a["data"];
+    let runs = data["runs_per_setting"].as_u64().unwrap();
+    assert!(runs > 0);
+    let rows = data["rows"].as_array().unwrap();
+    let settings: Vec<(String, u64, f64)> = rows
+        .iter()
+        .map(|r| {
+            (
+                r["algorithm"].as_str().unwrap().to_string(),
+                r["parameter"].as_u64().unwrap(),
+                r["paper_steps"].as_f64().unwrap(),
+            )
+        })
+        .collect();
+    let expected = [
+        ("original", 1, 183.0),
+        ("original", 2, 210.0),
+        ("original", 4, 155.0),
+        ("modified", 5, 159.0),
+        ("modified", 7, 100.0),
+        ("modified", 10, 93.0),
+    ];
+    assert_eq!(settings.len(), expected.len(), "{settings:?}");
+    for ((alg, p, steps), (ea, ep, es)) in settings.iter().zip(expected) {
+        assert_eq!((alg.as_str(), *p, *steps), (ea, ep, es));
+    }
+    for r in rows {
+        assert_eq!(r["runs"].as_u64(), Some(runs));
+        let lo = r["success_ci"]["lo"].as_f64().unwrap();
+        let hi = r["success_ci"]["hi"].as_f64().unwrap();
+        assert!(0.0 <= lo && lo <= hi && hi <= 1.0, "{r}");
+        if let (Some(m), Some(slo), Some(shi)) = (
+            r["mean_steps"].as_f64(),
+            r["steps_ci"]["lo"].as_f64(),
+            r["steps_ci"]["hi"].as_f64(),
+        ) {
+            assert!(slo <= m && m <= shi, "{r}");
+        }
+    }
+    let md = a["markdown"].as_str().unwrap();
+    assert!(
+        md.contains("Table 1: original algorithm") && md.contains("Table 2: modified algorithm")
+    );
+    assert_eq!(a, json("3"), "one seed, one report");
+    assert_ne!(a["data"], json("4")["data"], "another seed, other maps");
+}
