@@ -17,6 +17,7 @@
 //! | [`controller`] | the wheel controller that drives the robot to the centre of the committed cell |
 //! | [`odometry`] | §D.2 dead reckoning from Hall ticks: [`odometry::DeadReckoning`], a pure function of the tick stream |
 //! | [`process`] | the `hnav-agent` process: ports, the round loop in lockstep and realtime, map snapshots, the restart checkpoint |
+//! | [`ga_fuzzy`] | seed 004: the GA over time-indexed grids ([`ga_fuzzy::GaPlanner`], route planner `"ga-fuzzy"`) and the fuzzy controller |
 //! | [`route`] | [`route::RoutePlanner`]: the seeds' planners that answer with a whole route (PSO, GA) |
 //! | [`plan`] | [`plan_query`]: one start-goal query, answered with a JSON-ready [`PlanResult`](hnav_runtime::plan::PlanResult) |
 //! | [`error`] | [`Error`]: bad cells and bad options, never a panic |
@@ -33,6 +34,7 @@
 
 pub mod controller;
 pub mod error;
+pub mod ga_fuzzy;
 pub mod navigator;
 pub mod neural_map;
 pub mod odometry;
