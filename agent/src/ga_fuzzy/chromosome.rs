@@ -74,10 +74,17 @@ impl Operators {
         out.clear();
         out.push(from);
         self.stamp[grid.index(from)] = g;
+        // Waits (timed walks) can be pushed and backed out of again and again; bound the
+        // decisions so a walk ends in time linear in its length.
+        let mut budget = 16 * max_nodes.min(grid.len()) + 64;
         while let Some(&cur) = out.last() {
             if cur == to {
                 return true;
             }
+            if budget == 0 {
+                return false;
+            }
+            budget -= 1;
             let mut cand = [Cell::new(0, 0); 8];
             let mut n = 0;
             if out.len() < max_nodes {
@@ -219,8 +226,16 @@ impl Operators {
         let (from, to) = (route[i], route[j]);
         let mut walk = std::mem::take(&mut self.walk);
         let span = 2 * MUTATION_SPAN;
-        if self.random_walk(tg, timed.then_some(i), from, to, span, greed, rng, &mut walk)
-            && route.len() - (j - i) + walk.len() - 1 <= tg.depth()
+        if self.random_walk(
+            tg,
+            timed.then_some(i),
+            from,
+            to,
+            span,
+            greed,
+            rng,
+            &mut walk,
+        ) && route.len() - (j - i) + walk.len() - 1 <= tg.depth()
         {
             route.splice(i..=j, walk.iter().copied());
             self.remove_loops(tg.grid(), route);
@@ -247,7 +262,9 @@ fn nearest(cand: &[Cell], to: Cell, rng: &mut ChaCha8Rng) -> Cell {
 /// Whether `route` is a chain of legal moves (or waits) on `tg`'s walls under its corner rule.
 pub fn is_legal(tg: &TimeGrid, route: &[Cell]) -> bool {
     let grid = tg.grid();
-    route.iter().all(|&c| grid.contains(c) && !grid.is_blocked(c))
+    route
+        .iter()
+        .all(|&c| grid.contains(c) && !grid.is_blocked(c))
         && route.windows(2).all(|w| {
             w[0] == w[1]
                 || Direction::between(w[0], w[1]).is_some_and(|d| grid.can_move(w[0], d, tg.rule()))
@@ -261,10 +278,8 @@ mod tests {
     use rand::SeedableRng;
 
     fn room() -> TimeGrid {
-        let g = Grid::from_rows(&[
-            "........", ".@@@@@@.", "........", ".@@@@@@.", "........",
-        ])
-        .unwrap();
+        let g =
+            Grid::from_rows(&["........", ".@@@@@@.", "........", ".@@@@@@.", "........"]).unwrap();
         TimeGrid::fixed(g, CornerCutting::Forbidden, 200).unwrap()
     }
 
@@ -275,8 +290,20 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let mut out = Vec::new();
         for greed in [0.0, 0.5, 1.0] {
-            assert!(ops.random_walk(&tg, None, Cell::new(0, 0), Cell::new(7, 4), 200, greed, &mut rng, &mut out));
-            assert_eq!((out[0], *out.last().unwrap()), (Cell::new(0, 0), Cell::new(7, 4)));
+            assert!(ops.random_walk(
+                &tg,
+                None,
+                Cell::new(0, 0),
+                Cell::new(7, 4),
+                200,
+                greed,
+                &mut rng,
+                &mut out
+            ));
+            assert_eq!(
+                (out[0], *out.last().unwrap()),
+                (Cell::new(0, 0), Cell::new(7, 4))
+            );
             assert!(is_legal(&tg, &out), "{out:?}");
         }
         // Walled in: the walk gives up.
@@ -285,17 +312,38 @@ mod tests {
             g.set_blocked(c, true);
         }
         let tg = TimeGrid::fixed(g, CornerCutting::Forbidden, 9).unwrap();
-        assert!(!ops.random_walk(&tg, None, Cell::new(0, 0), Cell::new(2, 2), 9, 0.5, &mut rng, &mut out));
+        assert!(!ops.random_walk(
+            &tg,
+            None,
+            Cell::new(0, 0),
+            Cell::new(2, 2),
+            9,
+            0.5,
+            &mut rng,
+            &mut out
+        ));
     }
 
     #[test]
     fn loops_are_cut_and_waits_kept() {
         let tg = room();
         let c = |x, y| Cell::new(x, y);
-        let mut r = vec![c(0, 0), c(1, 0), c(2, 0), c(1, 0), c(1, 0), c(2, 0), c(2, 0), c(3, 0)];
+        let mut r = vec![
+            c(0, 0),
+            c(1, 0),
+            c(2, 0),
+            c(1, 0),
+            c(1, 0),
+            c(2, 0),
+            c(2, 0),
+            c(3, 0),
+        ];
         Operators::default().remove_loops(tg.grid(), &mut r);
         // The loop 1 -> 2 -> 1 goes; the wait at 1 and the one at 2 stay.
-        assert_eq!(r, vec![c(0, 0), c(1, 0), c(1, 0), c(2, 0), c(2, 0), c(3, 0)]);
+        assert_eq!(
+            r,
+            vec![c(0, 0), c(1, 0), c(1, 0), c(2, 0), c(2, 0), c(3, 0)]
+        );
     }
 
     #[test]
@@ -317,7 +365,10 @@ mod tests {
             }
             for timed in [false, true] {
                 ops.mutate(&tg, &mut a, 0.5, timed, &mut rng);
-                assert!(is_legal(&tg, &a) && a[0] == s && *a.last().unwrap() == g, "{a:?}");
+                assert!(
+                    is_legal(&tg, &a) && a[0] == s && *a.last().unwrap() == g,
+                    "{a:?}"
+                );
             }
         }
         assert!(crossed > 25, "{crossed}");

@@ -137,9 +137,23 @@ mod tests {
         let tg = TimeGrid::fixed(Grid::new(8, 5).unwrap(), CornerCutting::Forbidden, 64).unwrap();
         let c = Cell::new;
         // A zig-zag along row 2.
-        let mut route = vec![c(0, 2), c(1, 1), c(2, 2), c(3, 3), c(4, 2), c(5, 1), c(6, 2)];
+        let mut route = vec![
+            c(0, 2),
+            c(1, 1),
+            c(2, 2),
+            c(3, 3),
+            c(4, 2),
+            c(5, 1),
+            c(6, 2),
+        ];
         let before = route_length(&route).unwrap();
-        let n = refine(&tg, &FuzzyRules::default(), &mut route, &mut Vec::new(), &mut Vec::new());
+        let n = refine(
+            &tg,
+            &FuzzyRules::default(),
+            &mut route,
+            &mut Vec::new(),
+            &mut Vec::new(),
+        );
         assert!(n >= 1);
         assert!(is_legal(&tg, &route) && route[0] == c(0, 2) && *route.last().unwrap() == c(6, 2));
         assert!(route_length(&route).unwrap() < before);
@@ -151,7 +165,15 @@ mod tests {
         let g = Grid::from_rows(&["......", "..@...", "..@...", "......"]).unwrap();
         let tg = TimeGrid::fixed(g, CornerCutting::Forbidden, 64).unwrap();
         let mut out = Vec::new();
-        let ok = fuzzy_rollout(&tg, &FuzzyRules::default(), Cell::new(0, 1), Cell::new(5, 2), 0.0, 12, &mut out);
+        let ok = fuzzy_rollout(
+            &tg,
+            &FuzzyRules::default(),
+            Cell::new(0, 1),
+            Cell::new(5, 2),
+            0.0,
+            12,
+            &mut out,
+        );
         if ok {
             assert!(is_legal(&tg, &out), "{out:?}");
         }

@@ -129,14 +129,22 @@ mod tests {
         let tg = TimeGrid::fixed(Grid::new(6, 6).unwrap(), CornerCutting::Forbidden, 20).unwrap();
         let straight: Vec<Cell> = (0..4).map(|x| Cell::new(x, 0)).collect();
         let s = score(&straight, &tg, Weights::default());
-        assert_eq!((s.s_length, s.s_time, s.fitness, s.length), (1.0, 1.0, 1.0, 3.0));
+        assert_eq!(
+            (s.s_length, s.s_time, s.fitness, s.length),
+            (1.0, 1.0, 1.0, 3.0)
+        );
         let mut wait = straight.clone();
         wait.insert(2, Cell::new(1, 0));
         let sw = score(&wait, &tg, Weights::default());
         assert_eq!((sw.s_length, sw.s_time), (1.0, 0.8));
         assert!(sw.fitness < s.fitness);
         // A detour costs length (and time).
-        let detour = [Cell::new(0, 0), Cell::new(1, 1), Cell::new(2, 1), Cell::new(3, 0)];
+        let detour = [
+            Cell::new(0, 0),
+            Cell::new(1, 1),
+            Cell::new(2, 1),
+            Cell::new(3, 0),
+        ];
         let sd = score(&detour, &tg, Weights::default());
         assert!((sd.length - (1.0 + 2.0 * std::f64::consts::SQRT_2)).abs() < 1e-12);
         assert!(sd.s_length < 1.0 && sd.s_time == 1.0);
@@ -145,9 +153,26 @@ mod tests {
     #[test]
     fn weights_outside_the_unit_interval_are_refused() {
         assert!(Weights::default().validate().is_ok());
-        let bad = Weights { length: 1.5, time: 0.0 };
-        assert!(bad.validate().unwrap_err().to_string().contains("alpha_length"));
-        assert!(Weights { length: 0.0, time: 0.0 }.validate().is_err());
-        assert!(Weights { length: f64::NAN, time: 0.5 }.validate().is_err());
+        let bad = Weights {
+            length: 1.5,
+            time: 0.0,
+        };
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("alpha_length"));
+        assert!(Weights {
+            length: 0.0,
+            time: 0.0
+        }
+        .validate()
+        .is_err());
+        assert!(Weights {
+            length: f64::NAN,
+            time: 0.5
+        }
+        .validate()
+        .is_err());
     }
 }

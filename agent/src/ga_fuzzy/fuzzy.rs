@@ -79,8 +79,16 @@ pub struct Rule {
 pub fn rule_base() -> [Rule; RULES] {
     // Sector speed: full ahead, half at 45°, turn in place beyond [inferred].
     const SECTOR_SPEED: [f64; DIRECTIONS] = [1.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5];
-    let ahead = [(Ahead::Near, 0.4, FRAC_PI_4), (Ahead::Mid, 0.7, 0.35), (Ahead::Far, 1.0, 0.15)];
-    let side = [(Side::CcwFreer, -1.0), (Side::Even, 0.0), (Side::CwFreer, 1.0)];
+    let ahead = [
+        (Ahead::Near, 0.4, FRAC_PI_4),
+        (Ahead::Mid, 0.7, 0.35),
+        (Ahead::Far, 1.0, 0.15),
+    ];
+    let side = [
+        (Side::CcwFreer, -1.0),
+        (Side::Even, 0.0),
+        (Side::CwFreer, 1.0),
+    ];
     let mut rules = [Rule {
         b: 0,
         ahead: Ahead::Far,
@@ -174,7 +182,11 @@ impl FuzzyRules {
             s += w * r.shift;
         }
         // The three partitions sum to 1, so w_sum is 1 up to rounding; divide anyway.
-        let (v, s) = if w_sum > 0.0 { (v / w_sum, s / w_sum) } else { (0.0, 0.0) };
+        let (v, s) = if w_sum > 0.0 {
+            (v / w_sum, s / w_sum)
+        } else {
+            (0.0, 0.0)
+        };
         FuzzyOutput {
             speed: v.clamp(0.0, 1.0),
             turn: wrap_angle_shifted(b + s),
@@ -217,10 +229,15 @@ mod tests {
         }
         for i in 0..=100 {
             let f = f64::from(i) / 100.0;
-            let a: f64 = [Ahead::Near, Ahead::Mid, Ahead::Far].iter().map(|&t| mu_ahead(f, t)).sum();
+            let a: f64 = [Ahead::Near, Ahead::Mid, Ahead::Far]
+                .iter()
+                .map(|&t| mu_ahead(f, t))
+                .sum();
             let q = 2.0 * f - 1.0;
-            let s: f64 =
-                [Side::CcwFreer, Side::Even, Side::CwFreer].iter().map(|&t| mu_side(q, t)).sum();
+            let s: f64 = [Side::CcwFreer, Side::Even, Side::CwFreer]
+                .iter()
+                .map(|&t| mu_side(q, t))
+                .sum();
             assert!((a - 1.0).abs() < 1e-12 && (s - 1.0).abs() < 1e-12);
         }
     }

@@ -79,10 +79,16 @@ mod tests {
         ] {
             let r = ga.route(&g, s, t).unwrap().unwrap();
             let tg = TimeGrid::fixed(g.clone(), CornerCutting::Forbidden, 100).unwrap();
-            assert!(is_legal(&tg, &r) && r[0] == s && *r.last().unwrap() == t, "{r:?}");
+            assert!(
+                is_legal(&tg, &r) && r[0] == s && *r.last().unwrap() == t,
+                "{r:?}"
+            );
             let best = octile_shortest_path_len(&g, s, t, CornerCutting::Forbidden).unwrap();
             let len = fitness::route_length(&r).unwrap();
-            assert!(len >= best - 1e-9 && len <= 1.5 * best, "{s}->{t}: {len} vs {best}");
+            assert!(
+                len >= best - 1e-9 && len <= 1.5 * best,
+                "{s}->{t}: {len} vs {best}"
+            );
             // Same query, same route, whatever ran in between.
             let mut other = GaPlanner::new(GaOptions::default()).unwrap();
             assert_eq!(other.route(&g, s, t).unwrap().unwrap(), r);
@@ -93,14 +99,20 @@ mod tests {
     fn unreachable_goals_and_bad_endpoints() {
         let g = Grid::from_rows(&["..@..", "..@..", "..@.."]).unwrap();
         let mut ga = GaPlanner::new(GaOptions::default()).unwrap();
-        assert_eq!(ga.route(&g, Cell::new(0, 0), Cell::new(4, 2)).unwrap(), None);
+        assert_eq!(
+            ga.route(&g, Cell::new(0, 0), Cell::new(4, 2)).unwrap(),
+            None
+        );
         assert!(ga.route(&g, Cell::new(2, 0), Cell::new(4, 2)).is_err());
         assert!(ga.route(&g, Cell::new(0, 0), Cell::new(9, 2)).is_err());
         let bad = GaOptions {
             mutation: 1.5,
             ..GaOptions::default()
         };
-        assert!(GaPlanner::new(bad).unwrap_err().to_string().contains("mutation"));
+        assert!(GaPlanner::new(bad)
+            .unwrap_err()
+            .to_string()
+            .contains("mutation"));
     }
 
     #[test]
@@ -116,7 +128,10 @@ mod tests {
         let straight: Vec<Cell> = (0..8).map(|x| Cell::new(x, 1)).collect();
         assert!(tg.conflicts(&straight) > 0);
         let mut ga = GaPlanner::new(GaOptions::default()).unwrap();
-        let r = ga.plan(&tg, Cell::new(0, 1), Cell::new(7, 1)).unwrap().unwrap();
+        let r = ga
+            .plan(&tg, Cell::new(0, 1), Cell::new(7, 1))
+            .unwrap()
+            .unwrap();
         assert_eq!(r.score.conflicts, 0, "{:?}", r.cells);
         assert!(is_legal(&tg, &r.cells));
     }

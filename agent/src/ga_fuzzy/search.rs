@@ -75,7 +75,10 @@ impl GaOptions {
     /// Checks every option's domain.
     pub fn validate(&self) -> Result<(), Error> {
         if self.population < 2 {
-            return Err(Error::option("population", format!("{}: at least 2", self.population)));
+            return Err(Error::option(
+                "population",
+                format!("{}: at least 2", self.population),
+            ));
         }
         for (name, p) in [
             ("crossover", self.crossover),
@@ -131,7 +134,12 @@ impl GaPlanner {
 
     /// Plans from `start` to `goal` over the time layers of `tg`. `Ok(None)` when no route
     /// within `tg.depth()` nodes exists (the initial walks find none).
-    pub fn plan(&mut self, tg: &TimeGrid, start: Cell, goal: Cell) -> Result<Option<GaRoute>, Error> {
+    pub fn plan(
+        &mut self,
+        tg: &TimeGrid,
+        start: Cell,
+        goal: Cell,
+    ) -> Result<Option<GaRoute>, Error> {
         let grid = tg.grid();
         for (c, role) in [(start, Role::Start), (goal, Role::Goal)] {
             check_inside(c, role, grid.width(), grid.height())?;
@@ -140,8 +148,10 @@ impl GaPlanner {
             }
         }
         let o = self.options;
-        let mix = (u64::from(start.x) << 48) ^ (u64::from(start.y) << 32)
-            ^ (u64::from(goal.x) << 16) ^ u64::from(goal.y);
+        let mix = (u64::from(start.x) << 48)
+            ^ (u64::from(start.y) << 32)
+            ^ (u64::from(goal.x) << 16)
+            ^ u64::from(goal.y);
         let mut rng = ChaCha8Rng::seed_from_u64(o.seed ^ mix.wrapping_mul(0x9E37_79B9_7F4A_7C15));
         if !self.initialise(tg, start, goal, &mut rng) {
             return Ok(None);
@@ -186,7 +196,9 @@ impl GaPlanner {
                         .random_walk(tg, Some(0), start, goal, tg.depth(), o.greed, rng, &mut r)
                 });
             if !timed_ok
-                && !self.ops.random_walk(tg, None, start, goal, tg.depth(), o.greed, rng, &mut r)
+                && !self
+                    .ops
+                    .random_walk(tg, None, start, goal, tg.depth(), o.greed, rng, &mut r)
             {
                 self.spare.push(r);
                 return false;
@@ -224,7 +236,8 @@ impl GaPlanner {
             }
         }
         sort(&mut self.population);
-        self.spare.extend(self.population.drain(n..).map(|(_, r)| r));
+        self.spare
+            .extend(self.population.drain(n..).map(|(_, r)| r));
     }
 }
 

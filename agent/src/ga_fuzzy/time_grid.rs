@@ -26,7 +26,10 @@ impl TimeGrid {
     /// when nothing else moves). `depth` is the longest chromosome allowed, at least 2.
     pub fn fixed(grid: Grid, rule: CornerCutting, depth: usize) -> Result<TimeGrid, Error> {
         if depth < 2 {
-            return Err(Error::option("depth", format!("{depth}: needs at least 2 layers")));
+            return Err(Error::option(
+                "depth",
+                format!("{depth}: needs at least 2 layers"),
+            ));
         }
         Ok(TimeGrid {
             grid,
@@ -41,9 +44,8 @@ impl TimeGrid {
     pub fn add_moving(&mut self, trajectory: &[Cell]) -> Result<(), Error> {
         let (w, h) = (self.grid.width(), self.grid.height());
         for (t, &c) in trajectory.iter().enumerate() {
-            check_inside(c, Role::Obstacle, w, h).map_err(|e| {
-                Error::option("trajectory", format!("tick {t}: {e}"))
-            })?;
+            check_inside(c, Role::Obstacle, w, h)
+                .map_err(|e| Error::option("trajectory", format!("tick {t}: {e}")))?;
         }
         if self.moving.len() < trajectory.len() {
             self.moving.resize(trajectory.len(), Vec::new());
@@ -139,7 +141,9 @@ mod tests {
         let g = Grid::new(2, 2).unwrap();
         assert!(TimeGrid::fixed(g.clone(), CornerCutting::Forbidden, 1).is_err());
         let mut tg = TimeGrid::fixed(g, CornerCutting::Forbidden, 4).unwrap();
-        let e = tg.add_moving(&[Cell::new(0, 0), Cell::new(5, 0)]).unwrap_err();
+        let e = tg
+            .add_moving(&[Cell::new(0, 0), Cell::new(5, 0)])
+            .unwrap_err();
         assert!(e.to_string().contains("tick 1"), "{e}");
     }
 }
