@@ -152,12 +152,15 @@ pub struct FuzzyOutput {
 /// The fuzzy controller: the rule base, evaluated without allocating.
 #[derive(Clone, Debug)]
 pub struct FuzzyRules {
-    rules: [Rule; RULES],
+    // Boxed: 72 rules inline would make every controller holding them 2 kB.
+    rules: Box<[Rule; RULES]>,
 }
 
 impl Default for FuzzyRules {
     fn default() -> Self {
-        FuzzyRules { rules: rule_base() }
+        FuzzyRules {
+            rules: Box::new(rule_base()),
+        }
     }
 }
 
@@ -175,7 +178,7 @@ impl FuzzyRules {
         let ahead = free[d];
         let q = free[(d + 1) % DIRECTIONS] - free[(d + DIRECTIONS - 1) % DIRECTIONS];
         let (mut w_sum, mut v, mut s) = (0.0, 0.0, 0.0);
-        for r in &self.rules {
+        for r in self.rules.iter() {
             let w = mu_sector(b, usize::from(r.b)) * mu_ahead(ahead, r.ahead) * mu_side(q, r.side);
             w_sum += w;
             v += w * r.speed;
