@@ -18,6 +18,7 @@
 //! | [`odometry`] | §D.2 dead reckoning from Hall ticks: [`odometry::DeadReckoning`], a pure function of the tick stream |
 //! | [`process`] | the `hnav-agent` process: ports, the round loop in lockstep and realtime, map snapshots, the restart checkpoint |
 //! | [`pso`] | seed 003's particle swarm with virtual obstacles at swarm-detected local minima, a [`route::RoutePlanner`] |
+//! | [`ga_fuzzy`] | seed 004: the GA over time-indexed grids ([`ga_fuzzy::GaPlanner`], route planner `"ga-fuzzy"`) and the fuzzy controller |
 //! | [`route`] | [`route::RoutePlanner`]: the seeds' planners that answer with a whole route (PSO, GA) |
 //! | [`plan`] | [`plan_query`]: one start-goal query, answered with a JSON-ready [`PlanResult`](hnav_runtime::plan::PlanResult) |
 //! | [`error`] | [`Error`]: bad cells and bad options, never a panic |
@@ -34,6 +35,7 @@
 
 pub mod controller;
 pub mod error;
+pub mod ga_fuzzy;
 pub mod navigator;
 pub mod neural_map;
 pub mod odometry;

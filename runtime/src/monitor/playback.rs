@@ -10,7 +10,7 @@
 //! - **Ground truth**: one [`Truth`] per sampling time of the recording (all robots' samples
 //!   of one time folded into one message); the collision count is the number of the
 //!   summary's collision times up to then.
-//! - **Commits**: each round record rebuilt with [`RoundRecord::write_commit`], placed at
+//! - **Commits**: each round record rebuilt with [`RoundRecord::write_commit`](crate::consensus_log::record::RoundRecord::write_commit), placed at
 //!   `round x control period` of simulated time (the period is in the trajectory header). In
 //!   lockstep that is exact: round r and period r are the same instant (see the agent's
 //!   process docs). In realtime a round closes at most once a period, when every candidate is
