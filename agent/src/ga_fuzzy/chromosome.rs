@@ -10,10 +10,10 @@
 //! * initialisation: a goal-biased randomised depth-first walk (the "heuristic" initialisation
 //!   the review recommends when many routes exist) `[inferred: the bias and its strength]`;
 //!   with moving obstacles node `t` avoids layer `t`'s occupied cells and may wait for the
-//!   best neighbour to clear `[inferred]`;
+//!   best neighbour to clear `\[inferred\]`;
 //! * crossover: one point at a node both parents share, loops cut (Ahn & Ramakrishna);
 //! * mutation: a random stretch of up to [`MUTATION_SPAN`] nodes re-walked, or, when the
-//!   obstacles move, a wait inserted or removed `[inferred]`.
+//!   obstacles move, a wait inserted or removed `\[inferred\]`.
 //!
 //! The buffers live in [`Operators`] and are reused: after the first query on a grid the
 //! operators allocate only when a chromosome outgrows its capacity.
@@ -24,7 +24,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::time_grid::TimeGrid;
 
-/// The longest stretch (in nodes) a mutation re-walks `[inferred]`.
+/// The longest stretch (in nodes) a mutation re-walks `\[inferred\]`.
 pub const MUTATION_SPAN: usize = 12;
 
 /// Scratch space of the operators.
@@ -199,7 +199,7 @@ impl Operators {
     }
 
     /// Mutates `route` in place: re-walks a random stretch (goal-biased with `greed`), or,
-    /// when `timed`, inserts or removes a wait with probability one half `[inferred]`.
+    /// when `timed`, inserts or removes a wait with probability one half `\[inferred\]`.
     /// Routes stay at most `tg.depth()` nodes; a mutation that cannot keep that is dropped.
     pub fn mutate(
         &mut self,

@@ -7,7 +7,7 @@
 //! [`FuzzyRules`] towards a later nodal point, one grid move per step (its heading snapped to
 //! the nearest of the eight directions, the free areas `A` read from the grid up to
 //! [`SENSOR_CELLS`] cells). If it gets there along a shorter legal chain, that chain replaces
-//! the coarse stretch. Filled in `[inferred]`: every node is a nodal point, the farthest
+//! the coarse stretch. Filled in `\[inferred\]`: every node is a nodal point, the farthest
 //! nodal point tried is [`LOOKAHEAD`] nodes ahead, the sensor range, and (with moving
 //! obstacles) that a switch may not add a collision.
 
@@ -17,10 +17,10 @@ use super::fitness::route_length;
 use super::fuzzy::{direction_angle, nearest_direction, FuzzyRules, DIRECTIONS};
 use super::time_grid::TimeGrid;
 
-/// Sensor range of the free areas, in cells `[inferred]`.
+/// Sensor range of the free areas, in cells `\[inferred\]`.
 pub const SENSOR_CELLS: usize = 3;
 
-/// How many nodes ahead the farthest nodal point tried lies `[inferred]`.
+/// How many nodes ahead the farthest nodal point tried lies `\[inferred\]`.
 pub const LOOKAHEAD: usize = 10;
 
 /// Free areas of `cell` in the eight directions: free cells in a row (legal moves under the

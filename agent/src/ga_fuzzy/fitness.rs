@@ -3,16 +3,16 @@
 //!
 //! * `S1`, the length criterion: the route length with step `d = 1` to a horizontal or
 //!   vertical neighbour and `d = sqrt 2` on a diagonal (the diagonal value is lost in the
-//!   text: `sqrt 2` `[inferred]`, the centre-to-centre distance). A wait (the same cell
-//!   twice) has `d = 0`. Normalised `[inferred]` as `octile(start, goal) / length`, so the
+//!   text: `sqrt 2` `\[inferred\]`, the centre-to-centre distance). A wait (the same cell
+//!   twice) has `d = 0`. Normalised `\[inferred\]` as `octile(start, goal) / length`, so the
 //!   straight line scores 1 and longer routes less.
-//! * `S2`, the time criterion, uses `N_p`, the chromosome length: normalised `[inferred]` as
+//! * `S2`, the time criterion, uses `N_p`, the chromosome length: normalised `\[inferred\]` as
 //!   `(chebyshev(start, goal) + 1) / N_p`, the fewest nodes any route needs over `N_p`. A
 //!   route with waits is as short as without them but takes longer, which is what "choosing
 //!   the route independently of the robot's speed along it" asks the pair to separate.
-//! * `alpha_k = const in [0, 1]` (the seed); `0.5, 0.5` by default `[inferred]`.
+//! * `alpha_k = const in [0, 1]` (the seed); `0.5, 0.5` by default `\[inferred\]`.
 //! * Collisions with the time layers are not in the seed (its operators presumably keep
-//!   routes feasible); we divide `F` by `1 + conflicts` `[inferred]` so a colliding route can
+//!   routes feasible); we divide `F` by `1 + conflicts` `\[inferred\]` so a colliding route can
 //!   survive as a parent but never beats a clean one of similar quality.
 
 use hnav_runtime::grid::Cell;

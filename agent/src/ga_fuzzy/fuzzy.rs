@@ -7,7 +7,7 @@
 //! with term sets; a production-rule base of **72 rules: nine nested rules for each of eight
 //! values of the angular deviation**. Term names, membership functions, the `A` encoding
 //! (Fig. 2a, an image) and the inference method are not in the text. Filled in here
-//! `[inferred]`:
+//! `\[inferred\]`:
 //!
 //! * `b` has eight terms, the eight 45° sectors (triangles centred on `0, 45, ..., 315` degrees,
 //!   half-width 45°, so the memberships sum to 1 at every angle).

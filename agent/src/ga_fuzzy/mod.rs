@@ -8,7 +8,7 @@
 //! length with `d = 1` orthogonal, `S2` time through the chromosome length `N_p`) and the
 //! fuzzy controller's interface (free areas `A` in eight directions and heading deviation `b`
 //! in, speed `V` and direction `phi` out, 72 rules = 9 x 8). Everything else is marked
-//! `[inferred]` where it is decided, and listed in `docs/experiments/ga-fuzzy.md`.
+//! `\[inferred\]` where it is decided, and listed in `docs/experiments/ga-fuzzy.md`.
 //!
 //! | module | concept |
 //! |---|---|

@@ -7,7 +7,7 @@
 //!   [`GaOptions::mutation`] (the review: 5-10 %); then the worst of parents and children
 //!   are dropped (Ahn & Ramakrishna's "the worst part is replaced by offspring").
 //! * Stop after [`GaOptions::generations`] generations or [`GaOptions::stall`] without a
-//!   better best `[inferred]`; the best route then goes through the fine switch
+//!   better best `\[inferred\]`; the best route then goes through the fine switch
 //!   ([`super::fine`]).
 //!
 //! Deterministic: each query draws from a ChaCha stream seeded by the options' seed, the
@@ -26,7 +26,7 @@ use crate::error::{check_inside, Error, Role};
 use crate::route::RoutePlanner;
 
 /// The GA's parameters. Every default but the mutation rate and the tournament is
-/// `[inferred]`: the seed gives no population size, rates, selection or stopping rule.
+/// `\[inferred\]`: the seed gives no population size, rates, selection or stopping rule.
 #[derive(Clone, Copy, PartialEq, Debug)]
 pub struct GaOptions {
     /// Individuals per generation.

@@ -5,7 +5,7 @@
 //! changes between layers is the moving obstacles (other robots whose motion is known for the
 //! planning period), kept per tick as a short sorted list of cells. A layer past the last one
 //! is the last one: the seed says `N` is the depth over which the obstacles' motion is known,
-//! and it gives no rule for later ticks, so we keep the last known positions `[inferred]`.
+//! and it gives no rule for later ticks, so we keep the last known positions `\[inferred\]`.
 
 use hnav_runtime::grid::{Cell, CornerCutting, Grid};
 

@@ -1,7 +1,7 @@
 //! What the swarm knows of the map: the grid's cells it senses, plus its own virtual
 //! obstacles (a separate layer, persistent for the run, never removed: notes §3.4, §6.1).
 //!
-//! Sensing (notes §1, [A]): the paper gives no radius, only that a particle senses "a local
+//! Sensing (notes §1, \[A\]): the paper gives no radius, only that a particle senses "a local
 //! region". The swarm reads the grid in exactly two places, both local: a particle reads the
 //! one cell it is about to move to (at most `v_max + r_max` cells away per coordinate), and
 //! the local-minimum analysis reads the 24 cells of the 5 x 5 window around the swarm's best,

@@ -1,11 +1,11 @@
 //! Swarm local-minimum detection and the virtual obstacles placed around the minimum
 //! (Pseudocode 2, notes §3.2-§3.5).
 //!
-//! Detection [P]: a minimum is declared when the swarm's best x^G has not changed for more
+//! Detection \[P\]: a minimum is declared when the swarm's best x^G has not changed for more
 //! than n_lm iterations (`d_lm > n_lm`; `d_lm` is 1 on the iteration x^G changes). Before an
 //! obstacle is placed, the 24-cell window around x^G (5 x 5 minus centre, Fig. 4) is analysed
 //! to tell a corner or dead end from a straight wall (§3.5; the rule is the notes' suggestion,
-//! [A], swappable through [`CornerRule`]).
+//! \[A\], swappable through [`CornerRule`]).
 
 use hnav_runtime::grid::Grid;
 
@@ -26,7 +26,7 @@ impl Detector {
         self.count > n_lm
     }
 
-    /// The explicit reset after an exit (notes §3.3 [A]).
+    /// The explicit reset after an exit (notes §3.3 \[A\]).
     pub fn reset(&mut self) {
         self.count = 1;
     }

@@ -10,7 +10,7 @@
 //!
 //! | module | what |
 //! |---|---|
-//! | [`options`] | [`PsoOptions`]: the paper's parameters and one option per [A] choice |
+//! | [`options`] | [`PsoOptions`]: the paper's parameters and one option per \[A\] choice |
 //! | [`swarm`] | the particles and their update, eqs. (1)-(9), (20), Pseudocode 1 |
 //! | [`weights`] | the adaptive tanh local/global weights, eqs. (10)-(19) |
 //! | [`minimum`] | local-minimum detection, the 24-cell analysis, virtual obstacles (Pseudocode 2) |

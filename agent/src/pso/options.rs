@@ -1,5 +1,5 @@
 //! The swarm's options: the paper's parameters (§2.6 of the notes) and one explicit option for
-//! every choice the notes mark [A] (the paper leaves it open), each defaulting to the notes'
+//! every choice the notes mark \[A\] (the paper leaves it open), each defaulting to the notes'
 //! recommendation. [`PsoOptions::original`] and [`PsoOptions::modified`] are the two
 //! algorithms of Tables 1 and 2.
 
@@ -16,7 +16,7 @@ pub enum Variant {
     Modified,
 }
 
-/// How a real-valued velocity becomes a whole number of cells before the clamp (3). [A]
+/// How a real-valued velocity becomes a whole number of cells before the clamp (3). \[A\]
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub enum Rounding {
     /// Nearest integer, halves away from zero (the notes' recommendation).
@@ -25,7 +25,7 @@ pub enum Rounding {
     Truncate,
 }
 
-/// The distribution of the original algorithm's noise, eq. (20). [A]
+/// The distribution of the original algorithm's noise, eq. (20). \[A\]
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub enum NoiseForm {
     /// `round(-r_max + 2 r_max rand)`: the symmetric reading of the OCR (recommended); not
@@ -35,7 +35,7 @@ pub enum NoiseForm {
     Uniform,
 }
 
-/// When the original algorithm adds its noise (20) to the move (8). [A]
+/// When the original algorithm adds its noise (20) to the move (8). \[A\]
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub enum NoiseWhen {
     /// Only when the intended cell is blocked: the paper's rule for the discrete grid (§2.3,
@@ -45,7 +45,7 @@ pub enum NoiseWhen {
     Always,
 }
 
-/// The cell tried when the intended cell `x + v` is blocked. [A]
+/// The cell tried when the intended cell `x + v` is blocked. \[A\]
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub enum Alternative {
     /// `x + r`: stays in the 8-neighbourhood for `r` in {-1, 0, 1} (the modified default).
@@ -57,7 +57,7 @@ pub enum Alternative {
     Sum,
 }
 
-/// Which particles Pseudocode 2 step 2.2 displaces after a virtual obstacle is placed. [A]
+/// Which particles Pseudocode 2 step 2.2 displaces after a virtual obstacle is placed. \[A\]
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub enum Relocate {
     /// Particles on the minimum's cell (which the obstacle now occupies) or next to it
@@ -67,7 +67,7 @@ pub enum Relocate {
     OnCell,
 }
 
-/// How a personal best that lies on a new virtual obstacle is replaced (steps 2.3-2.4). [A]
+/// How a personal best that lies on a new virtual obstacle is replaced (steps 2.3-2.4). \[A\]
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub enum BestReset {
     /// The particle's current position (default: lets the swarm forget the trap).
@@ -76,7 +76,7 @@ pub enum BestReset {
     BestVisited,
 }
 
-/// The 24-cell (5 x 5 minus centre) analysis that gates the virtual obstacle (§3.5). [A]
+/// The 24-cell (5 x 5 minus centre) analysis that gates the virtual obstacle (§3.5). \[A\]
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub enum CornerRule {
     /// Pseudocode 2 alone ("Variant 1"): place the obstacle on every detection.
@@ -86,7 +86,7 @@ pub enum CornerRule {
     Sides,
 }
 
-/// Which cells get virtual obstacles once the rule has accepted a minimum. [A]
+/// Which cells get virtual obstacles once the rule has accepted a minimum. \[A\]
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub enum Footprint {
     /// The minimum's cell alone (Fig. 3 circles one cell; default).
@@ -97,7 +97,7 @@ pub enum Footprint {
 }
 
 /// How a run decides that the swarm's trace is broken (a "gap" makes a success a failure).
-/// [A]: the paper's Fig. 1 gaps are jumps, its conclusions speak of a trace graph falling
+/// \[A\]: the paper's Fig. 1 gaps are jumps, its conclusions speak of a trace graph falling
 /// into disconnected subgraphs.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub enum GapRule {
@@ -129,13 +129,13 @@ pub struct PsoOptions {
     pub n_lm: u32,
     /// k_max (1200).
     pub k_max: u32,
-    /// ε [A]: success when a particle's J is below it (0.5: the goal cell itself).
+    /// ε \[A\]: success when a particle's J is below it (0.5: the goal cell itself).
     pub epsilon: f64,
-    /// η_min [A] (0.5 per cell): the paper gives no value.
+    /// η_min \[A\] (0.5 per cell): the paper gives no value.
     pub eta_min: f64,
-    /// η_max [A] (2.0 per cell).
+    /// η_max \[A\] (2.0 per cell).
     pub eta_max: f64,
-    /// Chebyshev sensing radius of a particle [A] (2, the least the 24-cell analysis needs).
+    /// Chebyshev sensing radius of a particle \[A\] (2, the least the 24-cell analysis needs).
     pub sensing_radius: u32,
     /// See [`Rounding`].
     pub rounding: Rounding,

@@ -83,7 +83,7 @@ pub struct Swarm {
 
 impl Swarm {
     /// Sets up Pseudocode 1 steps 1-2: particle 1 on `start`, the others on its 8 neighbours
-    /// (3 x 3 block, §2.6); one whose cell is blocked starts on `start`. Zero velocity [A].
+    /// (3 x 3 block, §2.6); one whose cell is blocked starts on `start`. Zero velocity \[A\].
     pub fn reset(&mut self, grid: &Grid, start: [i64; 2], goal: [i64; 2], o: &PsoOptions) {
         const BLOCK: [[i64; 2]; 9] = [
             [0, 0],

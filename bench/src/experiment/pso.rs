@@ -32,7 +32,7 @@ const CLEARANCE: i64 = 2;
 const RESAMPLES: usize = 2000;
 
 /// A random map of the paper's kind: 15 axis-aligned rectangles, sides uniform in [1, 25],
-/// lower-left corner uniform over the map, overlap allowed, clipped at the border [A].
+/// lower-left corner uniform over the map, overlap allowed, clipped at the border \[A\].
 pub fn random_map(rng: &mut ChaCha8Rng) -> Grid {
     let mut blocked = vec![false; (SIDE * SIDE) as usize];
     for _ in 0..RECTANGLES {
@@ -48,7 +48,7 @@ pub fn random_map(rng: &mut ChaCha8Rng) -> Grid {
 }
 
 /// Whether every cell within Chebyshev distance 2 of `c` is inside and free (the paper's
-/// "distance to every obstacle at least 2 cells", read as a 2-cell free margin [A]).
+/// "distance to every obstacle at least 2 cells", read as a 2-cell free margin \[A\]).
 pub fn clear(grid: &Grid, c: Cell) -> bool {
     (-CLEARANCE..=CLEARANCE).all(|dy| {
         (-CLEARANCE..=CLEARANCE).all(|dx| {

@@ -1,4 +1,4 @@
-//! `hnav top [RUN] [--exit-on-end]`: the live view of a run in the terminal; [`view`] also
+//! `hnav top [RUN] [--exit-on-end]`: the live view of a run in the terminal; [`view()`] also
 //! shows a recorded run played back (`hnav log replay DIR --speed X`).
 //!
 //! The library's `monitor` module does the work: a feed (`LiveFeed`, a subscriber of the
