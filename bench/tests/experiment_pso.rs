@@ -1,5 +1,5 @@
-//! `hnav-bench experiment pso --quick` through the binary: the report's shape (both tables'
-//! six settings beside the paper's figures, intervals that bracket their estimates) and the
+//! `hnav-bench experiment pso --quick` through the binary: the report's shape (the nine
+//! settings of both tables and of Table 2 without the corner analysis, beside the paper's figures, intervals that bracket their estimates) and the
 //! same JSON twice for one seed, another for another seed. Nothing here is a timing.
 
 use std::process::Command;
@@ -48,6 +48,9 @@ fn quick_json_has_both_tables_and_is_deterministic() {
         ("modified", 5, 159.0),
         ("modified", 7, 100.0),
         ("modified", 10, 93.0),
+        ("modified-always", 5, 159.0),
+        ("modified-always", 7, 100.0),
+        ("modified-always", 10, 93.0),
     ];
     assert_eq!(settings.len(), expected.len(), "{settings:?}");
     for ((alg, p, steps), (ea, ep, es)) in settings.iter().zip(expected) {
