@@ -30,9 +30,19 @@ pub fn wilson(successes: u64, n: u64, z: f64) -> Option<Interval> {
     let z2 = z * z;
     let centre = (p + z2 / (2.0 * n)) / (1.0 + z2 / n);
     let half = z / (1.0 + z2 / n) * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt();
+    // At 0 or n successes the bound is exactly 0 or 1; the subtraction leaves a rounding
+    // residue (3.5e-18 at 0 of 100) that would print as a nonzero lower bound.
     Some(Interval {
-        lo: (centre - half).max(0.0),
-        hi: (centre + half).min(1.0),
+        lo: if successes == 0 {
+            0.0
+        } else {
+            (centre - half).max(0.0)
+        },
+        hi: if successes as f64 == n {
+            1.0
+        } else {
+            (centre + half).min(1.0)
+        },
     })
 }
 
