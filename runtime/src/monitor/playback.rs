@@ -389,11 +389,7 @@ fn collision_times(path: &PathBuf) -> Result<Vec<u64>, FeedError> {
         path: path.clone(),
         problem: format!("not JSON: {e}"),
     })?;
-    let mut times: Vec<u64> = v
-        .pointer("/recording/collisions_at_ns")
-        .and_then(serde_json::Value::as_array)
-        .map(|a| a.iter().filter_map(serde_json::Value::as_u64).collect())
-        .unwrap_or_default();
+    let mut times = crate::report::data::collisions_at_ns(&v);
     times.sort_unstable();
     Ok(times)
 }

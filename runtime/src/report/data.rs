@@ -242,12 +242,7 @@ impl RunData {
             .and_then(serde_json::Value::as_u64)
             .and_then(|c| u32::try_from(c).ok())
             .ok_or_else(|| bad("no collision count".into()))?;
-        let times = v
-            .pointer("/recording/collisions_at_ns")
-            .and_then(serde_json::Value::as_array)
-            .map(|a| a.iter().filter_map(serde_json::Value::as_u64).collect())
-            .unwrap_or_default();
-        Ok(times)
+        Ok(collisions_at_ns(&v))
     }
 
     /// Where the robots were at each rise of the collision count: the two closest robots if
@@ -339,6 +334,17 @@ fn involved(poses: &[(u32, f64, f64)]) -> Vec<(u32, f64, f64)> {
         Some((d, i, j)) if d <= 1.0 => vec![poses[i], poses[j]],
         _ => poses.to_vec(),
     }
+}
+
+/// The simulated times at which a run's collision count rose, from its `summary.json`
+/// (`recording.collisions_at_ns`; none without a recording). The report and the playback
+/// both read them here.
+pub(crate) fn collisions_at_ns(summary: &serde_json::Value) -> Vec<u64> {
+    summary
+        .pointer("/recording/collisions_at_ns")
+        .and_then(serde_json::Value::as_array)
+        .map(|a| a.iter().filter_map(serde_json::Value::as_u64).collect())
+        .unwrap_or_default()
 }
 
 #[cfg(test)]
