@@ -2,15 +2,13 @@
 //! settings of both tables and of Table 2 without the corner analysis, beside the paper's figures, intervals that bracket their estimates) and the
 //! same JSON twice for one seed, another for another seed. Nothing here is a timing.
 
-use std::process::Command;
-
 use serde_json::Value;
 
+mod common;
+use common::bench;
+
 fn json(seed: &str) -> Value {
-    let out = Command::new(env!("CARGO_BIN_EXE_hnav-bench"))
-        .args(["experiment", "pso", "--quick", "--json", "--seed", seed])
-        .output()
-        .expect("hnav-bench runs");
+    let out = bench(&["experiment", "pso", "--quick", "--json", "--seed", seed]);
     assert!(
         out.status.success(),
         "{}",

@@ -1,0 +1,31 @@
+//! What the experiment tests share: `hnav-bench` run through its binary, killed if it hangs.
+
+use std::process::{Command, Output, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+/// A quick run takes about a second; a run past this is a hang, and is killed.
+const LIMIT: Duration = Duration::from_secs(60);
+
+/// `hnav-bench ARGS`, its output once it exits; panics (failing the test) after [`LIMIT`].
+pub fn bench(args: &[&str]) -> Output {
+    let child = Command::new(env!("CARGO_BIN_EXE_hnav-bench"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("hnav-bench starts");
+    let pid = child.id();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(child.wait_with_output());
+    });
+    match rx.recv_timeout(LIMIT) {
+        Ok(out) => out.expect("hnav-bench output"),
+        Err(_) => {
+            let pid = nix::unistd::Pid::from_raw(pid as i32);
+            let _ = nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGKILL);
+            panic!("hnav-bench {args:?} did not finish within {LIMIT:?}");
+        }
+    }
+}
