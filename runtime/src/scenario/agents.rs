@@ -9,7 +9,7 @@
 use std::collections::HashSet;
 
 use super::error::{Loc, ScenarioError};
-use super::{AgentSpec, FaultTarget, Scenario};
+use super::{AgentSpec, FaultTarget, Planner, Scenario};
 use crate::grid::{components, Cell};
 use crate::hash::SplitMix64;
 use crate::msg::MAX_AGENTS;
@@ -86,6 +86,7 @@ pub(super) fn with_agent_count(
                 speed: AgentSpec::DEFAULT_SPEED,
                 priority: None,
                 start_heading_deg: 0.0,
+                planner: Planner::Hnav,
             });
             placed = true;
             break;

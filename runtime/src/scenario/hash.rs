@@ -24,7 +24,9 @@
 //! little-endian `u64`, floats as the little-endian bits of the `f64`, booleans and enum
 //! variants as one `u64` code, options as a presence code then the value.
 
-use super::params::{ClockMode, FsyncPolicy, GiveUpAction, RestartPolicy, RestartRule, Rules};
+use super::params::{
+    ClockMode, FsyncPolicy, GiveUpAction, Planner, RestartPolicy, RestartRule, Rules,
+};
 use super::{FaultAction, FaultSignal, FaultSpec, FaultTarget, FaultTime, Scenario};
 use crate::grid::{CornerCutting, TerrainKind};
 use crate::hash::Fnv1a64;
@@ -163,6 +165,14 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
             Some(p) => h.u64(1).f64(p),
         };
         h.f64(a.start_heading_deg);
+        // Off the default only, for the same reason as `rules`.
+        if a.planner != Planner::Hnav {
+            h.u64(match a.planner {
+                Planner::Hnav => 0,
+                Planner::Pso => 1,
+                Planner::GaFuzzy => 2,
+            });
+        }
     }
     h.u64(s.faults.len() as u64);
     for f in &s.faults {

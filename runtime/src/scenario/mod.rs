@@ -74,6 +74,8 @@
 //! priority = 2.0                       # optional, > 0; default 1 / speed
 //! start_heading_deg = 90.0             # optional, in [-360, 360]; default 0 = facing +x (towards
 //!                                      # larger columns); 90 faces +y (towards larger rows)
+//! planner = "hnav"                     # or "pso" (seed 003) or "ga-fuzzy" (seed 004): README,
+//!                                      # *Mixed swarms*
 //!
 //! [[faults]]                           # optional fault plan (more on the command line:
 //!                                      # `hnav run --kill/--term/--freeze`, [`fault_arg`])
@@ -146,8 +148,8 @@ pub use error::{Loc, ScenarioError};
 pub use health::HealthParams;
 pub use params::{
     default_startup_timeout_s, ClockMode, ClockModeError, CoordinatorParams, FsyncPolicy,
-    GiveUpAction, RestartConfig, RestartPolicy, RestartRule, RobotParams, Rules, RunParams,
-    SimParams,
+    GiveUpAction, Planner, RestartConfig, RestartPolicy, RestartRule, RobotParams, Rules,
+    RunParams, SimParams,
 };
 pub use record::RecordParams;
 pub use report::{default_out_dir, ScenarioReport};
@@ -180,6 +182,8 @@ pub struct AgentSpec {
     /// sim frame's +x axis (towards larger columns); 90 faces +y, towards larger rows (down
     /// the map as printed, since row 0 is the top). Default 0; within [-360, 360].
     pub start_heading_deg: f64,
+    /// The planner that drives this agent; default [`Planner::Hnav`].
+    pub planner: Planner,
 }
 
 impl AgentSpec {

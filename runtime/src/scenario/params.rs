@@ -211,6 +211,35 @@ impl Rules {
     }
 }
 
+/// Which planner drives an agent (`[[agents]] planner`). Every planner runs under the same
+/// coordinator, conflict rules and consensus log; they differ in how the agent picks its
+/// candidate step.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Planner {
+    /// The dissertation's Hopfield neural map climbed by the path constructor.
+    #[default]
+    Hnav,
+    /// Seed 003's particle swarm with virtual obstacles; the robot follows the swarm's route.
+    Pso,
+    /// Seed 004's genetic algorithm for the route and its fuzzy controller on the wheels.
+    GaFuzzy,
+}
+
+impl Planner {
+    /// Every planner, in the order of their wire codes.
+    pub const ALL: [Planner; 3] = [Planner::Hnav, Planner::Pso, Planner::GaFuzzy];
+
+    /// The name used in scenario files: `"hnav"`, `"pso"` or `"ga-fuzzy"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Planner::Hnav => "hnav",
+            Planner::Pso => "pso",
+            Planner::GaFuzzy => "ga-fuzzy",
+        }
+    }
+}
+
 /// Coordinator parameters (`[coordinator]`).
 #[derive(Clone, PartialEq, Debug, Serialize)]
 pub struct CoordinatorParams {

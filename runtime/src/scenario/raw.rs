@@ -9,7 +9,7 @@
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::params::{ClockMode, FsyncPolicy, GiveUpAction, RestartPolicy, Rules};
+use super::params::{ClockMode, FsyncPolicy, GiveUpAction, Planner, RestartPolicy, Rules};
 
 /// Top level.
 #[derive(Deserialize, Debug)]
@@ -116,6 +116,7 @@ pub(super) struct RawAgent {
     pub speed: Option<Spanned<f64>>,
     pub priority: Option<Spanned<f64>>,
     pub start_heading_deg: Option<Spanned<f64>>,
+    pub planner: Option<Planner>,
 }
 
 /// What a fault does.

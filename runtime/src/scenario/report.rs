@@ -43,6 +43,8 @@ pub struct AgentReport {
     pub speed: f64,
     /// Conflict priority in effect (given, or `1 / speed`).
     pub priority: f64,
+    /// The planner that drives it (`"hnav"`, `"pso"`, `"ga-fuzzy"`).
+    pub planner: &'static str,
     /// Straight-line octile distance, ignoring obstacles.
     pub octile_distance: f64,
     /// Shortest octile path length under the map's corner-cutting rule; `None` if unreachable.
@@ -103,6 +105,7 @@ impl ScenarioReport {
                     goal_id: g.cell_id(a.goal),
                     speed: a.speed,
                     priority: a.effective_priority(),
+                    planner: a.planner.name(),
                     octile_distance: octile(a.start, a.goal),
                     shortest_path_len: shortest,
                 }
@@ -170,8 +173,8 @@ impl ScenarioReport {
         let _ = writeln!(o, "agents    {}", self.agents.len());
         let _ = writeln!(
             o,
-            "  {:>4}  {:<12} {:<12} {:>6} {:>8} {:>10} {:>10}",
-            "#", "start", "goal", "speed", "priority", "octile", "shortest"
+            "  {:>4}  {:<12} {:<12} {:>6} {:>8} {:>10} {:>10}  {}",
+            "#", "start", "goal", "speed", "priority", "octile", "shortest", "planner"
         );
         for a in &self.agents {
             let shortest = a
@@ -179,14 +182,15 @@ impl ScenarioReport {
                 .map_or_else(|| "unreachable".into(), |l| format!("{l:.3}"));
             let _ = writeln!(
                 o,
-                "  {:>4}  {:<12} {:<12} {:>6.2} {:>8.3} {:>10.3} {:>10}",
+                "  {:>4}  {:<12} {:<12} {:>6.2} {:>8.3} {:>10.3} {:>10}  {}",
                 a.index,
                 format!("[{}, {}]", a.start[0], a.start[1]),
                 format!("[{}, {}]", a.goal[0], a.goal[1]),
                 a.speed,
                 a.priority,
                 a.octile_distance,
-                shortest
+                shortest,
+                a.planner
             );
         }
         if !self.faults.is_empty() {

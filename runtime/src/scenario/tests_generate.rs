@@ -190,3 +190,31 @@ fn rules_count_in_the_hash_only_off_the_default_and_a_bad_name_is_a_located_erro
         "{msg}"
     );
 }
+
+#[test]
+fn planner_counts_in_the_hash_only_off_the_default_and_a_bad_name_is_a_located_error() {
+    let a = parse(BASE).unwrap();
+    assert!(a.agents.iter().all(|s| s.planner == Planner::Hnav));
+    // The second agent's table is the last one in BASE, so an appended key lands in it.
+    let with = |planner: &str| format!("{BASE}planner = \"{planner}\"\n");
+    let b = parse(&with("hnav")).unwrap();
+    assert_eq!(a.scenario_hash(), b.scenario_hash(), "the default");
+    let c = parse(&with("pso")).unwrap();
+    assert_eq!(c.agents[1].planner, Planner::Pso);
+    assert_eq!(c.agents[0].planner, Planner::Hnav);
+    let d = parse(&with("ga-fuzzy")).unwrap();
+    assert_eq!(d.agents[1].planner, Planner::GaFuzzy);
+    assert_ne!(a.scenario_hash(), c.scenario_hash());
+    assert_ne!(c.scenario_hash(), d.scenario_hash());
+    let text = with("astar");
+    let e = parse(&text).unwrap_err();
+    let line = text.lines().position(|l| l.starts_with("planner")).unwrap() + 1;
+    assert_eq!(e.line(), Some(line), "{e}");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("astar") && msg.contains("`pso`") && msg.contains("`ga-fuzzy`"),
+        "{msg}"
+    );
+    let report = ScenarioReport::new(&d).render();
+    assert!(report.contains("ga-fuzzy"), "{report}");
+}

@@ -69,6 +69,7 @@ pub(super) fn build_agent(
             speed,
             priority,
             start_heading_deg,
+            planner: a.planner.unwrap_or_default(),
         },
         at,
     ))
