@@ -6,15 +6,18 @@
 use hnav_runtime::diag::is_no_space_io;
 use hnav_runtime::grid::geometry::{cell_centre_m, cell_centre_pose, cell_index};
 use hnav_runtime::grid::Cell;
+use hnav_runtime::hash::SplitMix64;
 use hnav_runtime::msg::{Estimate, MapHeader, Odometry, Pose, WheelCommand};
-use hnav_runtime::scenario::{AgentSpec, ClockMode, Scenario};
+use hnav_runtime::scenario::{AgentSpec, ClockMode, Planner, Scenario};
 
 use super::checkpoint::{Checkpoint, CheckpointFile};
 use super::ports::Ports;
 use super::{AgentError, AgentOutcome};
-use crate::controller::{ControllerParams, WheelController};
-use crate::navigator::{Navigator, Task};
+use crate::controller::{ControllerParams, FreeSpace, WheelController, WheelDrive};
+use crate::ga_fuzzy::{GaOptions, GaPlanner};
+use crate::navigator::{Guidance, Navigator, Task};
 use crate::odometry::{DeadReckoning, OdometryParams};
+use crate::pso::{PsoOptions, PsoPlanner};
 
 /// One agent's state: its navigator, dead reckoning and wheel controller, and where it stands
 /// in the rounds.
@@ -25,7 +28,7 @@ pub(super) struct Core {
     width: u32,
     nav: Navigator,
     dr: DeadReckoning,
-    ctl: WheelController,
+    ctl: WheelDrive,
     checkpoint: Option<CheckpointFile>,
     last_commit: u64,
     outstanding: Option<u64>,
@@ -64,15 +67,17 @@ impl Core {
             .and_then(|c| Some((c, cell(c.current)?, cell(c.next)?, cell(c.target)?)))
         {
             Some((c, current, next, target)) => {
-                let mut nav = Navigator::new(grid, corners, task, current, next, target)?;
+                let guide = guidance(scenario, spec, index)?;
+                let mut nav = Navigator::new(grid, corners, task, (current, next, target), guide)?;
                 nav.mark_restarted();
                 let dr = DeadReckoning::with_baseline(odo, c.pose, (c.ticks_left, c.ticks_right));
                 (nav, dr, c.last_commit, (c.ticks_left, c.ticks_right))
             }
             None => {
                 let start = cell_centre_pose(cs, spec.start, spec.start_heading_rad());
-                let mut nav =
-                    Navigator::new(grid, corners, task, spec.start, spec.start, spec.goal)?;
+                let row = (spec.start, spec.start, spec.goal);
+                let guide = guidance(scenario, spec, index)?;
+                let mut nav = Navigator::new(grid, corners, task, row, guide)?;
                 if restarted {
                     nav.mark_restarted();
                 }
@@ -86,7 +91,7 @@ impl Core {
             width: grid.width(),
             nav,
             dr,
-            ctl: WheelController::new(ControllerParams::new(&scenario.robot, spec.speed)),
+            ctl: wheel_drive(scenario, spec),
             checkpoint,
             last_commit,
             outstanding: None,
@@ -239,6 +244,9 @@ impl Core {
         let cand = self.nav.candidate(round);
         p.candidates.send(cand)?;
         self.outstanding = Some(round);
+        if self.nav.take_replanned() {
+            self.publish_map(p)?;
+        }
         Ok(())
     }
 
@@ -253,7 +261,12 @@ impl Core {
         let pose = self.dr.pose();
         let (l, r) = if self.nav.is_moving() {
             let (x, y) = cell_centre_m(self.cell_size_m, self.nav.next());
-            let w = self.ctl.command(pose, x, y);
+            let free = if self.ctl.needs_free_space() {
+                FreeSpace::from_grid(self.nav.grid(), self.cell_size_m, pose, self.ctl.range_m())
+            } else {
+                FreeSpace::open(0.0)
+            };
+            let w = self.ctl.command(pose, x, y, &free);
             (w.left_rad_s, w.right_rad_s)
         } else {
             (0.0, 0.0)
@@ -279,7 +292,7 @@ impl Core {
 
     /// Publishes the neural map, written straight into loaned shared memory.
     fn publish_map(&mut self, p: &Ports) -> Result<(), AgentError> {
-        let map = self.nav.map();
+        let nav = &self.nav;
         let len = p.map.max_len();
         let mut loan = p.map.loan(len)?;
         *loan.header_mut() = MapHeader {
@@ -287,14 +300,14 @@ impl Core {
             agent: self.index,
             width: self.width,
             height: (len / self.width.max(1) as usize) as u32,
-            iterations: self.nav.report().sweeps,
-            target: cell_index(self.width, self.nav.target()) as u32,
-            activation: map.options().activation.to_kind() as u8,
+            iterations: nav.snapshot_iterations(),
+            target: cell_index(self.width, nav.target()) as u32,
+            activation: nav.snapshot_kind() as u8,
             reserved: [0; 3],
         };
         // Zero first: cells the map does not write (a slice longer than the grid) read 0.
         loan.fill_with(0.0, |values| {
-            map.write_values_f32(values).map_err(AgentError::from)
+            nav.write_snapshot(values).map_err(AgentError::from)
         })?;
         Ok(())
     }
@@ -329,5 +342,38 @@ impl Core {
             }
             Ok(()) => Ok(()),
         }
+    }
+}
+
+/// The guide of `spec`'s planner. A swarm's random stream is seeded by the run's seed and the
+/// agent's index, so a lockstep run repeats itself and two PSO agents do not share a stream.
+fn guidance(scenario: &Scenario, spec: &AgentSpec, index: u32) -> Result<Guidance, AgentError> {
+    let corners = scenario.map.corner_cutting;
+    Ok(match spec.planner {
+        Planner::Hnav => Guidance::NeuralMap,
+        Planner::Pso => {
+            let seed = SplitMix64::new(scenario.sim.seed ^ u64::from(index)).next_u64();
+            Guidance::Route(Box::new(PsoPlanner::new(
+                PsoOptions::default(),
+                corners,
+                seed,
+            )?))
+        }
+        Planner::GaFuzzy => Guidance::Route(Box::new(GaPlanner::new(GaOptions {
+            corner_cutting: corners,
+            seed: scenario.sim.seed ^ u64::from(index),
+            ..GaOptions::default()
+        })?)),
+    })
+}
+
+/// The wheel controller of `spec`'s planner: seed 004's fuzzy one for `ga-fuzzy`, the
+/// proportional one otherwise.
+fn wheel_drive(scenario: &Scenario, spec: &AgentSpec) -> WheelDrive {
+    match spec.planner {
+        Planner::GaFuzzy => WheelDrive::fuzzy(&scenario.robot, spec.speed),
+        Planner::Hnav | Planner::Pso => WheelDrive::Proportional(WheelController::new(
+            ControllerParams::new(&scenario.robot, spec.speed),
+        )),
     }
 }

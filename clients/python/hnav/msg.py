@@ -231,7 +231,7 @@ class Heartbeat(_Payload):
 class ActivationKind:
     """Values of `MapHeader.activation`."""
 
-    NAMES = {1: "linear", 2: "tanh"}
+    NAMES = {1: "linear", 2: "tanh", 3: "route"}
 
 
 class MapHeader(_Payload):

@@ -10,6 +10,10 @@ pub enum ActivationKind {
     Linear = 1,
     /// Hyperbolic tangent.
     Tanh = 2,
+    /// Not a neural map: the route of a route-following agent (`planner = "pso"` or
+    /// `"ga-fuzzy"`), each remaining route cell valued `1 / (1 + steps from it to the
+    /// target)`, every other cell 0, so a viewer shows it on the same colour scale.
+    Route = 3,
 }
 
 impl ActivationKind {
@@ -18,6 +22,7 @@ impl ActivationKind {
         match v {
             1 => Some(Self::Linear),
             2 => Some(Self::Tanh),
+            3 => Some(Self::Route),
             _ => None,
         }
     }
@@ -67,11 +72,15 @@ mod tests {
 
     #[test]
     fn activation_round_trips_and_rejects_unknown_bytes() {
-        for a in [ActivationKind::Linear, ActivationKind::Tanh] {
+        for a in [
+            ActivationKind::Linear,
+            ActivationKind::Tanh,
+            ActivationKind::Route,
+        ] {
             assert_eq!(ActivationKind::from_u8(a as u8), Some(a));
         }
-        for bad in [0u8, 5, 200, 255] {
-            assert_eq!(ActivationKind::from_u8(bad.max(3)), None);
+        for bad in [0u8, 4, 5, 200, 255] {
+            assert_eq!(ActivationKind::from_u8(bad), None);
         }
     }
 }

@@ -173,8 +173,8 @@ impl ScenarioReport {
         let _ = writeln!(o, "agents    {}", self.agents.len());
         let _ = writeln!(
             o,
-            "  {:>4}  {:<12} {:<12} {:>6} {:>8} {:>10} {:>10}  {}",
-            "#", "start", "goal", "speed", "priority", "octile", "shortest", "planner"
+            "  {:>4}  {:<12} {:<12} {:>6} {:>8} {:>10} {:>10}  planner",
+            "#", "start", "goal", "speed", "priority", "octile", "shortest"
         );
         for a in &self.agents {
             let shortest = a
