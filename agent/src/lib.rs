@@ -13,7 +13,7 @@
 //! |---|---|
 //! | [`neural_map`] | the network (eq. 3.2–3.4, §2.8–2.11): options, the `f32` fast path [`NeuralMap`], the `f64` [`ReferenceMap`], Table 2-2's weight matrix, §2.10 repair |
 //! | [`path_constructor`] | gradient ascent (eq. 3.5 ascent form, Fig. 3-7 corners, eq. 3.7 heading, seed 001's sign flip); [`Walker`] for step-by-step use with the coordinator's direction masks |
-//! | [`navigator`] | one agent's decision-round logic: its `shared_paths` row, candidates, what each verdict does, waypoints |
+//! | [`navigator`] | one agent's decision-round logic: its `shared_paths` row, candidates, what each verdict does, waypoints; its guide: the neural map climbed, or a [`route::RoutePlanner`]'s route followed (`planner = "pso"`, `"ga-fuzzy"`) |
 //! | [`controller`] | the wheel controller that drives the robot to the centre of the committed cell |
 //! | [`odometry`] | §D.2 dead reckoning from Hall ticks: [`odometry::DeadReckoning`], a pure function of the tick stream |
 //! | [`process`] | the `hnav-agent` process: ports, the round loop in lockstep and realtime, map snapshots, the restart checkpoint |

@@ -3,10 +3,12 @@
 //! waypoint, and what it does with each of the coordinator's verdicts.
 //!
 //! The guide is the agent's planner (`[[agents]] planner`): the dissertation's neural map
-//! climbed by the path constructor ([`climb`], `"hnav"`), or a route of one of the seeds'
-//! route planners followed cell by cell ([`follow`], `"pso"`, `"ga-fuzzy"`). The rules below
+//! climbed by the path constructor (`climb.rs`, `"hnav"`), or a route of one of the seeds'
+//! route planners followed cell by cell (`follow.rs`, `"pso"`, `"ga-fuzzy"`). The rules below
 //! are the neural map's; a route follower keeps the row, the verdicts and the waypoints the
-//! same way and differs where [`follow`] says.
+//! same way, asks for its next route cell (again after a refusal), replans the route when a
+//! learned obstacle cuts it, when it is pushed off it or when the target changes, and reports
+//! a failed route query as a local extremum.
 //!
 //! - **Candidate.** At rest (current == next) and not at the goal, the agent climbs its map
 //!   one step from `current` with the directions the coordinator refused last round masked
