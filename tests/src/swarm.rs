@@ -119,6 +119,35 @@ pub fn verify_log(dir: &Path) -> (bool, String) {
     }
 }
 
+/// Runs `scenario` in lockstep into `dir` and checks the end a swarm test expects of it:
+/// exit 0, `all-at-goal`, no collision, `agents` robots all at their goals, a log that
+/// verifies. Returns the summary and the log segment's bytes, which two lockstep runs of one
+/// scenario must write identically. Panics (the test fails) with the processes' log tails.
+pub fn lockstep_all_home(
+    tag: &str,
+    scenario: &Path,
+    dir: &Path,
+    registry: &Path,
+    agents: usize,
+) -> (serde_json::Value, Vec<u8>) {
+    const RUN_TIMEOUT: Duration = Duration::from_secs(300);
+    let mut run = TestRun::new(tag);
+    let mut swarm = SwarmRun::start(&mut run, scenario, dir, registry, &["--mode", "lockstep"])
+        .expect("hnav run starts");
+    let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
+    assert!(status.success(), "{status}\n{}", swarm.log_tails());
+    let s = swarm.summary().unwrap();
+    assert_eq!(s["end"], "all-at-goal", "{s}\n{}", swarm.log_tails());
+    assert_eq!(s["collisions"], 0, "{s}");
+    let robots = s["agents"].as_array().unwrap();
+    assert_eq!(robots.len(), agents, "{s}");
+    assert!(robots.iter().all(|a| a["reached_goal"] == true), "{s}");
+    let (ok, report) = verify_log(&dir.join("log"));
+    assert!(ok, "log does not verify:\n{report}");
+    let log = std::fs::read(dir.join("log/seg-00000000.hlog")).unwrap();
+    (s, log)
+}
+
 /// A scenario of `agents` robots on the MovingAI map `map` (absolute path), each with a
 /// seeded random start and a goal whose octile shortest path (no corner cutting) is
 /// `min_len..=max_len` cells long, all starts and goals distinct, at `speed` cells/s. Written

@@ -4,32 +4,15 @@
 //! planners really drove their agents (their snapshots are routes, not neural maps).
 
 use std::path::Path;
-use std::time::Duration;
 
 use hnav_runtime::msg::ActivationKind;
 use hnav_runtime::recording::MapReader;
-use hnav_tests::swarm::{repo_root, verify_log, SwarmRun};
-use hnav_tests::TestRun;
-
-const RUN_TIMEOUT: Duration = Duration::from_secs(300);
+use hnav_tests::swarm::{lockstep_all_home, repo_root};
 
 /// Runs the scenario in lockstep into `dir`; returns the log segment's bytes.
 fn run(tag: &str, dir: &Path, registry: &Path) -> Vec<u8> {
     let scenario = repo_root().join("scenarios/mixed.toml");
-    let mut run = TestRun::new(tag);
-    let mut swarm = SwarmRun::start(&mut run, &scenario, dir, registry, &["--mode", "lockstep"])
-        .expect("hnav run starts");
-    let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
-    assert!(status.success(), "{status}\n{}", swarm.log_tails());
-    let s = swarm.summary().unwrap();
-    assert_eq!(s["end"], "all-at-goal", "{s}\n{}", swarm.log_tails());
-    assert_eq!(s["collisions"], 0, "{s}");
-    let agents = s["agents"].as_array().unwrap();
-    assert_eq!(agents.len(), 6);
-    assert!(agents.iter().all(|a| a["reached_goal"] == true), "{s}");
-    let (ok, report) = verify_log(&dir.join("log"));
-    assert!(ok, "log does not verify:\n{report}");
-    std::fs::read(dir.join("log/seg-00000000.hlog")).unwrap()
+    lockstep_all_home(tag, &scenario, dir, registry, 6).1
 }
 
 /// The activation kind of each agent's snapshots in the recording.

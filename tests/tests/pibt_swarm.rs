@@ -5,12 +5,8 @@
 //! same log.
 
 use std::path::Path;
-use std::time::Duration;
 
-use hnav_tests::swarm::{verify_log, SwarmRun};
-use hnav_tests::TestRun;
-
-const RUN_TIMEOUT: Duration = Duration::from_secs(300);
+use hnav_tests::swarm::lockstep_all_home;
 
 fn scenario(dir: &Path) -> std::path::PathBuf {
     let mut text = String::from(
@@ -29,24 +25,13 @@ fn scenario(dir: &Path) -> std::path::PathBuf {
 
 /// Runs the scenario in lockstep into `dir`; returns the log segment's bytes.
 fn run(tag: &str, scenario: &Path, dir: &Path, registry: &Path) -> Vec<u8> {
-    let mut run = TestRun::new(tag);
-    let mut swarm = SwarmRun::start(&mut run, scenario, dir, registry, &["--mode", "lockstep"])
-        .expect("hnav run starts");
-    let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
-    assert!(status.success(), "{status}\n{}", swarm.log_tails());
-    let s = swarm.summary().unwrap();
-    assert_eq!(s["end"], "all-at-goal", "{s}\n{}", swarm.log_tails());
-    assert_eq!(s["collisions"], 0, "{s}");
+    let (s, log) = lockstep_all_home(tag, scenario, dir, registry, 8);
     let agents = s["agents"].as_array().unwrap();
-    assert_eq!(agents.len(), 8);
-    assert!(agents.iter().all(|a| a["reached_goal"] == true), "{s}");
     assert!(
         agents.iter().all(|a| a["replans"] == 0),
         "no replans in pibt mode: {s}"
     );
-    let (ok, report) = verify_log(&dir.join("log"));
-    assert!(ok, "log does not verify:\n{report}");
-    std::fs::read(dir.join("log/seg-00000000.hlog")).unwrap()
+    log
 }
 
 #[test]

@@ -29,6 +29,16 @@ fn accept(n: &Navigator, c: &Candidate) -> Decision {
     }
 }
 
+/// The coordinator moves the agent to `to` out of another's way (PIBT).
+fn pushed(grid: &Grid, to: Cell) -> Decision {
+    Decision {
+        verdict: Verdict::Accept as u8,
+        kind: ConflictKind::Pushed as u8,
+        cell: grid.index(to) as u32,
+        ..Decision::default()
+    }
+}
+
 #[test]
 fn accepted_steps_walk_to_the_goal() {
     let grid = Grid::new(8, 8).unwrap();
@@ -147,13 +157,7 @@ fn an_agent_pushed_off_its_goal_climbs_back() {
     for to in [Cell::new(3, 2), Cell::new(4, 2)] {
         let c = n.candidate(round);
         assert_eq!(c.probable == NO_CELL, n.at_goal(), "asks only off the goal");
-        let pushed = Decision {
-            verdict: Verdict::Accept as u8,
-            kind: ConflictKind::Pushed as u8,
-            cell: grid.index(to) as u32,
-            ..Decision::default()
-        };
-        assert!(n.apply(&pushed).unwrap().accepted);
+        assert!(n.apply(&pushed(&grid, to)).unwrap().accepted);
         n.arrived().unwrap();
         assert_eq!(n.current(), to);
         round += 1;
@@ -337,13 +341,7 @@ fn a_follower_pushed_off_its_route_replans_from_where_it_is() {
     let off = Cell::new(0, 2);
     assert!(!n.route().unwrap().contains(&off));
     n.candidate(1);
-    let pushed = Decision {
-        verdict: Verdict::Accept as u8,
-        kind: ConflictKind::Pushed as u8,
-        cell: grid.index(off) as u32,
-        ..Decision::default()
-    };
-    assert!(n.apply(&pushed).unwrap().accepted);
+    assert!(n.apply(&pushed(&grid, off)).unwrap().accepted);
     n.arrived().unwrap();
     let c = n.candidate(2);
     assert_ne!(c.probable, NO_CELL);
