@@ -12,7 +12,7 @@
 //! |---|---|
 //! | [`planners`] | the three planners on one query: found, length, ticks, collisions, time |
 //! | [`scen`] | a seeded sample of the MovingAI `.scen` entries |
-//! | [`own`] | the seed's setting: a 32 x 32 grid, ten other robots moving along known routes |
+//! | [`own`] | the seed's setting: a 32 x 32 grid, twenty other robots moving along known routes |
 //! | [`tables`] | per setting and planner: success, paired length over the optimal, collisions; markdown and JSON |
 
 pub mod own;
@@ -50,8 +50,8 @@ impl Size {
             }
         } else {
             Size {
-                entries_per_file: 100,
-                worlds: 200,
+                entries_per_file: 200,
+                worlds: 300,
             }
         }
     }

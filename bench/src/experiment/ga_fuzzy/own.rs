@@ -29,7 +29,7 @@ pub const RECTANGLES: usize = 12;
 /// Longest side of a rectangle, cells.
 pub const MAX_RECT: u32 = 4;
 /// The other robots of the group (the moving obstacles).
-pub const ROBOTS: usize = 10;
+pub const ROBOTS: usize = 20;
 /// Shortest octile distance between the task's start and goal.
 pub const MIN_DISTANCE: f64 = 16.0;
 /// `N`, the time layers: the depth of the plan and the longest route.
