@@ -67,7 +67,35 @@ fn quick_json_has_both_tables_and_is_deterministic() {
             assert!(slo <= m && m <= shi, "{r}");
         }
     }
+    // The paired steps: nine setting pairs and the pooled row per corner rule, each on at
+    // most the tasks there are, its mean difference the difference of its means.
+    let pairs = data["paired_steps"].as_array().unwrap();
+    assert_eq!(pairs.len(), 2 * (9 + 1), "{pairs:?}");
+    for (i, p) in pairs.iter().enumerate() {
+        let rule = if i < 10 {
+            "modified"
+        } else {
+            "modified-always"
+        };
+        assert_eq!(p["modified"], rule, "{p}");
+        assert_eq!(p["r_max"].is_null(), i % 10 == 9, "{p}");
+        let s = &p["steps"];
+        assert!(s["n"].as_u64().unwrap() <= runs, "{p}");
+        if let (Some(a), Some(b), Some(d)) = (
+            s["mean_a"].as_f64(),
+            s["mean_b"].as_f64(),
+            s["mean_diff"].as_f64(),
+        ) {
+            assert!((b - a - d).abs() < 1e-9, "{p}");
+            let (lo, hi) = (
+                s["diff_ci"]["lo"].as_f64().unwrap(),
+                s["diff_ci"]["hi"].as_f64().unwrap(),
+            );
+            assert!(lo <= d + 1e-9 && d <= hi + 1e-9, "{p}");
+        }
+    }
     let md = a["markdown"].as_str().unwrap();
+    assert!(md.contains("Paired steps"), "{md}");
     assert!(
         md.contains("Table 1: original algorithm") && md.contains("Table 2: modified algorithm")
     );

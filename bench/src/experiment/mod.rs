@@ -7,14 +7,18 @@
 //!
 //! | module | experiment | what |
 //! |---|---|---|
+//! | [`ga_fuzzy`] | `ga-fuzzy` | seed 004: the GA + fuzzy planner against A* and HNAV on the MovingAI maps and on the seed's setting with moving robots |
 //! | [`hnav_vs_astar`] | `hnav-vs-astar` | dissertation Tables 3-8/3-9: HNAV against A* on four 20x20 tasks, tanh against linear, partial against full activation; then MovingAI scenario samples |
 //! | [`pso`] | `pso` | seed 003's Tables 1 and 2: the original swarm against the modified one |
+//! | [`pso_paired`] | — | the `pso` experiment's paired step comparison: original against modified on the tasks both solve |
 //! | [`stats`] | — | the intervals the tables print: Wilson for rates, bootstrap for means |
 
 use serde::Serialize;
 
+pub mod ga_fuzzy;
 pub mod hnav_vs_astar;
 pub mod pso;
+pub mod pso_paired;
 pub mod stats;
 
 /// One experiment: its command-line name, a line for `--help`, and the function that runs it.
@@ -39,6 +43,11 @@ pub const EXPERIMENTS: &[Experiment] = &[
         name: "pso",
         about: "seed 003, Tables 1-2: original PSO (r_max 1/2/4) vs modified (n_lm 5/7/10)",
         run: pso::run,
+    },
+    Experiment {
+        name: ga_fuzzy::NAME,
+        about: "seed 004: GA + fuzzy vs A* and HNAV on the MovingAI maps and the seed's moving-robot setting",
+        run: ga_fuzzy::run,
     },
 ];
 

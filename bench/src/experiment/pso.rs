@@ -1,7 +1,8 @@
 //! Experiment `pso`: seed 003's Tables 1 and 2 — the original swarm algorithm at r_max 1, 2,
 //! 4 against the modified one (adaptive weights, virtual obstacles) at n_lm 5, 7, 10 — on
 //! 100 x 100 maps of 15 random rectangles, 9 particles, 1200 iterations, 100 runs a setting
-//! (`--quick`: 20). Every setting runs on the same maps (paired; the paper does not say).
+//! (`--quick`: 20). Every setting runs on the same maps (paired; the paper does not say), so
+//! [`pso_paired`] also compares the steps on the tasks both algorithms solve.
 //! The differences from the paper are discussed in `docs/experiments/pso.md`.
 
 use std::fmt::Write as _;
@@ -13,6 +14,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
+use super::pso_paired;
 use super::stats::{bootstrap_mean, mean, wilson, Interval, Z95};
 use super::{Options, Report};
 
@@ -131,15 +133,16 @@ pub struct Row {
     pub gaps: u64,
     /// Mean virtual obstacles placed per run.
     pub mean_virtual_obstacles: f64,
-    /// The iterations of each successful run, in task order (for pooling).
+    /// The iterations of each run, in task order, `None` where it failed (for pooling and
+    /// for the paired comparison).
     #[serde(skip)]
-    steps: Vec<f64>,
+    pub per_task: Vec<Option<f64>>,
 }
 
 fn run_setting(tasks: &[Task], options: &PsoOptions, salt: u64, seed: u64) -> anyhow::Result<Row> {
     let mut swarm = Swarm::default();
     let (mut successes, mut not_reached, mut unsolvable, mut gaps, mut vo) = (0, 0, 0, 0, 0);
-    let mut steps = Vec::with_capacity(tasks.len());
+    let mut per_task = Vec::with_capacity(tasks.len());
     for (i, t) in tasks.iter().enumerate() {
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (salt << 32) ^ i as u64);
         let out = pso::run(
@@ -151,9 +154,9 @@ fn run_setting(tasks: &[Task], options: &PsoOptions, salt: u64, seed: u64) -> an
             &mut rng,
         )?;
         vo += out.virtual_obstacles;
+        per_task.push(out.success().then(|| f64::from(out.iterations)));
         if out.success() {
             successes += 1;
-            steps.push(f64::from(out.iterations));
         } else if out.reached {
             gaps += 1;
         } else {
@@ -162,6 +165,7 @@ fn run_setting(tasks: &[Task], options: &PsoOptions, salt: u64, seed: u64) -> an
         }
     }
     let runs = tasks.len() as u64;
+    let steps: Vec<f64> = per_task.iter().flatten().copied().collect();
     Ok(Row {
         algorithm: "",
         parameter: 0,
@@ -176,7 +180,7 @@ fn run_setting(tasks: &[Task], options: &PsoOptions, salt: u64, seed: u64) -> an
         unsolvable,
         gaps,
         mean_virtual_obstacles: vo as f64 / runs.max(1) as f64,
-        steps,
+        per_task,
     })
 }
 
@@ -200,7 +204,10 @@ pub struct Pooled {
 fn pool(rows: &[Row], seed: u64) -> Pooled {
     let successes = rows.iter().map(|r| r.successes).sum();
     let runs = rows.iter().map(|r| r.runs).sum();
-    let all: Vec<f64> = rows.iter().flat_map(|r| r.steps.iter().copied()).collect();
+    let all: Vec<f64> = rows
+        .iter()
+        .flat_map(|r| r.per_task.iter().flatten().copied())
+        .collect();
     let means: Vec<f64> = rows.iter().filter_map(|r| r.mean_steps).collect();
     Pooled {
         successes,
@@ -284,15 +291,18 @@ pub fn run(options: Options) -> anyhow::Result<Report> {
         (original.successes, original.runs),
         (always.successes, always.runs),
     );
-    let markdown = render(
+    let paired = pso_paired::compare(&rows, options.seed);
+    let mut markdown = render(
         &rows,
         [&original, &modified, &always],
         [z, z_always],
         (density, unsolvable, n),
     );
+    markdown.push_str(&pso_paired::render(&paired));
     let data = serde_json::json!({
         "runs_per_setting": n,
         "rows": rows,
+        "paired_steps": paired,
         "pooled": { "original": original, "modified": modified, "z_success": z,
                     "modified_always": always, "z_success_always": z_always },
         "maps": { "mean_blocked_fraction": density, "notes_estimate": NOTES_DENSITY, "unsolvable": unsolvable },

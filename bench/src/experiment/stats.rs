@@ -75,6 +75,41 @@ pub fn bootstrap_mean(
     })
 }
 
+/// Two algorithms on the same tasks, compared on the tasks both solve.
+#[derive(Clone, Copy, PartialEq, Debug, serde::Serialize)]
+pub struct Paired {
+    /// Tasks both solved.
+    pub n: u64,
+    /// Mean of the first algorithm's values on those tasks.
+    pub mean_a: Option<f64>,
+    /// Mean of the second's.
+    pub mean_b: Option<f64>,
+    /// Mean of the per-task differences `b - a` (equal to `mean_b - mean_a`).
+    pub mean_diff: Option<f64>,
+    /// Bootstrap 95 % interval of `mean_diff` (tasks resampled, the pairs kept together).
+    pub diff_ci: Option<Interval>,
+}
+
+/// Compares `a` and `b`, one value per task or `None` where the algorithm failed, on the
+/// tasks both solved. The bootstrap resamples tasks, so the interval is the paired one.
+pub fn paired(a: &[Option<f64>], b: &[Option<f64>], resamples: usize, seed: u64) -> Paired {
+    let both: Vec<(f64, f64)> = a
+        .iter()
+        .zip(b)
+        .filter_map(|(x, y)| Some(((*x)?, (*y)?)))
+        .collect();
+    let xs: Vec<f64> = both.iter().map(|p| p.0).collect();
+    let ys: Vec<f64> = both.iter().map(|p| p.1).collect();
+    let diffs: Vec<f64> = both.iter().map(|p| p.1 - p.0).collect();
+    Paired {
+        n: both.len() as u64,
+        mean_a: mean(&xs),
+        mean_b: mean(&ys),
+        mean_diff: mean(&diffs),
+        diff_ci: bootstrap_mean(&diffs, resamples, 0.05, seed),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -105,5 +140,22 @@ mod tests {
         assert!(a.lo < m && m < a.hi, "{a:?} around {m}");
         assert_eq!(a, bootstrap_mean(&xs, 2000, 0.05, 7).unwrap());
         assert!(bootstrap_mean(&[], 10, 0.05, 7).is_none());
+    }
+
+    #[test]
+    fn paired_keeps_only_the_tasks_both_solve() {
+        let a = [Some(10.0), None, Some(4.0), Some(6.0)];
+        let b = [Some(12.0), Some(1.0), None, Some(7.0)];
+        let p = paired(&a, &b, 500, 3);
+        assert_eq!(
+            (p.n, p.mean_a, p.mean_b, p.mean_diff),
+            (2, Some(8.0), Some(9.5), Some(1.5))
+        );
+        let ci = p.diff_ci.unwrap();
+        assert!(
+            ci.lo >= 1.0 && ci.hi <= 2.0 && ci.lo <= 1.5 && 1.5 <= ci.hi,
+            "{ci:?}"
+        );
+        assert_eq!(paired(&[None], &[Some(1.0)], 10, 1).n, 0);
     }
 }
