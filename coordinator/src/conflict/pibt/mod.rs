@@ -202,8 +202,8 @@ impl Pibt {
         }
     }
 
-    /// Switches the swap operation ([`swap`]) on or off. It is off by default and not a
-    /// scenario option yet: on the MovingAI instances it brings more robots home (the
+    /// Switches the swap operation (LaCAM3's, in `pibt/swap.rs`) on or off. It is off by
+    /// default and not a scenario option yet: on the MovingAI instances it brings more robots home (the
     /// `mapf_table` measurement), but on one random instance of the property test it keeps 4
     /// of 11 agents from ever reaching their goals, which plain PIBT solves.
     pub fn set_swap(&mut self, on: bool) {
