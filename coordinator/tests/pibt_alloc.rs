@@ -71,6 +71,12 @@ fn advance(p: &Pibt, rows: &mut [AgentRow], goals: &[Cell], out: &[Outcome]) {
 
 #[test]
 fn pibt_rounds_allocate_nothing() {
+    // One test for both: the allocation counter is global, and tests run in parallel.
+    rounds_allocate_nothing(false);
+    rounds_allocate_nothing(true);
+}
+
+fn rounds_allocate_nothing(swap: bool) {
     // 64 agents on a 16x16 room with a wall across (25 % of the free cells): the first 64
     // cells go to the last 64, so every agent crosses the others.
     let mut grid = Grid::new(16, 16).unwrap();
@@ -84,6 +90,7 @@ fn pibt_rounds_allocate_nothing() {
     let starts = &free[..64];
     let goals: Vec<Cell> = free[free.len() - 64..].iter().rev().copied().collect();
     let mut p = Pibt::new(&grid, &goals, Options::default());
+    p.set_swap(swap);
     let mut rows: Vec<AgentRow> = starts
         .iter()
         .map(|&s| AgentRow::at_rest(s, None, 1.0))

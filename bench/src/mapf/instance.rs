@@ -45,8 +45,11 @@ pub enum InstanceError {
 /// A `.scen` loaded against its map, from which instances of any size are taken.
 #[derive(Debug, Clone)]
 pub struct Benchmark {
-    /// The map file, absolute, as the scenario files name it.
+    /// The map file, absolute, as the scenario files name it (they run in another
+    /// directory).
     pub map: PathBuf,
+    /// The map file as given, for reports (like [`Benchmark::scen`]).
+    pub map_given: String,
     /// The map.
     pub grid: Grid,
     /// The `.scen` file as given.
@@ -63,9 +66,11 @@ impl Benchmark {
         if let Some(e) = validate_scen(&grid, &file).into_iter().next() {
             return Err(e.into());
         }
+        let map_given = map.display().to_string();
         let map = std::fs::canonicalize(map).unwrap_or_else(|_| map.to_path_buf());
         Ok(Benchmark {
             map,
+            map_given,
             grid,
             scen: file.source_name,
             entries: file.entries,
@@ -259,6 +264,23 @@ mod tests {
         );
         assert_eq!(s.coordinator.time_limit_s, 90.0);
         assert_eq!(s.map.grid, b.grid);
+    }
+
+    #[test]
+    fn reports_name_the_map_and_the_scen_as_given() {
+        // Relative to this crate's directory, where `cargo test` runs.
+        let (map, scen) = (
+            Path::new("../maps/random-32-32-10.map"),
+            Path::new("../maps/random-32-32-10-random-1.scen"),
+        );
+        let b = Benchmark::load(map, scen).unwrap();
+        assert_eq!(b.map_given, "../maps/random-32-32-10.map");
+        assert_eq!(b.scen, "../maps/random-32-32-10-random-1.scen");
+        assert!(
+            b.map.is_absolute(),
+            "the scenario needs {:?} absolute",
+            b.map
+        );
     }
 
     #[test]

@@ -64,7 +64,7 @@ impl Row {
     /// A row for `instance` with nothing measured yet but its memory.
     pub fn new(instance: &Instance<'_>, settings: &RunSettings, memory: RunMemory) -> Self {
         Row {
-            map: instance.benchmark.map.display().to_string(),
+            map: instance.benchmark.map_given.clone(),
             scen: instance.benchmark.scen.clone(),
             agents: instance.agents(),
             rules: settings

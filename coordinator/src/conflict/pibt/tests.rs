@@ -356,3 +356,33 @@ fn rounds_are_deterministic() {
 fn expect(o: &Outcome, verdict: Verdict, kind: ConflictKind) {
     assert_eq!((o.verdict, o.kind), (verdict, kind), "{o:?}");
 }
+
+#[test]
+fn with_the_swap_an_agent_backs_out_of_a_dead_end_for_the_one_leaving_it() {
+    // Agent 0 heads for the dead end's last cell (5, 0); agent 1 stands in front of it and
+    // wants out, to the two-cell bay in the west, the only place where they can pass.
+    let g = Grid::from_rows(&["......", "..@@@@"]).unwrap();
+    let (starts, goals) = ([c(3, 0), c(4, 0)], [c(5, 0), c(0, 1)]);
+    let mut plain = World::new(g.clone(), &starts, &goals);
+    plain.step().unwrap();
+    expect(&plain.out[0], Verdict::Hold, ConflictKind::Reserved);
+    expect(&plain.out[1], Verdict::Accept, ConflictKind::Pushed);
+    assert_eq!(
+        plain.out[1].cell,
+        Some(c(5, 0)),
+        "plain PIBT pushes it deeper"
+    );
+    let mut w = World::new(g, &starts, &goals);
+    w.pibt.set_swap(true);
+    w.step().unwrap();
+    expect(&w.out[0], Verdict::Accept, ConflictKind::Redirected);
+    assert_eq!(
+        w.out[0].cell,
+        Some(c(2, 0)),
+        "the swap reverses agent 0's preferences"
+    );
+    // The pull: agent 1 takes over agent 0's rank and follows; the checker of `step` holds
+    // on every round until both are home.
+    let rounds = w.run(80).unwrap();
+    assert!(w.pibt.waited(1) == 0 && rounds > 4, "{rounds} rounds");
+}

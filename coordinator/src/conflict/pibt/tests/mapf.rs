@@ -11,14 +11,21 @@ fn maps_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../maps")
 }
 
-/// Runs the first `n` entries of `scen` on `map` for at most `limit` rounds; the rounds until
-/// all were home at once, or the agents away at the end.
-fn run(map: &str, scen: &str, n: usize, limit: u64) -> Result<u64, Vec<usize>> {
+/// Runs the first `n` entries of `scen` on `map` for at most `limit` rounds, with or without
+/// the swap operation; the rounds until all were home at once, or the agents away at the end.
+pub(super) fn run(
+    map: &str,
+    scen: &str,
+    n: usize,
+    limit: u64,
+    swap: bool,
+) -> Result<u64, Vec<usize>> {
     let grid = read_map_file(maps_dir().join(map)).unwrap();
     let scen = read_scen_file(maps_dir().join(scen)).unwrap();
     let (starts, goals): (Vec<Cell>, Vec<Cell>) =
         scen.entries[..n].iter().map(|e| (e.start, e.goal)).unzip();
     let mut w = World::new(grid, &starts, &goals);
+    w.pibt.set_swap(swap);
     w.run(limit).map_err(|_| {
         (0..n)
             .filter(|&i| w.rows[i].current != w.goals[i] || !w.rows[i].is_at_rest())
@@ -26,8 +33,8 @@ fn run(map: &str, scen: &str, n: usize, limit: u64) -> Result<u64, Vec<usize>> {
     })
 }
 
-/// Prints the table of the three benchmark maps (`cargo test -p hnav-coordinator mapf_table
-/// -- --ignored --nocapture`).
+/// Prints the table of the three benchmark maps, without and with the swap operation
+/// (`cargo test -p hnav-coordinator --lib mapf_table -- --ignored --nocapture`).
 #[test]
 #[ignore = "a measurement: prints the sim-only table"]
 fn mapf_table() {
@@ -42,9 +49,12 @@ fn mapf_table() {
     ];
     for (map, scen, max) in sets {
         for n in [50, 100, 150, 200, 250].into_iter().filter(|&n| n <= max) {
-            match run(map, scen, n, 20_000) {
-                Ok(r) => eprintln!("{map} N={n}: all home at round {r}"),
-                Err(away) => eprintln!("{map} N={n}: {} away: {away:?}", away.len()),
+            for swap in [false, true] {
+                let label = if swap { "swap" } else { "no swap" };
+                match run(map, scen, n, 20_000, swap) {
+                    Ok(r) => eprintln!("{map} N={n} {label}: all home at round {r}"),
+                    Err(away) => eprintln!("{map} N={n} {label}: {} away: {away:?}", away.len()),
+                }
             }
         }
     }
