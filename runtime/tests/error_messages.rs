@@ -192,7 +192,7 @@ fn every_scenario_error_class_has_its_exact_message() {
     check(
         &scenario("", &format!("{ok_agent}\ncolour = \"red\"")),
         "bad.toml:9: unknown key `colour` (expected one of `start`, `goal`, `speed`, \
-         `priority`, `start_heading_deg`)",
+         `priority`, `start_heading_deg`, `planner`)",
     );
     check(
         "[map]\nrows = [\"....\"]\n\n[[agents]]\nstart = [0, 0]\ngoal = [3, 0]\n",
