@@ -37,17 +37,29 @@ const RESAMPLES: usize = 2000;
 /// A random map of the paper's kind: 15 axis-aligned rectangles, sides uniform in [1, 25],
 /// lower-left corner uniform over the map, overlap allowed, clipped at the border \[A\].
 pub fn random_map(rng: &mut ChaCha8Rng) -> Grid {
-    let mut blocked = vec![false; (SIDE * SIDE) as usize];
-    for _ in 0..RECTANGLES {
-        let (w, h) = (rng.gen_range(1..=MAX_RECT), rng.gen_range(1..=MAX_RECT));
-        let (x0, y0) = (rng.gen_range(0..SIDE), rng.gen_range(0..SIDE));
-        for y in y0..(y0 + h).min(SIDE) {
-            for x in x0..(x0 + w).min(SIDE) {
-                blocked[(y * SIDE + x) as usize] = true;
+    random_rectangles(rng, SIDE, RECTANGLES, MAX_RECT)
+}
+
+/// A `side x side` map with `rectangles` random axis-aligned rectangles, sides uniform in
+/// [1, `max_rect`], corner uniform over the map, overlap allowed, clipped at the border: the
+/// generator of the pso experiment's maps and of the ga-fuzzy experiment's own setting.
+pub fn random_rectangles(
+    rng: &mut ChaCha8Rng,
+    side: u32,
+    rectangles: usize,
+    max_rect: u32,
+) -> Grid {
+    let mut blocked = vec![false; (side * side) as usize];
+    for _ in 0..rectangles {
+        let (w, h) = (rng.gen_range(1..=max_rect), rng.gen_range(1..=max_rect));
+        let (x0, y0) = (rng.gen_range(0..side), rng.gen_range(0..side));
+        for y in y0..(y0 + h).min(side) {
+            for x in x0..(x0 + w).min(side) {
+                blocked[(y * side + x) as usize] = true;
             }
         }
     }
-    Grid::from_blocked(SIDE, SIDE, &blocked).expect("a 100 x 100 grid is valid")
+    Grid::from_blocked(side, side, &blocked).expect("a non-empty square grid is valid")
 }
 
 /// Whether every cell within Chebyshev distance 2 of `c` is inside and free (the paper's

@@ -51,17 +51,7 @@ pub struct World {
 }
 
 fn random_map(rng: &mut ChaCha8Rng) -> Grid {
-    let mut blocked = vec![false; (SIDE * SIDE) as usize];
-    for _ in 0..RECTANGLES {
-        let (w, h) = (rng.gen_range(1..=MAX_RECT), rng.gen_range(1..=MAX_RECT));
-        let (x0, y0) = (rng.gen_range(0..SIDE), rng.gen_range(0..SIDE));
-        for y in y0..(y0 + h).min(SIDE) {
-            for x in x0..(x0 + w).min(SIDE) {
-                blocked[(y * SIDE + x) as usize] = true;
-            }
-        }
-    }
-    Grid::from_blocked(SIDE, SIDE, &blocked).expect("a 32 x 32 grid is valid")
+    super::super::pso::random_rectangles(rng, SIDE, RECTANGLES, MAX_RECT)
 }
 
 fn free_cell(grid: &Grid, taken: &[Cell], rng: &mut ChaCha8Rng) -> Option<Cell> {
