@@ -18,7 +18,12 @@ const ROGUE_TIMEOUT: Duration = Duration::from_secs(30);
 
 /// Four robots in an 8 x 8 room with a central pillar: a head-on pair and a diagonal
 /// crossing, so that the rounds hold conflicts, refusals and replans a forged candidate
-/// could change.
+/// could change. Every robot has its own speed, hence its own priority (`1 / speed`): under
+/// the dissertation's rules equal priorities refuse both parties, and two equal robots
+/// crossing can then refuse each other for as long as the realtime timing keeps them in step
+/// (seen: agents 2 and 3, both at speed 2, stuck for 35 s of a flooded realtime run on a
+/// loaded machine). That is the rules' weakness (README, *Dense swarms: PIBT*), not what
+/// this file tests.
 const ROOM: &str = r#"
 name = "rogue-room"
 
@@ -60,7 +65,7 @@ speed = 2
 [[agents]]
 start = [7, 7]
 goal = [0, 0]
-speed = 2
+speed = 1.8
 "#;
 
 /// The scenario file, written once per test process.
@@ -95,6 +100,8 @@ fn log_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
 /// What one run gave.
 struct Outcome {
     log: Vec<(String, Vec<u8>)>,
+    /// The log's records, decoded (`Debug`), to show where two logs part.
+    records: Vec<String>,
     summary: serde_json::Value,
     coordinator_log: String,
     rogue: Option<String>,
@@ -136,8 +143,15 @@ fn run(tag: &str, mode: &str, class: Option<&str>) -> Outcome {
     assert_eq!(summary["collisions"], 0, "{summary}");
     let (ok, report) = verify_log(&dir.join("log"));
     assert!(ok, "log does not verify:\n{report}");
+    let records = hnav_runtime::consensus_log::read_log(dir.join("log"))
+        .expect("the log reads")
+        .records
+        .iter()
+        .map(|r| format!("{r:?}"))
+        .collect();
     Outcome {
         log: log_bytes(&dir.join("log")),
+        records,
         coordinator_log: std::fs::read_to_string(dir.join("logs/coordinator.log"))
             .unwrap_or_default(),
         summary,
@@ -155,10 +169,10 @@ fn stop_rogue(p: &mut Peer) -> String {
     sent
 }
 
-/// The lockstep log of the room without a rogue.
-fn clean_log() -> &'static [(String, Vec<u8>)] {
-    static LOG: OnceLock<Vec<(String, Vec<u8>)>> = OnceLock::new();
-    LOG.get_or_init(|| {
+/// The lockstep run of the room without a rogue.
+fn clean() -> &'static Outcome {
+    static CLEAN: OnceLock<Outcome> = OnceLock::new();
+    CLEAN.get_or_init(|| {
         let clean = run("rogue-clean", "lockstep", None);
         let total: u64 = clean.summary["rejected"]
             .as_object()
@@ -167,8 +181,41 @@ fn clean_log() -> &'static [(String, Vec<u8>)] {
             .map(|v| v.as_u64().unwrap())
             .sum();
         assert_eq!(total, 0, "a clean run drops nothing: {}", clean.summary);
-        clean.log
+        clean
     })
+}
+
+/// Asserts that `out`'s log is the clean run's, byte for byte; if not, shows the first
+/// records where the two part and both summaries.
+fn assert_same_log_as_clean(out: &Outcome) {
+    let clean = clean();
+    if out.log == clean.log {
+        return;
+    }
+    let at = out
+        .records
+        .iter()
+        .zip(&clean.records)
+        .position(|(a, b)| a != b)
+        .unwrap_or(out.records.len().min(clean.records.len()));
+    let show = |r: &[String]| {
+        r.iter()
+            .skip(at.saturating_sub(2))
+            .take(6)
+            .cloned()
+            .collect::<Vec<_>>()
+            .join("\n  ")
+    };
+    panic!(
+        "the attacked run's log differs from the clean run's at record {at} \
+         ({} records against {}):\nattacked:\n  {}\nclean:\n  {}\nattacked summary: {}\nclean summary: {}",
+        out.records.len(),
+        clean.records.len(),
+        show(&out.records),
+        show(&clean.records),
+        out.summary,
+        clean.summary
+    );
 }
 
 /// Lines of the coordinator's log about dropped candidates.
@@ -192,10 +239,7 @@ fn attacked_lockstep_run_is_unaffected(class: Rejected) {
         "one warning for the class, one for the totals:\n{}",
         out.coordinator_log
     );
-    assert!(
-        out.log == clean_log(),
-        "the attacked run's log differs from the clean run's"
-    );
+    assert_same_log_as_clean(&out);
 }
 
 #[test]
@@ -251,10 +295,7 @@ fn a_flood_costs_a_few_log_lines_and_changes_nothing() {
         "{} bytes of coordinator log",
         out.coordinator_log.len()
     );
-    assert!(
-        out.log == clean_log(),
-        "the flooded run's log differs from the clean run's"
-    );
+    assert_same_log_as_clean(&out);
 }
 
 #[test]

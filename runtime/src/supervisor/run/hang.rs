@@ -13,8 +13,11 @@
 //! `CLOCK_MONOTONIC` time, so a supervisor that was itself paused (Ctrl-Z then `fg`, or
 //! SIGSTOP) judges its children by when they beat, not by when it read the beats. When its
 //! children were paused with it, their beats are as old as the pause; so when the supervisor
-//! wakes much later than it asked to ([`HangWatch::after_wait`]), every process gets a fresh
-//! deadline from that moment instead of being killed for the supervisor's own absence.
+//! comes back to a check much later than it expected to ([`PauseDetector`]), every process
+//! gets a fresh deadline from that moment instead of being killed for the supervisor's own
+//! absence. The pause may fall anywhere in the supervisor's loop, in its wait or between two
+//! checks (reaping, restarting, printing): what counts is the time from one check to the next
+//! against the time the supervisor meant to be away.
 
 use std::time::{Duration, Instant};
 
@@ -45,11 +48,48 @@ pub(super) struct HangWatch {
     deadline: [Duration; 3],
     /// One entry per process, in the slots' order: sim, coordinator, agent 0, 1, ...
     nodes: Vec<Option<Watched>>,
-    /// How much later than asked a wait may return before the supervisor counts itself as
-    /// paused: half the shortest hang deadline.
-    pause: Duration,
-    /// The instant the last wait was asked to end by.
-    asked: Option<Instant>,
+    /// Tells when the supervisor itself was away (paused or starved).
+    pause: PauseDetector,
+}
+
+/// Tells when the supervisor was away far longer than it meant to be between two hang checks.
+///
+/// After each check the supervisor is expected back at once; a wait raises that to the
+/// instant it was asked to end by. Coming back more than `slack` after the expected instant
+/// means the supervisor was paused (SIGSTOP) or starved, wherever in its loop that happened.
+/// Counting a slow restart as a pause only postpones hang deadlines, never kills anyone.
+#[derive(Debug, Clone, Copy)]
+struct PauseDetector {
+    /// How much later than expected the supervisor may come back before it counts itself
+    /// as paused: half the shortest hang deadline.
+    slack: Duration,
+    /// The instant the supervisor expects to be back at its next check by.
+    back_by: Option<Instant>,
+}
+
+impl PauseDetector {
+    fn new(slack: Duration) -> Self {
+        Self {
+            slack,
+            back_by: None,
+        }
+    }
+
+    /// A check happens at `now`: whether the supervisor was away (by more than the slack)
+    /// since it last expected to be back. The next check is expected at once from `now`.
+    fn check_at(&mut self, now: Instant) -> Option<Duration> {
+        let late = self
+            .back_by
+            .map(|b| now.saturating_duration_since(b))
+            .filter(|late| *late > self.slack);
+        self.back_by = Some(now);
+        late
+    }
+
+    /// The supervisor is about to wait until `until`: it is expected back by then.
+    fn wait_until(&mut self, until: Instant) {
+        self.back_by = Some(self.back_by.map_or(until, |b| b.max(until)));
+    }
 }
 
 impl HangWatch {
@@ -67,8 +107,7 @@ impl HangWatch {
             beats: transport.receiver(topics::HEARTBEAT, topics::heartbeat_qos(n))?,
             deadline,
             nodes: vec![None; 2 + n],
-            pause: shortest / 2,
-            asked: None,
+            pause: PauseDetector::new(shortest / 2),
         })
     }
 
@@ -106,8 +145,11 @@ impl HangWatch {
         round: u64,
     ) -> Result<Option<Instant>, TransportError> {
         self.take_beats()?;
-        let now_ns = monotonic_ns();
         let now = Instant::now();
+        if let Some(late) = self.pause.check_at(now) {
+            self.restart_deadlines(late);
+        }
+        let now_ns = monotonic_ns();
         let mut next: Option<Instant> = None;
         for k in 0..self.nodes.len() {
             let Some(w) = self.nodes[k].filter(|w| !w.declared) else {
@@ -129,24 +171,18 @@ impl HangWatch {
         Ok(next)
     }
 
-    /// Notes the instant the coming wait is asked to end by.
+    /// Notes the instant the coming wait is asked to end by: the supervisor is expected back
+    /// at its next check by then.
     pub(super) fn before_wait(&mut self, until: Instant) {
-        self.asked = Some(until);
+        self.pause.wait_until(until);
     }
 
-    /// After a wait: if it ended much later than asked, the supervisor itself was paused (or
-    /// starved), and every process's silence is counted afresh from now.
-    pub(super) fn after_wait(&mut self) {
-        let Some(asked) = self.asked.take() else {
-            return;
-        };
-        let late = Instant::now().saturating_duration_since(asked);
-        if late <= self.pause {
-            return;
-        }
+    /// The supervisor was away `late` longer than it meant to be: every process's silence is
+    /// counted afresh from now.
+    fn restart_deadlines(&mut self, late: Duration) {
         tracing::warn!(
             paused_s = late.as_secs_f64(),
-            "the supervisor was paused; every process gets a fresh hang deadline"
+            "the supervisor was paused (or starved); every process gets a fresh hang deadline"
         );
         let now = monotonic_ns();
         for w in self.nodes.iter_mut().flatten() {
@@ -243,5 +279,55 @@ impl HangWatch {
             Role::Coordinator => 1,
             Role::Agent => 2,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SLACK: Duration = Duration::from_millis(500);
+
+    #[test]
+    fn a_wait_that_ends_late_is_a_pause() {
+        let mut p = PauseDetector::new(SLACK);
+        let t0 = Instant::now();
+        assert_eq!(p.check_at(t0), None);
+        p.wait_until(t0 + Duration::from_millis(100));
+        assert_eq!(p.check_at(t0 + Duration::from_millis(120)), None);
+        p.wait_until(t0 + Duration::from_millis(220));
+        let late = p.check_at(t0 + Duration::from_millis(2220));
+        assert_eq!(late, Some(Duration::from_secs(2)));
+    }
+
+    /// The CI failure of `hang.rs::a_whole_run_paused_past_the_deadline_kills_nobody`: the
+    /// supervisor was stopped after a wait had ended, between two checks, and came back to a
+    /// check with no late wait to tell it; it killed every child for its own absence.
+    #[test]
+    fn a_pause_between_two_checks_outside_any_wait_is_a_pause() {
+        let mut p = PauseDetector::new(SLACK);
+        let t0 = Instant::now();
+        p.check_at(t0);
+        p.wait_until(t0 + Duration::from_millis(100));
+        // The wait ends early (a child's event), then the supervisor is stopped for 2 s
+        // while it reaps and restarts, before it checks again.
+        let late = p.check_at(t0 + Duration::from_millis(2050));
+        assert_eq!(late, Some(Duration::from_millis(1950)));
+        // Without a wait in between, too.
+        let t1 = t0 + Duration::from_millis(2050);
+        assert_eq!(
+            p.check_at(t1 + Duration::from_secs(3)),
+            Some(Duration::from_secs(3))
+        );
+    }
+
+    #[test]
+    fn an_early_wake_or_a_short_delay_is_not_a_pause() {
+        let mut p = PauseDetector::new(SLACK);
+        let t0 = Instant::now();
+        p.check_at(t0);
+        p.wait_until(t0 + Duration::from_secs(1));
+        assert_eq!(p.check_at(t0 + Duration::from_millis(10)), None);
+        assert_eq!(p.check_at(t0 + Duration::from_millis(500)), None);
     }
 }

@@ -356,9 +356,7 @@ impl Watch<'_> {
                 until = until.min(d);
             }
             self.hang.before_wait(until);
-            let wake = waiter.wait(Some(until));
-            self.hang.after_wait();
-            match wake? {
+            match waiter.wait(Some(until))? {
                 Wake::Stop => return Ok(Some(End::Signalled)),
                 // A child's exit, an `Up`, or only a re-check: reap and look again.
                 Wake::Data => return Ok(None),
