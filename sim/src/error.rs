@@ -45,7 +45,7 @@ pub enum SimError {
     /// or the supervisor never answered the start-up handshake.
     #[error(transparent)]
     Transport(#[from] TransportError),
-    /// The restart checkpoint `DIR/sim.ckpt` could not be written, or a restarted sim could
+    /// The restart checkpoint `DIR/sim.ckpt.{0,1}` could not be written, or a restarted sim could
     /// not use the one it found.
     #[error("sim checkpoint {0}")]
     Checkpoint(#[from] crate::process::CheckpointError),

@@ -1,4 +1,4 @@
-//! A SIGKILLed sim is restarted and resumes from its checkpoint (`DIR/sim.ckpt`): the robots'
+//! A SIGKILLed sim is restarted and resumes from its checkpoint (`DIR/sim.ckpt.{0,1}`): the robots'
 //! ground truth, tick counters and collision count carry on where they were, so every agent's
 //! odometry stays continuous and every robot reaches its goal. In lockstep the run decides
 //! exactly what the same run without the kill decides.

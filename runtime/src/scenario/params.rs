@@ -340,7 +340,7 @@ impl RestartRule {
 
 /// Restart rules per role (`[restart]`). Every role is restarted on failure by default: an
 /// agent resumes from its checkpoint, the coordinator from the consensus log, the simulator
-/// from its ground-truth checkpoint (`DIR/sim.ckpt`).
+/// from its ground-truth checkpoint (`DIR/sim.ckpt.{0,1}`).
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Serialize)]
 pub struct RestartConfig {
     /// Rule for agent processes.

@@ -25,8 +25,8 @@ pub const LOCK_FILE: &str = ".hnav-run.lock";
 pub const RUN_OUTPUTS: [&str; 12] = [
     "log",
     "agents",
-    "sim.ckpt",
-    "sim.ckpt.tmp",
+    "sim.ckpt.0",
+    "sim.ckpt.1",
     "logs",
     "summary.json",
     "events.jsonl",

@@ -1,31 +1,46 @@
-//! The sim's restart checkpoint, `DIR/sim.ckpt`: the period counter and the world's dynamic
-//! state ([`World::write_snapshot`]) after each stepped period.
+//! The sim's restart checkpoint: the period counter and the world's dynamic state
+//! ([`World::write_snapshot`]) after each stepped period, in two slot files `DIR/sim.ckpt.0`
+//! and `DIR/sim.ckpt.1`.
 //!
 //! A sample does not outlive its publisher in iceoryx2, so what the sim last published cannot
-//! be read back from shared memory by its successor: it is kept in a file instead. Unlike the
-//! agents' fixed-size checkpoint (rewritten in place), the world's state grows with its
-//! collisions, so each checkpoint is written whole to `sim.ckpt.tmp` and renamed over
-//! `sim.ckpt`: a SIGKILL at any instant leaves the previous one or the new one, never a mix.
-//! No fsync: the page cache survives the process's death, which is the failure this is for.
-//! A checksum over the file rejects a torn or foreign one; the scenario hash ties it to its
-//! run's scenario.
+//! be read back from shared memory by its successor: it is kept in a file instead.
+//!
+//! **Why two slots rewritten in place.** The checkpoint is written in the sim's control loop,
+//! every period, so its cost is the loop's. It used to be written whole to a temporary file
+//! and renamed over the last one: a file created, an inode freed and a directory changed per
+//! period, each a journal transaction, and on ext4 the rename over an existing file also
+//! starts the new file's write-back. Under a busy disk (other runs' consensus logs fsyncing
+//! every record) one such checkpoint took 100–440 ms and the sim, stuck in the kernel,
+//! missed its heartbeat and was SIGKILLed as hung (`tests/tests/rogue.rs`'s flood runs). Now
+//! period `p` is written with one `pwrite` at offset 0 of slot `p % 2`, both files opened
+//! once: a page-cache copy and no metadata change but the file times.
+//!
+//! A SIGKILL can cut a write short (the kernel checks for a fatal signal between pages), so
+//! a slot can be torn; then it is the slot being written, and the other one holds the
+//! period before, complete. Each slot carries its length and a checksum; [`SimCheckpoint::load`]
+//! takes the newest usable one. No fsync: the page cache survives the process's death, which
+//! is the failure this is for. The scenario hash ties a slot to its run's scenario.
 //!
 //! Written after a period is stepped and before its odometry and truth are published, so that
 //! a restarted sim never resumes behind what the agents have seen (their tick counters never
 //! go back); it publishes that period's odometry and truth again on resuming, in case its
-//! predecessor died between the two (the agents drop a reading of a period they have).
+//! predecessor died between the two (the agents drop a reading of a period they have). A
+//! torn slot of period `p` means the sim died before publishing `p`, so resuming from `p - 1`
+//! is exact.
 
-use std::fs::File;
-use std::io::Write;
+use std::fs::{File, OpenOptions};
+use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
 
 use hnav_runtime::hash::Fnv1a64;
 
 use crate::world::World;
 
-const MAGIC: u64 = 0x4b43_5341_4e48_0001; // "HNASCK" v1
-/// Header words: magic, scenario hash, period.
-const HEADER: usize = 3 * 8;
+const MAGIC: u64 = 0x4b43_5341_4e48_0002; // "HNASCK" v2: slots with a length
+/// Header words: magic, scenario hash, period, body length in bytes.
+const HEADER: usize = 4 * 8;
+/// The slot files, by period parity.
+pub const SLOT_FILES: [&str; 2] = ["sim.ckpt.0", "sim.ckpt.1"];
 
 /// What a checkpoint file restores.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -55,11 +70,11 @@ pub enum CheckpointError {
     },
 }
 
-/// The sim's checkpoint file in a run directory, with the buffer it is encoded in (reused,
-/// so that a checkpoint allocates nothing once the buffer has grown).
+/// The sim's checkpoint slots in a run directory, with the buffer a checkpoint is encoded in
+/// (reused, so that a checkpoint allocates nothing once the buffer has grown).
 pub struct SimCheckpoint {
-    path: PathBuf,
-    tmp: PathBuf,
+    paths: [PathBuf; 2],
+    files: [Option<File>; 2],
     scenario_hash: u64,
     buf: Vec<u8>,
 }
@@ -68,79 +83,123 @@ impl SimCheckpoint {
     /// The checkpoint of a run of the scenario with hash `scenario_hash` in `run_dir`.
     pub fn in_dir(run_dir: &Path, scenario_hash: u64) -> Self {
         Self {
-            path: run_dir.join("sim.ckpt"),
-            tmp: run_dir.join("sim.ckpt.tmp"),
+            paths: SLOT_FILES.map(|f| run_dir.join(f)),
+            files: [None, None],
             scenario_hash,
             buf: Vec::new(),
         }
     }
 
-    /// The file's path.
-    pub fn path(&self) -> &Path {
-        &self.path
+    /// The slot file period `period` is written to.
+    pub fn path(&self, period: u64) -> &Path {
+        &self.paths[(period % 2) as usize]
     }
 
-    /// Writes the checkpoint of `world` with `period` periods stepped.
+    /// Writes the checkpoint of `world` with `period` periods stepped, into slot `period % 2`.
     pub fn store(&mut self, world: &World, period: u64) -> Result<(), CheckpointError> {
         self.buf.clear();
-        for w in [MAGIC, self.scenario_hash, period] {
+        for w in [MAGIC, self.scenario_hash, period, 0] {
             self.buf.extend_from_slice(&w.to_le_bytes());
         }
         world.write_snapshot(&mut self.buf);
+        let body = (self.buf.len() - HEADER) as u64;
+        self.buf[24..32].copy_from_slice(&body.to_le_bytes());
         let sum = Fnv1a64::new().bytes(&self.buf).finish();
         self.buf.extend_from_slice(&sum.to_le_bytes());
-        let written = File::create(&self.tmp)
-            .and_then(|mut f| f.write_all(&self.buf))
-            .and_then(|()| std::fs::rename(&self.tmp, &self.path));
-        written.map_err(|source| CheckpointError::Io {
-            path: self.path.clone(),
+        let slot = (period % 2) as usize;
+        let io = |source| CheckpointError::Io {
+            path: self.paths[slot].clone(),
             source,
-        })
+        };
+        if self.files[slot].is_none() {
+            let f = OpenOptions::new()
+                .write(true)
+                .create(true)
+                .truncate(false)
+                .open(&self.paths[slot])
+                .map_err(io)?;
+            self.files[slot] = Some(f);
+        }
+        let f = self.files[slot].as_ref().expect("opened above");
+        f.write_all_at(&self.buf, 0).map_err(io)
     }
 
-    /// Restores `world` from the checkpoint, if there is one: `Ok(None)` when the file does
-    /// not exist (the sim died before it stepped a period), an error when it exists but
-    /// cannot be used (a restarted sim must not silently start its robots over).
+    /// Restores `world` from the newest usable slot, if there is one: `Ok(None)` when no slot
+    /// exists (the sim died before it stepped a period), an error when a slot exists but none
+    /// can be used (a restarted sim must not silently start its robots over).
     pub fn load(&self, world: &mut World) -> Result<Option<Restored>, CheckpointError> {
-        let bytes = match std::fs::read(&self.path) {
-            Ok(b) => b,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-            Err(source) => {
-                return Err(CheckpointError::Io {
-                    path: self.path.clone(),
-                    source,
-                })
+        let mut best: Option<(u64, &Path, Vec<u8>)> = None;
+        let mut refused = None;
+        for path in &self.paths {
+            let bytes = match std::fs::read(path) {
+                Ok(b) => b,
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => continue,
+                Err(source) => {
+                    return Err(CheckpointError::Io {
+                        path: path.clone(),
+                        source,
+                    })
+                }
+            };
+            match self.check(&bytes) {
+                Ok(period) if best.as_ref().is_none_or(|b| period > b.0) => {
+                    best = Some((period, path, bytes));
+                }
+                Ok(_) => {}
+                Err(what) => {
+                    refused = Some(CheckpointError::Unusable {
+                        path: path.clone(),
+                        what,
+                    })
+                }
             }
-        };
-        let unusable = |what: String| CheckpointError::Unusable {
-            path: self.path.clone(),
-            what,
-        };
-        let Some((body, sum)) = bytes
-            .split_last_chunk::<8>()
-            .filter(|(body, _)| body.len() >= HEADER)
-        else {
-            return Err(unusable("too short for a sim checkpoint".into()));
-        };
-        if Fnv1a64::new().bytes(body).finish() != u64::from_le_bytes(*sum) {
-            return Err(unusable("checksum mismatch (torn or damaged)".into()));
         }
-        let word = |i: usize| {
-            let mut w = [0u8; 8];
-            w.copy_from_slice(&body[8 * i..8 * i + 8]);
-            u64::from_le_bytes(w)
+        let Some((period, path, bytes)) = best else {
+            return refused.map_or(Ok(None), Err);
         };
-        if word(0) != MAGIC {
-            return Err(unusable("not a sim checkpoint of this version".into()));
-        }
-        if word(1) != self.scenario_hash {
-            return Err(unusable("written for another scenario".into()));
-        }
+        let body = &bytes[HEADER..HEADER + word(&bytes, 3) as usize];
         world
-            .restore_snapshot(&body[HEADER..])
-            .map_err(|e| unusable(format!("world state {e}")))?;
-        Ok(Some(Restored { period: word(2) }))
+            .restore_snapshot(body)
+            .map_err(|e| CheckpointError::Unusable {
+                path: path.to_path_buf(),
+                what: format!("world state {e}"),
+            })?;
+        Ok(Some(Restored { period }))
     }
+
+    /// The period of a complete slot of this scenario, or what is wrong with it.
+    fn check(&self, bytes: &[u8]) -> Result<u64, String> {
+        if bytes.len() < HEADER + 8 {
+            return Err("too short for a sim checkpoint".into());
+        }
+        if word(bytes, 0) != MAGIC {
+            return Err("not a sim checkpoint of this version".into());
+        }
+        let end = usize::try_from(word(bytes, 3))
+            .ok()
+            .and_then(|body| body.checked_add(HEADER))
+            .filter(|&end| end.checked_add(8).is_some_and(|e| e <= bytes.len()))
+            .ok_or("length beyond the file (torn or damaged)")?;
+        if Fnv1a64::new().bytes(&bytes[..end]).finish() != u64_at(bytes, end) {
+            return Err("checksum mismatch (torn or damaged)".into());
+        }
+        if word(bytes, 1) != self.scenario_hash {
+            return Err("written for another scenario".into());
+        }
+        Ok(word(bytes, 2))
+    }
+}
+
+/// The little-endian header word `i` of `bytes` (`bytes` holds it).
+fn word(bytes: &[u8], i: usize) -> u64 {
+    u64_at(bytes, 8 * i)
+}
+
+/// The little-endian `u64` at byte `offset` of `bytes` (`bytes` holds it).
+fn u64_at(bytes: &[u8], offset: usize) -> u64 {
+    let mut w = [0u8; 8];
+    w.copy_from_slice(&bytes[offset..offset + 8]);
+    u64::from_le_bytes(w)
 }
 
 #[cfg(test)]
@@ -162,35 +221,103 @@ mod tests {
         .unwrap()
     }
 
-    #[test]
-    fn a_checkpoint_round_trips_and_a_damaged_or_foreign_one_is_an_error() {
-        let dir = tempfile::tempdir().unwrap();
+    fn stepped(periods: usize) -> World {
         let mut w = world();
         w.apply_command(0, 0, 5.0, 4.0, 0).unwrap();
-        for _ in 0..30 {
+        for _ in 0..periods {
             w.step();
         }
+        w
+    }
+
+    #[test]
+    fn a_checkpoint_round_trips_through_alternating_slots() {
+        let dir = tempfile::tempdir().unwrap();
         let mut ck = SimCheckpoint::in_dir(dir.path(), 7);
         let mut fresh = world();
-        assert_eq!(ck.load(&mut fresh).unwrap(), None, "no file yet");
-        ck.store(&w, 3).unwrap();
+        assert_eq!(ck.load(&mut fresh).unwrap(), None, "no slot yet");
+        let (w3, w4) = (stepped(30), stepped(40));
+        ck.store(&w3, 3).unwrap();
         assert_eq!(ck.load(&mut fresh).unwrap(), Some(Restored { period: 3 }));
-        assert_eq!(fresh.pose(0), w.pose(0));
-        assert_eq!(fresh.ticks(0), w.ticks(0));
-        assert!(!dir.path().join("sim.ckpt.tmp").exists());
+        assert_eq!(fresh.pose(0), w3.pose(0));
+        ck.store(&w4, 4).unwrap();
+        assert_ne!(ck.path(3), ck.path(4), "consecutive periods use both slots");
+        assert_eq!(ck.load(&mut fresh).unwrap(), Some(Restored { period: 4 }));
+        assert_eq!(fresh.pose(0), w4.pose(0));
+        assert_eq!(fresh.ticks(0), w4.ticks(0));
+        // A shorter record over a longer one: its length, not the file's, bounds it.
+        let long = std::fs::metadata(ck.path(4)).unwrap().len();
+        std::fs::OpenOptions::new()
+            .append(true)
+            .open(ck.path(4))
+            .unwrap()
+            .write_all_at(&[0xAA; 64], long)
+            .unwrap();
+        assert_eq!(ck.load(&mut fresh).unwrap(), Some(Restored { period: 4 }));
+    }
 
+    /// The regression the slots fix: a checkpoint per period created a file, freed an inode
+    /// and renamed, a journal transaction each, which stalled the sim for hundreds of
+    /// milliseconds on a busy disk (see the module docs).
+    #[test]
+    fn a_checkpoint_rewrites_its_slot_in_place_and_creates_no_file() {
+        use std::os::unix::fs::MetadataExt;
+        let dir = tempfile::tempdir().unwrap();
+        let mut ck = SimCheckpoint::in_dir(dir.path(), 7);
+        ck.store(&stepped(10), 1).unwrap();
+        ck.store(&stepped(20), 2).unwrap();
+        let inodes =
+            |ck: &SimCheckpoint| [1, 2].map(|p| std::fs::metadata(ck.path(p)).unwrap().ino());
+        let before = inodes(&ck);
+        for period in 3..40 {
+            ck.store(&stepped(period as usize), period).unwrap();
+        }
+        assert_eq!(inodes(&ck), before, "the same two files, rewritten");
+        let mut names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        assert_eq!(names, SLOT_FILES);
+    }
+
+    #[test]
+    fn a_torn_slot_falls_back_to_the_period_before() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut ck = SimCheckpoint::in_dir(dir.path(), 7);
+        let (w5, w6) = (stepped(50), stepped(60));
+        ck.store(&w5, 5).unwrap();
+        ck.store(&w6, 6).unwrap();
+        // The write of period 6 cut short after its first bytes (a SIGKILL between pages).
+        let mut torn = std::fs::read(ck.path(6)).unwrap();
+        torn[40..].fill(0);
+        std::fs::write(ck.path(6), &torn).unwrap();
+        let mut fresh = world();
+        assert_eq!(ck.load(&mut fresh).unwrap(), Some(Restored { period: 5 }));
+        assert_eq!(fresh.pose(0), w5.pose(0));
+    }
+
+    #[test]
+    fn damaged_or_foreign_slots_are_an_error_naming_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut ck = SimCheckpoint::in_dir(dir.path(), 7);
+        ck.store(&stepped(30), 3).unwrap();
         let other = SimCheckpoint::in_dir(dir.path(), 8);
         let err = other.load(&mut world()).unwrap_err().to_string();
         assert!(
-            err.ends_with("sim.ckpt: written for another scenario"),
+            err.ends_with("sim.ckpt.1: written for another scenario"),
             "{err}"
         );
-        let mut bytes = std::fs::read(ck.path()).unwrap();
-        bytes[30] ^= 4;
-        std::fs::write(ck.path(), &bytes).unwrap();
+        let mut bytes = std::fs::read(ck.path(3)).unwrap();
+        bytes[40] ^= 4;
+        std::fs::write(ck.path(3), &bytes).unwrap();
         let err = ck.load(&mut world()).unwrap_err().to_string();
         assert!(err.contains("checksum mismatch"), "{err}");
-        std::fs::write(ck.path(), b"x").unwrap();
+        bytes[24..32].copy_from_slice(&u64::MAX.to_le_bytes());
+        std::fs::write(ck.path(3), &bytes).unwrap();
+        let err = ck.load(&mut world()).unwrap_err().to_string();
+        assert!(err.contains("length beyond the file"), "{err}");
+        std::fs::write(ck.path(3), b"x").unwrap();
         let err = ck.load(&mut world()).unwrap_err().to_string();
         assert!(err.contains("too short"), "{err}");
     }

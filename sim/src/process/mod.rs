@@ -111,7 +111,7 @@ impl<'t> SimProcess<'t> {
         self
     }
 
-    /// Checkpoints every stepped period to `run_dir/sim.ckpt` (see [`SimCheckpoint`]); a
+    /// Checkpoints every stepped period to `run_dir/sim.ckpt.{0,1}` (see [`SimCheckpoint`]); a
     /// restarted sim ([`SimProcess::resuming`]) resumes from it.
     pub fn with_checkpoint(mut self, run_dir: &Path, scenario: &Scenario) -> Self {
         self.state.checkpoint = Some(SimCheckpoint::in_dir(run_dir, scenario.scenario_hash()));

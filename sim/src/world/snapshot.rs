@@ -1,5 +1,5 @@
 //! The world's dynamic state as bytes, for the sim's restart checkpoint
-//! ([`crate::process`] writes it to `DIR/sim.ckpt`).
+//! ([`crate::process`] writes it to `DIR/sim.ckpt.{0,1}`).
 //!
 //! A restarted sim rebuilds its world from the scenario and then restores this: every value
 //! that a step reads and the scenario does not fix (step count, poses with the carried

@@ -339,7 +339,7 @@ fn role_writes(role: Role, index: u32, dir: &Path) -> String {
         ),
         Role::Sim => format!(
             "its checkpoint {} or its log {}",
-            dir.join("sim.ckpt").display(),
+            dir.join("sim.ckpt.{0,1}").display(),
             log.display()
         ),
     }
