@@ -118,18 +118,79 @@ fn movingai_32x32_maps() {
     }
 }
 
+/// The default options and their linear, no-corner-cutting counterpart.
+fn default_and_linear() -> [NeuralMapOptions; 2] {
+    [
+        NeuralMapOptions::default(),
+        NeuralMapOptions {
+            activation: Activation::Linear,
+            diagonals: DiagonalRule::NoCornerCutting,
+            ..NeuralMapOptions::default()
+        },
+    ]
+}
+
 #[test]
 fn movingai_larger_maps_default_options() {
     for name in ["den312d.map", "warehouse-10-20-10-2-1.map"] {
         let g = common::movingai(name);
-        let opts = [
-            NeuralMapOptions::default(),
-            NeuralMapOptions {
-                activation: Activation::Linear,
-                diagonals: DiagonalRule::NoCornerCutting,
-                ..NeuralMapOptions::default()
-            },
-        ];
-        compare(&g, name, 2, &opts);
+        compare(&g, name, 2, &default_and_linear());
     }
+}
+
+/// A map much larger than one tile of the fast path: walls with gaps every 16 cells plus
+/// scattered blocks, so the wave crosses many tiles, tiles hold obstacles, and a tile can
+/// hold cells on both sides of a wall (values far apart) or cells the wave never reaches
+/// (a walled-off pocket).
+fn tiled_obstacles(n: u32) -> Grid {
+    let mut g = Grid::new(n, n).unwrap();
+    let mut x = 0x9e37_79b9_7f4a_7c15u64;
+    let mut rnd = |m: u32| {
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (x >> 33) as u32 % m
+    };
+    for w in (16..n).step_by(21) {
+        for y in 0..n {
+            // A vertical wall with a gap near one end, so the wave winds around it.
+            if (w / 21) % 2 == 0 && y < n - 3 || (w / 21) % 2 == 1 && y > 2 {
+                g.set_blocked(Cell::new(w, y), true);
+            }
+        }
+    }
+    for _ in 0..n * 2 {
+        g.set_blocked(Cell::new(rnd(n), rnd(n)), true);
+    }
+    // A walled-off pocket: a closed ring of obstacles.
+    for i in 0..9 {
+        for c in [
+            Cell::new(5 + i, 5),
+            Cell::new(5 + i, 13),
+            Cell::new(5, 5 + i),
+            Cell::new(13, 5 + i),
+        ] {
+            g.set_blocked(c, true);
+        }
+    }
+    g
+}
+
+#[test]
+fn many_tiles_with_walls_and_pockets() {
+    let g = tiled_obstacles(100);
+    let opts = default_and_linear();
+    assert!(compare(&g, "tiled obstacles 100x100", 3, &opts) > 0);
+    // A target inside the pocket: the rest of the map stays 0.
+    let mut fast = NeuralMap::new(&g, opts[0]).unwrap();
+    let mut reference = ReferenceMap::new(&g, opts[0]).unwrap();
+    let (goal, start) = (Cell::new(8, 8), Cell::new(60, 60));
+    let rf = fast
+        .build(goal, StopRule::PartialActivation { start })
+        .unwrap();
+    let rr = reference
+        .build(goal, StopRule::PartialActivation { start })
+        .unwrap();
+    assert_eq!((rf.outcome, rf.sweeps), (rr.outcome, rr.sweeps));
+    assert!(!fast.is_on(start));
 }

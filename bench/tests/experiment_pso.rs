@@ -1,6 +1,7 @@
 //! `hnav-bench experiment pso --quick` through the binary: the report's shape (the nine
 //! settings of both tables and of Table 2 without the corner analysis, beside the paper's figures, intervals that bracket their estimates) and the
-//! same JSON twice for one seed, another for another seed. Nothing here is a timing.
+//! same JSON twice for one seed, another for another seed; the ablation's tables and their
+//! invariants (not the paper's direction). Nothing here is a timing.
 
 use serde_json::Value;
 
@@ -94,11 +95,108 @@ fn quick_json_has_both_tables_and_is_deterministic() {
             assert!(lo <= d + 1e-9 && d <= hi + 1e-9, "{p}");
         }
     }
+    ablation_has_its_shape(&data["ablation"], runs);
     let md = a["markdown"].as_str().unwrap();
     assert!(md.contains("Paired steps"), "{md}");
+    assert!(md.contains("Ablation") && md.contains("How steps are counted"));
     assert!(
         md.contains("Table 1: original algorithm") && md.contains("Table 2: modified algorithm")
     );
     assert_eq!(a, json("3"), "one seed, one report");
     assert_ne!(a["data"], json("4")["data"], "another seed, other maps");
+}
+
+/// The ablation: eight variants (the original first), each pooled over three settings; the
+/// task splits cover every task once per corner rule; the counting table has the nine
+/// settings of the tables. Checks shapes and invariants only, never which way a result goes.
+fn ablation_has_its_shape(ab: &Value, runs: u64) {
+    let rows = ab["rows"].as_array().unwrap();
+    let names: Vec<&str> = rows
+        .iter()
+        .map(|r| r["algorithm"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "original",
+            "modified",
+            "modified-always",
+            "no-virtual-obstacles",
+            "fixed-weights",
+            "fixed-weights-always",
+            "original-blocked-move",
+            "original-blocked-move-always"
+        ]
+    );
+    for r in rows {
+        assert_eq!(r["runs"].as_u64(), Some(3 * runs), "{r}");
+        assert!(r["successes"].as_u64().unwrap() <= 3 * runs, "{r}");
+        let (lo, hi) = (
+            r["success_ci"]["lo"].as_f64().unwrap(),
+            r["success_ci"]["hi"].as_f64().unwrap(),
+        );
+        assert!(0.0 <= lo && lo <= hi && hi <= 1.0, "{r}");
+        let obstacles = r["obstacles_per_run"].as_f64().unwrap();
+        assert!(r["detections_per_run"].as_f64().unwrap() >= 0.0 && obstacles >= 0.0);
+        let places = !r["corner_rule"].is_null();
+        assert!(
+            places || obstacles == 0.0,
+            "no obstacle without a corner rule: {r}"
+        );
+        let reference = r["algorithm"] == "original";
+        for key in ["steps", "vs_r_max_1", "common", "all_runs", "route"] {
+            let p = &r[key];
+            assert_eq!(p.is_null(), reference, "{key}: {r}");
+            if reference {
+                continue;
+            }
+            let n = p["n"].as_u64().unwrap();
+            assert!(n <= runs, "{key}: {r}");
+            if let (Some(a), Some(b), Some(d)) = (
+                p["mean_a"].as_f64(),
+                p["mean_b"].as_f64(),
+                p["mean_diff"].as_f64(),
+            ) {
+                assert!((b - a - d).abs() < 1e-9, "{key}: {r}");
+                let (lo, hi) = (
+                    p["diff_ci"]["lo"].as_f64().unwrap(),
+                    p["diff_ci"]["hi"].as_f64().unwrap(),
+                );
+                assert!(lo <= d + 1e-9 && d <= hi + 1e-9, "{key}: {r}");
+            }
+        }
+        if !reference {
+            // Every run has an iteration count, so the all-runs comparison keeps every task.
+            assert_eq!(r["all_runs"]["n"].as_u64(), Some(runs), "{r}");
+            assert_eq!(r["route"]["n"], r["steps"]["n"], "{r}");
+        }
+    }
+    let splits = ab["splits"].as_array().unwrap();
+    assert_eq!(splits.len(), 8);
+    for rule in ["modified", "modified-always"] {
+        let mine: Vec<&Value> = splits.iter().filter(|x| x["modified"] == rule).collect();
+        let total: u64 = mine.iter().map(|x| x["tasks"].as_u64().unwrap()).sum();
+        assert_eq!(total, runs, "{rule}: every task in one group");
+        let both = mine.iter().find(|x| x["group"] == "both solve").unwrap();
+        let by_stall: u64 = ab["stall_splits"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|x| x["variant"] == rule)
+            .map(|x| x["steps"]["n"].as_u64().unwrap())
+            .sum();
+        assert_eq!(by_stall, both["tasks"].as_u64().unwrap(), "{rule}");
+    }
+    assert_eq!(ab["stall_splits"].as_array().unwrap().len(), 6);
+    let counting = ab["counting"].as_array().unwrap();
+    assert_eq!(counting.len(), 9);
+    for c in counting {
+        let all = c["all_runs_mean"].as_f64().unwrap();
+        assert!((0.0..=1200.0).contains(&all), "{c}");
+        // A run that never reaches counts 1200, at least any reached run's count.
+        if let Some(reached) = c["reached_mean"].as_f64() {
+            assert!(reached <= all + 1e-9, "{c}");
+        }
+        assert!(c["paper_implied_reached"].as_f64().unwrap() > 0.0, "{c}");
+    }
 }

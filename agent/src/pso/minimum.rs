@@ -32,6 +32,19 @@ impl Detector {
     }
 }
 
+/// What the local-minimum handling did in one run: counters only, one increment per event.
+#[derive(Clone, Copy, PartialEq, Eq, Debug, Default)]
+pub struct MinimumCounts {
+    /// Detections: the iterations on which `d_lm` first exceeds n_lm (one per stall of x^G;
+    /// after an exit resets `d_lm`, the next needs n_lm more unchanged iterations).
+    pub detections: u32,
+    /// Iterations on which the exit algorithm ran: every iteration with `d_lm > n_lm`, since
+    /// a minimum the [`CornerRule`] refuses is examined again until x^G moves.
+    pub checks: u32,
+    /// Exits that placed at least one virtual obstacle (at most one per detection).
+    pub accepted: u32,
+}
+
 /// The four axis directions of the window: N (-y), S (+y), W (-x), E (+x).
 const AXES: [[i64; 2]; 4] = [[0, -1], [0, 1], [-1, 0], [1, 0]];
 

@@ -28,7 +28,7 @@ use hnav_runtime::grid::{Cell, CornerCutting, Grid};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-pub use options::{GapRule, PsoOptions, Variant};
+pub use options::{Escape, GapRule, PsoOptions, Variant, WeightLaw};
 pub use swarm::Swarm;
 
 use crate::error::{check_inside, Error, Role};
@@ -45,8 +45,9 @@ pub struct Outcome {
     pub gap: bool,
     /// The route through the trace, start to goal, when reached and connected.
     pub route: Option<Vec<Cell>>,
-    /// Minima declared, and how many of them got virtual obstacles.
-    pub minima: (u32, u32),
+    /// What the local-minimum handling did: detections, exits tried, exits that placed
+    /// obstacles (all zero under [`options::Escape::Off`]).
+    pub minima: minimum::MinimumCounts,
     /// Virtual obstacles placed.
     pub virtual_obstacles: usize,
 }
@@ -145,5 +146,62 @@ impl RoutePlanner for PsoPlanner {
             &mut self.rng,
         )?;
         Ok(if out.success() { out.route } else { None })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 24 x 24, a wall across the middle open only at its right end: a swarm heading from the
+    /// top left to the bottom left stalls against it.
+    fn walled() -> Grid {
+        let mut rows = vec![".".repeat(24); 24];
+        rows[12] = format!("{}{}", "@".repeat(20), "....");
+        let rows: Vec<&str> = rows.iter().map(String::as_str).collect();
+        Grid::from_rows(&rows).unwrap()
+    }
+
+    fn once(o: &PsoOptions, seed: u64) -> Outcome {
+        let (start, goal) = (Cell::new(3, 3), Cell::new(3, 20));
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        run(
+            &mut Swarm::default(),
+            &walled(),
+            (start, goal),
+            o,
+            CornerCutting::Allowed,
+            &mut rng,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn detect_only_moves_as_without_escape_and_counts_its_detections() {
+        let mut detected = 0;
+        for seed in 0..6 {
+            let off = PsoOptions {
+                escape: Escape::Off,
+                ..PsoOptions::modified(5)
+            };
+            let detect = PsoOptions {
+                escape: Escape::DetectOnly,
+                ..off
+            };
+            let (a, b) = (once(&off, seed), once(&detect, seed));
+            assert_eq!(
+                (a.iterations, a.reached, &a.route),
+                (b.iterations, b.reached, &b.route)
+            );
+            assert_eq!(a.minima, minimum::MinimumCounts::default());
+            assert_eq!((b.minima.checks, b.minima.accepted), (0, 0));
+            assert_eq!(b.virtual_obstacles, 0);
+            detected += b.minima.detections;
+            let full = once(&PsoOptions::modified(5), seed);
+            let m = full.minima;
+            assert!(m.accepted <= m.detections && m.detections <= m.checks.max(m.detections));
+            assert!(full.virtual_obstacles >= m.accepted as usize, "{full:?}");
+        }
+        assert!(detected > 0, "the wall stalls the swarm at least once");
     }
 }

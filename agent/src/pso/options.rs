@@ -1,19 +1,45 @@
 //! The swarm's options: the paper's parameters (§2.6 of the notes) and one explicit option for
 //! every choice the notes mark \[A\] (the paper leaves it open), each defaulting to the notes'
 //! recommendation. [`PsoOptions::original`] and [`PsoOptions::modified`] are the two
-//! algorithms of Tables 1 and 2.
+//! algorithms of Tables 1 and 2; the modified algorithm's changes are separate options
+//! ([`Variant`] for the blocked-move noise, [`WeightLaw`], [`Escape`]) so that each one can be
+//! switched off alone (the `pso` experiment's ablation).
 
 use crate::error::Error;
 
-/// Which of the paper's two algorithms runs.
+/// Which of the paper's two algorithms runs: its noise on a blocked move. The velocity law and
+/// the local-minimum handling are [`WeightLaw`] and [`Escape`], which
+/// [`PsoOptions::original`] and [`PsoOptions::modified`] set to each algorithm's.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub enum Variant {
-    /// Table 1: velocity (2) with complementary random factors (5), fixed weights, noise (20),
-    /// no local-minimum handling.
+    /// Table 1: noise (20) of amplitude `r_max` ([`NoiseForm`], [`NoiseWhen`]); `original()`
+    /// adds [`WeightLaw::Fixed`], [`Escape::Off`] and [`Alternative::Sum`].
     Original,
-    /// Table 2: velocity (9) with the adaptive tanh weights (10)-(19), noise in {-1, 0, 1},
-    /// local-minimum detection and virtual obstacles (Pseudocode 2 plus the 24-cell analysis).
+    /// Table 2: noise -1, 0 or +1 with equal probability, on blocked moves; `modified()` adds
+    /// [`WeightLaw::Adaptive`], [`Escape::VirtualObstacles`] and [`Alternative::Noise`].
     Modified,
+}
+
+/// The velocity law, i.e. how the local and global weights are set.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum WeightLaw {
+    /// Velocity (2) with fixed k1 = `k_initial`, k2 = 1 - `k_initial` and the complementary
+    /// random factors (5), r2 = 1 - r1: the original algorithm's.
+    Fixed,
+    /// Velocity (9) with the adaptive tanh weights (10)-(19): the modified algorithm's.
+    Adaptive,
+}
+
+/// What the swarm does about local minima (Pseudocode 2).
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum Escape {
+    /// Nothing, not even the detector: the original algorithm.
+    Off,
+    /// The detector runs and its detections are counted, but nothing is placed: the swarm
+    /// moves exactly as with [`Escape::Off`] (the ablation's "no virtual obstacles").
+    DetectOnly,
+    /// Detection, the [`CornerRule`] and virtual obstacles: the modified algorithm.
+    VirtualObstacles,
 }
 
 /// How a real-valued velocity becomes a whole number of cells before the clamp (3). \[A\]
@@ -113,8 +139,12 @@ pub enum GapRule {
 /// Everything the swarm runs with. Distances are in cells.
 #[derive(Clone, Copy, PartialEq, Debug)]
 pub struct PsoOptions {
-    /// The algorithm.
+    /// The algorithm's blocked-move noise.
     pub variant: Variant,
+    /// See [`WeightLaw`].
+    pub weight_law: WeightLaw,
+    /// See [`Escape`].
+    pub escape: Escape,
     /// Swarm size N (9): the start cell and its 8 neighbours, then the start again.
     pub particles: usize,
     /// Inertia w (1.0).
@@ -162,6 +192,8 @@ impl PsoOptions {
     pub fn original(r_max: i32) -> PsoOptions {
         PsoOptions {
             variant: Variant::Original,
+            weight_law: WeightLaw::Fixed,
+            escape: Escape::Off,
             r_max,
             alternative: Alternative::Sum,
             ..PsoOptions::modified(5)
@@ -172,6 +204,8 @@ impl PsoOptions {
     pub fn modified(n_lm: u32) -> PsoOptions {
         PsoOptions {
             variant: Variant::Modified,
+            weight_law: WeightLaw::Adaptive,
+            escape: Escape::VirtualObstacles,
             particles: 9,
             inertia: 1.0,
             k_initial: 0.5,

@@ -10,9 +10,10 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::field::{chebyshev, Field};
-use super::minimum::{self, Detector};
+use super::minimum::{self, Detector, MinimumCounts};
 use super::options::{
-    Alternative, BestReset, NoiseForm, NoiseWhen, PsoOptions, Relocate, Rounding, Variant,
+    Alternative, BestReset, Escape, NoiseForm, NoiseWhen, PsoOptions, Relocate, Rounding, Variant,
+    WeightLaw,
 };
 use super::weights::{self, Weights};
 
@@ -76,8 +77,8 @@ pub struct Swarm {
     pub field: Field,
     /// d_lm.
     pub detector: Detector,
-    /// How many minima were declared, and how many of them got an obstacle.
-    pub minima: (u32, u32),
+    /// What the local-minimum handling did this run.
+    pub minima: MinimumCounts,
     positions: Vec<[i64; 2]>,
 }
 
@@ -99,7 +100,7 @@ impl Swarm {
         self.field.reset(grid);
         self.goal = goal;
         self.detector = Detector::default();
-        self.minima = (0, 0);
+        self.minima = MinimumCounts::default();
         self.particles.truncate(o.particles);
         for i in 0..o.particles {
             let d = BLOCK[i % BLOCK.len()];
@@ -165,15 +166,21 @@ impl Swarm {
             }
         }
         let changed = self.update_global();
-        if o.variant == Variant::Modified && self.detector.observe(changed, o.n_lm) {
-            self.exit_minimum(grid, o, rng);
+        if o.escape != Escape::Off && self.detector.observe(changed, o.n_lm) {
+            if self.detector.count == o.n_lm + 1 {
+                self.minima.detections += 1;
+            }
+            if o.escape == Escape::VirtualObstacles {
+                self.exit_minimum(grid, o, rng);
+            }
         }
         self.particles
             .iter()
             .position(|p| objective(p.pos, self.goal) < o.epsilon)
     }
 
-    /// Velocity (2) (original) or (9) (modified, after the weight update), rounded and clamped.
+    /// Velocity (2) ([`WeightLaw::Fixed`]) or (9) ([`WeightLaw::Adaptive`], after the weight
+    /// update), rounded and clamped.
     fn velocity(&mut self, i: usize, o: &PsoOptions, rng: &mut ChaCha8Rng) -> [i64; 2] {
         let (goal, gbest) = (self.goal, self.best);
         let p = &mut self.particles[i];
@@ -182,15 +189,15 @@ impl Swarm {
             let to_local = (p.best[j] - p.pos[j]) as f64;
             let to_global = (gbest[j] - p.pos[j]) as f64;
             let inertia = o.inertia * p.vel[j] as f64;
-            let v = match o.variant {
-                Variant::Original => {
+            let v = match o.weight_law {
+                WeightLaw::Fixed => {
                     // (5): r2 = 1 - r1, with k1 = k2 = k_initial fixed.
                     let r1: f64 = rng.gen();
                     inertia
                         + o.k_initial * r1 * to_local
                         + (1.0 - o.k_initial) * (1.0 - r1) * to_global
                 }
-                Variant::Modified => {
+                WeightLaw::Adaptive => {
                     let b_local = (p.best[j] - goal[j]).abs() as f64;
                     let b_global = (gbest[j] - goal[j]).abs() as f64;
                     let eta = weights::eta(o.eta_min, o.eta_max, rng.gen());
@@ -253,7 +260,7 @@ impl Swarm {
     /// displace the particles there, reset the bests that became blocked, recompute x^G.
     fn exit_minimum(&mut self, grid: &Grid, o: &PsoOptions, rng: &mut ChaCha8Rng) {
         let m = self.best;
-        self.minima.0 += 1;
+        self.minima.checks += 1;
         self.positions.clear();
         self.positions.extend(self.particles.iter().map(|p| p.pos));
         let radius = i64::from(o.sensing_radius);
@@ -264,7 +271,7 @@ impl Swarm {
         if minimum::place(grid, &mut self.field, o.footprint, m, axes, self.goal) == 0 {
             return;
         }
-        self.minima.1 += 1;
+        self.minima.accepted += 1;
         for i in 0..self.particles.len() {
             let pos = self.particles[i].pos;
             let near = match o.relocate {

@@ -11,6 +11,7 @@
 //! | [`hnav_vs_astar`] | `hnav-vs-astar` | dissertation Tables 3-8/3-9: HNAV against A* on four 20x20 tasks, tanh against linear, partial against full activation; then MovingAI scenario samples |
 //! | [`pso`] | `pso` | seed 003's Tables 1 and 2: the original swarm against the modified one |
 //! | [`pso_paired`] | — | the `pso` experiment's paired step comparison: original against modified on the tasks both solve |
+//! | [`pso_ablation`] | — | the `pso` experiment's ablation: the modified algorithm with one modification switched off, and how steps are counted |
 //! | [`stats`] | — | the intervals the tables print: Wilson for rates, bootstrap for means |
 
 use serde::Serialize;
@@ -18,6 +19,7 @@ use serde::Serialize;
 pub mod ga_fuzzy;
 pub mod hnav_vs_astar;
 pub mod pso;
+pub mod pso_ablation;
 pub mod pso_paired;
 pub mod stats;
 

@@ -2,20 +2,21 @@
 //! 4 against the modified one (adaptive weights, virtual obstacles) at n_lm 5, 7, 10 — on
 //! 100 x 100 maps of 15 random rectangles, 9 particles, 1200 iterations, 100 runs a setting
 //! (`--quick`: 20). Every setting runs on the same maps (paired; the paper does not say), so
-//! [`pso_paired`] also compares the steps on the tasks both algorithms solve.
+//! [`pso_paired`] also compares the steps on the tasks both algorithms solve, and
+//! [`pso_ablation`] runs the modified algorithm with one modification switched off at a time.
 //! The differences from the paper are discussed in `docs/experiments/pso.md`.
 
 use std::fmt::Write as _;
 
-use hnav_agent::pso::options::CornerRule;
-use hnav_agent::pso::{self, PsoOptions, Swarm};
-use hnav_runtime::grid::{octile_shortest_path_len, Cell, CornerCutting, Grid};
+use hnav_agent::pso::options::{Alternative, CornerRule};
+use hnav_agent::pso::{self, Escape, PsoOptions, Swarm, Variant, WeightLaw};
+use hnav_runtime::grid::{octile, octile_shortest_path_len, Cell, CornerCutting, Grid};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
-use super::pso_paired;
 use super::stats::{bootstrap_mean, mean, wilson, Interval, Z95};
+use super::{pso_ablation, pso_paired};
 use super::{Options, Report};
 
 /// Table 1 of the paper: (r_max, mean steps, success %).
@@ -87,12 +88,13 @@ pub fn endpoints(grid: &Grid, rng: &mut ChaCha8Rng) -> Option<(Cell, Cell)> {
         .map(|g| (start, g))
 }
 
-/// One task: a map and its endpoints, and whether the goal is reachable at all.
+/// One task: a map and its endpoints, and the length of its shortest path (octile, cells),
+/// `None` when the goal is unreachable.
 struct Task {
     grid: Grid,
     start: Cell,
     goal: Cell,
-    solvable: bool,
+    shortest: Option<f64>,
 }
 
 fn tasks(n: usize, seed: u64) -> Vec<Task> {
@@ -103,13 +105,12 @@ fn tasks(n: usize, seed: u64) -> Vec<Task> {
         let Some((start, goal)) = endpoints(&grid, &mut rng) else {
             continue;
         };
-        let solvable =
-            octile_shortest_path_len(&grid, start, goal, CornerCutting::Allowed).is_some();
+        let shortest = octile_shortest_path_len(&grid, start, goal, CornerCutting::Allowed);
         out.push(Task {
             grid,
             start,
             goal,
-            solvable,
+            shortest,
         });
     }
     out
@@ -145,16 +146,41 @@ pub struct Row {
     pub gaps: u64,
     /// Mean virtual obstacles placed per run.
     pub mean_virtual_obstacles: f64,
+    /// Mean local-minimum detections per run (x^G unchanged for more than n_lm iterations;
+    /// the original runs the detector at n_lm = 5 without acting on it, which leaves its
+    /// moves unchanged).
+    pub mean_detections: f64,
     /// The iterations of each run, in task order, `None` where it failed (for pooling and
     /// for the paired comparison).
     #[serde(skip)]
     pub per_task: Vec<Option<f64>>,
+    /// Each run's record, in task order.
+    #[serde(skip)]
+    pub detail: Vec<TaskRun>,
+}
+
+/// What one run did, beyond success (the ablation's per-task record).
+#[derive(Clone, Copy, PartialEq, Debug)]
+pub struct TaskRun {
+    /// Goal reached with a connected trace.
+    pub success: bool,
+    /// Goal reached within k_max (a success, or a gap).
+    pub reached: bool,
+    /// Iterations run: to the goal (also when the trace then has a gap), k_max otherwise.
+    pub iterations: u32,
+    /// Octile length (cells) of the route through the trace, on success.
+    pub route_len: Option<f64>,
+    /// Local-minimum detections.
+    pub detections: u32,
+    /// Virtual obstacles placed.
+    pub obstacles: u32,
 }
 
 fn run_setting(tasks: &[Task], options: &PsoOptions, salt: u64, seed: u64) -> anyhow::Result<Row> {
     let mut swarm = Swarm::default();
-    let (mut successes, mut not_reached, mut unsolvable, mut gaps, mut vo) = (0, 0, 0, 0, 0);
+    let (mut successes, mut not_reached, mut unsolvable, mut gaps) = (0, 0, 0, 0);
     let mut per_task = Vec::with_capacity(tasks.len());
+    let mut detail = Vec::with_capacity(tasks.len());
     for (i, t) in tasks.iter().enumerate() {
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (salt << 32) ^ i as u64);
         let out = pso::run(
@@ -165,19 +191,35 @@ fn run_setting(tasks: &[Task], options: &PsoOptions, salt: u64, seed: u64) -> an
             CornerCutting::Allowed,
             &mut rng,
         )?;
-        vo += out.virtual_obstacles;
         per_task.push(out.success().then(|| f64::from(out.iterations)));
+        detail.push(TaskRun {
+            success: out.success(),
+            reached: out.reached,
+            iterations: out.iterations,
+            route_len: out
+                .route
+                .as_ref()
+                .filter(|_| out.success())
+                .map(|r| r.windows(2).map(|w| octile(w[0], w[1])).sum()),
+            detections: out.minima.detections,
+            obstacles: u32::try_from(out.virtual_obstacles).unwrap_or(u32::MAX),
+        });
         if out.success() {
             successes += 1;
         } else if out.reached {
             gaps += 1;
         } else {
             not_reached += 1;
-            unsolvable += u64::from(!t.solvable);
+            unsolvable += u64::from(t.shortest.is_none());
         }
     }
     let runs = tasks.len() as u64;
     let steps: Vec<f64> = per_task.iter().flatten().copied().collect();
+    let per_run = |f: fn(&TaskRun) -> u32| {
+        detail.iter().map(|d| f64::from(f(d))).sum::<f64>() / runs.max(1) as f64
+    };
+    let (mean_virtual_obstacles, mean_detections) =
+        (per_run(|d| d.obstacles), per_run(|d| d.detections));
     Ok(Row {
         algorithm: "",
         parameter: 0,
@@ -191,9 +233,47 @@ fn run_setting(tasks: &[Task], options: &PsoOptions, salt: u64, seed: u64) -> an
         not_reached,
         unsolvable,
         gaps,
-        mean_virtual_obstacles: vo as f64 / runs.max(1) as f64,
+        mean_virtual_obstacles,
+        mean_detections,
         per_task,
+        detail,
     })
+}
+
+/// The ablation's settings (after the tables' nine): the modified algorithm at n_lm 5, 7, 10
+/// with one modification reverted to the original's, each under both corner rules where the
+/// rule matters. Their names are the rows' `algorithm`; [`pso_ablation`] describes them.
+fn ablation_settings() -> Vec<(&'static str, u32, f64, f64, PsoOptions)> {
+    let mut out = Vec::new();
+    for (n_lm, s, p) in PAPER_TABLE_2 {
+        let m = PsoOptions::modified(n_lm);
+        let always = PsoOptions {
+            corner_rule: CornerRule::Always,
+            ..m
+        };
+        let no_obstacles = PsoOptions {
+            escape: Escape::DetectOnly,
+            ..m
+        };
+        let fixed = |o: PsoOptions| PsoOptions {
+            weight_law: WeightLaw::Fixed,
+            ..o
+        };
+        let blocked = |o: PsoOptions| PsoOptions {
+            variant: Variant::Original,
+            r_max: 1,
+            alternative: Alternative::Sum,
+            ..o
+        };
+        out.extend([
+            ("no-virtual-obstacles", n_lm, s, p, no_obstacles),
+            ("fixed-weights", n_lm, s, p, fixed(m)),
+            ("fixed-weights-always", n_lm, s, p, fixed(always)),
+            ("original-blocked-move", n_lm, s, p, blocked(m)),
+            ("original-blocked-move-always", n_lm, s, p, blocked(always)),
+        ]);
+    }
+    out
 }
 
 /// Pooled figures of one algorithm over its three settings.
@@ -245,7 +325,12 @@ pub fn run(options: Options) -> anyhow::Result<Report> {
     let tasks = tasks(n, options.seed);
     let mut settings: Vec<(&'static str, u32, f64, f64, PsoOptions)> = Vec::new();
     for (r, s, p) in PAPER_TABLE_1 {
-        settings.push(("original", r as u32, s, p, PsoOptions::original(r)));
+        // The detector only counts here: the original's moves are those of `Escape::Off`.
+        let original = PsoOptions {
+            escape: Escape::DetectOnly,
+            ..PsoOptions::original(r)
+        };
+        settings.push(("original", r as u32, s, p, original));
     }
     for (n_lm, s, p) in PAPER_TABLE_2 {
         settings.push(("modified", n_lm, s, p, PsoOptions::modified(n_lm)));
@@ -257,6 +342,8 @@ pub fn run(options: Options) -> anyhow::Result<Report> {
         };
         settings.push(("modified-always", n_lm, s, p, always));
     }
+    let tables = settings.len();
+    settings.extend(ablation_settings());
     let mid = settings.len() / 2;
     // Two threads (the machine's two cores), each a fixed half of the settings: the figures
     // do not depend on the split, since every run has its own seeded stream.
@@ -290,11 +377,17 @@ pub fn run(options: Options) -> anyhow::Result<Report> {
         );
         Ok::<_, anyhow::Error>(rows)
     })?;
+    let (rows, ablation_rows) = {
+        let mut rows = rows;
+        let rest = rows.split_off(tables);
+        (rows, rest)
+    };
     let original = pool(&rows[..3], options.seed ^ 0x0a);
     let modified = pool(&rows[3..6], options.seed ^ 0x0b);
     let always = pool(&rows[6..], options.seed ^ 0x0c);
     let density = tasks.iter().map(|t| t.grid.blocked_fraction()).sum::<f64>() / n as f64;
-    let unsolvable = tasks.iter().filter(|t| !t.solvable).count();
+    let unsolvable = tasks.iter().filter(|t| t.shortest.is_none()).count();
+    let shortest: Vec<Option<f64>> = tasks.iter().map(|t| t.shortest).collect();
     let z = two_proportion_z(
         (original.successes, original.runs),
         (modified.successes, modified.runs),
@@ -311,10 +404,14 @@ pub fn run(options: Options) -> anyhow::Result<Report> {
         (density, unsolvable, n),
     );
     markdown.push_str(&pso_paired::render(&paired));
+    let all_rows: Vec<&Row> = rows.iter().chain(&ablation_rows).collect();
+    let ablation = pso_ablation::analyse(&all_rows, &shortest, options.seed);
+    markdown.push_str(&pso_ablation::render(&ablation));
     let data = serde_json::json!({
         "runs_per_setting": n,
         "rows": rows,
         "paired_steps": paired,
+        "ablation": ablation,
         "pooled": { "original": original, "modified": modified, "z_success": z,
                     "modified_always": always, "z_success_always": z_always },
         "maps": { "mean_blocked_fraction": density, "notes_estimate": NOTES_DENSITY, "unsolvable": unsolvable },
@@ -353,12 +450,12 @@ fn render(rows: &[Row], pooled: [&Pooled; 3], z: [f64; 2], maps: (f64, usize, us
         ),
     ] {
         let _ = writeln!(s, "{title}\n");
-        let _ = writeln!(s, "| {par} | paper steps | our steps [95 %] | paper success | our success | [95 %] | not reached (unsolvable) | gaps | virtual obstacles/run |");
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
+        let _ = writeln!(s, "| {par} | paper steps | our steps [95 %] | paper success | our success | [95 %] | not reached (unsolvable) | gaps | detections/run | virtual obstacles/run |");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
         for r in rows.iter().filter(|r| r.algorithm == alg) {
             let _ = writeln!(
                 s,
-                "| {} | {:.0} | {} | {:.0} % | {:.1} % ({}/{}) | {} | {} ({}) | {} | {:.1} |",
+                "| {} | {:.0} | {} | {:.0} % | {:.1} % ({}/{}) | {} | {} ({}) | {} | {:.1} | {:.1} |",
                 r.parameter,
                 r.paper_steps,
                 steps(r.mean_steps, r.steps_ci),
@@ -370,6 +467,7 @@ fn render(rows: &[Row], pooled: [&Pooled; 3], z: [f64; 2], maps: (f64, usize, us
                 r.not_reached,
                 r.unsolvable,
                 r.gaps,
+                r.mean_detections,
                 r.mean_virtual_obstacles
             );
         }

@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
-use super::pso::{Row, PAPER_TABLE_1, PAPER_TABLE_2};
+use super::pso::{Row, TaskRun, PAPER_TABLE_1, PAPER_TABLE_2};
 use super::stats::{mean, paired, Paired};
 
 const RESAMPLES: usize = 2000;
@@ -28,14 +28,27 @@ pub struct PairRow {
     pub steps: Paired,
 }
 
-fn pooled_per_task(rows: &[&Row]) -> Vec<Option<f64>> {
-    let n = rows.first().map_or(0, |r| r.per_task.len());
+/// The bootstrap stream of the pooled comparison of `modified` (a corner rule's rows), so
+/// that the ablation's rows for the full modified algorithm repeat this table's pooled rows.
+pub fn pooled_stream(seed: u64, modified: &str) -> u64 {
+    seed ^ (0x5f_0000 | u64::from(modified == "modified-always"))
+}
+
+/// Per task, the mean of `value` over the runs of `rows` (the settings of one algorithm) on
+/// that task where it is `Some`; `None` where it is `None` for every setting.
+pub fn per_task_mean(rows: &[&Row], value: impl Fn(&TaskRun) -> Option<f64>) -> Vec<Option<f64>> {
+    let n = rows.first().map_or(0, |r| r.detail.len());
     (0..n)
         .map(|i| {
-            let solved: Vec<f64> = rows.iter().filter_map(|r| r.per_task[i]).collect();
-            mean(&solved)
+            let values: Vec<f64> = rows.iter().filter_map(|r| value(&r.detail[i])).collect();
+            mean(&values)
         })
         .collect()
+}
+
+/// Per task, the mean iterations over the settings of `rows` that solve it.
+pub fn pooled_per_task(rows: &[&Row]) -> Vec<Option<f64>> {
+    per_task_mean(rows, |d| d.success.then_some(f64::from(d.iterations)))
 }
 
 /// The paired comparisons of `rows` (the experiment's rows, every setting on the same tasks):
@@ -64,7 +77,7 @@ pub fn compare(rows: &[Row], seed: u64) -> Vec<PairRow> {
                 &pooled_per_task(&original),
                 &pooled_per_task(&modified),
                 RESAMPLES,
-                seed ^ (0x5f_0000 | k as u64),
+                pooled_stream(seed, rule),
             ),
         });
     }

@@ -88,6 +88,25 @@ pub struct Paired {
     pub mean_diff: Option<f64>,
     /// Bootstrap 95 % interval of `mean_diff` (tasks resampled, the pairs kept together).
     pub diff_ci: Option<Interval>,
+    /// Median of the per-task differences (the mean of the middle two for an even count):
+    /// step counts have long tails, and a few tasks can carry the mean.
+    pub median_diff: Option<f64>,
+    /// Tasks where `b` is lower, and where it is higher (ties in neither).
+    pub b_lower: u64,
+    /// See `b_lower`.
+    pub b_higher: u64,
+}
+
+/// The median of `samples`, `None` if there are none.
+pub fn median(samples: &[f64]) -> Option<f64> {
+    let mut s = samples.to_vec();
+    s.sort_by(f64::total_cmp);
+    let n = s.len();
+    match n {
+        0 => None,
+        _ if n % 2 == 1 => Some(s[n / 2]),
+        _ => Some((s[n / 2 - 1] + s[n / 2]) / 2.0),
+    }
 }
 
 /// Compares `a` and `b`, one value per task or `None` where the algorithm failed, on the
@@ -107,6 +126,9 @@ pub fn paired(a: &[Option<f64>], b: &[Option<f64>], resamples: usize, seed: u64)
         mean_b: mean(&ys),
         mean_diff: mean(&diffs),
         diff_ci: bootstrap_mean(&diffs, resamples, 0.05, seed),
+        median_diff: median(&diffs),
+        b_lower: diffs.iter().filter(|&&d| d < 0.0).count() as u64,
+        b_higher: diffs.iter().filter(|&&d| d > 0.0).count() as u64,
     }
 }
 
@@ -157,5 +179,12 @@ mod tests {
             "{ci:?}"
         );
         assert_eq!(paired(&[None], &[Some(1.0)], 10, 1).n, 0);
+        // Differences 2, 1, -1 and 0: median 0.5, one lower, two higher, one tie.
+        let c = [Some(1.0), Some(1.0), Some(3.0), Some(5.0)];
+        let d = [Some(3.0), Some(2.0), Some(2.0), Some(5.0)];
+        let q = paired(&c, &d, 100, 1);
+        assert_eq!((q.median_diff, q.b_lower, q.b_higher), (Some(0.5), 1, 2));
+        assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(&[]), None);
     }
 }
