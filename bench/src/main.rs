@@ -22,7 +22,8 @@ struct Cli {
 /// (`plan`, `sim`, ...) are added without touching the others.
 #[derive(Debug, Subcommand)]
 enum Command {
-    /// One-way and round-trip latency: raw iceoryx2, HNAV transport, Unix socket, TCP.
+    /// One-way and round-trip latency, 8 B to 40 MiB: raw iceoryx2, the HNAV transport, Unix
+    /// socket, TCP loopback, and the in-process floors (crossbeam channel, futex wake-up).
     Latency(LatencyArgs),
     /// Plan one query, or every entry of a MovingAI .scen file, with one of HNAV's planners.
     Plan(PlanCli),
@@ -35,13 +36,26 @@ enum Command {
     /// Neural-map speed: updates per second and time per map, 20x20 to 1024x1024, tanh
     /// against linear, and plan queries corner to corner.
     NeuralMap {
-        /// Spend 0.05 s a point instead of 0.3 s.
+        /// Spend 0.05 s a point instead of 0.3 s, and stop at 512x512.
         #[arg(long)]
         quick: bool,
     },
     /// Decision-round latency (all candidates in -> commit at every agent) against a real
-    /// hnav-coordinator for 1..128 agents; with --faults, SIGKILL -> Down and rejoin latency.
+    /// hnav-coordinator for 1..256 agents; with --faults, SIGKILL -> Down and rejoin latency.
     Round(hnav_bench::round::RoundArgs),
+    /// The performance suite in one run (latency, round at 1..256 agents, neural map), each
+    /// part's output in DIR and DIR/perf.md for the README.
+    Perf {
+        /// The smoke-check variant (under 2 minutes).
+        #[arg(long)]
+        quick: bool,
+        /// Directory for every part's files and perf.md (created if missing).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Peer rows for the latency part (see `latency --peers`).
+        #[arg(long, value_delimiter = ',', value_name = "FILE")]
+        peers: Vec<PathBuf>,
+    },
     /// Chaos campaign: seeded runs of a small swarm with agents, the coordinator or the sim
     /// killed or frozen; checks every run and prints a table and the recovery figures.
     Chaos(ChaosCli),
@@ -355,15 +369,24 @@ fn plan_cmd(args: PlanCli) -> Result<()> {
 
 #[derive(Debug, Args)]
 struct LatencyArgs {
-    /// 10,000 measured iterations per point instead of 100,000.
+    /// 5,000 measured iterations per small point instead of 100,000 (larger sizes get a
+    /// tenth or a hundredth of that either way): a smoke check of the whole suite.
     #[arg(long)]
     quick: bool,
-    /// Directory for latency.csv and latency-sockets.csv (created if missing).
+    /// Directory for latency.csv, latency.md and latency.svg (created if missing).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
-    /// Measure only these transports (iceoryx2, hnav, uds, tcp; comma-separated).
+    /// Measure only these transports (iceoryx2, hnav, uds, tcp, crossbeam, futex;
+    /// comma-separated).
     #[arg(long, value_delimiter = ',', value_name = "TRANSPORT")]
     only: Vec<TransportKind>,
+    /// Measure only these modes (poll, event; comma-separated).
+    #[arg(long, value_delimiter = ',', value_name = "MODE")]
+    modes: Vec<latency::Mode>,
+    /// CSV files of peer rows written by `bench/peers/*/run.sh` (Zenoh, dora-rs), reported
+    /// beside ours (comma-separated).
+    #[arg(long, value_delimiter = ',', value_name = "FILE")]
+    peers: Vec<PathBuf>,
     /// Payload sizes in bytes (comma-separated).
     #[arg(long, value_delimiter = ',', value_name = "BYTES",
           default_values_t = latency::DEFAULT_SIZES)]
@@ -373,6 +396,8 @@ struct LatencyArgs {
 fn latency(args: LatencyArgs) -> Result<()> {
     let mut opts = latency::Options::new(args.quick, args.out);
     opts.only = args.only;
+    opts.peers = args.peers;
+    opts.modes = args.modes;
     opts.sizes = args.sizes;
     let report = latency::run(&opts)?;
     hnav_runtime::out!("{}", report.render());
@@ -391,6 +416,11 @@ fn main() -> std::process::ExitCode {
             Ok(())
         }
         Command::Round(args) => hnav_bench::round::main(args),
+        Command::Perf { quick, out, peers } => {
+            hnav_bench::perf::run(quick, &out, &peers).map(|md| {
+                hnav_runtime::errln!("wrote {}", md.display());
+            })
+        }
         Command::Chaos(args) => chaos(args),
         Command::Mapf(args) => mapf(args),
         Command::Experiment(args) => experiment(args),

@@ -1,5 +1,6 @@
 //! `hnav-bench latency`: how long a sample takes from one thread to another over raw iceoryx2,
-//! the HNAV transport, a Unix domain socket and TCP loopback.
+//! the HNAV transport, a Unix domain socket, TCP loopback, and the in-process floors (a
+//! crossbeam channel and a bare futex wake-up).
 //!
 //! Method (modelled on iceoryx2's own `benchmark-publish-subscribe`, see
 //! `shared/reference/iceoryx2-0.10.md` B.2):
@@ -9,18 +10,26 @@
 //! - Ping-pong: Ping stamps the time (ns since a shared [`Instant`](std::time::Instant)) into a
 //!   [`Stamp`] header and sends; Pong records `now - stamp` (one-way) and echoes; Ping records
 //!   `now - send time` (round trip). One run gives both directions of a point.
-//! - 1,000 warm-up iterations are discarded, then every one of N iterations is kept
-//!   (N = 10,000 with `--quick`, 100,000 otherwise): no trimming, no outlier removal.
+//! - Warm-up iterations are discarded, then every one of N iterations is kept: no trimming, no
+//!   outlier removal. N is 100,000 per point up to 64 KiB, 10,000 at 1 and 4 MiB (a socket
+//!   round trip of 4 MiB takes milliseconds) and 1,000 at 40 MiB; `--quick` takes a twentieth
+//!   ([`Options::iterations_for`]). The output says how many each point has.
 //! - Payload: a `[u8]` slice service of `size` bytes with the [`Stamp`] user header. It is not
 //!   filled per iteration: we measure transfer, not memset.
 //! - Modes: [`Mode::Poll`] spins on `receive`; [`Mode::Event`] also notifies and the receiver
-//!   blocks until woken: raw iceoryx2 in a WaitSet, HNAV in its `Waiter`.
+//!   blocks until woken: raw iceoryx2 in a WaitSet, HNAV in its `Waiter`, sockets in `read`,
+//!   crossbeam in `recv`, the futex in `FUTEX_WAIT`.
 //!
-//! Results: `DIR/latency.csv` (iceoryx2 and hnav) and `DIR/latency-sockets.csv` (uds, tcp).
+//! Results: `DIR/latency.csv` (every point, dora-benchmark's columns then p99.9 and max),
+//! `DIR/latency.md` (the same as a markdown table) and `DIR/latency.svg` (one-way p50 and p99
+//! against size, [`plot`]).
 
 pub mod csv;
 mod hnav;
+mod inproc;
+pub mod peers;
 mod pingpong;
+pub mod plot;
 mod raw;
 pub mod report;
 mod sockets;
@@ -40,12 +49,15 @@ use pingpong::{run_pair, Role, Samples};
 
 /// Iterations run before measuring: connections, page faults and caches settle.
 pub const WARMUP: usize = 1_000;
-/// Measured iterations with `--quick`.
-pub const ITERATIONS_QUICK: usize = 10_000;
-/// Measured iterations of a full run.
+/// Measured iterations per small point with `--quick`.
+pub const ITERATIONS_QUICK: usize = 5_000;
+/// Measured iterations per small point of a full run.
 pub const ITERATIONS_FULL: usize = 100_000;
-/// Payload sizes measured by default: a small message and a 1024×1024 `f32` map snapshot.
-pub const DEFAULT_SIZES: [usize; 2] = [64, 4_194_304];
+/// One MiB.
+pub const MIB: usize = 1024 * 1024;
+/// Payload sizes measured by default: from a bare stamp to a 40 MiB point cloud, through a
+/// small message, a page, a 64 KiB image tile, 1 MiB, and a 1024×1024 `f32` map snapshot.
+pub const DEFAULT_SIZES: [usize; 7] = [8, 64, 4096, 65_536, MIB, 4 * MIB, 40 * MIB];
 
 /// The user header of every benchmark sample.
 #[derive(Debug, Default, Clone, Copy, ZeroCopySend)]
@@ -81,34 +93,65 @@ pub enum TransportKind {
     Uds,
     /// `std::net::TcpStream` over 127.0.0.1.
     Tcp,
+    /// A `crossbeam-channel` pair inside one process, moving the payload buffer: the floor
+    /// of any handover between threads.
+    Crossbeam,
+    /// A bare futex wake-up inside one process, no payload: the floor of any blocking
+    /// notification.
+    Futex,
+    /// Zenoh pub/sub over loopback TCP, measured by `bench/peers/zenoh` ([`peers`]).
+    Zenoh,
+    /// Zenoh with its shared-memory transport, measured by `bench/peers/zenoh`.
+    ZenohShm,
+    /// dora-rs nodes (node to node over Zenoh, shared memory from 4 KiB), measured by
+    /// `bench/peers/dora`.
+    Dora,
 }
 
 impl TransportKind {
-    /// Every transport, in the order they are measured.
-    pub const ALL: [TransportKind; 4] = [Self::Iceoryx2, Self::Hnav, Self::Uds, Self::Tcp];
+    /// Every transport `hnav-bench latency` measures itself, in the order it measures them.
+    pub const ALL: [TransportKind; 6] = [
+        Self::Iceoryx2,
+        Self::Hnav,
+        Self::Uds,
+        Self::Tcp,
+        Self::Crossbeam,
+        Self::Futex,
+    ];
 
-    /// The name used in output (`iceoryx2`, `hnav`, `uds`, `tcp`).
+    /// The peers measured by their own programs under `bench/peers/`, whose rows
+    /// `--peers` reads ([`peers`]): they need toolchains the workspace build does not pay for.
+    pub const PEERS: [TransportKind; 3] = [Self::Zenoh, Self::ZenohShm, Self::Dora];
+
+    /// The name used in output (`iceoryx2`, `hnav`, `uds`, `tcp`, `crossbeam`, `futex`).
     pub fn name(self) -> &'static str {
         match self {
             Self::Iceoryx2 => "iceoryx2",
             Self::Hnav => "hnav",
             Self::Uds => "uds",
             Self::Tcp => "tcp",
+            Self::Crossbeam => "crossbeam",
+            Self::Futex => "futex",
+            Self::Zenoh => "zenoh",
+            Self::ZenohShm => "zenoh-shm",
+            Self::Dora => "dora",
         }
     }
 
-    /// Whether this is a shared-memory transport (rows in `latency.csv`) or a socket.
-    pub fn is_shared_memory(self) -> bool {
-        matches!(self, Self::Iceoryx2 | Self::Hnav)
-    }
-
-    /// The modes it is measured in: sockets only block.
+    /// The modes it is measured in: sockets and the futex only block.
     pub fn modes(self) -> &'static [Mode] {
-        if self.is_shared_memory() {
-            &[Mode::Poll, Mode::Event]
-        } else {
-            &[Mode::Event]
+        match self {
+            Self::Iceoryx2 | Self::Hnav | Self::Crossbeam => &[Mode::Poll, Mode::Event],
+            Self::Uds | Self::Tcp | Self::Futex | Self::Zenoh | Self::ZenohShm | Self::Dora => {
+                &[Mode::Event]
+            }
         }
+    }
+
+    /// Whether it is measured at `size`: the futex moves no payload, so it is measured once,
+    /// at the smallest sizes (up to 64 B), as the wake-up reference.
+    pub fn measures(self, size: usize) -> bool {
+        self != Self::Futex || size <= 64
     }
 }
 
@@ -116,10 +159,14 @@ impl core::str::FromStr for TransportKind {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL
-            .into_iter()
-            .find(|t| t.name() == s)
-            .ok_or_else(|| format!("unknown transport {s:?} (expected iceoryx2, hnav, uds or tcp)"))
+        let all = Self::ALL.into_iter().chain(Self::PEERS);
+        all.clone().find(|t| t.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = all.map(|t| t.name()).collect();
+            format!(
+                "unknown transport {s:?} (expected one of {})",
+                names.join(", ")
+            )
+        })
     }
 }
 
@@ -130,6 +177,18 @@ pub enum Mode {
     Poll,
     /// Block until woken: an iceoryx2 WaitSet (raw) or the HNAV `Waiter`, or a blocking socket read.
     Event,
+}
+
+impl core::str::FromStr for Mode {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "poll" => Ok(Self::Poll),
+            "event" => Ok(Self::Event),
+            _ => Err(format!("unknown mode {s:?} (expected poll or event)")),
+        }
+    }
 }
 
 impl Mode {
@@ -191,14 +250,19 @@ impl Point {
 /// What to measure and where to write it.
 #[derive(Debug, Clone)]
 pub struct Options {
-    /// Measured iterations per point.
+    /// Measured iterations per point up to 64 KiB; larger sizes get fewer
+    /// ([`Options::iterations_for`]).
     pub iterations: usize,
-    /// Discarded warm-up iterations per point.
+    /// Discarded warm-up iterations per small point.
     pub warmup: usize,
     /// Payload sizes in bytes.
     pub sizes: Vec<usize>,
     /// Transports to measure; empty means all.
     pub only: Vec<TransportKind>,
+    /// Modes to measure; empty means both.
+    pub modes: Vec<Mode>,
+    /// CSV files of peer rows (`bench/peers/*/run.sh`) to report beside ours.
+    pub peers: Vec<PathBuf>,
     /// Output directory (created if missing).
     pub out: PathBuf,
 }
@@ -206,17 +270,39 @@ pub struct Options {
 impl Options {
     /// The standard options: all transports, the default sizes, quick or full iterations.
     pub fn new(quick: bool, out: PathBuf) -> Self {
+        let iterations = if quick {
+            ITERATIONS_QUICK
+        } else {
+            ITERATIONS_FULL
+        };
         Self {
-            iterations: if quick {
-                ITERATIONS_QUICK
-            } else {
-                ITERATIONS_FULL
-            },
-            warmup: WARMUP,
+            iterations,
+            warmup: WARMUP.min(iterations),
             sizes: DEFAULT_SIZES.to_vec(),
             only: Vec::new(),
+            modes: Vec::new(),
+            peers: Vec::new(),
             out,
         }
+    }
+
+    /// Measured iterations at `size`: all of them up to 64 KiB, a tenth from 1 MiB, a
+    /// hundredth from 16 MiB — a socket moves 4 MiB in about a millisecond and 40 MiB in ten,
+    /// and a full run must stay within minutes. Never fewer than 10.
+    pub fn iterations_for(&self, size: usize) -> usize {
+        let divisor = match size {
+            s if s >= 16 * MIB => 100,
+            s if s >= MIB => 10,
+            _ => 1,
+        };
+        (self.iterations / divisor).max(10)
+    }
+
+    /// Warm-up iterations at `size`, scaled like the measured ones.
+    pub fn warmup_for(&self, size: usize) -> usize {
+        (self.warmup * self.iterations_for(size))
+            .div_ceil(self.iterations.max(1))
+            .max(1)
     }
 
     fn selected(&self, t: TransportKind) -> bool {
@@ -229,16 +315,16 @@ impl Options {
 pub struct Report {
     /// Date, language, platform.
     pub info: RunInfo,
-    /// Measured iterations per point.
+    /// Measured iterations per small point (see [`Options::iterations_for`]).
     pub iterations: usize,
     /// Whether the two threads were pinned to CPUs 0 and 1.
     pub pinned: bool,
-    /// iceoryx2 and hnav points (`latency.csv`).
-    pub shm: Vec<Point>,
-    /// uds and tcp points (`latency-sockets.csv`).
-    pub sockets: Vec<Point>,
-    /// The CSV files written.
+    /// Every point, by size, mode, direction and transport.
+    pub points: Vec<Point>,
+    /// The files written (CSV, markdown, SVG).
     pub files: Vec<PathBuf>,
+    /// How long the measurements took.
+    pub elapsed: std::time::Duration,
 }
 
 /// Measures every selected point, writes the CSV files and returns the results.
@@ -250,48 +336,62 @@ pub fn run(opts: &Options) -> Result<Report> {
         bail!("sizes must be a non-empty list of positive byte counts");
     }
     std::fs::create_dir_all(&opts.out).with_context(|| format!("create {}", opts.out.display()))?;
+    // Read the peers' rows first: a bad file fails before minutes of measuring.
+    let mut peer_points = Vec::new();
+    for path in &opts.peers {
+        peer_points.extend(peers::read(path)?);
+    }
     let info = RunInfo::now();
     let run = RunId::unique("bench");
+    let started = std::time::Instant::now();
     let measured = measure_all(opts, &run);
+    let elapsed = started.elapsed();
     // Remove whatever the run left in /dev/shm, also after a failure.
     let purged = purge_run(&run);
     let mut points = measured?;
     purged.context("purge the benchmark's iceoryx2 resources")?;
+    points.extend(peer_points);
 
     points.sort_by_key(|p| (p.size, p.mode, p.direction, p.transport));
-    let (shm, sockets): (Vec<Point>, Vec<Point>) = points
-        .into_iter()
-        .partition(|p| p.transport.is_shared_memory());
-    let mut files = Vec::new();
-    for (file, rows) in [("latency.csv", &shm), ("latency-sockets.csv", &sockets)] {
-        if !rows.is_empty() {
-            let path = opts.out.join(file);
-            csv::write(&path, &info, rows)?;
-            files.push(path);
-        }
-    }
-    Ok(Report {
+    let csv_path = opts.out.join("latency.csv");
+    csv::write(&csv_path, &info, &points)?;
+    let md_path = opts.out.join("latency.md");
+    let mut report = Report {
         info,
         iterations: opts.iterations,
         pinned: pingpong::pinning_possible(),
-        shm,
-        sockets,
-        files,
-    })
+        points,
+        files: vec![csv_path],
+        elapsed,
+    };
+    std::fs::write(&md_path, report.markdown())
+        .with_context(|| format!("write {}", md_path.display()))?;
+    report.files.push(md_path);
+    let svg_path = opts.out.join("latency.svg");
+    plot::write_svg(&svg_path, &report.points)?;
+    report.files.push(svg_path);
+    Ok(report)
 }
 
 fn measure_all(opts: &Options, run: &RunId) -> Result<Vec<Point>> {
     let mut points = Vec::new();
-    let transports = TransportKind::ALL.into_iter().filter(|&t| opts.selected(t));
-    let shm: Vec<_> = transports
-        .clone()
-        .filter(|t| t.is_shared_memory())
+    if let Some(t) = opts.only.iter().find(|t| TransportKind::PEERS.contains(t)) {
+        bail!(
+            "{} is measured by bench/peers/, not here: pass its rows with --peers",
+            t.name()
+        );
+    }
+    let transports: Vec<_> = TransportKind::ALL
+        .into_iter()
+        .filter(|&t| opts.selected(t))
         .collect();
-    let sockets: Vec<_> = transports.filter(|t| !t.is_shared_memory()).collect();
+    let modes = [Mode::Poll, Mode::Event]
+        .into_iter()
+        .filter(|m| opts.modes.is_empty() || opts.modes.contains(m));
     for &size in &opts.sizes {
-        for mode in [Mode::Poll, Mode::Event] {
-            for &t in shm.iter().chain(&sockets) {
-                if t.modes().contains(&mode) {
+        for mode in modes.clone() {
+            for &t in &transports {
+                if t.modes().contains(&mode) && t.measures(size) {
                     points.extend(measure(opts, run, t, mode, size)?);
                 }
             }
@@ -309,14 +409,10 @@ fn measure(
     size: usize,
 ) -> Result<[Point; 2]> {
     let what = format!("{}/{} {size} B", transport.name(), mode.name());
-    hnav_runtime::errln!(
-        "measuring {what}: {} + {} warm-up round trips",
-        opts.iterations,
-        opts.warmup
-    );
+    let (w, n) = (opts.warmup_for(size), opts.iterations_for(size));
+    hnav_runtime::errln!("measuring {what}: {n} + {w} warm-up round trips");
     // Every point gets its own services, so nothing of one run can leak into the next.
     let prefix = format!("{}/{}/{size}", transport.name(), mode.name());
-    let (w, n) = (opts.warmup, opts.iterations);
     let samples: Samples = match transport {
         TransportKind::Iceoryx2 => run_pair(
             w,
@@ -347,6 +443,27 @@ fn measure(
                 move |pp| sockets::side(pp, Role::Ping, a, size),
                 move |pp| sockets::side(pp, Role::Pong, b, size),
             )
+        }
+        TransportKind::Crossbeam => {
+            let (a, b) = inproc::crossbeam_pair();
+            run_pair(
+                w,
+                n,
+                move |pp| inproc::crossbeam_side(pp, Role::Ping, a, size, mode),
+                move |pp| inproc::crossbeam_side(pp, Role::Pong, b, size, mode),
+            )
+        }
+        TransportKind::Futex => {
+            let pair = inproc::FutexPair::default();
+            run_pair(
+                w,
+                n,
+                |pp| inproc::futex_side(pp, Role::Ping, &pair),
+                |pp| inproc::futex_side(pp, Role::Pong, &pair),
+            )
+        }
+        TransportKind::Zenoh | TransportKind::ZenohShm | TransportKind::Dora => {
+            bail!("{} is measured by bench/peers/, not here", transport.name())
         }
     }
     .with_context(|| format!("ping-pong {what}"))?;

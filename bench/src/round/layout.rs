@@ -1,8 +1,9 @@
 //! Where the benchmark's agents stand and what they ask for, round by round.
 //!
-//! The map is an open 32 x 32 grid. Agents come in pairs on odd rows: agent `2k` at
-//! `(x0, y)` and agent `2k + 1` at `(x0 + 2, y)` with `x0 = 4 (k mod 8)` and
-//! `y = 1 + 2 (k div 8)`, so the cell between a pair, and the even rows, are free. Every
+//! The map is an open 36 x 36 grid (room for the largest swarm a commit carries, 256). Agents
+//! come in pairs on odd rows: agent `2k` at `(x0, y)` and agent `2k + 1` at `(x0 + 2, y)` with
+//! `x0 = 4 (k mod 9)` and `y = 1 + 2 (k div 9)`, so the cell between a pair, and the even
+//! rows, are free. Every
 //! agent is at rest (`current = next` = its start, never moved: the benchmark measures
 //! rounds, not motion), and what it proposes cycles with the round:
 //!
@@ -22,17 +23,26 @@
 
 use std::fmt::Write as _;
 
+use hnav_runtime::msg::MAX_AGENTS as COMMIT_CAPACITY;
 use hnav_runtime::msg::{Candidate, CandidateFlags, NO_CELL};
 use hnav_runtime::scenario::FsyncPolicy;
 
 /// Side of the square map, in cells.
-pub const SIDE: u32 = 32;
+pub const SIDE: u32 = 36;
 /// Pairs per row of agents.
 const PAIRS_PER_ROW: u32 = SIDE / 4;
-/// Rows of agents (odd rows 1, 3, ..., 29: row 31 would have no free row below it).
+/// Rows of agents (odd rows 1, 3, ..., 33: row 35 would have no free row below it).
 const AGENT_ROWS: u32 = (SIDE - 2) / 2;
-/// The largest swarm that fits the layout.
-pub const MAX_AGENTS: usize = (2 * PAIRS_PER_ROW * AGENT_ROWS) as usize;
+/// The largest swarm the layout holds: as many as a commit carries, which is fewer than
+/// the map's pairs of cells.
+pub const MAX_AGENTS: usize = {
+    let fits = (2 * PAIRS_PER_ROW * AGENT_ROWS) as usize;
+    if fits < COMMIT_CAPACITY {
+        fits
+    } else {
+        COMMIT_CAPACITY
+    }
+};
 
 /// The layout of a swarm of `n` agents.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -161,6 +171,10 @@ mod tests {
 
     #[test]
     fn the_largest_swarm_fits_on_distinct_cells() {
+        assert_eq!(
+            MAX_AGENTS, COMMIT_CAPACITY,
+            "the bench reaches the largest swarm"
+        );
         let l = Layout::new(MAX_AGENTS).unwrap();
         let starts: HashSet<_> = (0..MAX_AGENTS).map(|i| l.start(i)).collect();
         let goals: HashSet<_> = (0..MAX_AGENTS).map(|i| l.goal(i)).collect();

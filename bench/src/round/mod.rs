@@ -3,7 +3,7 @@
 //!
 //! ## Round latency
 //!
-//! For each swarm size and fsync policy: a scenario (an open 32 x 32 map, the agents of
+//! For each swarm size and fsync policy: a scenario (an open 36 x 36 map, the agents of
 //! `layout`, `[coordinator] fsync`, lockstep clock) is written to a temporary directory,
 //! the real `hnav-coordinator` next to this executable is started on it, and this process
 //! plays the supervisor's start-up handshake and all N agents: one candidate publisher and
@@ -58,9 +58,9 @@ pub const ROUNDS_QUICK: u64 = 300;
 /// The command line of `hnav-bench round`.
 #[derive(Debug, Args)]
 pub struct RoundArgs {
-    /// Swarm sizes (comma-separated, 1 to 240 agents).
+    /// Swarm sizes (comma-separated, 1 to 256 agents).
     #[arg(long, value_delimiter = ',', value_name = "N",
-          default_values_t = [1usize, 8, 32, 128], conflicts_with = "faults")]
+          default_values_t = [1usize, 8, 32, 128, 256], conflicts_with = "faults")]
     pub agents: Vec<usize>,
     /// Measured rounds per point [default: 2000, 300 with --quick].
     #[arg(long, value_name = "N", conflicts_with = "faults")]

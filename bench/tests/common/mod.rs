@@ -8,7 +8,14 @@ use std::time::Duration;
 const LIMIT: Duration = Duration::from_secs(60);
 
 /// `hnav-bench ARGS`, its output once it exits; panics (failing the test) after [`LIMIT`].
+#[allow(dead_code)] // Not every test binary that includes this module calls both.
 pub fn bench(args: &[&str]) -> Output {
+    bench_within(args, LIMIT)
+}
+
+/// `hnav-bench ARGS`, its output once it exits; panics (failing the test) after `limit`.
+#[allow(dead_code)]
+pub fn bench_within(args: &[&str], limit: Duration) -> Output {
     let child = Command::new(env!("CARGO_BIN_EXE_hnav-bench"))
         .args(args)
         .stdout(Stdio::piped())
@@ -20,12 +27,12 @@ pub fn bench(args: &[&str]) -> Output {
     std::thread::spawn(move || {
         let _ = tx.send(child.wait_with_output());
     });
-    match rx.recv_timeout(LIMIT) {
+    match rx.recv_timeout(limit) {
         Ok(out) => out.expect("hnav-bench output"),
         Err(_) => {
             let pid = nix::unistd::Pid::from_raw(pid as i32);
             let _ = nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGKILL);
-            panic!("hnav-bench {args:?} did not finish within {LIMIT:?}");
+            panic!("hnav-bench {args:?} did not finish within {limit:?}");
         }
     }
 }
