@@ -7,6 +7,7 @@
 //! |---|---|---|
 //! | [`chaos`] | `hnav-bench chaos [--runs N] [--seed S] [--quick] [--only N]` | a seeded campaign of runs with agents, the coordinator or the sim killed or frozen: per-run checks (at goal, no collision, log verifies, every commit seen once, nothing left behind), a table per class and mode, detection and recovery latencies |
 //! | [`experiment`] | `hnav-bench experiment <name> [--quick] [--json] [--seed S]` | the seeds' experiments, ours beside the paper's tables with intervals |
+//! | [`fanout`] | `hnav-bench fanout [--listeners 1,8,32,128,256] [--mechanisms hnav,eventfd,futex] [--quick] [--out DIR]` | waking N waiting agents per commit: HNAV's publish + notify against one eventfd write and one futex wake; the notifier's cost and the last waiter's wake-up |
 //! | [`latency`] | `hnav-bench latency [--quick] --out DIR` | one-way and round-trip latency, 8 B to 40 MiB, of raw iceoryx2, the HNAV transport, a Unix domain socket, TCP loopback and the in-process floors (crossbeam channel, futex wake-up), in a two-thread ping-pong; CSV, markdown and an SVG plot |
 //! | [`mapf`] | `hnav-bench mapf --map FILE --scen FILE [--agents 50,100] [--rules dissertation,pibt] [--json] [--out DIR] [--quick]` | the first-N-entries MAPF instances of a MovingAI `.scen` run by whole swarms: robots at goal, collisions, makespan, sum of lengths against the lower bound, conflicts, replans, wall time, the processes' memory |
 //! | [`neural_map`] | `hnav-bench neural-map [--quick]` | neuron updates per second and time per map for 20x20 to 1024x1024, tanh against linear, and plan queries |
@@ -22,6 +23,8 @@
 
 pub mod chaos;
 pub mod experiment;
+pub mod fanout;
+pub mod futex;
 pub mod latency;
 pub mod mapf;
 pub mod neural_map;

@@ -43,6 +43,9 @@ enum Command {
     /// Decision-round latency (all candidates in -> commit at every agent) against a real
     /// hnav-coordinator for 1..256 agents; with --faults, SIGKILL -> Down and rejoin latency.
     Round(hnav_bench::round::RoundArgs),
+    /// Waking N waiting agents per commit: HNAV's publish + notify against one eventfd write
+    /// and one futex wake (the notifier's cost and the last waiter's wake-up).
+    Fanout(hnav_bench::fanout::FanoutArgs),
     /// The performance suite in one run (latency, round at 1..256 agents, neural map), each
     /// part's output in DIR and DIR/perf.md for the README.
     Perf {
@@ -416,6 +419,7 @@ fn main() -> std::process::ExitCode {
             Ok(())
         }
         Command::Round(args) => hnav_bench::round::main(args),
+        Command::Fanout(args) => hnav_bench::fanout::run(&args).map(drop),
         Command::Perf { quick, out, peers } => {
             hnav_bench::perf::run(quick, &out, &peers).map(|md| {
                 hnav_runtime::errln!("wrote {}", md.display());

@@ -1,9 +1,10 @@
 //! `hnav-bench perf`: the performance suite in one command — the latency suite, the decision
-//! round at 1 to 256 agents under both fsync policies, and the neural map — run one after the
-//! other on a quiet machine, so that every ratio in the README comes from one run.
+//! round at 1 to 256 agents under both fsync policies, the commit fan-out, and the neural map
+//! — run one after the other on a quiet machine, so that every ratio in the README comes from
+//! one run.
 //!
 //! Each part is this binary's own subcommand run as a child process (`latency`, `round`,
-//! `neural-map`): the parts stay usable alone, and a part that fails or hangs is reported
+//! `fanout`, `neural-map`): the parts stay usable alone, and a part that fails or hangs is reported
 //! with its output instead of taking the suite down with it. Their output is echoed and kept
 //! in `DIR/<part>.txt`; `DIR/perf.md` gathers the machine, each part's command and duration,
 //! and the outputs, ready to paste into the README's *Performance* section.
@@ -44,9 +45,11 @@ fn parts(quick: bool, out: &Path, peers: &[PathBuf]) -> Vec<Part> {
         "--fsync".into(),
         "every-record,none".into(),
         "--out".into(),
-        out,
+        out.clone(),
     ];
     quick_flag(&mut round);
+    let mut fanout = vec!["fanout".into(), "--out".into(), out];
+    quick_flag(&mut fanout);
     let mut neural = vec!["neural-map".into()];
     quick_flag(&mut neural);
     vec![
@@ -57,6 +60,10 @@ fn parts(quick: bool, out: &Path, peers: &[PathBuf]) -> Vec<Part> {
         Part {
             name: "round",
             args: round,
+        },
+        Part {
+            name: "fanout",
+            args: fanout,
         },
         Part {
             name: "neural-map",
@@ -165,7 +172,7 @@ mod tests {
     fn quick_parts_pass_quick_and_write_under_the_directory() {
         let parts = parts(true, Path::new("/tmp/x"), &[]);
         let names: Vec<&str> = parts.iter().map(|p| p.name).collect();
-        assert_eq!(names, ["latency", "round", "neural-map"]);
+        assert_eq!(names, ["latency", "round", "fanout", "neural-map"]);
         for p in &parts {
             assert_eq!(p.args[0], p.name);
             assert!(p.args.iter().any(|a| a == "--quick"), "{:?}", p.args);

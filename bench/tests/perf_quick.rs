@@ -1,5 +1,5 @@
 //! `hnav-bench perf --quick` through the binary: the whole performance suite runs (latency,
-//! decision round at 1 to 256 agents, neural map) and writes every point it promises. For the
+//! decision round at 1 to 256 agents, commit fan-out, neural map) and writes every point it promises. For the
 //! latency part: each transport in each of its modes, both directions, every default size,
 //! with the sample count the method gives that size, as CSV (dora-benchmark's columns first),
 //! markdown and SVG. A smoke check: nothing here is a timing.
@@ -42,10 +42,39 @@ fn the_quick_suite_writes_every_point() {
     );
     latency_points(dir.path(), &stdout);
     round_points(dir.path());
+    fanout_points(dir.path());
     let md = std::fs::read_to_string(dir.path().join("perf.md")).unwrap();
-    for part in ["## latency", "## round", "## neural-map", "512x512"] {
+    for part in [
+        "## latency",
+        "## round",
+        "## fanout",
+        "## neural-map",
+        "512x512",
+    ] {
         assert!(md.contains(part), "no {part:?} in perf.md");
     }
+}
+
+/// `fanout.csv`: every mechanism at every default listener count, the quick sample count.
+fn fanout_points(dir: &std::path::Path) {
+    let text = std::fs::read_to_string(dir.join("fanout.csv")).unwrap();
+    let mut seen = BTreeSet::new();
+    for line in text.lines().skip(1) {
+        let cols: Vec<&str> = line.split(',').collect();
+        assert_eq!(
+            cols[2].parse::<usize>().unwrap(),
+            hnav_bench::fanout::ROUNDS_QUICK,
+            "{line}"
+        );
+        seen.insert((cols[0].to_string(), cols[1].parse::<usize>().unwrap()));
+    }
+    let mut expected = BTreeSet::new();
+    for m in ["hnav", "eventfd", "futex"] {
+        for n in [1, 8, 32, 128, 256] {
+            expected.insert((m.to_string(), n));
+        }
+    }
+    assert_eq!(seen, expected);
 }
 
 /// `round.csv`: both fsync policies at every swarm size up to 256 agents, both measures.

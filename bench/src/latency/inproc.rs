@@ -18,6 +18,7 @@ use crossbeam_channel::{Receiver, RecvTimeoutError, Sender, TryRecvError};
 use super::pingpong::{PingPong, Role, ABORT_POLL};
 use super::sockets::{decode_header, encode_header, HEADER_LEN};
 use super::{Mode, Stamp};
+use crate::futex;
 
 /// One direction of a crossbeam ping-pong: the buffers travel on it.
 pub(crate) struct Lane {
@@ -114,7 +115,7 @@ impl FutexSlot {
         self.seq.store(stamp.seq, Ordering::Relaxed);
         // Release: the stamp is visible to whoever sees the new word.
         self.word.fetch_add(1, Ordering::Release);
-        futex_wake(&self.word);
+        futex::wake(&self.word, 1);
     }
 
     /// Blocks until the word moves past `*seen`, then reads the stamp.
@@ -128,7 +129,7 @@ impl FutexSlot {
                     seq: self.seq.load(Ordering::Relaxed),
                 });
             }
-            futex_wait(&self.word, now)?;
+            futex::wait(&self.word, now, ABORT_POLL).context("futex wait")?;
             pp.check()?;
         }
     }
@@ -150,48 +151,6 @@ pub(crate) fn futex_side(pp: &PingPong, role: Role, pair: &FutexPair) -> Result<
         },
         || rx.recv(pp, &mut seen),
     )
-}
-
-/// `FUTEX_WAIT` on `word` while it holds `expected`, at most [`ABORT_POLL`].
-fn futex_wait(word: &AtomicU32, expected: u32) -> Result<()> {
-    let timeout = libc::timespec {
-        tv_sec: ABORT_POLL.as_secs() as libc::time_t,
-        tv_nsec: ABORT_POLL.subsec_nanos() as libc::c_long,
-    };
-    // SAFETY: `word` is a live, aligned 32-bit atomic for the whole call (borrowed), the
-    // timeout points at a local `timespec`, and FUTEX_WAIT_PRIVATE reads the word only.
-    let r = unsafe {
-        libc::syscall(
-            libc::SYS_futex,
-            word.as_ptr(),
-            libc::FUTEX_WAIT | libc::FUTEX_PRIVATE_FLAG,
-            expected,
-            &timeout as *const libc::timespec,
-        )
-    };
-    if r == -1 {
-        let e = std::io::Error::last_os_error();
-        // EAGAIN: the word had already moved; EINTR/ETIMEDOUT: look again.
-        match e.raw_os_error() {
-            Some(libc::EAGAIN | libc::EINTR | libc::ETIMEDOUT) => {}
-            _ => return Err(e).context("futex wait"),
-        }
-    }
-    Ok(())
-}
-
-/// `FUTEX_WAKE` one waiter of `word`.
-fn futex_wake(word: &AtomicU32) {
-    // SAFETY: `word` is a live, aligned 32-bit atomic; FUTEX_WAKE_PRIVATE does not access
-    // memory beyond looking up the waiters of its address.
-    unsafe {
-        libc::syscall(
-            libc::SYS_futex,
-            word.as_ptr(),
-            libc::FUTEX_WAKE | libc::FUTEX_PRIVATE_FLAG,
-            1,
-        );
-    }
 }
 
 #[cfg(test)]
