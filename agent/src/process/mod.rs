@@ -161,6 +161,7 @@ impl<'t> AgentProcess<'t> {
         let waiter = self.transport.waiter()?;
         let _odom = waiter.attach(&p.odom)?;
         let _commit = waiter.attach(&p.commit)?;
+        let _bell = p.bell.as_ref().map(|b| waiter.attach_bell(b)).transpose()?;
         let _life = waiter.attach(p.life.events())?;
         loop {
             self.heart.beat()?;

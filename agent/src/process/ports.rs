@@ -4,13 +4,17 @@ use hnav_runtime::grid::Grid;
 use hnav_runtime::launch::LifecyclePorts;
 use hnav_runtime::msg::{Candidate, Commit, Estimate, MapHeader, Odometry, Role, WheelCommand};
 use hnav_runtime::topics;
-use hnav_runtime::transport::{Receiver, Sender, SliceSender, Transport, TransportError};
+use hnav_runtime::transport::{
+    Bell, BellWatch, Receiver, Sender, SliceSender, Transport, TransportError,
+};
 
 /// The topics of agent `index`: its odometry and the commits in, its wheel commands,
 /// candidates, neural-map snapshots and dead-reckoned poses out, and its side of the lifecycle protocol.
 pub(super) struct Ports {
     pub(super) odom: Receiver<Odometry>,
     pub(super) commit: Receiver<Commit>,
+    /// The run's commit bell, watched in place of a datagram per commit (under a supervisor).
+    pub(super) bell: Option<BellWatch>,
     pub(super) wheels: Sender<WheelCommand>,
     pub(super) candidates: Sender<Candidate>,
     pub(super) map: SliceSender<f32, MapHeader>,
@@ -28,9 +32,17 @@ impl Ports {
         agents: usize,
     ) -> Result<Self, TransportError> {
         let i = index as usize;
+        // With a bell the commit listener is one the coordinator does not send datagrams to;
+        // it still reports a coordinator that appears or dies.
+        let bell = Bell::from_env()?;
+        let commit = match bell {
+            Some(_) => transport.bell_receiver(topics::COMMIT, topics::commit_qos(agents))?,
+            None => transport.receiver(topics::COMMIT, topics::commit_qos(agents))?,
+        };
         Ok(Self {
             odom: transport.receiver(&topics::odometry(i), topics::state_qos())?,
-            commit: transport.receiver(topics::COMMIT, topics::commit_qos(agents))?,
+            commit,
+            bell: bell.map(Bell::into_watch).transpose()?,
             wheels: transport.sender(&topics::wheels(i), topics::state_qos())?,
             candidates: transport.sender(topics::CANDIDATES, topics::candidates_qos(agents))?,
             map: transport.slice_sender(&topics::map(i), grid.len(), topics::state_qos())?,

@@ -4,7 +4,7 @@
 use hnav_runtime::launch::LifecyclePorts;
 use hnav_runtime::msg::{Candidate, Commit, Progress, Role};
 use hnav_runtime::topics;
-use hnav_runtime::transport::{Receiver, Sender, Transport, TransportError};
+use hnav_runtime::transport::{Bell, Receiver, Sender, Transport, TransportError};
 
 /// Every port of the coordinator, opened before it announces itself.
 pub(super) struct Ports {
@@ -19,11 +19,16 @@ pub(super) struct Ports {
 }
 
 impl Ports {
-    /// Opens the ports of the coordinator of a swarm of `agents`.
+    /// Opens the ports of the coordinator of a swarm of `agents`. Under a supervisor the
+    /// commits ring the run's [`Bell`], which wakes every agent with one write.
     pub(super) fn open(transport: &Transport, agents: usize) -> Result<Self, TransportError> {
+        let mut commit = transport.sender(topics::COMMIT, topics::commit_qos(agents))?;
+        if let Some(bell) = Bell::from_env()? {
+            commit = commit.ringing(bell);
+        }
         Ok(Self {
             candidates: transport.receiver(topics::CANDIDATES, topics::candidates_qos(agents))?,
-            commit: transport.sender(topics::COMMIT, topics::commit_qos(agents))?,
+            commit,
             progress: transport.sender(topics::PROGRESS, topics::state_qos())?,
             life: LifecyclePorts::open(transport, Role::Coordinator, 0, agents)?,
         })

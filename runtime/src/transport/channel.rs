@@ -6,10 +6,13 @@ use iceoryx2::node::Node;
 use iceoryx2::port::backpressure_strategy::BackpressureStrategy;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::notifier::NotifierNotifyError;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::port::update_connections::UpdateConnections;
-use iceoryx2::prelude::{EventId, IceoryxSend, ServiceName, ZeroCopySend};
+use iceoryx2::prelude::{
+    CallbackProgression, EventId, IceoryxSend, PortName, ServiceName, ZeroCopySend,
+};
 use iceoryx2::sample::Sample;
 use iceoryx2::sample_mut::SampleMut;
 use iceoryx2::service::builder::event::{EventCreateError, EventOpenError, EventOpenOrCreateError};
@@ -18,6 +21,7 @@ use iceoryx2::service::builder::publish_subscribe::{
 };
 use iceoryx2::service::port_factory::event::PortFactory as EventFactory;
 
+use super::bell::{Bell, BELL_LISTENER};
 use super::{event_id, Delivery, Ipc, Qos, TransportError};
 
 /// How often and how long opening a service is retried while another process is creating or
@@ -140,12 +144,22 @@ fn create_notifier(
         .map_err(|e| TransportError::ipc("create notifier", name.as_str(), e))
 }
 
+/// A listener, named `port` if given (a [`BELL_LISTENER`] is woken by the bell, not by a
+/// datagram).
 fn create_listener(
     events: &EventFactory<Ipc>,
     name: &ServiceName,
+    port: Option<&str>,
 ) -> Result<Listener<Ipc>, TransportError> {
-    events
-        .listener_builder()
+    let mut builder = events.listener_builder();
+    if let Some(port) = port {
+        let port = PortName::new(port).map_err(|e| TransportError::InvalidName {
+            name: port.to_string(),
+            why: format!("{e:?}"),
+        })?;
+        builder = builder.name(&port);
+    }
+    builder
         .create()
         .map_err(|e| TransportError::ipc("create listener", name.as_str(), e))
 }
@@ -195,6 +209,8 @@ where
     name: ServiceName,
     publisher: Publisher<Ipc, P, H>,
     notifier: Notifier<Ipc>,
+    /// The run's commit bell, if this sender rings it ([`Sender::ringing`]).
+    bell: Option<Bell>,
 }
 
 impl<P, H> Sender<P, H>
@@ -216,6 +232,7 @@ where
             name,
             publisher,
             notifier,
+            bell: None,
         };
         sender.update_connections()?;
         Ok(sender)
@@ -226,16 +243,48 @@ where
         self.name.as_str()
     }
 
+    /// From now on every send rings `bell`, which wakes the receivers whose listener is a
+    /// [`BELL_LISTENER`] ([`Transport::bell_receiver`](super::Transport::bell_receiver)), and
+    /// notifies only the other listeners, one datagram each (see [`Bell`]).
+    pub fn ringing(mut self, bell: Bell) -> Self {
+        self.bell = Some(bell);
+        self
+    }
+
     /// Publishes a written sample and wakes the receivers; returns how many subscribers it
     /// reached.
     pub(crate) fn publish(&self, sample: SampleMut<Ipc, P, H>) -> Result<usize, TransportError> {
         let reached = sample
             .send()
             .map_err(|e| TransportError::ipc("send sample", self.name.as_str(), e))?;
-        self.notifier
-            .notify()
-            .map_err(|e| TransportError::ipc("notify", self.name.as_str(), e))?;
+        match &self.bell {
+            None => {
+                self.notifier
+                    .notify()
+                    .map_err(|e| TransportError::ipc("notify", self.name.as_str(), e))?;
+            }
+            Some(bell) => self.ring_and_notify_the_others(bell)?,
+        }
         Ok(reached)
+    }
+
+    /// Rings `bell`, then notifies every listener that is not a [`BELL_LISTENER`].
+    fn ring_and_notify_the_others(&self, bell: &Bell) -> Result<(), TransportError> {
+        bell.ring()?;
+        let mut failed = None;
+        self.notifier.for_each_listener(|listener, details| {
+            if details.listener_name != BELL_LISTENER {
+                if let Err(e) = listener.notify() {
+                    failed.get_or_insert(e);
+                }
+            }
+            CallbackProgression::Continue
+        });
+        match failed {
+            // A listener that left meanwhile is not an error of this send.
+            None | Some(NotifierNotifyError::InvalidListenerKey) => Ok(()),
+            Some(e) => Err(TransportError::ipc("notify", self.name.as_str(), e)),
+        }
     }
 
     pub(crate) fn loan_error(&self, e: impl Debug) -> TransportError {
@@ -333,9 +382,10 @@ where
         name: ServiceName,
         qos: &Qos,
         subscriber: Subscriber<Ipc, P, H>,
+        listener_port: Option<&str>,
     ) -> Result<Self, TransportError> {
         let events = open_event(node, &name, qos)?;
-        let listener = create_listener(&events, &name)?;
+        let listener = create_listener(&events, &name, listener_port)?;
         subscriber
             .update_connections()
             .map_err(|e| TransportError::ipc("connect subscriber", name.as_str(), e))?;
@@ -376,10 +426,12 @@ where
 }
 
 impl<T: Debug + ZeroCopySend + 'static> Receiver<T> {
+    /// Opens the receiver; its listener is named `listener_port` if given.
     pub(crate) fn open(
         node: &Node<Ipc>,
         name: ServiceName,
         qos: Qos,
+        listener_port: Option<&str>,
     ) -> Result<Self, TransportError> {
         let service = open_pubsub!(node, &name, qos, T)?;
         let subscriber = service
@@ -387,7 +439,7 @@ impl<T: Debug + ZeroCopySend + 'static> Receiver<T> {
             .buffer_size(qos.buffer)
             .create()
             .map_err(|e| TransportError::ipc("create subscriber", name.as_str(), e))?;
-        Self::assemble(node, name, &qos, subscriber)
+        Self::assemble(node, name, &qos, subscriber, listener_port)
     }
 
     /// Takes the oldest unread sample, if any. The sample stays in shared memory (zero-copy)

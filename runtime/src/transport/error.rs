@@ -40,6 +40,14 @@ pub enum TransportError {
         /// iceoryx2's error in words (`InsufficientPermissions` becomes "insufficient permissions").
         detail: String,
     },
+    /// The commit bell ([`Bell`](super::Bell)) could not be created, inherited or rung.
+    #[error("commit bell: {op}: {source}")]
+    Bell {
+        /// What was being done ("create", "inherit", "ring", "watch").
+        op: &'static str,
+        /// The system's error.
+        source: std::io::Error,
+    },
 }
 
 impl TransportError {

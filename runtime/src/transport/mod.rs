@@ -13,6 +13,8 @@
 //! - **One wait** ([`Waiter`], [`Wake`]): the only place a process blocks, on its receivers, an
 //!   interval and a deadline; it guarantees the drain order, tells a paused process from a
 //!   stopped one and bounds iceoryx2's lost wake-up.
+//! - **One wake-up for the whole swarm** ([`Bell`]): the coordinator wakes every agent with one
+//!   eventfd write instead of one datagram per agent.
 //! - **In-place slices** ([`SliceSender`], [`SliceReceiver`]): the neural-map snapshot is loaned
 //!   from shared memory and written there directly; no intermediate `Vec`.
 //! - **QoS from the swarm size** ([`Qos`]): iceoryx2's defaults allow two publishers per service;
@@ -36,6 +38,7 @@
 //! # Ok(()) }
 //! ```
 
+mod bell;
 mod channel;
 mod error;
 mod node;
@@ -44,6 +47,7 @@ mod run;
 mod slice;
 mod waiter;
 
+pub use bell::{Bell, BellWatch, BELL_ENV, BELL_LISTENER};
 pub use channel::{Drained, Receiver, Sender, Wakeup};
 pub use error::TransportError;
 pub use node::{CleanupReport, NodeInfo, NodeLiveness, Transport, TransportBuilder};

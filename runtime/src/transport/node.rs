@@ -120,7 +120,24 @@ impl Transport {
         topic: &str,
         qos: Qos,
     ) -> Result<Receiver<T>, TransportError> {
-        Receiver::open(&self.node, self.run.service_name(topic)?, qos)
+        Receiver::open(&self.node, self.run.service_name(topic)?, qos, None)
+    }
+
+    /// [`Transport::receiver`] for a process that watches the run's [`Bell`](super::Bell):
+    /// its listener is a [`BELL_LISTENER`](super::BELL_LISTENER), which a
+    /// [`Sender::send_ringing`](super::Sender::send_ringing) wakes by the bell instead of a
+    /// datagram. It still reports publishers that appear, leave or die.
+    pub fn bell_receiver<T: Debug + ZeroCopySend + 'static>(
+        &self,
+        topic: &str,
+        qos: Qos,
+    ) -> Result<Receiver<T>, TransportError> {
+        Receiver::open(
+            &self.node,
+            self.run.service_name(topic)?,
+            qos,
+            Some(super::BELL_LISTENER),
+        )
     }
 
     /// Opens the sending half of a slice topic whose samples hold at most `max_len` elements.

@@ -173,7 +173,7 @@ where
             .buffer_size(qos.buffer)
             .create()
             .map_err(|e| TransportError::ipc("create slice subscriber", name.as_str(), e))?;
-        Self::assemble(node, name, &qos, subscriber)
+        Self::assemble(node, name, &qos, subscriber, None)
     }
 
     /// Takes the oldest unread sample; `sample.user_header()` and `sample.payload()` read it in

@@ -79,6 +79,7 @@
 
 use core::cell::RefCell;
 use core::fmt::Debug;
+use std::os::fd::RawFd;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -89,6 +90,7 @@ use iceoryx2::waitset::{WaitSetAttachmentId, WaitSetGuard, WaitSetRunResult};
 use iceoryx2_bb_posix::file_descriptor_set::SynchronousMultiplexing;
 use iceoryx2_bb_posix::signal::SignalHandler;
 
+use super::bell::{take_ring, BellWatch};
 use super::{Ipc, Receiver, TransportError};
 
 /// The longest single timed sleep: iceoryx2 hands epoll the timeout in milliseconds as an
@@ -142,14 +144,14 @@ pub struct AttachmentId(WaitSetAttachmentId<Ipc>);
 #[must_use = "dropping an attachment detaches it at once"]
 pub struct Attachment<'w, 'a> {
     guard: WaitSetGuard<'w, 'a, Ipc>,
-    /// The waiter whose interval list names this attachment, if it is an interval.
-    interval_of: Option<&'w Waiter>,
+    /// The waiter whose interval or bell list names this attachment, if it is one of those.
+    listed_by: Option<&'w Waiter>,
 }
 
 impl Debug for Attachment<'_, '_> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("Attachment")
-            .field("interval", &self.interval_of.is_some())
+            .field("listed", &self.listed_by.is_some())
             .finish_non_exhaustive()
     }
 }
@@ -163,9 +165,10 @@ impl Attachment<'_, '_> {
 
 impl Drop for Attachment<'_, '_> {
     fn drop(&mut self) {
-        if let Some(waiter) = self.interval_of {
+        if let Some(waiter) = self.listed_by {
             let id = WaitSetAttachmentId::from_guard(&self.guard);
             waiter.intervals.borrow_mut().retain(|t| *t != id);
+            waiter.bells.borrow_mut().retain(|(b, _)| *b != id);
         }
     }
 }
@@ -180,6 +183,8 @@ pub struct Waiter {
     recheck: Option<Duration>,
     /// The attachment ids of attached intervals, to tell a tick from a signalled input.
     intervals: RefCell<Vec<WaitSetAttachmentId<Ipc>>>,
+    /// Attached bell watches and their epoll descriptors, whose rings the wait takes.
+    bells: RefCell<Vec<(WaitSetAttachmentId<Ipc>, RawFd)>>,
 }
 
 impl Debug for Waiter {
@@ -220,6 +225,7 @@ impl Waiter {
             handle_signals,
             recheck: Some(Self::LOST_WAKEUP_RECHECK),
             intervals: RefCell::new(Vec::new()),
+            bells: RefCell::new(Vec::new()),
         })
     }
 
@@ -261,8 +267,24 @@ impl Waiter {
             .push(WaitSetAttachmentId::from_guard(&guard));
         Ok(Attachment {
             guard,
-            interval_of: Some(self),
+            listed_by: Some(self),
         })
+    }
+
+    /// Wakes the waiter when the bell rings (see [`Bell`](super::Bell)). The wait takes each
+    /// ring it reports ([`BellWatch::take`]), before the loop drains its commits; a
+    /// ring left untaken would keep every later wait from sleeping.
+    pub fn attach_bell<'a>(
+        &self,
+        watch: &'a BellWatch,
+    ) -> Result<Attachment<'_, 'a>, TransportError> {
+        let mut attachment = self.attach_named(watch, "commit bell")?;
+        self.bells.borrow_mut().push((
+            WaitSetAttachmentId::from_guard(&attachment.guard),
+            watch.raw_fd(),
+        ));
+        attachment.listed_by = Some(self);
+        Ok(attachment)
     }
 
     /// Wakes the waiter when `fd` becomes readable (the supervisor's child exit descriptors).
@@ -288,7 +310,7 @@ impl Waiter {
             .map_err(|e| TransportError::ipc("attach to waiter", what, e))?;
         Ok(Attachment {
             guard,
-            interval_of: None,
+            listed_by: None,
         })
     }
 
@@ -329,11 +351,15 @@ impl Waiter {
         };
         let (mut any_signalled, mut ticked) = (false, false);
         let intervals = self.intervals.borrow();
+        let bells = self.bells.borrow();
         let result = self.waitset.wait_and_process_once_with_timeout(
             |id| {
                 if intervals.contains(&id) {
                     ticked = true;
                 } else {
+                    if let Some(&(_, fd)) = bells.iter().find(|(b, _)| *b == id) {
+                        take_ring(fd);
+                    }
                     any_signalled = true;
                     signalled(AttachmentId(id));
                 }

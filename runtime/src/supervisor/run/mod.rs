@@ -53,7 +53,7 @@ use crate::launch::ProcessArgs;
 use crate::msg::{Lifecycle, Progress, StopReason, Truth};
 use crate::scenario::{ClockMode, Scenario};
 use crate::topics;
-use crate::transport::{purge_run, Receiver, RunId, Transport, Wake};
+use crate::transport::{purge_run, Bell, Receiver, RunId, Transport, Wake};
 use error::io;
 use faults::FaultSchedule;
 use hang::HangWatch;
@@ -113,6 +113,9 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     result
 }
 
+/// Set to `1`, the supervisor runs without the commit [`Bell`] (for comparisons).
+pub const NO_BELL_ENV: &str = "HNAV_NO_BELL";
+
 /// The run once its id and directory are its own.
 fn run_owned(
     opts: &RunOptions,
@@ -151,7 +154,13 @@ fn run_owned(
     let mut record = registry.new_record(&run, &dir);
     record.set_process_args(&opts.args);
     let started = Instant::now();
-    let mut slots = Slots::new(&opts.args, &opts.bin_dir, &scenario, &dir);
+    // Kept open for the whole run: restarted processes inherit it too. `HNAV_NO_BELL=1` runs
+    // without it (one datagram per agent and commit, as before the bell), to compare.
+    let bell = match std::env::var_os(NO_BELL_ENV) {
+        Some(v) if v == "1" => None,
+        _ => Some(Bell::create()?),
+    };
+    let mut slots = Slots::new(&opts.args, &opts.bin_dir, &scenario, &dir, bell.as_ref());
     // The last ground truth seen: a sample does not outlive its publisher, so a sim that is
     // down at the end (or gone for good) leaves only what was taken while it ran.
     let mut truth = None;

@@ -15,7 +15,7 @@ use crate::supervisor::events::{RunEvent, RunEvents};
 use crate::supervisor::registry::RunRecord;
 use crate::supervisor::restart::{GiveUpReason, RestartDecision, RestartTracker};
 use crate::supervisor::startup::SupervisorPorts;
-use crate::transport::Transport;
+use crate::transport::{Bell, Transport, BELL_ENV};
 
 /// One process of the run and what the supervisor knows of it.
 struct Slot {
@@ -45,9 +45,15 @@ pub(super) struct Slots {
 
 impl Slots {
     /// The slots of `scenario`'s processes, started from `bin_dir` with `args` (and agents
-    /// with their `--index`), each one's output appended to `dir/logs/<node>.log`. Nothing
-    /// is spawned yet.
-    pub(super) fn new(args: &ProcessArgs, bin_dir: &Path, scenario: &Scenario, dir: &Path) -> Self {
+    /// with their `--index`), each one's output appended to `dir/logs/<node>.log`; the
+    /// coordinator and the agents are handed the commit `bell`, if any. Nothing is spawned yet.
+    pub(super) fn new(
+        args: &ProcessArgs,
+        bin_dir: &Path,
+        scenario: &Scenario,
+        dir: &Path,
+        bell: Option<&Bell>,
+    ) -> Self {
         let mut slots = Vec::with_capacity(2 + scenario.agents.len());
         let mut add = |role: Role, index: u32, program: &str| {
             let rule = match role {
@@ -65,6 +71,9 @@ impl Slots {
             }
             if role == Role::Agent {
                 spec = spec.arg("--index").arg(index.to_string());
+            }
+            if let Some(bell) = bell.filter(|_| role != Role::Sim) {
+                spec = spec.env(BELL_ENV, bell.env_value());
             }
             slots.push(Slot {
                 spec,
