@@ -2,6 +2,7 @@
 //! handshake (`Up` on `ready`, `Start` on `lifecycle`), lifecycle events, polite stop, and
 //! removal of the run's shared memory.
 
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -11,8 +12,9 @@ use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::msg::{Lifecycle, Role, StopReason};
 use hnav_runtime::scenario::FsyncPolicy;
 use hnav_runtime::supervisor::child::{Child, ChildSpec, ExitInfo, Signal};
+use hnav_runtime::supervisor::run::NO_BELL_ENV;
 use hnav_runtime::supervisor::startup::{Startup, SupervisorPorts};
-use hnav_runtime::transport::{purge_run, RunId, Transport};
+use hnav_runtime::transport::{purge_run, Bell, RunId, Transport, BELL_ENV};
 
 use super::layout::Layout;
 use super::swarm::Swarm;
@@ -145,8 +147,18 @@ fn session<T>(
     let n = layout.agents();
     let transport = Transport::builder(run).node_name("supervisor").create()?;
     let life = SupervisorPorts::open(&transport, n)?;
+    // The commit bell, as `hnav run` hands it out (and, like it, not with HNAV_NO_BELL=1).
+    let bell = match std::env::var_os(NO_BELL_ENV) {
+        Some(v) if v == "1" => None,
+        _ => Some(Bell::create()?),
+    };
+    let env = bell
+        .as_ref()
+        .map(|b| (OsString::from(BELL_ENV), OsString::from(b.env_value())))
+        .into_iter()
+        .collect();
     // Every agent port exists before the coordinator starts, as after a real start-up.
-    let mut swarm = Swarm::open(run, layout)?;
+    let mut swarm = Swarm::open(run, layout, bell)?;
     let args = ProcessArgs {
         run: run.as_str().to_string(),
         scenario,
@@ -164,7 +176,7 @@ fn session<T>(
         program: program.to_path_buf(),
         args: args.to_args(),
         log_file: log_file.clone(),
-        env: Vec::new(),
+        env,
     };
     let spawned = Instant::now();
     let child = Child::spawn(&spec).context("start hnav-coordinator")?;

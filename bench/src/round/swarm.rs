@@ -11,7 +11,9 @@ use hnav_runtime::msg::{Candidate, CandidateFlags, Commit, Lifecycle, Role};
 use hnav_runtime::supervisor::child::Child;
 use hnav_runtime::supervisor::startup::SupervisorPorts;
 use hnav_runtime::topics;
-use hnav_runtime::transport::{AttachmentId, Receiver, RunId, Sender, Transport, Wake};
+use hnav_runtime::transport::{
+    AttachmentId, Bell, BellWatch, Receiver, RunId, Sender, Transport, Wake,
+};
 
 use super::layout::Layout;
 
@@ -63,12 +65,17 @@ pub struct Swarm {
     next_round: u64,
     tx: Vec<Option<Sender<Candidate>>>,
     rx: Vec<Option<Receiver<Commit>>>,
+    /// Each agent's watch of the commit bell, when the run has one (as each agent process
+    /// has its own).
+    watch: Vec<Option<BellWatch>>,
+    bell: Option<Bell>,
     transport: Transport,
 }
 
 impl Swarm {
-    /// Opens every agent's ports.
-    pub fn open(run: &RunId, layout: Layout) -> Result<Self> {
+    /// Opens every agent's ports; with a `bell`, each agent watches it and its commit
+    /// listener is one the coordinator does not send datagrams to.
+    pub fn open(run: &RunId, layout: Layout, bell: Option<Bell>) -> Result<Self> {
         let n = layout.agents();
         let transport = Transport::builder(run).node_name("bench-agents").create()?;
         let mut swarm = Swarm {
@@ -78,6 +85,8 @@ impl Swarm {
             next_round: 1,
             tx: (0..n).map(|_| None).collect(),
             rx: (0..n).map(|_| None).collect(),
+            watch: (0..n).map(|_| None).collect(),
+            bell,
             transport,
         };
         for i in 0..n {
@@ -93,10 +102,12 @@ impl Swarm {
             self.transport
                 .sender(topics::CANDIDATES, topics::candidates_qos(n))?,
         );
-        self.rx[i] = Some(
-            self.transport
-                .receiver(topics::COMMIT, topics::commit_qos(n))?,
-        );
+        let qos = topics::commit_qos(n);
+        self.rx[i] = Some(match &self.bell {
+            Some(_) => self.transport.bell_receiver(topics::COMMIT, qos)?,
+            None => self.transport.receiver(topics::COMMIT, qos)?,
+        });
+        self.watch[i] = self.bell.as_ref().map(Bell::watch).transpose()?;
         Ok(())
     }
 
@@ -104,6 +115,7 @@ impl Swarm {
     pub fn kill(&mut self, i: usize) {
         self.tx[i] = None;
         self.rx[i] = None;
+        self.watch[i] = None;
         self.order.retain(|&j| j != i);
     }
 
@@ -144,14 +156,20 @@ impl Swarm {
         let exit_id = exit.id();
         let mut attached = Vec::with_capacity(n);
         let mut owner: HashMap<AttachmentId, usize> = HashMap::with_capacity(n);
+        let mut live = 0;
         for (i, rx) in self.rx.iter().enumerate() {
             if let Some(rx) = rx {
                 let a = waiter.attach(rx)?;
                 owner.insert(a.id(), i);
                 attached.push(a);
+                live += 1;
+            }
+            if let Some(w) = &self.watch[i] {
+                let a = waiter.attach_bell(w)?;
+                owner.insert(a.id(), i);
+                attached.push(a);
             }
         }
-        let live = attached.len();
         let mut got: Vec<Option<(Instant, bool)>> = vec![None; n];
         let mut fired: Vec<usize> = Vec::with_capacity(n);
         let mut played = 0;

@@ -22,12 +22,16 @@ impl Ports {
     /// Opens the ports of the coordinator of a swarm of `agents`. Under a supervisor the
     /// commits ring the run's [`Bell`], which wakes every agent with one write.
     pub(super) fn open(transport: &Transport, agents: usize) -> Result<Self, TransportError> {
+        // The candidates' subscriber first: creating the commit sender tells every agent that
+        // a coordinator is up, and a restarted coordinator's agents answer with their open
+        // candidate at once, which a subscriber created after that would never see.
+        let candidates = transport.receiver(topics::CANDIDATES, topics::candidates_qos(agents))?;
         let mut commit = transport.sender(topics::COMMIT, topics::commit_qos(agents))?;
         if let Some(bell) = Bell::from_env()? {
             commit = commit.ringing(bell);
         }
         Ok(Self {
-            candidates: transport.receiver(topics::CANDIDATES, topics::candidates_qos(agents))?,
+            candidates,
             commit,
             progress: transport.sender(topics::PROGRESS, topics::state_qos())?,
             life: LifecyclePorts::open(transport, Role::Coordinator, 0, agents)?,

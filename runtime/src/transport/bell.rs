@@ -269,4 +269,45 @@ mod tests {
         inherited.ring().unwrap();
         assert!(watch.take(), "the inherited bell rings the same eventfd");
     }
+
+    /// A ringing sender wakes a bell receiver by the bell only (no datagram: its listener
+    /// has no data event) and a plain receiver by its datagram; both get the sample.
+    #[test]
+    fn a_ringing_send_sends_datagrams_only_to_plain_listeners() {
+        use crate::transport::{purge_run, Qos, RunId, Transport};
+        struct Run(RunId);
+        impl Drop for Run {
+            fn drop(&mut self) {
+                let _ = purge_run(&self.0);
+            }
+        }
+        let run = Run(RunId::unique("bellsend"));
+        let t = Transport::builder(&run.0)
+            .handle_signals(false)
+            .create()
+            .unwrap();
+        let qos = Qos::reliable(2);
+        let agent = t.bell_receiver::<u64>("commit", qos).unwrap();
+        let viewer = t.receiver::<u64>("commit", qos).unwrap();
+        let bell = Bell::create().unwrap();
+        let watch = bell.watch().unwrap();
+        let tx = t.sender::<u64>("commit", qos).unwrap().ringing(bell);
+        // The sender's appearance reaches both listeners (iceoryx2's own event).
+        assert!(agent.take_wakeup().unwrap().peer_up);
+        assert!(viewer.take_wakeup().unwrap().peer_up);
+        tx.send(7).unwrap();
+        assert!(watch.take(), "the bell rang");
+        assert!(
+            !agent.take_wakeup().unwrap().data,
+            "no datagram to a bell listener"
+        );
+        assert!(
+            viewer.take_wakeup().unwrap().data,
+            "a datagram to a plain listener"
+        );
+        let mut got = (0, 0);
+        agent.drain(|&v| got.0 = v).unwrap();
+        viewer.drain(|&v| got.1 = v).unwrap();
+        assert_eq!(got, (7, 7));
+    }
 }

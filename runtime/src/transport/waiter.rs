@@ -454,6 +454,38 @@ mod tests {
         assert_eq!(busy.drain_pending(|_| {}).unwrap().samples, 1);
     }
 
+    /// A ring wakes the waiter and is taken by the wait: the next wait sleeps until its
+    /// deadline instead of returning at once for ever (the watch is level-triggered in the
+    /// `WaitSet`), and a later ring wakes it again.
+    #[test]
+    fn a_bell_ring_wakes_the_waiter_once() {
+        use crate::transport::Bell;
+        let run = Run(RunId::unique("waitbell"));
+        let t = Transport::builder(&run.0)
+            .handle_signals(false)
+            .create()
+            .unwrap();
+        let waiter = t.waiter().unwrap().with_recheck(None);
+        let bell = Bell::create().unwrap();
+        let watch = bell.watch().unwrap();
+        let at = waiter.attach_bell(&watch).unwrap();
+        let long = Instant::now() + Duration::from_secs(30);
+        bell.ring().unwrap();
+        let mut fired = Vec::new();
+        assert_eq!(
+            waiter.wait_with(Some(long), |id| fired.push(id)).unwrap(),
+            Wake::Data
+        );
+        assert_eq!(fired, vec![at.id()]);
+        assert!(!watch.take(), "the wait took the ring");
+        let short = Instant::now() + Duration::from_millis(50);
+        assert_eq!(waiter.wait(Some(short)).unwrap(), Wake::TimedOut);
+        bell.ring().unwrap();
+        assert_eq!(waiter.wait(Some(long)).unwrap(), Wake::Data);
+        drop(at);
+        assert!(waiter.bells.borrow().is_empty(), "detached");
+    }
+
     #[test]
     fn a_dropped_interval_no_longer_counts_as_a_tick() {
         let run = Run(RunId::unique("waittick"));
