@@ -15,13 +15,16 @@
 //!
 //! Mechanisms:
 //!
-//! - `hnav`: what HNAV does today. Each waiter is a node with a commit `Receiver` blocked in
-//!   its own [`Waiter`](hnav_runtime::transport::Waiter); the notifier publishes a `u64` round
-//!   with `Sender::send` (loan, publish to N subscribers, notify N listeners).
-//! - `eventfd`: a candidate replacement that still fits a waiter's `epoll`: one eventfd, and
-//!   each waiter its own epoll instance watching it edge-triggered; the notifier stores the
-//!   round in shared memory and writes the eventfd once. Edge-triggered, so no waiter needs to
-//!   read (and so reset) the counter the others watch.
+//! - `hnav`: HNAV's commit path without the bell (what it was before it, and what a process
+//!   started without a supervisor still does). Each waiter is a node with a commit `Receiver`
+//!   blocked in its own [`Waiter`](hnav_runtime::transport::Waiter); the notifier publishes a
+//!   `u64` round with `Sender::send` (loan, publish to N subscribers, notify N listeners).
+//! - `hnav-bell`: the same with the commit [`Bell`] (`hnav run`'s default): bell receivers,
+//!   each waiter's `Waiter` watching the bell; the notifier publishes and rings once.
+//! - `eventfd`: the bare mechanism the bell is built on: one eventfd, and each waiter its own
+//!   epoll instance watching it edge-triggered; the notifier stores the round in shared memory
+//!   and writes the eventfd once. Edge-triggered, so no waiter needs to read (and so reset)
+//!   the counter the others watch.
 //! - `futex`: the floor. The round in a shared word, one `FUTEX_WAKE` for every waiter. A
 //!   futex cannot join an `epoll` set, so an agent that also waits for odometry and lifecycle
 //!   events could not use it as it is.
@@ -41,7 +44,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 
 use hnav_runtime::topics;
-use hnav_runtime::transport::{purge_run, RunId, Transport, Wake};
+use hnav_runtime::transport::{purge_run, Bell, RunId, Transport, Wake};
 
 use crate::futex;
 use crate::latency::Summary;
@@ -61,8 +64,12 @@ const STUCK: Duration = Duration::from_secs(10);
 /// How the notifier wakes the waiters.
 #[derive(Clone, Copy, PartialEq, Eq, Debug, ValueEnum)]
 pub enum Mechanism {
-    /// HNAV's commit path: publish + iceoryx2 notify, one `Waiter` per waiter.
+    /// HNAV's commit path without the bell: publish + iceoryx2 notify (one datagram per
+    /// listener), one `Waiter` per waiter.
     Hnav,
+    /// HNAV's commit path with the bell (`hnav run`'s default): publish + one eventfd write,
+    /// each waiter's `Waiter` watching the bell.
+    HnavBell,
     /// One eventfd write; each waiter's own epoll watches it edge-triggered.
     Eventfd,
     /// One `FUTEX_WAKE` for all waiters (the floor; cannot join an epoll set).
@@ -73,6 +80,7 @@ impl Mechanism {
     fn name(self) -> &'static str {
         match self {
             Self::Hnav => "hnav",
+            Self::HnavBell => "hnav-bell",
             Self::Eventfd => "eventfd",
             Self::Futex => "futex",
         }
@@ -86,7 +94,11 @@ pub struct FanoutArgs {
     #[arg(long, value_delimiter = ',', default_value = "1,8,32,128,256")]
     pub listeners: Vec<usize>,
     /// Mechanisms to measure.
-    #[arg(long, value_delimiter = ',', default_value = "hnav,eventfd,futex")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "hnav,hnav-bell,eventfd,futex"
+    )]
     pub mechanisms: Vec<Mechanism>,
     /// Measured commits per point (default 2000, 200 with --quick).
     #[arg(long)]
@@ -264,16 +276,25 @@ fn measure_in(run: &RunId, mechanism: Mechanism, n: usize, rounds: usize) -> Res
         seen_ns: (0..n).map(|_| AtomicU64::new(0)).collect(),
         abort: AtomicBool::new(false),
     });
-    let notifier = Notifier::open(mechanism, run, n)?;
+    let bell = match mechanism {
+        Mechanism::HnavBell => Some(Bell::create()?),
+        _ => None,
+    };
+    let notifier = Notifier::open(mechanism, run, n, bell.as_ref())?;
     let total = (WARMUP + rounds) as u64;
     std::thread::scope(|s| {
         let mut handles = Vec::with_capacity(n);
         // Only the descriptor crosses to the waiters (iceoryx2 ports stay on their thread).
-        let eventfd = notifier.eventfd();
+        let side = WaiterSide {
+            mechanism,
+            run,
+            eventfd: notifier.eventfd(),
+            bell: bell.as_ref(),
+        };
         for k in 0..n {
             let shared = &shared;
             handles.push(s.spawn(move || {
-                let r = waiter(mechanism, run, eventfd, shared, k, n, total);
+                let r = waiter(side, shared, k, n, total);
                 if r.is_err() {
                     shared.abort.store(true, Ordering::Relaxed);
                     // Wake the notifier wherever it waits.
@@ -350,17 +371,20 @@ fn notify_rounds(
     Ok((notify, first, last))
 }
 
+/// What a waiter needs to set up its side of the mechanism.
+#[derive(Clone, Copy)]
+struct WaiterSide<'a> {
+    mechanism: Mechanism,
+    run: &'a RunId,
+    /// The `eventfd` mechanism's descriptor (only the number crosses threads).
+    eventfd: libc::c_int,
+    /// The `hnav-bell` mechanism's bell.
+    bell: Option<&'a Bell>,
+}
+
 /// One waiter: sets up its side of `mechanism`, then per commit announces it is armed,
 /// waits until it sees the commit, and stamps when it did.
-fn waiter(
-    mechanism: Mechanism,
-    run: &RunId,
-    eventfd: libc::c_int,
-    shared: &Shared,
-    k: usize,
-    n: usize,
-    total: u64,
-) -> Result<()> {
+fn waiter(side: WaiterSide<'_>, shared: &Shared, k: usize, n: usize, total: u64) -> Result<()> {
     let rounds = |wait: &mut dyn FnMut(u64) -> Result<()>| -> Result<()> {
         for r in 1..=total {
             shared.arrive(&shared.armed, n);
@@ -370,15 +394,30 @@ fn waiter(
         }
         Ok(())
     };
+    let WaiterSide {
+        mechanism,
+        run,
+        eventfd,
+        bell,
+    } = side;
     match mechanism {
-        Mechanism::Hnav => {
-            // An agent's commit receiver in its own node and `Waiter`, attached once.
+        Mechanism::Hnav | Mechanism::HnavBell => {
+            // An agent's commit receiver in its own node and `Waiter`, attached once; with
+            // the bell, its listener is a bell listener and the waiter watches the bell.
             let transport = Transport::builder(run)
                 .node_name(&format!("fanout-{k}"))
                 .create()?;
-            let receiver = transport.receiver::<u64>(topics::COMMIT, topics::commit_qos(n))?;
+            let qos = topics::commit_qos(n);
+            let (receiver, watch) = match bell {
+                Some(bell) => (
+                    transport.bell_receiver::<u64>(topics::COMMIT, qos)?,
+                    Some(bell.watch()?),
+                ),
+                None => (transport.receiver::<u64>(topics::COMMIT, qos)?, None),
+            };
             let waiter = transport.waiter()?;
             let _attached = waiter.attach(&receiver)?;
+            let _bell = watch.as_ref().map(|w| waiter.attach_bell(w)).transpose()?;
             let mut seen = 0;
             rounds(&mut |r| loop {
                 receiver.drain_pending(|&v| seen = seen.max(v))?;
@@ -411,13 +450,16 @@ enum Notifier {
 }
 
 impl Notifier {
-    fn open(mechanism: Mechanism, run: &RunId, n: usize) -> Result<Self> {
+    fn open(mechanism: Mechanism, run: &RunId, n: usize, bell: Option<&Bell>) -> Result<Self> {
         Ok(match mechanism {
-            Mechanism::Hnav => {
+            Mechanism::Hnav | Mechanism::HnavBell => {
                 let transport = Transport::builder(run)
                     .node_name("fanout-notifier")
                     .create()?;
-                let sender = transport.sender::<u64>(topics::COMMIT, topics::commit_qos(n))?;
+                let mut sender = transport.sender::<u64>(topics::COMMIT, topics::commit_qos(n))?;
+                if let Some(bell) = bell {
+                    sender = sender.ringing(bell.try_clone()?);
+                }
                 Notifier::Hnav {
                     sender: Box::new(sender),
                     _transport: Box::new(transport),
@@ -562,7 +604,12 @@ mod tests {
     /// 100 ms re-check, not a failure, so this checks delivery and the shape, not speed).
     #[test]
     fn every_mechanism_wakes_every_waiter_for_every_commit() {
-        for m in [Mechanism::Hnav, Mechanism::Eventfd, Mechanism::Futex] {
+        for m in [
+            Mechanism::Hnav,
+            Mechanism::HnavBell,
+            Mechanism::Eventfd,
+            Mechanism::Futex,
+        ] {
             let p = measure(m, 3, 20).unwrap();
             assert_eq!(p.listeners, 3);
             assert_eq!(p.last.n, 20);

@@ -69,7 +69,7 @@ fn fanout_points(dir: &std::path::Path) {
         seen.insert((cols[0].to_string(), cols[1].parse::<usize>().unwrap()));
     }
     let mut expected = BTreeSet::new();
-    for m in ["hnav", "eventfd", "futex"] {
+    for m in ["hnav", "hnav-bell", "eventfd", "futex"] {
         for n in [1, 8, 32, 128, 256] {
             expected.insert((m.to_string(), n));
         }

@@ -116,6 +116,13 @@ impl Bell {
         Ok(Self { fd })
     }
 
+    /// A second handle on the same eventfd (a `dup`, closed on exec): rings of either wake the
+    /// watchers of both.
+    pub fn try_clone(&self) -> Result<Self, TransportError> {
+        let fd = self.fd.try_clone().map_err(|e| bell_error("clone", e))?;
+        Ok(Self { fd })
+    }
+
     /// The descriptor number to put in a child's [`BELL_ENV`].
     pub fn env_value(&self) -> String {
         self.fd.as_raw_fd().to_string()
