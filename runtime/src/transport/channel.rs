@@ -268,9 +268,9 @@ where
         Ok(reached)
     }
 
-    /// Rings `bell`, then notifies every listener that is not a [`BELL_LISTENER`].
+    /// Notifies every listener that is not a [`BELL_LISTENER`], then rings `bell`: last, so
+    /// that the woken agents do not preempt this loop on a busy machine.
     fn ring_and_notify_the_others(&self, bell: &Bell) -> Result<(), TransportError> {
-        bell.ring()?;
         let mut failed = None;
         self.notifier.for_each_listener(|listener, details| {
             if details.listener_name != BELL_LISTENER {
@@ -280,6 +280,7 @@ where
             }
             CallbackProgression::Continue
         });
+        bell.ring()?;
         match failed {
             // A listener that left meanwhile is not an error of this send.
             None | Some(NotifierNotifyError::InvalidListenerKey) => Ok(()),
