@@ -15,7 +15,7 @@
 //!
 //! **Who rings, who listens.** The coordinator publishes a commit, rings, and notifies by
 //! datagram only the commit listeners that are not named [`BELL_LISTENER`]
-//! ([`Sender::send_ringing`](super::Sender::send_ringing)): viewers, observers, the Python
+//! ([`Sender::ringing`](super::Sender::ringing)): viewers, observers, the Python
 //! client and a bell-less agent still get theirs. An agent with a bell names its commit
 //! listener so and watches the bell with its own epoll instance ([`BellWatch`]); its listener
 //! still reports a coordinator that appears or dies (iceoryx2 sends those events itself).

@@ -125,7 +125,7 @@ impl Transport {
 
     /// [`Transport::receiver`] for a process that watches the run's [`Bell`](super::Bell):
     /// its listener is a [`BELL_LISTENER`](super::BELL_LISTENER), which a
-    /// [`Sender::send_ringing`](super::Sender::send_ringing) wakes by the bell instead of a
+    /// sender made [`ringing`](super::Sender::ringing) wakes by the bell instead of a
     /// datagram. It still reports publishers that appear, leave or die.
     pub fn bell_receiver<T: Debug + ZeroCopySend + 'static>(
         &self,
