@@ -113,8 +113,21 @@ impl TestRun {
     /// Starts `program` with exactly `args` (the caller places the run id, e.g. after a
     /// subcommand: `hnav run --run <id> ...`).
     pub fn spawn_exact(&mut self, program: &str, args: &[String]) -> Result<Peer, String> {
+        self.spawn_exact_env(program, args, &[])
+    }
+
+    /// [`TestRun::spawn_exact`] with `env` added to the child's environment only. Tests of
+    /// one binary run in parallel threads of one process, so a variable that differs between
+    /// them must never go through `std::env::set_var`: another test's spawn would inherit it.
+    pub fn spawn_exact_env(
+        &mut self,
+        program: &str,
+        args: &[String],
+        env: &[(&str, &std::path::Path)],
+    ) -> Result<Peer, String> {
         let mut child = Command::new(program)
             .args(args)
+            .envs(env.iter().map(|(k, v)| (*k, *v)))
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())

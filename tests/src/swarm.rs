@@ -45,8 +45,6 @@ impl SwarmRun {
         registry: &Path,
         extra: &[&str],
     ) -> Result<SwarmRun, String> {
-        // Every test of a binary sets the same value, so the race is harmless.
-        std::env::set_var("HNAV_RUNS_DIR", registry);
         let mut args: Vec<String> = vec![
             "run".into(),
             scenario.display().to_string(),
@@ -57,7 +55,13 @@ impl SwarmRun {
         ];
         args.extend(extra.iter().map(|s| s.to_string()));
         let hnav = workspace_bin("hnav");
-        let peer = run.spawn_exact(&hnav.display().to_string(), &args)?;
+        // Only the child gets the registry: two tests of one binary with their own registries
+        // raced on a process-wide `set_var`, and a run registered in the other test's one.
+        let peer = run.spawn_exact_env(
+            &hnav.display().to_string(),
+            &args,
+            &[("HNAV_RUNS_DIR", registry)],
+        )?;
         Ok(SwarmRun {
             peer,
             dir: dir.to_path_buf(),
