@@ -20,7 +20,8 @@
 //! hybrid replanning above (`dissertation`), or [`Pibt`] (`pibt`), which may move an agent
 //! other than it asked, also one that asked for nothing; such a decision is published only
 //! when the agent moves. PIBT needs no replanning (its priorities rise until an agent gets
-//! through), so none is made in that mode.
+//! through), so none is made in that mode. [`Lacam`] (`lacam`) plans every robot's moves at
+//! once and executes the plan, deciding like `pibt` (no replanning either).
 
 use hnav_runtime::consensus_log::{LoggedDecision, ReplanRecord, RoundRecord, Tally};
 use hnav_runtime::grid::{Cell, Direction, Grid};
@@ -28,7 +29,7 @@ use hnav_runtime::msg::{Candidate, CandidateFlags, Decision, Verdict, NO_CELL};
 use hnav_runtime::rejected::Rejected;
 use hnav_runtime::scenario::{Rules, Scenario};
 
-use crate::conflict::{AgentMode, AgentRow, Options, Outcome, Pibt, Resolver};
+use crate::conflict::{AgentMode, AgentRow, Lacam, Options, Outcome, Pibt, Resolver};
 use crate::planner::{AStar, LazyTheta, Planner, PlannerConfig};
 
 /// How many A* steps ahead the fallback waypoint lies.
@@ -38,6 +39,7 @@ const FALLBACK_STEPS: usize = 4;
 enum Round {
     Dissertation(Resolver),
     Pibt(Box<Pibt>),
+    Lacam(Box<Lacam>),
 }
 
 /// The coordinator's round logic; see the [module docs](self).
@@ -75,6 +77,7 @@ impl Arbiter {
         let round = match scenario.coordinator.rules {
             Rules::Dissertation => Round::Dissertation(Resolver::new(&grid, n, options)),
             Rules::Pibt => Round::Pibt(Box::new(Pibt::new(&grid, &goals, options))),
+            Rules::Lacam => Round::Lacam(Box::new(Lacam::new(&grid, &goals, options))),
         };
         Arbiter {
             scratch: grid.clone(),
@@ -203,6 +206,10 @@ impl Arbiter {
             }
             Round::Pibt(p) => {
                 p.resolve(&self.rows, &mut self.outcomes);
+                false
+            }
+            Round::Lacam(l) => {
+                l.resolve(&self.rows, &mut self.outcomes);
                 false
             }
         };

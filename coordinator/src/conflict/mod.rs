@@ -73,6 +73,7 @@
 //! agent) with generation stamps instead of clearing per-cell tables, and allocates nothing
 //! (the caller's `out` keeps its capacity).
 
+pub mod lacam;
 pub mod pibt;
 mod resolve;
 #[cfg(test)]
@@ -81,6 +82,7 @@ mod tests;
 use hnav_runtime::grid::{Cell, CornerCutting, Direction, Grid};
 use hnav_runtime::msg::{ConflictKind, Decision, Verdict, NO_CELL};
 
+pub use lacam::Lacam;
 pub use pibt::Pibt;
 pub use resolve::Resolver;
 

@@ -146,6 +146,7 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
         h.u64(match c.rules {
             Rules::Dissertation => 0,
             Rules::Pibt => 1,
+            Rules::Lacam => 2,
         });
     }
 

@@ -199,14 +199,19 @@ pub enum Rules {
     /// Priority inheritance with backtracking (PIBT, Okumura et al.): the coordinator may move
     /// an agent out of a higher-priority agent's way, and priorities rise with waiting.
     Pibt,
+    /// PIBT made complete: the coordinator plans every robot's moves at once with LaCAM
+    /// (Okumura, AAAI 2023) and executes the plan as an action dependency graph, falling back
+    /// to online PIBT when a search fails.
+    Lacam,
 }
 
 impl Rules {
-    /// The name used in scenario files: `"dissertation"` or `"pibt"`.
+    /// The name used in scenario files: `"dissertation"`, `"pibt"` or `"lacam"`.
     pub fn name(self) -> &'static str {
         match self {
             Rules::Dissertation => "dissertation",
             Rules::Pibt => "pibt",
+            Rules::Lacam => "lacam",
         }
     }
 }

@@ -180,13 +180,20 @@ fn rules_count_in_the_hash_only_off_the_default_and_a_bad_name_is_a_located_erro
     let c = parse(&with("pibt")).unwrap();
     assert_eq!(c.coordinator.rules, Rules::Pibt);
     assert_ne!(a.scenario_hash(), c.scenario_hash());
+    let l = parse(&with("lacam")).unwrap();
+    assert_eq!(l.coordinator.rules, Rules::Lacam);
+    assert_ne!(l.scenario_hash(), a.scenario_hash());
+    assert_ne!(l.scenario_hash(), c.scenario_hash());
     let text = with("fifo");
     let e = parse(&text).unwrap_err();
     let line = text.lines().position(|l| l.starts_with("rules")).unwrap() + 1;
     assert_eq!(e.line(), Some(line), "{e}");
     let msg = e.to_string();
     assert!(
-        msg.contains("fifo") && msg.contains("`dissertation`") && msg.contains("`pibt`"),
+        msg.contains("fifo")
+            && msg.contains("`dissertation`")
+            && msg.contains("`pibt`")
+            && msg.contains("`lacam`"),
         "{msg}"
     );
 }

@@ -67,7 +67,7 @@
 pub mod distance;
 mod swap;
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 
 use hnav_runtime::grid::{Cell, Direction, Grid};
 use hnav_runtime::msg::{ConflictKind, Verdict};

@@ -3,12 +3,15 @@
 use hnav_runtime::grid::{Cell, Direction, Grid};
 use hnav_runtime::msg::{ConflictKind, Verdict};
 
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
 use super::distance::can_step;
 use super::Pibt;
-use crate::conflict::{AgentMode, AgentRow, Options, Outcome};
+use crate::conflict::{AgentMode, AgentRow, Lacam, Options, Outcome};
 
-mod mapf;
-mod props;
+pub(crate) mod mapf;
+pub(crate) mod props;
 
 fn c(x: u32, y: u32) -> Cell {
     Cell::new(x, y)
@@ -17,16 +20,23 @@ fn c(x: u32, y: u32) -> Cell {
 /// Agents on a grid, each at rest asking for its greedy step (the neighbour closest to its
 /// goal, other agents ignored); an accepted move holds both cells for the next round and
 /// arrives at its end.
-pub(super) struct World {
+pub(crate) struct World {
     pub grid: Grid,
     pub goals: Vec<Cell>,
     pub rows: Vec<AgentRow>,
     pub pibt: Pibt,
+    /// When set, the rounds are LaCAM's (`rules = "lacam"`), not `pibt`'s.
+    pub lacam: Option<Lacam>,
     pub out: Vec<Outcome>,
     /// Per agent, whether it has stood on its goal at rest at some round.
     pub reached: Vec<bool>,
     /// Per cell, the agent holding it (checker scratch).
     holder: Vec<u32>,
+    /// When set, a driving robot arrives with probability 1/3 a round (robots at their own
+    /// pace); else the round after its accept.
+    pub pace: Option<ChaCha8Rng>,
+    /// Per agent, whether it has stopped (standing: it asks nothing and is never moved).
+    pub stopped: Vec<bool>,
 }
 
 impl World {
@@ -37,12 +47,24 @@ impl World {
             .collect();
         World {
             pibt: Pibt::new(&grid, goals, Options::default()),
+            lacam: None,
             reached: vec![false; starts.len()],
             holder: vec![u32::MAX; grid.len()],
+            pace: None,
+            stopped: vec![false; starts.len()],
             grid,
             goals: goals.to_vec(),
             rows,
             out: Vec::new(),
+        }
+    }
+
+    /// The same world decided by LaCAM rounds.
+    pub fn with_lacam(grid: Grid, starts: &[Cell], goals: &[Cell]) -> Self {
+        let lacam = Lacam::new(&grid, goals, Options::default());
+        World {
+            lacam: Some(lacam),
+            ..World::new(grid, starts, goals)
         }
     }
 
@@ -67,13 +89,15 @@ impl World {
     pub fn ask(&mut self) {
         for i in 0..self.rows.len() {
             let at_goal = self.rows[i].is_at_rest() && self.rows[i].current == self.goals[i];
-            let probable = if self.rows[i].is_at_rest() && !at_goal {
+            let probable = if self.rows[i].is_at_rest() && !at_goal && !self.stopped[i] {
                 self.greedy(i)
             } else {
                 None
             };
             let row = &mut self.rows[i];
-            row.mode = if at_goal {
+            row.mode = if self.stopped[i] {
+                AgentMode::Standing
+            } else if at_goal {
                 AgentMode::Finished
             } else {
                 AgentMode::Active
@@ -89,10 +113,15 @@ impl World {
         for (r, row) in self.reached.iter_mut().zip(&self.rows) {
             *r |= row.mode == AgentMode::Finished;
         }
-        self.pibt.resolve(&self.rows, &mut self.out);
+        match &mut self.lacam {
+            Some(l) => l.resolve(&self.rows, &mut self.out),
+            None => self.pibt.resolve(&self.rows, &mut self.out),
+        }
         for (row, o) in self.rows.iter_mut().zip(&self.out) {
             if !row.is_at_rest() {
-                row.current = row.next;
+                if self.pace.as_mut().is_none_or(|r| r.gen_ratio(1, 3)) {
+                    row.current = row.next;
+                }
             } else if o.verdict == Verdict::Accept {
                 let to = o.cell.ok_or("an accept without a cell")?;
                 if Direction::between(row.current, to).is_none() {
@@ -125,11 +154,13 @@ impl World {
         Ok(())
     }
 
+    /// Whether every agent that has not stopped is at rest on its goal.
     pub fn all_home(&self) -> bool {
         self.rows
             .iter()
             .zip(&self.goals)
-            .all(|(r, &g)| r.is_at_rest() && r.current == g)
+            .zip(&self.stopped)
+            .all(|((r, &g), &stopped)| stopped || (r.is_at_rest() && r.current == g))
     }
 
     /// Steps until every agent is home; the rounds it took, or the first checker error.

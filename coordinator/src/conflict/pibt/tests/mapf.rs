@@ -11,29 +11,46 @@ fn maps_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../maps")
 }
 
-/// Runs the first `n` entries of `scen` on `map` for at most `limit` rounds, with or without
-/// the swap operation; the rounds until all were home at once, or the agents away at the end.
-pub(super) fn run(
+/// The rounds of a run of the model.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(crate) enum Rounds {
+    Pibt,
+    /// PIBT with the swap operation.
+    PibtSwap,
+    Lacam,
+}
+
+/// Runs the first `n` entries of `scen` on `map` for at most `limit` rounds; the rounds until
+/// all were home at once, or the agents away at the end.
+pub(crate) fn run(
     map: &str,
     scen: &str,
     n: usize,
     limit: u64,
-    swap: bool,
+    rounds: Rounds,
 ) -> Result<u64, Vec<usize>> {
     let grid = read_map_file(maps_dir().join(map)).unwrap();
     let scen = read_scen_file(maps_dir().join(scen)).unwrap();
     let (starts, goals): (Vec<Cell>, Vec<Cell>) =
         scen.entries[..n].iter().map(|e| (e.start, e.goal)).unzip();
-    let mut w = World::new(grid, &starts, &goals);
-    w.pibt.set_swap(swap);
-    w.run(limit).map_err(|_| {
+    let mut w = match rounds {
+        Rounds::Lacam => World::with_lacam(grid, &starts, &goals),
+        _ => World::new(grid, &starts, &goals),
+    };
+    w.pibt.set_swap(rounds == Rounds::PibtSwap);
+    let r = w.run(limit);
+    if let Some(l) = &w.lacam {
+        eprintln!("  {:?}", l.stats());
+    }
+    r.map_err(|_| {
         (0..n)
             .filter(|&i| w.rows[i].current != w.goals[i] || !w.rows[i].is_at_rest())
             .collect()
     })
 }
 
-/// Prints the table of the three benchmark maps, without and with the swap operation
+/// Prints the table of the three benchmark maps: PIBT without and with the swap operation,
+/// and LaCAM
 /// (`cargo test -p hnav-coordinator --lib mapf_table -- --ignored --nocapture`).
 #[test]
 #[ignore = "a measurement: prints the sim-only table"]
@@ -49,9 +66,9 @@ fn mapf_table() {
     ];
     for (map, scen, max) in sets {
         for n in [50, 100, 150, 200, 250].into_iter().filter(|&n| n <= max) {
-            for swap in [false, true] {
-                let label = if swap { "swap" } else { "no swap" };
-                match run(map, scen, n, 20_000, swap) {
+            for rounds in [Rounds::Pibt, Rounds::PibtSwap, Rounds::Lacam] {
+                let label = format!("{rounds:?}");
+                match run(map, scen, n, 20_000, rounds) {
                     Ok(r) => eprintln!("{map} N={n} {label}: all home at round {r}"),
                     Err(away) => eprintln!("{map} N={n} {label}: {} away: {away:?}", away.len()),
                 }

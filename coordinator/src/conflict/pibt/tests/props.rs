@@ -57,7 +57,7 @@ fn bridges(
 /// which every move lies on a cycle: PIBT's condition for the agent of highest priority to
 /// reach its goal. Ends of bridges and everything outside the part become walls, which may
 /// remove diagonals and make new bridges, so it repeats until there are none.
-fn map(rng: &mut ChaCha8Rng) -> (Grid, Vec<Cell>) {
+pub(crate) fn map(rng: &mut ChaCha8Rng) -> (Grid, Vec<Cell>) {
     let (w, h) = (rng.gen_range(12..=24), rng.gen_range(12..=24));
     let walls = rng.gen_range(0.0..0.25);
     let mut g = Grid::new(w, h).unwrap();
