@@ -173,6 +173,17 @@ impl Arbiter {
         round: u64,
         candidates: &[Option<Candidate>],
     ) -> (&[Decision], &[ReplanRecord]) {
+        self.decide_with(round, candidates, &mut || {})
+    }
+
+    /// [`Arbiter::decide`], calling `tick` often while a long computation runs (LaCAM's
+    /// search), so that the caller can keep its heartbeat going.
+    pub fn decide_with(
+        &mut self,
+        round: u64,
+        candidates: &[Option<Candidate>],
+        tick: &mut dyn FnMut(),
+    ) -> (&[Decision], &[ReplanRecord]) {
         self.decisions.clear();
         self.replans.clear();
         for (i, row) in self.rows.iter_mut().enumerate() {
@@ -209,7 +220,7 @@ impl Arbiter {
                 false
             }
             Round::Lacam(l) => {
-                l.resolve(&self.rows, &mut self.outcomes);
+                l.resolve_with(&self.rows, &mut self.outcomes, tick);
                 false
             }
         };

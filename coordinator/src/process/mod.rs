@@ -147,6 +147,10 @@ fn rounds(
     waiter: &Waiter,
     heart: &Heartbeat,
 ) -> Result<EndReason, CoordinatorError> {
+    // A failed beat inside a long decision shows again at the loop's own beat.
+    let mut tick = || {
+        let _ = heart.beat();
+    };
     loop {
         // Every pass beats if due: a backlog of rounds closes back to back without a wait.
         heart.beat()?;
@@ -158,7 +162,7 @@ fn rounds(
             return Ok(reason);
         }
         if st.ready() {
-            st.close_round(p)?;
+            st.close_round(p, &mut tick)?;
             continue;
         }
         // Lockstep has no round deadline: only candidates and liveness close a round, and
@@ -166,7 +170,7 @@ fn rounds(
         // bounds the wait; the round deadline is checked on the clock.
         let deadline = st.round_deadline();
         if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
-            st.close_round(p)?;
+            st.close_round(p, &mut tick)?;
             continue;
         }
         match waiter.wait(heart.until(deadline)?)? {

@@ -437,11 +437,16 @@ impl State {
         }
     }
 
-    /// Decides the open round, makes it durable, then commits it.
-    pub(super) fn close_round(&mut self, p: &Ports) -> Result<(), CoordinatorError> {
+    /// Decides the open round, makes it durable, then commits it. `tick` is called often
+    /// while the decision takes long (LaCAM's search): the caller beats its heartbeat there.
+    pub(super) fn close_round(
+        &mut self,
+        p: &Ports,
+        tick: &mut dyn FnMut(),
+    ) -> Result<(), CoordinatorError> {
         let round = self.round + 1;
         self.confirm_unreachable(round)?;
-        let (decisions, replans) = self.arbiter.decide(round, &self.pending);
+        let (decisions, replans) = self.arbiter.decide_with(round, &self.pending, tick);
         for r in replans {
             self.log.append(&Record::Replan(r.clone()))?;
         }

@@ -130,6 +130,17 @@ impl Lacam {
 
     /// Decides one round: `out[i]` is the outcome for `rows[i]`. `out` is cleared first.
     pub fn resolve(&mut self, rows: &[AgentRow], out: &mut Vec<Outcome>) {
+        self.resolve_with(rows, out, &mut || {});
+    }
+
+    /// [`Lacam::resolve`], calling `tick` often while a search runs (the coordinator beats its
+    /// heartbeat there: a search of seconds is not a hang).
+    pub fn resolve_with(
+        &mut self,
+        rows: &[AgentRow],
+        out: &mut Vec<Outcome>,
+        tick: &mut dyn FnMut(),
+    ) {
         self.round += 1;
         if self.phase == Phase::Following
             && !self.schedule.as_ref().is_some_and(|s| s.follows(rows))
@@ -153,7 +164,7 @@ impl Lacam {
                 out.resize(rows.len(), Outcome::default());
                 return;
             }
-            self.plan(rows);
+            self.plan(rows, tick);
         }
         match (&mut self.schedule, self.phase) {
             (Some(s), Phase::Following) => s.decide(rows, out),
@@ -162,7 +173,7 @@ impl Lacam {
     }
 
     /// Searches a plan from the rows (all at rest or standing) and follows it, or falls back.
-    fn plan(&mut self, rows: &[AgentRow]) {
+    fn plan(&mut self, rows: &[AgentRow], tick: &mut dyn FnMut()) {
         let index = |c: Cell| c.y * self.width + c.x;
         self.blocked.fill(false);
         let mut members = Vec::new();
@@ -199,7 +210,7 @@ impl Lacam {
                 goals: &goals,
                 distance: &distance,
             };
-            search::solve(&problem, &starts, self.budget)
+            search::solve(&problem, &starts, self.budget, tick)
         };
         match result {
             Ok(plan) => {

@@ -11,6 +11,7 @@
 //! for the same reason.
 
 use std::collections::{HashMap, VecDeque};
+use std::rc::Rc;
 
 use super::generator::{Generator, Problem};
 use super::graph::NONE;
@@ -25,11 +26,12 @@ pub struct Budget {
 }
 
 impl Default for Budget {
-    /// About 2 GB of work in the worst case of 256 agents; instances of the MAPF benchmark need
-    /// a few thousand configurations.
+    /// At most about 200 MiB for 256 agents (a configuration and its priorities take 8 bytes
+    /// per agent, a constraint 16 bytes); the MAPF benchmark's hardest instance here
+    /// (warehouse, 200 robots) needs 59 000 configurations.
     fn default() -> Self {
         Budget {
-            configurations: 200_000,
+            configurations: 100_000,
             constraints: 4_000_000,
         }
     }
@@ -68,23 +70,17 @@ struct Constraint {
 /// The search's nodes.
 #[derive(Default)]
 struct Tree {
-    configs: Vec<Box<[u32]>>,
+    /// Shared with `explored`: a configuration is stored once.
+    configs: Vec<Rc<[u32]>>,
     priorities: Vec<Box<[f32]>>,
-    orders: Vec<Box<[u32]>>,
     nodes: Vec<Node>,
     lows: Vec<Constraint>,
-    explored: HashMap<Box<[u32]>, u32>,
+    explored: HashMap<Rc<[u32]>, u32>,
 }
 
 impl Tree {
-    /// A new configuration, its agents ordered by priority (highest first).
-    fn add(&mut self, config: Box<[u32]>, prio: Box<[f32]>, parent: u32) -> u32 {
-        let mut order: Vec<u32> = (0..prio.len() as u32).collect();
-        order.sort_by(|&a, &b| {
-            prio[b as usize]
-                .total_cmp(&prio[a as usize])
-                .then(a.cmp(&b))
-        });
+    /// A new configuration.
+    fn add(&mut self, config: Rc<[u32]>, prio: Box<[f32]>, parent: u32) -> u32 {
         let id = self.nodes.len() as u32;
         self.lows.push(Constraint {
             parent: NONE,
@@ -99,7 +95,6 @@ impl Tree {
         self.explored.insert(config.clone(), id);
         self.configs.push(config);
         self.priorities.push(prio);
-        self.orders.push(order.into_boxed_slice());
         id
     }
 
@@ -108,7 +103,7 @@ impl Tree {
         let mut out = Vec::new();
         let mut k = end;
         while k != NONE {
-            out.push(self.configs[k as usize].clone());
+            out.push(self.configs[k as usize].as_ref().into());
             k = self.nodes[k as usize].parent;
         }
         out.reverse();
@@ -117,12 +112,12 @@ impl Tree {
 
     /// Grows the constraint tree of node `t` below constraint `low`: the next agent in the
     /// node's order, to each of its cells.
-    fn expand(&mut self, p: &Problem, t: usize, low: u32) {
+    fn expand(&mut self, p: &Problem, t: usize, low: u32, order: &[u32]) {
         let c = self.lows[low as usize];
-        if c.depth as usize >= self.orders[t].len() {
+        if c.depth as usize >= order.len() {
             return;
         }
-        let who = self.orders[t][c.depth as usize];
+        let who = order[c.depth as usize];
         let at = self.configs[t][who as usize];
         let moves = p.graph.moves(at);
         let k = moves.len() + 1;
@@ -138,6 +133,18 @@ impl Tree {
                 depth: c.depth + 1,
             });
         }
+    }
+
+    /// Node `t`'s agents by priority, highest first (PIBT's order), into `out`.
+    fn order(&self, t: usize, out: &mut Vec<u32>) {
+        let prio = &self.priorities[t];
+        out.clear();
+        out.extend(0..prio.len() as u32);
+        out.sort_by(|&a, &b| {
+            prio[b as usize]
+                .total_cmp(&prio[a as usize])
+                .then(a.cmp(&b))
+        });
     }
 
     /// The constraints of `low`, shallowest first.
@@ -161,8 +168,14 @@ pub(super) struct Plan {
     pub visited: usize,
 }
 
-/// Searches a plan from `starts` to the problem's goals.
-pub(super) fn solve(p: &Problem, starts: &[u32], budget: Budget) -> Result<Plan, SearchError> {
+/// Searches a plan from `starts` to the problem's goals, calling `tick` once per step of the
+/// search (a long search keeps the process's heartbeat going through it).
+pub(super) fn solve(
+    p: &Problem,
+    starts: &[u32],
+    budget: Budget,
+    tick: &mut dyn FnMut(),
+) -> Result<Plan, SearchError> {
     let n = starts.len();
     let mut gen = Generator::new(p.graph.cells(), n);
     let mut tree = Tree::default();
@@ -174,10 +187,12 @@ pub(super) fn solve(p: &Problem, starts: &[u32], budget: Budget) -> Result<Plan,
     let mut open = vec![tree.add(starts.into(), first, NONE)];
     let mut fixed: Vec<(u32, u32)> = Vec::with_capacity(n);
     let mut next: Vec<u32> = Vec::with_capacity(n);
+    let mut order: Vec<u32> = Vec::with_capacity(n);
     let over = |tree: &Tree| SearchError::Budget {
         configurations: tree.nodes.len(),
     };
     while let Some(&top) = open.last() {
+        tick();
         let t = top as usize;
         if tree.configs[t].iter().zip(p.goals).all(|(a, b)| a == b) {
             return Ok(Plan {
@@ -189,20 +204,14 @@ pub(super) fn solve(p: &Problem, starts: &[u32], budget: Budget) -> Result<Plan,
             open.pop();
             continue;
         };
-        tree.expand(p, t, low);
+        tree.order(t, &mut order);
+        tree.expand(p, t, low, &order);
         if tree.lows.len() > budget.constraints {
             return Err(over(&tree));
         }
         tree.constraints(low, &mut fixed);
         let salt = (u64::from(top) << 32) | u64::from(low);
-        if !gen.generate(
-            p,
-            &tree.configs[t],
-            &fixed,
-            &tree.orders[t],
-            salt,
-            &mut next,
-        ) {
+        if !gen.generate(p, &tree.configs[t], &fixed, &order, salt, &mut next) {
             continue;
         }
         if let Some(&known) = tree.explored.get(next.as_slice()) {

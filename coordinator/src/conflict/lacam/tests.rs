@@ -160,3 +160,21 @@ proptest! {
             {} steps, {} configurations searched", part.len(), s.steps, s.visited);
     }
 }
+
+#[test]
+fn a_search_ticks_once_per_configuration_step() {
+    // The coordinator beats its heartbeat in the tick: a search of seconds is not a hang.
+    let g = Grid::new(8, 8).unwrap();
+    let starts: Vec<Cell> = (0..8).map(|y| c(0, y)).collect();
+    let goals: Vec<Cell> = starts.iter().map(|s| c(7, 7 - s.y)).collect();
+    let mut l = super::Lacam::new(&g, &goals, Options::default());
+    let rows: Vec<_> = starts
+        .iter()
+        .map(|&s| crate::conflict::AgentRow::at_rest(s, None, 1.0))
+        .collect();
+    let (mut ticks, mut out) = (0u32, Vec::new());
+    l.resolve_with(&rows, &mut out, &mut || ticks += 1);
+    let s = l.stats();
+    assert_eq!(s.plans, 1, "{s:?}");
+    assert!(ticks >= s.visited && s.visited > 1, "{ticks} ticks, {s:?}");
+}
