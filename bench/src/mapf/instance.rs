@@ -128,7 +128,7 @@ pub struct Instance<'a> {
 pub struct RunSettings {
     /// `lockstep` or `realtime`.
     pub mode: String,
-    /// The coordinator's rules (`dissertation`, `pibt`); `None` writes no `rules` key, for a
+    /// The coordinator's rules (`dissertation`, `pibt`, `lacam`); `None` writes no `rules` key, for a
     /// runtime that has only the dissertation's rules.
     pub rules: Option<String>,
     /// `[coordinator] time_limit_s`: simulated seconds in lockstep.

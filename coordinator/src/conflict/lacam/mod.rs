@@ -192,6 +192,9 @@ impl Lacam {
             starts.push(index(row.current));
             goals.push(self.goals[i]);
         }
+        // The clock is only reported, never decides: a lockstep run plans the same way
+        // everywhere.
+        let started = std::time::Instant::now();
         let cut_off = members
             .iter()
             .zip(&starts)
@@ -212,8 +215,17 @@ impl Lacam {
             };
             search::solve(&problem, &starts, self.budget, tick)
         };
+        let took = started.elapsed();
         match result {
             Ok(plan) => {
+                tracing::info!(
+                    round = self.round,
+                    robots = starts.len(),
+                    steps = plan.configs.len().saturating_sub(1),
+                    configurations = plan.visited,
+                    seconds = took.as_secs_f64(),
+                    "lacam: plan found"
+                );
                 self.stats.plans += 1;
                 self.stats.steps = plan.configs.len().saturating_sub(1) as u32;
                 self.stats.visited = plan.visited as u32;
@@ -223,6 +235,12 @@ impl Lacam {
                 self.phase = Phase::Following;
             }
             Err(e) => {
+                tracing::warn!(
+                    round = self.round,
+                    robots = starts.len(),
+                    seconds = took.as_secs_f64(),
+                    "lacam: {e}; online PIBT for {RETRY_ROUNDS} rounds"
+                );
                 self.stats.failed += 1;
                 self.stats.last_error = Some(e);
                 self.schedule = None;
