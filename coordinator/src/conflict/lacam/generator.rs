@@ -75,12 +75,17 @@ impl Generator {
         for &c in from {
             self.occ_now[c as usize] = NONE;
         }
+        self.clear_next();
+        ok
+    }
+
+    /// Forgets every entry and sweep of the step.
+    fn clear_next(&mut self) {
         for &c in &self.touched {
             self.occ_next[c as usize] = NONE;
             self.swept[c as usize] = NONE;
         }
         self.touched.clear();
-        ok
     }
 
     fn fill(
@@ -217,11 +222,7 @@ impl Generator {
     /// fixed cells, no two in one cell, no swap, corners free, no rotation.
     fn executable(&mut self, p: &Problem, from: &[u32]) -> bool {
         // `swept` and `occ_next` are recounted from `next` alone.
-        for &c in &self.touched {
-            self.occ_next[c as usize] = NONE;
-            self.swept[c as usize] = NONE;
-        }
-        self.touched.clear();
+        self.clear_next();
         for (i, &at) in from.iter().enumerate() {
             let to = self.next[i];
             let Some(m) = (to != NONE).then(|| p.graph.step(at, to)).flatten() else {

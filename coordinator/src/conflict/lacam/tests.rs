@@ -3,8 +3,7 @@
 
 use hnav_runtime::grid::{Cell, Grid};
 use proptest::prelude::*;
-use rand::seq::SliceRandom;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use super::generator::{Generator, Problem};
@@ -140,14 +139,10 @@ proptest! {
     /// one round per drive that is at most two rounds per move (accepted, then driving).
     #[test]
     fn every_robot_gets_home_without_collisions(seed in any::<u64>()) {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let (grid, mut part) = props::map(&mut rng);
-        prop_assume!(part.len() >= 8);
-        let n = ((part.len() as f64 * rng.gen_range(0.05..=0.40)) as usize).max(2);
-        part.shuffle(&mut rng);
-        let starts: Vec<Cell> = part[..n].to_vec();
-        part.shuffle(&mut rng);
-        let goals: Vec<Cell> = part[..n].to_vec();
+        let inst = props::instance(seed);
+        prop_assume!(inst.is_some());
+        let props::Instance { grid, free, starts, goals } = inst.unwrap();
+        let n = starts.len();
         let mut w = World::with_lacam(grid.clone(), &starts, &goals);
         let rounds = w.run(200_000).map_err(|e| TestCaseError::fail(format!("seed {seed}: {e}\n{:?}", stats(&w))))?;
         let s = stats(&w);
@@ -157,7 +152,7 @@ proptest! {
         paced.pace = Some(ChaCha8Rng::seed_from_u64(seed ^ 1));
         paced.run(200_000).map_err(|e| TestCaseError::fail(format!("seed {seed}, paced: {e}")))?;
         eprintln!("lacam props: {n} agents on {} free cells: home at round {rounds}, plan of \
-            {} steps, {} configurations searched", part.len(), s.steps, s.visited);
+            {} steps, {} configurations searched", free, s.steps, s.visited);
     }
 }
 

@@ -112,6 +112,34 @@ fn largest_part(g: &Grid) -> Vec<Cell> {
     best
 }
 
+/// A random dense instance: a [`map`] (`None` when under 8 free cells), its free cells, and
+/// random starts and goals for 5 to 40 % of them.
+pub(crate) struct Instance {
+    pub grid: Grid,
+    pub free: usize,
+    pub starts: Vec<Cell>,
+    pub goals: Vec<Cell>,
+}
+
+pub(crate) fn instance(seed: u64) -> Option<Instance> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let (grid, mut part) = map(&mut rng);
+    if part.len() < 8 {
+        return None;
+    }
+    let n = ((part.len() as f64 * rng.gen_range(0.05..=0.40)) as usize).max(2);
+    part.shuffle(&mut rng);
+    let starts: Vec<Cell> = part[..n].to_vec();
+    part.shuffle(&mut rng);
+    let goals: Vec<Cell> = part[..n].to_vec();
+    Some(Instance {
+        grid,
+        free: part.len(),
+        starts,
+        goals,
+    })
+}
+
 /// The round bound: see `every_agent_gets_home_without_collisions`.
 fn bound(free: usize, agents: usize) -> u64 {
     4 * (free as u64 + 2 * agents as u64)
@@ -152,16 +180,12 @@ proptest! {
     /// so the test uses `4 (free + 2 agents)`; the largest measured ratio was 0.29.
     #[test]
     fn every_agent_reaches_its_goal_without_collisions(seed in any::<u64>()) {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let (grid, mut part) = map(&mut rng);
-        prop_assume!(part.len() >= 8);
-        let n = ((part.len() as f64 * rng.gen_range(0.05..=0.40)) as usize).max(2);
-        part.shuffle(&mut rng);
-        let starts: Vec<Cell> = part[..n].to_vec();
-        part.shuffle(&mut rng);
-        let goals: Vec<Cell> = part[..n].to_vec();
+        let inst = instance(seed);
+        prop_assume!(inst.is_some());
+        let Instance { grid, free, starts, goals } = inst.unwrap();
+        let n = starts.len();
         let mut w = World::new(grid, &starts, &goals);
-        let limit = bound(part.len(), n);
+        let limit = bound(free, n);
         let mut rounds = 0;
         while rounds < limit && !w.reached.iter().all(|&r| r) {
             w.step().map_err(|e| TestCaseError::fail(format!("seed {seed}: round {rounds}: {e}")))?;
@@ -170,12 +194,12 @@ proptest! {
         let missing: Vec<usize> = (0..n).filter(|&i| !w.reached[i]).collect();
         // See the doc comment: reachability of 3 agents in 4 is asserted up to 30 % of the
         // free cells.
-        let dense = n * 10 > part.len() * 3;
+        let dense = n * 10 > free * 3;
         prop_assert!(dense || missing.len() * 4 <= n, "seed {seed}, {n} agents on {} free cells: {missing:?} \
-            never reached their goals in {limit} rounds\n{}", part.len(), w.picture());
+            never reached their goals in {limit} rounds\n{}", free, w.picture());
         let home = w.run(limit / 2).is_ok();
         eprintln!("pibt props: {n} agents, {} free: {} never reached; all reached in {rounds} \
             rounds ({:.3} of the bound {limit}); all home at once: {home}",
-            part.len(), missing.len(), rounds as f64 / limit as f64);
+            free, missing.len(), rounds as f64 / limit as f64);
     }
 }
