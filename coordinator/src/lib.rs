@@ -12,7 +12,7 @@
 //! |---|---|
 //! | [`planner`] | the [`Planner`](planner::Planner) trait; A*, Basic Theta*, Lazy Theta*; line of sight; single queries for the bench |
 //! | [`terrain`] | slope, roughness and relief from a height map; the hazard index `R`; route hazard `c = sum alpha R` |
-//! | [`conflict`] | one decision round of `shared_paths`: the conflict types (a)–(d), corners, reservations; the [`Resolver`](conflict::Resolver); [`Pibt`](conflict::Pibt), priority inheritance (`rules = "pibt"`) |
+//! | [`conflict`] | one decision round of `shared_paths`: the conflict types (a)–(d), corners, reservations; the [`Resolver`](conflict::Resolver); [`Pibt`](conflict::Pibt), priority inheritance (`rules = "pibt"`); [`Lacam`](conflict::Lacam), PIBT made complete (`rules = "lacam"`) |
 //! | [`round`] | the decision round: [`Arbiter`](round::Arbiter) keeps the rows, runs the resolver, tallies the decisions, replans (hybrid mode) |
 //! | [`process`] | the `hnav-coordinator` process: `new`/`run`, its ports and state, the [`Waiter`](hnav_runtime::transport::Waiter) loop, round deadline, log-then-commit (through [`LogWriter`](hnav_runtime::consensus_log::LogWriter)), restart from the log |
 //! | [`error`] | [`PlanError`], every way a caller's input can be unusable |

@@ -3,8 +3,9 @@
 //!
 //! A pure function of the round's rows, with no I/O: the coordinator process calls
 //! [`Resolver::resolve`] once per decision round, tests call it from a discrete-time loop.
-//! [`Pibt`] is the other round (`[coordinator] rules = "pibt"`, priority inheritance; see
-//! [`pibt`]) over the same rows and outcomes, with the same invariants.
+//! [`Pibt`] is another round (`[coordinator] rules = "pibt"`, priority inheritance; see
+//! [`pibt`]) over the same rows and outcomes, with the same invariants, and [`Lacam`] a third
+//! (`rules = "lacam"`: a whole plan searched with LaCAM and followed; see [`lacam`]).
 //!
 //! # The model, and why it is this one
 //!

@@ -1,6 +1,6 @@
 //! `[coordinator] rules = "lacam"`: PIBT made complete. The coordinator plans every robot's
 //! moves at once with LaCAM ([`search`], Okumura, AAAI 2023), whose steps are PIBT steps, and
-//! executes the plan as an action dependency graph ([`schedule`]), so robots that drive at
+//! executes the plan as an action dependency graph (`schedule.rs`), so robots that drive at
 //! their own pace and hold a cell until they have left it never meet and never wait for ever.
 //!
 //! Online PIBT ([`Pibt`]) decides one round at a time and is incomplete on these robots: its

@@ -1,5 +1,5 @@
 //! LaCAM (Okumura, AAAI 2023): a depth-first search over configurations whose successors the
-//! [`Generator`] makes, one PIBT step each, under constraints that a lazily grown breadth-first
+//! generator (`generator.rs`) makes, one PIBT step each, under constraints that a lazily grown breadth-first
 //! tree of "agent `i` goes to cell `v`" adds per configuration. The first successor is plain
 //! PIBT's; every later visit of a configuration tries the next constraint, so in the end every
 //! executable successor is generated: the search is complete (it finds a solution whenever
