@@ -119,7 +119,7 @@ struct MapfCli {
     #[arg(long, value_delimiter = ',', value_name = "N")]
     agents: Vec<usize>,
     /// Coordinator rules, each run at every size (the scenario's [coordinator] rules).
-    #[arg(long, value_delimiter = ',', default_value = "dissertation")]
+    #[arg(long, value_delimiter = ',', default_value = "lacam")]
     rules: Vec<String>,
     /// lockstep (the same log every time) or realtime.
     #[arg(long, default_value = "lockstep", value_parser = ["lockstep", "realtime"])]

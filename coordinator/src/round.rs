@@ -367,6 +367,7 @@ mod tests {
         [map]
         rows = ["........", "........", "........"]
         [coordinator]
+        rules = "dissertation"
         replan_after_rounds = 2
         [[agents]]
         start = [0, 1]

@@ -185,6 +185,8 @@ mod tests {
         name = "room"
         [map]
         rows = ["......", "......", "......", "......"]
+        [coordinator]
+        rules = "dissertation"
         [[agents]]
         start = [0, 0]
         goal = [5, 3]

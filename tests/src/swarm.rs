@@ -175,7 +175,7 @@ pub fn generated_scenario(
     let mut pick = || free[(rng.next_u64() % free.len() as u64) as usize];
     let mut used = std::collections::HashSet::new();
     let mut text = format!(
-        "name = \"generated-{agents}\"\n\n[map]\nfile = {:?}\ncorner_cutting = false\n\n[sim]\nseed = {seed}\n\n[coordinator]\ntime_limit_s = 300\n",
+        "name = \"generated-{agents}\"\n\n[map]\nfile = {:?}\ncorner_cutting = false\n\n[sim]\nseed = {seed}\n\n[coordinator]\nrules = \"dissertation\"\ntime_limit_s = 300\n",
         map.display().to_string()
     );
     let mut n = 0;

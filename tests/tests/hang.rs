@@ -48,7 +48,7 @@ fn scenario(dir: &Path, mode: &str, agent_hang: Duration) -> PathBuf {
         "name = \"hang\"\n\
          [map]\nrows = [\".......\", \".......\", \".......\"]\n\
          [sim]\nclock = \"{mode}\"\nseed = 3\n\
-         [coordinator]\ntime_limit_s = 120\n\
+         [coordinator]\nrules = \"dissertation\"\ntime_limit_s = 120\n\
          [health]\nheartbeat_ms = {}\nagent_hang_ms = {}\ncoordinator_hang_ms = {h}\n\
          sim_hang_ms = {h}\n\
          [[agents]]\nstart = [3, 1]\ngoal = [3, 0]\nspeed = 0.3\n\

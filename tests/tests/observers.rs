@@ -33,7 +33,7 @@ fn scenario(dir: &Path) -> PathBuf {
         .collect();
     let text = format!(
         "name = \"observers\"\n[map]\nrows = [{}]\ncorner_cutting = false\n\n[sim]\n\
-         clock = \"lockstep\"\nseed = 1\n\n[coordinator]\ntime_limit_s = 120\n\n\
+         clock = \"lockstep\"\nseed = 1\n\n[coordinator]\nrules = \"dissertation\"\ntime_limit_s = 120\n\n\
          [[agents]]\nstart = [0, 0]\ngoal = [1, 0]\n\n\
          [[agents]]\nstart = [0, 3]\ngoal = [15, 3]\nspeed = 0.5\n",
         rows.join(", ")

@@ -44,6 +44,7 @@ corner_cutting = false
 seed = 3
 
 [coordinator]
+rules = "dissertation"
 round_deadline_ms = 50
 time_limit_s = 60
 

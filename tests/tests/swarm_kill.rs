@@ -18,15 +18,25 @@ use hnav_tests::TestRun;
 
 const RUN_TIMEOUT: Duration = Duration::from_secs(600);
 
-/// The 8-agent MovingAI scenario with a fault appended (the map path made absolute, so the
-/// scenario can live in a temporary directory).
-fn scenario_with_fault(dir: &Path, fault: &str) -> std::path::PathBuf {
+/// The 8-agent MovingAI scenario with `coordinator` keys added to its `[coordinator]` table
+/// and a fault appended (the map path made absolute, so the scenario can live in a temporary
+/// directory).
+fn scenario_with_fault(dir: &Path, coordinator: &str, fault: &str) -> std::path::PathBuf {
     let root = repo_root();
     let text = std::fs::read_to_string(root.join("scenarios/random-32-32-10.toml")).unwrap();
     let map = root.join("maps/random-32-32-10.map");
     let text = text.replace(
         "file = \"../maps/random-32-32-10.map\"",
         &format!("file = {:?}", map.display().to_string()),
+    );
+    assert!(
+        text.contains("\n[coordinator]\n"),
+        "the scenario lost its [coordinator] table"
+    );
+    let text = text.replacen(
+        "\n[coordinator]\n",
+        &format!("\n[coordinator]\n{coordinator}"),
+        1,
     );
     let path = dir.join("scenario.toml");
     std::fs::write(&path, format!("{text}\n{fault}\n")).unwrap();
@@ -113,10 +123,14 @@ impl Observer {
 /// lockstep rounds crawl, and none of these tests is about contention.
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 
-fn run_with_fault(tag: &str, fault: &str) -> (SwarmRun, BTreeMap<u64, Commit>, Snapshot, TestRun) {
+fn run_with_fault(
+    tag: &str,
+    coordinator: &str,
+    fault: &str,
+) -> (SwarmRun, BTreeMap<u64, Commit>, Snapshot, TestRun) {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let tmp = tempfile::tempdir().unwrap().keep();
-    let scenario = scenario_with_fault(&tmp, fault);
+    let scenario = scenario_with_fault(&tmp, coordinator, fault);
     let mut run = TestRun::new(tag);
     // The observer joins before the supervisor starts anything, so it sees every commit.
     let observer = Observer::start(&run.run, 8);
@@ -142,7 +156,8 @@ fn run_with_fault(tag: &str, fault: &str) -> (SwarmRun, BTreeMap<u64, Commit>, S
 fn a_killed_coordinator_restarts_from_its_log_and_loses_no_commit() {
     let (swarm, seen, map, _run) = run_with_fault(
         "killcoord",
-        "[coordinator]\nfsync = \"every-record\"\ntime_limit_s = 600\n\n[[faults]]\nat_round = 400\naction = \"kill\"\nrole = \"coordinator\"\n",
+        "fsync = \"every-record\"\ntime_limit_s = 600\n",
+        "[[faults]]\nat_round = 400\naction = \"kill\"\nrole = \"coordinator\"\n",
     );
     let log = swarm.dir.join("log");
     let (ok, report) = verify_log(&log);
@@ -200,7 +215,8 @@ fn a_killed_coordinator_restarts_from_its_log_and_loses_no_commit() {
 fn a_killed_agent_resumes_from_its_checkpoint_and_arrives() {
     let (swarm, _seen, _map, _run) = run_with_fault(
         "killagent",
-        "[coordinator]\ntime_limit_s = 600\n\n[[faults]]\nat_round = 300\naction = \"kill\"\nrole = \"agent\"\nindex = 1\n",
+        "time_limit_s = 600\n",
+        "[[faults]]\nat_round = 300\naction = \"kill\"\nrole = \"agent\"\nindex = 1\n",
     );
     let s = swarm.summary().unwrap();
     for a in s["agents"].as_array().unwrap() {

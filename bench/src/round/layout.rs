@@ -124,6 +124,9 @@ impl Layout {
         s.push_str("]\n\n[sim]\nclock = \"lockstep\"\n\n[coordinator]\n");
         let _ = writeln!(s, "fsync = \"{}\"", fsync_name(fsync));
         s.push_str("replan_after_rounds = 3\n");
+        // The layout's conflicts (one loser per pair, every other round) are the dissertation
+        // rules' decisions; the default `lacam` would plan them away.
+        s.push_str("rules = \"dissertation\"\n");
         // The bench plays as many rounds as it is asked for: a lockstep coordinator ends the
         // run after its time limit's rounds (12 000 by default), so the limit is set far out.
         s.push_str("time_limit_s = 1e9\n");

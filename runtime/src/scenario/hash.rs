@@ -140,8 +140,11 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
         FsyncPolicy::None => 2,
     });
     h.u64(c.replan_after_rounds.into()).f64(c.time_limit_s);
-    // Hashed only off its default, so that every scenario written before the option (and
-    // the golden logs, which carry the hash) keeps its hash.
+    // Hashed only off the dissertation's rules, the default before the option existed and
+    // until `lacam` became the default: a scenario that names `rules = "dissertation"` keeps
+    // the hash it had without the key (the golden logs carry it), and an old scenario without
+    // the key, now read as `lacam`, no longer matches its logs (replay refuses it by hash
+    // rather than replaying other rules).
     if c.rules != Rules::Dissertation {
         h.u64(match c.rules {
             Rules::Dissertation => 0,

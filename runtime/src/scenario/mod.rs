@@ -42,7 +42,7 @@
 //! fsync = "every-record"               # or "batched", "none"
 //! replan_after_rounds = 3
 //! time_limit_s = 120.0                 # lockstep: simulated time, in rounds; realtime: wall clock
-//! rules = "dissertation"               # or "pibt", "lacam": README, *Dense swarms*
+//! rules = "lacam"                      # or "dissertation" (the seeds' reproductions), "pibt": README, *Dense swarms*
 //!
 //! [restart]                            # per role; default for each role as shown
 //! agent = { policy = "on-failure", max_restarts = 3, backoff_ms = 100 }

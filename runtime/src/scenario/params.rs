@@ -189,19 +189,23 @@ pub enum FsyncPolicy {
 }
 
 /// The rules of the decision round (`[coordinator] rules`).
+///
+/// The default is [`Rules::Lacam`], the only rules measured to bring every robot home on the
+/// MAPF benchmark at every size (README, *MAPF benchmark*); the seeds' reproductions name
+/// [`Rules::Dissertation`].
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Rules {
     /// The dissertation's conflict types (a)-(d) with priority `1 / speed` and hybrid
     /// replanning: the reproduction mode.
-    #[default]
     Dissertation,
     /// Priority inheritance with backtracking (PIBT, Okumura et al.): the coordinator may move
     /// an agent out of a higher-priority agent's way, and priorities rise with waiting.
     Pibt,
     /// PIBT made complete: the coordinator plans every robot's moves at once with LaCAM
     /// (Okumura, AAAI 2023) and executes the plan as an action dependency graph, falling back
-    /// to online PIBT when a search fails.
+    /// to online PIBT when a search fails. The default.
+    #[default]
     Lacam,
 }
 
@@ -268,7 +272,7 @@ impl Default for CoordinatorParams {
             fsync: FsyncPolicy::EveryRecord,
             replan_after_rounds: 3,
             time_limit_s: 120.0,
-            rules: Rules::Dissertation,
+            rules: Rules::Lacam,
         }
     }
 }

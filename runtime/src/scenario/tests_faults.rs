@@ -92,8 +92,10 @@ fn a_kill_plan_keeps_its_hash_and_new_kinds_change_it() {
     let kills = "[[faults]]\nat_round = 40\naction = \"kill\"\nrole = \"agent\"\nindex = 1\n\
                  [[faults]]\nat_round = 90\naction = \"kill\"\nrole = \"coordinator\"\n\
                  signal = \"TERM\"\n";
-    let s = parse(&format!("{BASE}{kills}")).unwrap();
-    // What `hnav check` printed for this scenario before times in seconds and freezes.
+    let mut s = parse(&format!("{BASE}{kills}")).unwrap();
+    // What `hnav check` printed for this scenario before times in seconds and freezes, when
+    // the dissertation's rules were the only ones.
+    s.coordinator.rules = Rules::Dissertation;
     assert_eq!(format!("{:016x}", s.scenario_hash()), "a74e51dad32551c6");
     let mut seconds = s.clone();
     seconds.faults[0].at = FaultTime::Seconds(40.0);
