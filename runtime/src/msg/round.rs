@@ -123,11 +123,13 @@ pub enum ConflictKind {
     Reserved = 6,
     /// Not a legal move at all: not a neighbour, off the grid, or a blocked cell.
     Invalid = 7,
-    /// `[coordinator] rules = "pibt"`, on an accept: the agent is moved out of the way of a
-    /// higher-priority agent (priority inheritance), whatever it asked for.
+    /// `[coordinator] rules = "pibt"` or `"lacam"`, on an accept: the agent is moved out of
+    /// the way of a higher-priority agent (priority inheritance) or along the plan, though it
+    /// asked for no step.
     Pushed = 8,
-    /// `[coordinator] rules = "pibt"`, on an accept: the coordinator chose another step than
-    /// the agent asked for (its cell was taken, or it asked for none), by distance to its goal.
+    /// `[coordinator] rules = "pibt"` or `"lacam"`, on an accept: the coordinator chose another
+    /// step than the agent asked for (pibt: its cell was taken, or it asked for none, by
+    /// distance to its goal; lacam: the plan's step).
     Redirected = 9,
 }
 
