@@ -15,6 +15,7 @@
 //! | [`conflict`] | one decision round of `shared_paths`: the conflict types (a)–(d), corners, reservations; the [`Resolver`](conflict::Resolver); [`Pibt`](conflict::Pibt), priority inheritance (`rules = "pibt"`); [`Lacam`](conflict::Lacam), PIBT made complete (`rules = "lacam"`) |
 //! | [`round`] | the decision round: [`Arbiter`](round::Arbiter) keeps the rows, runs the resolver, tallies the decisions, replans (hybrid mode) |
 //! | [`process`] | the `hnav-coordinator` process: `new`/`run`, its ports and state, the [`Waiter`](hnav_runtime::transport::Waiter) loop, round deadline, log-then-commit (through [`LogWriter`](hnav_runtime::consensus_log::LogWriter)), restart from the log |
+//! | [`replication`] | one replica's Raft peer ([`Replica`](replication::Replica), the `raft` crate): propose round records, take the committed ones; the building block of the replicated consensus log |
 //! | [`error`] | [`PlanError`], every way a caller's input can be unusable |
 //!
 //! ```
@@ -35,6 +36,7 @@ pub mod conflict;
 pub mod error;
 pub mod planner;
 pub mod process;
+pub mod replication;
 pub mod round;
 pub mod terrain;
 

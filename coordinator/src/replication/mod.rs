@@ -1,0 +1,293 @@
+//! One coordinator replica's Raft peer: the building block of a replicated consensus log.
+//!
+//! The dissertation's consensus log is a replicated state machine: a cluster of coordinators
+//! agrees on every decision, and a cluster of `2f + 1` keeps deciding while `f` are lost. The
+//! agreement is Raft from a well-kept library, the `raft` crate (the consensus core of TiKV),
+//! not a hand-written one. It is a passive state machine: the owner ticks it, steps it with
+//! the messages other replicas sent, and takes what it has to persist, send and apply from its
+//! `Ready` cycle. That fits the coordinator's loop (one thread, a [`Waiter`]) without an async
+//! runtime, which is why it was picked over `openraft` (async, tokio).
+//!
+//! [`Replica`] owns that cycle, in the order Raft's safety needs: new entries and the hard
+//! state reach the storage before the messages that acknowledge them are released
+//! ([`Replica::take_messages`]), and only entries a majority holds come out of
+//! [`Replica::take_committed`]. What the coordinator proposes is opaque bytes (an encoded
+//! round record); what it gets back, in the same order on every replica, is the committed
+//! sequence.
+//!
+//! The storage is the library's `MemStorage`, shared with the caller ([`Replica::storage`]),
+//! so that a replica restarted over the same storage (a process restarted over its log) comes
+//! back with its term, vote and entries. Storing the entries in the consensus-log segments
+//! themselves, and carrying the messages on the HNAV transport between processes, are the
+//! next steps (README, *Replicated consensus log*).
+//!
+//! [`Waiter`]: hnav_runtime::transport::Waiter
+
+use std::collections::VecDeque;
+
+use protobuf::Message as _;
+use raft::eraftpb::{ConfState, Entry, EntryType, Message};
+use raft::storage::MemStorage;
+use raft::{Config, RawNode, StateRole};
+
+mod log_bridge;
+#[cfg(test)]
+mod tests;
+
+/// Why a replica could not be made, or could not take a message or a proposal.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplicaError {
+    /// The replica's id is 0 (Raft's "nobody") or not among the voters.
+    #[error("replica id {id} is not one of the voters {voters:?} (ids start at 1)")]
+    NotAVoter {
+        /// The id asked for.
+        id: u64,
+        /// The cluster's voters.
+        voters: Vec<u64>,
+    },
+    /// A proposal reached a replica that is not the leader: only the leader decides rounds.
+    #[error("replica {id} is not the leader (the leader is {leader})")]
+    NotLeader {
+        /// This replica.
+        id: u64,
+        /// The leader it knows of, 0 for none.
+        leader: u64,
+    },
+    /// A message from the wire that is no Raft message.
+    #[error("a Raft message that does not decode ({0})")]
+    Decode(String),
+    /// A message that does not encode (protobuf refused it).
+    #[error("a Raft message that does not encode ({0})")]
+    Encode(String),
+    /// The Raft library refused (a bad configuration, a message for another cluster, a
+    /// storage error).
+    #[error("raft: {0}")]
+    Raft(#[from] raft::Error),
+}
+
+/// A replica's timing and identity.
+#[derive(Debug, Clone)]
+pub struct ReplicaConfig {
+    /// This replica's id, 1-based.
+    pub id: u64,
+    /// Every voter of the cluster, this one included.
+    pub voters: Vec<u64>,
+    /// Ticks without a leader's heartbeat before a follower stands for election; Raft
+    /// randomises each timeout in `[election_ticks, 2 * election_ticks)`.
+    pub election_ticks: usize,
+    /// Ticks between the leader's heartbeats; well below `election_ticks`.
+    pub heartbeat_ticks: usize,
+}
+
+impl ReplicaConfig {
+    /// A replica of a cluster of `n` voters (ids 1..=n) with etcd's default timing, 10 ticks
+    /// to an election and 1 between heartbeats.
+    pub fn cluster(id: u64, n: u64) -> Self {
+        ReplicaConfig {
+            id,
+            voters: (1..=n).collect(),
+            election_ticks: 10,
+            heartbeat_ticks: 1,
+        }
+    }
+}
+
+/// A replica's part in the cluster, as Raft names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    /// Decides the rounds and replicates them.
+    Leader,
+    /// Follows the leader of its term.
+    Follower,
+    /// Stands for election.
+    Candidate,
+    /// Asks whether it could win before raising the term (pre-vote).
+    PreCandidate,
+}
+
+impl Role {
+    /// Lower-case name, as `hnav ps` would show it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Role::Leader => "leader",
+            Role::Follower => "follower",
+            Role::Candidate => "candidate",
+            Role::PreCandidate => "pre-candidate",
+        }
+    }
+}
+
+/// An entry the cluster has committed: a majority holds it durably, it is final.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Committed {
+    /// Raft's log index (1-based, gapless over every entry, empty ones included).
+    pub index: u64,
+    /// The term of the leader that proposed it.
+    pub term: u64,
+    /// What was proposed.
+    pub data: Vec<u8>,
+}
+
+/// One voter of a Raft cluster, driven by its owner's loop.
+pub struct Replica {
+    node: RawNode<MemStorage>,
+    outbox: Vec<Message>,
+    committed: VecDeque<Committed>,
+}
+
+impl Replica {
+    /// A replica of a new cluster: empty storage that knows the voters.
+    pub fn new(config: &ReplicaConfig) -> Result<Self, ReplicaError> {
+        let storage =
+            MemStorage::new_with_conf_state(ConfState::from((config.voters.clone(), Vec::new())));
+        Self::restart(config, storage)
+    }
+
+    /// A replica over storage that survived it: its term, vote and entries come back; what it
+    /// had applied is applied again from the start (its owner's state machine starts empty).
+    pub fn restart(config: &ReplicaConfig, storage: MemStorage) -> Result<Self, ReplicaError> {
+        if config.id == 0 || !config.voters.contains(&config.id) {
+            return Err(ReplicaError::NotAVoter {
+                id: config.id,
+                voters: config.voters.clone(),
+            });
+        }
+        let raft_config = Config {
+            id: config.id,
+            election_tick: config.election_ticks,
+            heartbeat_tick: config.heartbeat_ticks,
+            // A replica that was cut off and comes back must not depose a working leader by
+            // its higher term alone (pre-vote), and a leader cut off from the majority steps
+            // down instead of believing it still leads (check-quorum): its stale decisions
+            // can then never be taken for the cluster's.
+            pre_vote: true,
+            check_quorum: true,
+            ..Config::default()
+        };
+        raft_config.validate()?;
+        let node = RawNode::new(&raft_config, storage, &log_bridge::logger(config.id))?;
+        Ok(Replica {
+            node,
+            outbox: Vec::new(),
+            committed: VecDeque::new(),
+        })
+    }
+
+    /// This replica's id.
+    pub fn id(&self) -> u64 {
+        self.node.raft.id
+    }
+
+    /// Its role now.
+    pub fn role(&self) -> Role {
+        match self.node.raft.state {
+            StateRole::Leader => Role::Leader,
+            StateRole::Follower => Role::Follower,
+            StateRole::Candidate => Role::Candidate,
+            StateRole::PreCandidate => Role::PreCandidate,
+        }
+    }
+
+    /// The term it is in.
+    pub fn term(&self) -> u64 {
+        self.node.raft.term
+    }
+
+    /// The leader it knows of, if any.
+    pub fn leader(&self) -> Option<u64> {
+        Some(self.node.raft.leader_id).filter(|&l| l != 0)
+    }
+
+    /// The storage, to keep for a restart ([`Replica::restart`]).
+    pub fn storage(&self) -> &MemStorage {
+        self.node.store()
+    }
+
+    /// Advances its logical clock by one tick (elections, heartbeats).
+    pub fn tick(&mut self) -> Result<(), ReplicaError> {
+        self.node.tick();
+        self.process()
+    }
+
+    /// Takes a message another replica sent.
+    pub fn step(&mut self, message: Message) -> Result<(), ReplicaError> {
+        self.node.step(message)?;
+        self.process()
+    }
+
+    /// Proposes `data` (a round record) for the cluster to commit; only the leader may.
+    pub fn propose(&mut self, data: &[u8]) -> Result<(), ReplicaError> {
+        if self.role() != Role::Leader {
+            return Err(ReplicaError::NotLeader {
+                id: self.id(),
+                leader: self.node.raft.leader_id,
+            });
+        }
+        self.node.propose(Vec::new(), data.to_vec())?;
+        self.process()
+    }
+
+    /// The messages to send to the other replicas, each addressed (`Message::to`). Every one
+    /// may be sent at once: what they acknowledge is already in the storage.
+    pub fn take_messages(&mut self) -> std::vec::Drain<'_, Message> {
+        self.outbox.drain(..)
+    }
+
+    /// The entries committed since the last call, in log order. Entries without data (the
+    /// empty entry each new leader appends) are left out; their indices are skipped.
+    pub fn take_committed(&mut self) -> std::collections::vec_deque::Drain<'_, Committed> {
+        self.committed.drain(..)
+    }
+
+    /// The `Ready` cycle: persist, release messages, apply, until Raft has nothing left.
+    fn process(&mut self) -> Result<(), ReplicaError> {
+        while self.node.has_ready() {
+            let mut ready = self.node.ready();
+            // Messages of a leader may leave before its own append (Raft's leader writes in
+            // parallel with its followers); the rest wait for the storage below.
+            self.outbox.extend(ready.take_messages());
+            let store = self.node.store().clone();
+            if !ready.snapshot().is_empty() {
+                store.wl().apply_snapshot(ready.snapshot().clone())?;
+            }
+            self.collect(ready.take_committed_entries());
+            store.wl().append(ready.entries())?;
+            if let Some(hs) = ready.hs() {
+                store.wl().set_hardstate(hs.clone());
+            }
+            self.outbox.extend(ready.take_persisted_messages());
+            let mut light = self.node.advance(ready);
+            if let Some(commit) = light.commit_index() {
+                store.wl().mut_hard_state().set_commit(commit);
+            }
+            self.outbox.extend(light.take_messages());
+            self.collect(light.take_committed_entries());
+            self.node.advance_apply();
+        }
+        Ok(())
+    }
+
+    fn collect(&mut self, entries: Vec<Entry>) {
+        for e in entries {
+            if e.get_entry_type() == EntryType::EntryNormal && !e.data.is_empty() {
+                self.committed.push_back(Committed {
+                    index: e.index,
+                    term: e.term,
+                    data: e.data.to_vec(),
+                });
+            }
+        }
+    }
+}
+
+/// A message as bytes for the wire (protobuf, Raft's own encoding).
+pub fn encode(message: &Message) -> Result<Vec<u8>, ReplicaError> {
+    message
+        .write_to_bytes()
+        .map_err(|e| ReplicaError::Encode(e.to_string()))
+}
+
+/// A message from the wire.
+pub fn decode(bytes: &[u8]) -> Result<Message, ReplicaError> {
+    Message::parse_from_bytes(bytes).map_err(|e| ReplicaError::Decode(e.to_string()))
+}

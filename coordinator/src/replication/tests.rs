@@ -1,0 +1,291 @@
+//! The failure semantics the replicated log promises, on an in-memory cluster: messages are
+//! delivered by the test, a lost replica is one whose messages go nowhere, a restart is a new
+//! [`Replica`] over the old storage.
+
+use super::*;
+
+/// Replicas 1..=n, each `None` while lost, with the storages kept for restarts and every
+/// entry each has committed so far.
+struct Cluster {
+    replicas: Vec<Option<Replica>>,
+    storages: Vec<MemStorage>,
+    committed: Vec<Vec<Committed>>,
+    /// Pairs (from, to) whose messages are dropped: a partition.
+    cut: Vec<(u64, u64)>,
+}
+
+impl Cluster {
+    fn new(n: u64) -> Self {
+        let replicas: Vec<_> = (1..=n)
+            .map(|id| Some(Replica::new(&ReplicaConfig::cluster(id, n)).unwrap()))
+            .collect();
+        let storages = replicas
+            .iter()
+            .map(|r| r.as_ref().unwrap().storage().clone())
+            .collect();
+        Cluster {
+            replicas,
+            storages,
+            committed: vec![Vec::new(); n as usize],
+            cut: Vec::new(),
+        }
+    }
+
+    fn n(&self) -> u64 {
+        self.replicas.len() as u64
+    }
+
+    fn get(&mut self, id: u64) -> &mut Replica {
+        self.replicas[id as usize - 1]
+            .as_mut()
+            .expect("a live replica")
+    }
+
+    fn kill(&mut self, id: u64) {
+        self.replicas[id as usize - 1] = None;
+    }
+
+    /// Restarts `id` over its storage; its state machine starts empty and is rebuilt from the
+    /// committed entries it is given again.
+    fn restart(&mut self, id: u64) {
+        let i = id as usize - 1;
+        let config = ReplicaConfig::cluster(id, self.n());
+        self.replicas[i] = Some(Replica::restart(&config, self.storages[i].clone()).unwrap());
+        self.committed[i].clear();
+    }
+
+    /// Delivers messages until none is in flight; collects what each replica committed.
+    fn settle(&mut self) {
+        loop {
+            let mut mail = Vec::new();
+            for (i, r) in self.replicas.iter_mut().enumerate() {
+                if let Some(r) = r {
+                    self.committed[i].extend(r.take_committed());
+                    mail.extend(r.take_messages());
+                }
+            }
+            if mail.is_empty() {
+                return;
+            }
+            for m in mail {
+                // The wire: every message crosses as bytes.
+                let m = decode(&encode(&m).unwrap()).unwrap();
+                if self.cut.contains(&(m.from, m.to)) {
+                    continue;
+                }
+                if let Some(r) = self.replicas[m.to as usize - 1].as_mut() {
+                    r.step(m).unwrap();
+                }
+            }
+        }
+    }
+
+    /// `ticks` ticks of every live replica, settling after each.
+    fn run(&mut self, ticks: usize) {
+        for _ in 0..ticks {
+            for r in self.replicas.iter_mut().flatten() {
+                r.tick().unwrap();
+            }
+            self.settle();
+        }
+    }
+
+    /// Ticks until exactly one live replica leads; its id and the ticks it took.
+    fn elect(&mut self, limit: usize) -> (u64, usize) {
+        self.elect_other_than(0, limit)
+    }
+
+    /// Ticks until exactly one live replica other than `deposed` leads (`deposed` may still
+    /// believe it leads on its side of a partition); its id and the ticks it took.
+    fn elect_other_than(&mut self, deposed: u64, limit: usize) -> (u64, usize) {
+        for t in 1..=limit {
+            self.run(1);
+            let leaders: Vec<u64> = self
+                .replicas
+                .iter()
+                .flatten()
+                .filter(|r| r.role() == Role::Leader && r.id() != deposed)
+                .map(Replica::id)
+                .collect();
+            if let [l] = leaders[..] {
+                return (l, t);
+            }
+        }
+        panic!("no single leader after {limit} ticks");
+    }
+
+    fn data(&self, id: u64) -> Vec<Vec<u8>> {
+        self.committed[id as usize - 1]
+            .iter()
+            .map(|c| c.data.clone())
+            .collect()
+    }
+}
+
+fn record(round: u64) -> Vec<u8> {
+    format!("round {round}").into_bytes()
+}
+
+#[test]
+fn three_replicas_commit_the_same_records_in_the_same_order() {
+    let mut c = Cluster::new(3);
+    let (leader, _) = c.elect(100);
+    for round in 1..=20 {
+        c.get(leader).propose(&record(round)).unwrap();
+        c.settle();
+    }
+    c.run(3);
+    let want: Vec<_> = (1..=20).map(record).collect();
+    for id in 1..=3 {
+        assert_eq!(c.data(id), want, "replica {id}");
+    }
+    // The same indices and terms too: one log.
+    assert_eq!(c.committed[0], c.committed[1]);
+    assert_eq!(c.committed[1], c.committed[2]);
+    let follower = if leader == 1 { 2 } else { 1 };
+    let e = c.get(follower).propose(b"x").unwrap_err();
+    assert!(matches!(e, ReplicaError::NotLeader { .. }), "{e}");
+}
+
+#[test]
+fn a_lost_leader_is_replaced_and_the_committed_prefix_survives() {
+    let mut c = Cluster::new(3);
+    let (old, _) = c.elect(100);
+    for round in 1..=5 {
+        c.get(old).propose(&record(round)).unwrap();
+        c.settle();
+    }
+    c.kill(old);
+    // Election timeouts are randomised in [10, 20) ticks; check-quorum and pre-vote add a
+    // round of messages, not ticks.
+    let (new, ticks) = c.elect(60);
+    assert_ne!(new, old);
+    assert!(ticks <= 40, "failover took {ticks} ticks");
+    for round in 6..=10 {
+        c.get(new).propose(&record(round)).unwrap();
+        c.settle();
+    }
+    c.run(3);
+    let want: Vec<_> = (1..=10).map(record).collect();
+    for id in (1..=3).filter(|&id| id != old) {
+        assert_eq!(c.data(id), want, "replica {id}");
+    }
+    // The old leader comes back over its storage and catches up on the same log.
+    c.restart(old);
+    c.run(30);
+    assert_eq!(c.data(old), want);
+    assert_eq!(c.get(old).role(), Role::Follower);
+}
+
+#[test]
+fn without_a_majority_nothing_commits_and_with_it_back_the_rounds_resume() {
+    let mut c = Cluster::new(3);
+    let (leader, _) = c.elect(100);
+    c.get(leader).propose(&record(1)).unwrap();
+    c.settle();
+    let others: Vec<u64> = (1..=3).filter(|&id| id != leader).collect();
+    for &id in &others {
+        c.kill(id);
+    }
+    // The lone leader may still take a proposal before check-quorum deposes it, but nothing
+    // commits: the majority is gone.
+    let _ = c.get(leader).propose(&record(2));
+    c.run(60);
+    assert_eq!(
+        c.data(leader),
+        vec![record(1)],
+        "a commit without a majority"
+    );
+    assert_ne!(
+        c.get(leader).role(),
+        Role::Leader,
+        "check-quorum deposes it"
+    );
+    // One replica back: a majority again; a leader is elected and rounds resume.
+    c.restart(others[0]);
+    let (l, _) = c.elect(100);
+    c.get(l).propose(&record(3)).unwrap();
+    c.settle();
+    c.run(3);
+    for id in [leader, others[0]] {
+        let got = c.data(id);
+        assert_eq!(got.first(), Some(&record(1)), "replica {id}: {got:?}");
+        assert_eq!(got.last(), Some(&record(3)), "replica {id}");
+        // Round 2 commits only if the new leader is the one that held it; never twice.
+        assert!(got.len() == 2 || got == vec![record(1), record(2), record(3)]);
+    }
+    assert_eq!(c.data(leader), c.data(others[0]));
+}
+
+#[test]
+fn five_replicas_lose_two_at_once_and_keep_committing() {
+    let mut c = Cluster::new(5);
+    let (leader, _) = c.elect(100);
+    let lost: Vec<u64> = (1..=5).filter(|&id| id != leader).take(2).collect();
+    for &id in &lost {
+        c.kill(id);
+    }
+    for round in 1..=10 {
+        c.get(leader).propose(&record(round)).unwrap();
+        c.settle();
+    }
+    c.run(3);
+    let want: Vec<_> = (1..=10).map(record).collect();
+    for id in (1..=5).filter(|id| !lost.contains(id)) {
+        assert_eq!(c.data(id), want, "replica {id}");
+    }
+    // And when the leader is one of the two lost, the other three elect a new one.
+    c.kill(leader);
+    c.restart(lost[0]);
+    let (new, _) = c.elect(100);
+    c.get(new).propose(&record(11)).unwrap();
+    c.settle();
+    c.run(3);
+    assert_eq!(c.data(new).last(), Some(&record(11)));
+}
+
+#[test]
+fn a_partitioned_leader_steps_down_and_its_stale_proposal_never_commits() {
+    let mut c = Cluster::new(3);
+    let (old, _) = c.elect(100);
+    c.get(old).propose(&record(1)).unwrap();
+    c.settle();
+    for id in (1..=3).filter(|&id| id != old) {
+        c.cut.push((old, id));
+        c.cut.push((id, old));
+    }
+    // On its side of the partition the old leader still takes a proposal.
+    c.get(old).propose(b"stale").unwrap();
+    let (new, _) = c.elect_other_than(old, 60);
+    let new_term = c.get(new).term();
+    c.get(new).propose(&record(2)).unwrap();
+    c.settle();
+    c.run(30);
+    assert_ne!(c.get(old).role(), Role::Leader, "cut off from the majority");
+    c.cut.clear();
+    c.run(30);
+    assert_eq!(c.get(old).role(), Role::Follower);
+    assert!(c.get(old).term() >= new_term);
+    let want = vec![record(1), record(2)];
+    for id in 1..=3 {
+        assert_eq!(
+            c.data(id),
+            want,
+            "replica {id}: the stale entry was overwritten"
+        );
+    }
+}
+
+#[test]
+fn a_bad_id_and_a_bad_message_are_errors() {
+    let e = Replica::new(&ReplicaConfig::cluster(4, 3)).err().unwrap();
+    assert!(e.to_string().contains("not one of the voters"), "{e}");
+    let e = Replica::new(&ReplicaConfig::cluster(0, 3)).err().unwrap();
+    assert!(matches!(e, ReplicaError::NotAVoter { id: 0, .. }), "{e}");
+    let e = decode(&[0xff, 0xff, 0xff]).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("a Raft message that does not decode"),
+        "{e}"
+    );
+}
