@@ -17,9 +17,9 @@
 //!
 //! The storage is the library's `MemStorage`, shared with the caller ([`Replica::storage`]),
 //! so that a replica restarted over the same storage (a process restarted over its log) comes
-//! back with its term, vote and entries. Storing the entries in the consensus-log segments
-//! themselves, and carrying the messages on the HNAV transport between processes, are the
-//! next steps (README, *Replicated consensus log*).
+//! back with its term, vote and entries. [`RaftLink`] carries the messages between processes
+//! on the HNAV transport (`raft/<i>` topics). Storing the entries in the consensus-log
+//! segments themselves is the next step (README, *Replicated consensus log*).
 //!
 //! [`Waiter`]: hnav_runtime::transport::Waiter
 
@@ -30,9 +30,12 @@ use raft::eraftpb::{ConfState, Entry, EntryType, Message};
 use raft::storage::MemStorage;
 use raft::{Config, RawNode, StateRole};
 
+mod link;
 mod log_bridge;
 #[cfg(test)]
 mod tests;
+
+pub use link::{topic, Inbox, RaftHeader, RaftLink, MAX_ENTRIES_BYTES, MAX_MESSAGE_BYTES};
 
 /// Why a replica could not be made, or could not take a message or a proposal.
 #[derive(Debug, thiserror::Error)]
@@ -56,9 +59,13 @@ pub enum ReplicaError {
     /// A message from the wire that is no Raft message.
     #[error("a Raft message that does not decode ({0})")]
     Decode(String),
-    /// A message that does not encode (protobuf refused it).
-    #[error("a Raft message that does not encode ({0})")]
+    /// A message that does not encode (protobuf refused it, it is too large for its topic,
+    /// or it is addressed to no other voter).
+    #[error("a Raft message that does not go out ({0})")]
     Encode(String),
+    /// The HNAV transport failed under a `raft/<i>` topic.
+    #[error("raft transport: {0}")]
+    Transport(#[from] hnav_runtime::transport::TransportError),
     /// The Raft library refused (a bad configuration, a message for another cluster, a
     /// storage error).
     #[error("raft: {0}")]
@@ -162,6 +169,8 @@ impl Replica {
             // can then never be taken for the cluster's.
             pre_vote: true,
             check_quorum: true,
+            // Appends fit the `raft/<i>` topics (`link`).
+            max_size_per_msg: MAX_ENTRIES_BYTES,
             ..Config::default()
         };
         raft_config.validate()?;
