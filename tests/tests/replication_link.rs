@@ -121,7 +121,7 @@ fn replica_loop(
                 replica.propose(&record).map_err(|x| e(&x))?;
             }
         }
-        for m in replica.take_messages().collect::<Vec<_>>() {
+        for m in replica.take_messages() {
             link.send(&m).map_err(|x| e(&x))?;
         }
         let mut s = shared.lock().unwrap();

@@ -9,10 +9,8 @@
 //! follower, so the topics overwrite the oldest unread message of a slow reader instead of
 //! holding the writer ([`Delivery::LatestOnly`]).
 //!
-//! These topics are between coordinator replicas only: no client reads them, so their header
-//! is not part of the layout table of `hnav_runtime::msg`.
+//! A sample has no user header: the message names its sender and addressee itself.
 
-use iceoryx2::prelude::ZeroCopySend;
 use protobuf::{CodedOutputStream, Message as _};
 use raft::eraftpb::Message;
 
@@ -20,7 +18,7 @@ use hnav_runtime::transport::{
     Delivery, Qos, SliceReceiver, SliceSender, Transport, TransportError,
 };
 
-use super::ReplicaError;
+use super::{decode, ReplicaError};
 
 /// The largest encoded message a topic carries. [`MAX_ENTRIES_BYTES`] keeps Raft's appends
 /// well below it; a round record is a few KiB at 256 agents.
@@ -33,15 +31,6 @@ pub const MAX_ENTRIES_BYTES: u64 = 16 * 1024;
 /// Messages buffered per reader before the oldest is overwritten.
 const BUFFER: usize = 32;
 
-/// The user header of a `raft/<i>` sample; the payload is the encoded message.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend)]
-#[repr(C)]
-#[type_name("hnav::RaftHeader")]
-pub struct RaftHeader {
-    /// The sending replica's id.
-    pub from: u64,
-}
-
 /// The topic replica `id` reads.
 pub fn topic(id: u64) -> String {
     format!("raft/{id}")
@@ -50,9 +39,9 @@ pub fn topic(id: u64) -> String {
 /// One replica's end of the Raft topics.
 pub struct RaftLink {
     id: u64,
-    inbox: SliceReceiver<u8, RaftHeader>,
+    inbox: SliceReceiver<u8, ()>,
     /// Senders to every other voter, by id.
-    peers: Vec<(u64, SliceSender<u8, RaftHeader>)>,
+    peers: Vec<(u64, SliceSender<u8, ()>)>,
 }
 
 impl RaftLink {
@@ -81,7 +70,7 @@ impl RaftLink {
     }
 
     /// The inbox, to attach to the process's [`Waiter`](hnav_runtime::transport::Waiter).
-    pub fn inbox(&self) -> &SliceReceiver<u8, RaftHeader> {
+    pub fn inbox(&self) -> &SliceReceiver<u8, ()> {
         &self.inbox
     }
 
@@ -100,9 +89,7 @@ impl RaftLink {
                 sender.max_len()
             )));
         }
-        let mut loan = sender.loan(len)?;
-        loan.header_mut().from = self.id;
-        loan.fill_with(0u8, |bytes| {
+        sender.loan(len)?.fill_with(0u8, |bytes| {
             let mut out = CodedOutputStream::bytes(bytes);
             message
                 .write_to_with_cached_sizes(&mut out)
@@ -113,18 +100,17 @@ impl RaftLink {
     }
 
     /// Hands every message waiting in the inbox to `f`, decoded; a sample that does not
-    /// decode, or whose header names another sender than the message, is counted in the
-    /// returned [`Inbox::dropped`] and skipped.
+    /// decode, or is addressed to another replica, is counted in the returned
+    /// [`Inbox::dropped`] and skipped.
     pub fn receive(&self, mut f: impl FnMut(Message)) -> Result<Inbox, ReplicaError> {
         let mut inbox = Inbox::default();
-        self.inbox
-            .drain_pending(|header, bytes| match Message::parse_from_bytes(bytes) {
-                Ok(m) if m.from == header.from && m.to == self.id => {
-                    inbox.messages += 1;
-                    f(m);
-                }
-                _ => inbox.dropped += 1,
-            })?;
+        self.inbox.drain_pending(|(), bytes| match decode(bytes) {
+            Ok(m) if m.to == self.id => {
+                inbox.messages += 1;
+                f(m);
+            }
+            _ => inbox.dropped += 1,
+        })?;
         Ok(inbox)
     }
 }
@@ -134,7 +120,6 @@ impl RaftLink {
 pub struct Inbox {
     /// Messages handed on.
     pub messages: usize,
-    /// Samples dropped: not a Raft message, or not from whom the header says, or not for
-    /// this replica.
+    /// Samples dropped: not a Raft message, or not for this replica.
     pub dropped: usize,
 }

@@ -35,7 +35,7 @@ mod log_bridge;
 #[cfg(test)]
 mod tests;
 
-pub use link::{topic, Inbox, RaftHeader, RaftLink, MAX_ENTRIES_BYTES, MAX_MESSAGE_BYTES};
+pub use link::{topic, Inbox, RaftLink, MAX_ENTRIES_BYTES, MAX_MESSAGE_BYTES};
 
 /// Why a replica could not be made, or could not take a message or a proposal.
 #[derive(Debug, thiserror::Error)]
@@ -282,7 +282,8 @@ impl Replica {
                 self.committed.push_back(Committed {
                     index: e.index,
                     term: e.term,
-                    data: e.data.to_vec(),
+                    // The entry is consumed: its buffer becomes the record, no copy.
+                    data: e.data.into(),
                 });
             }
         }

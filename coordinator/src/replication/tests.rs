@@ -114,6 +114,15 @@ impl Cluster {
         panic!("no single leader after {limit} ticks");
     }
 
+    /// The leader proposes the records of `rounds`, one at a time, each delivered before the
+    /// next (as a coordinator proposes one round record per round).
+    fn propose_rounds(&mut self, leader: u64, rounds: std::ops::RangeInclusive<u64>) {
+        for round in rounds {
+            self.get(leader).propose(&record(round)).unwrap();
+            self.settle();
+        }
+    }
+
     fn data(&self, id: u64) -> Vec<Vec<u8>> {
         self.committed[id as usize - 1]
             .iter()
@@ -130,10 +139,7 @@ fn record(round: u64) -> Vec<u8> {
 fn three_replicas_commit_the_same_records_in_the_same_order() {
     let mut c = Cluster::new(3);
     let (leader, _) = c.elect(100);
-    for round in 1..=20 {
-        c.get(leader).propose(&record(round)).unwrap();
-        c.settle();
-    }
+    c.propose_rounds(leader, 1..=20);
     c.run(3);
     let want: Vec<_> = (1..=20).map(record).collect();
     for id in 1..=3 {
@@ -151,20 +157,14 @@ fn three_replicas_commit_the_same_records_in_the_same_order() {
 fn a_lost_leader_is_replaced_and_the_committed_prefix_survives() {
     let mut c = Cluster::new(3);
     let (old, _) = c.elect(100);
-    for round in 1..=5 {
-        c.get(old).propose(&record(round)).unwrap();
-        c.settle();
-    }
+    c.propose_rounds(old, 1..=5);
     c.kill(old);
     // Election timeouts are randomised in [10, 20) ticks; check-quorum and pre-vote add a
     // round of messages, not ticks.
     let (new, ticks) = c.elect(60);
     assert_ne!(new, old);
     assert!(ticks <= 40, "failover took {ticks} ticks");
-    for round in 6..=10 {
-        c.get(new).propose(&record(round)).unwrap();
-        c.settle();
-    }
+    c.propose_rounds(new, 6..=10);
     c.run(3);
     let want: Vec<_> = (1..=10).map(record).collect();
     for id in (1..=3).filter(|&id| id != old) {
@@ -225,10 +225,7 @@ fn five_replicas_lose_two_at_once_and_keep_committing() {
     for &id in &lost {
         c.kill(id);
     }
-    for round in 1..=10 {
-        c.get(leader).propose(&record(round)).unwrap();
-        c.settle();
-    }
+    c.propose_rounds(leader, 1..=10);
     c.run(3);
     let want: Vec<_> = (1..=10).map(record).collect();
     for id in (1..=5).filter(|id| !lost.contains(id)) {
