@@ -10,7 +10,7 @@ use std::path::Path;
 use hnav_runtime::consensus_log::{
     encode_frame, read_log, segment_path, verify, AgentEntry, EndReason, EndRecord,
     LifecycleRecord, LoggedDecision, Record, ReplanRecord, RoundRecord, RunHeader, FORMAT_VERSION,
-    MAGIC,
+    MAGIC, REPLICATED_VERSION,
 };
 use hnav_runtime::grid::{read_map, read_map_file, read_scen, read_scen_file, validate_scen};
 use hnav_runtime::msg::{Lifecycle, Role};
@@ -470,11 +470,11 @@ fn every_log_error_class_has_its_exact_message() {
     );
     let mut other = good();
     if let Record::Header(h) = &mut other[0] {
-        h.version = FORMAT_VERSION + 1;
+        h.version = REPLICATED_VERSION + 1;
     }
     error(
         vec![segment(&other)],
-        "DIR/seg-00000000.hlog: byte 8: log format version 2, this build reads version 1",
+        "DIR/seg-00000000.hlog: byte 8: log format version 3, this build reads versions 1 and 2",
     );
     let dir = log_dir(&[segment(&good())]);
     fs::rename(segment_path(dir.path(), 0), segment_path(dir.path(), 2)).unwrap();

@@ -179,7 +179,7 @@ impl State {
                     *r = Some(true);
                 }
             }
-            Record::Header(_) | Record::Replan(_) => {}
+            Record::Header(_) | Record::Replan(_) | Record::Raft(_) | Record::RaftState(_) => {}
         }
     }
 

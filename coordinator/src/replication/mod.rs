@@ -15,11 +15,12 @@
 //! round record); what it gets back, in the same order on every replica, is the committed
 //! sequence.
 //!
-//! The storage is the library's `MemStorage`, shared with the caller ([`Replica::storage`]),
-//! so that a replica restarted over the same storage (a process restarted over its log) comes
-//! back with its term, vote and entries. [`RaftLink`] carries the messages between processes
-//! on the HNAV transport (`raft/<i>` topics). Storing the entries in the consensus-log
-//! segments themselves is the next step (README, *Replicated consensus log*).
+//! Raft reads its log from the library's `MemStorage`; a durable replica also writes every
+//! entry and hard state to its [`Journal`], the consensus-log segments of `DIR/log/<id>/`,
+//! and flushes it before the messages that acknowledge them leave ([`Replica::durable`]).
+//! A replica restarted over its journal comes back with its term, vote and entries, and Raft
+//! hands its committed entries out again. [`RaftLink`] carries the messages between processes
+//! on the HNAV transport (`raft/<i>` topics).
 //!
 //! [`Waiter`]: hnav_runtime::transport::Waiter
 
@@ -30,11 +31,13 @@ use raft::eraftpb::{ConfState, Entry, EntryType, Message};
 use raft::storage::MemStorage;
 use raft::{Config, RawNode, StateRole};
 
+mod journal;
 mod link;
 mod log_bridge;
 #[cfg(test)]
 mod tests;
 
+pub use journal::Journal;
 pub use link::{topic, Inbox, RaftLink, MAX_ENTRIES_BYTES, MAX_MESSAGE_BYTES};
 
 /// Why a replica could not be made, or could not take a message or a proposal.
@@ -70,6 +73,21 @@ pub enum ReplicaError {
     /// storage error).
     #[error("raft: {0}")]
     Raft(#[from] raft::Error),
+    /// The replica's journal (its consensus log) failed: nothing may be acknowledged.
+    #[error(transparent)]
+    Log(#[from] hnav_runtime::consensus_log::LogError),
+    /// The journal in the replica's log directory belongs to another run.
+    #[error("the replica log in {dir} was written for another run: {what}")]
+    ForeignLog {
+        /// The log directory.
+        dir: String,
+        /// What differs.
+        what: String,
+    },
+    /// Raft asked to install a snapshot; replicas catch up by log replay only (entries are
+    /// never compacted away).
+    #[error("raft sent a snapshot; replicas catch up from the log and never compact it")]
+    Snapshot,
 }
 
 /// A replica's timing and identity.
@@ -138,6 +156,9 @@ pub struct Committed {
 /// One voter of a Raft cluster, driven by its owner's loop.
 pub struct Replica {
     node: RawNode<MemStorage>,
+    /// Where entries and hard states are made durable; `None` keeps them in memory only (the
+    /// in-process tests).
+    journal: Option<Journal>,
     outbox: Vec<Message>,
     committed: VecDeque<Committed>,
 }
@@ -148,6 +169,32 @@ impl Replica {
         let storage =
             MemStorage::new_with_conf_state(ConfState::from((config.voters.clone(), Vec::new())));
         Self::restart(config, storage)
+    }
+
+    /// A replica whose Raft log is the journal in `dir` (created with `header` if new,
+    /// replayed if not): a restarted process comes back with its term, vote and entries, and
+    /// its committed entries come out of [`take_committed`](Self::take_committed) again.
+    pub fn durable(
+        config: &ReplicaConfig,
+        dir: &std::path::Path,
+        header: hnav_runtime::consensus_log::RunHeader,
+        fsync: hnav_runtime::scenario::FsyncPolicy,
+    ) -> Result<Self, ReplicaError> {
+        let (journal, storage) = Journal::open(dir, header, fsync, &config.voters)?;
+        let mut replica = Self::restart(config, storage)?;
+        replica.journal = Some(journal);
+        // The committed entries of the journal are ready at once.
+        replica.process()?;
+        Ok(replica)
+    }
+
+    /// Makes everything the journal holds durable (the end of a run); nothing for a replica
+    /// in memory.
+    pub fn sync(&mut self) -> Result<(), ReplicaError> {
+        match &mut self.journal {
+            Some(j) => j.sync(),
+            None => Ok(()),
+        }
     }
 
     /// A replica over storage that survived it: its term, vote and entries come back; what it
@@ -177,6 +224,7 @@ impl Replica {
         let node = RawNode::new(&raft_config, storage, &log_bridge::logger(config.id))?;
         Ok(Replica {
             node,
+            journal: None,
             outbox: Vec::new(),
             committed: VecDeque::new(),
         })
@@ -257,17 +305,28 @@ impl Replica {
             self.outbox.extend(ready.take_messages());
             let store = self.node.store().clone();
             if !ready.snapshot().is_empty() {
-                store.wl().apply_snapshot(ready.snapshot().clone())?;
+                return Err(ReplicaError::Snapshot);
             }
             self.collect(ready.take_committed_entries());
             store.wl().append(ready.entries())?;
             if let Some(hs) = ready.hs() {
                 store.wl().set_hardstate(hs.clone());
             }
+            if let Some(j) = &mut self.journal {
+                j.entries(ready.entries());
+                if let Some(hs) = ready.hs() {
+                    j.hard_state(hs);
+                }
+                // Durable before the messages that acknowledge it.
+                j.flush()?;
+            }
             self.outbox.extend(ready.take_persisted_messages());
             let mut light = self.node.advance(ready);
             if let Some(commit) = light.commit_index() {
                 store.wl().mut_hard_state().set_commit(commit);
+                if let Some(j) = &mut self.journal {
+                    j.commit(commit);
+                }
             }
             self.outbox.extend(light.take_messages());
             self.collect(light.take_committed_entries());

@@ -1,14 +1,18 @@
-//! The failure semantics the replicated log promises, on an in-memory cluster: messages are
+//! The failure semantics the replicated log promises, on an in-process cluster: messages are
 //! delivered by the test, a lost replica is one whose messages go nowhere, a restart is a new
-//! [`Replica`] over the old storage.
+//! [`Replica`] over the old storage (in memory) or over its journal on disk (durable).
 
 use super::*;
+use hnav_runtime::consensus_log::{encode_record, read_decided, Record, RoundRecord, RunHeader};
+use hnav_runtime::scenario::FsyncPolicy;
 
 /// Replicas 1..=n, each `None` while lost, with the storages kept for restarts and every
 /// entry each has committed so far.
 struct Cluster {
     replicas: Vec<Option<Replica>>,
     storages: Vec<MemStorage>,
+    /// The replicas' journals (`<dir>/<id>/`), for a durable cluster.
+    journals: Option<tempfile::TempDir>,
     committed: Vec<Vec<Committed>>,
     /// Pairs (from, to) whose messages are dropped: a partition.
     cut: Vec<(u64, u64)>,
@@ -26,6 +30,22 @@ impl Cluster {
         Cluster {
             replicas,
             storages,
+            journals: None,
+            committed: vec![Vec::new(); n as usize],
+            cut: Vec::new(),
+        }
+    }
+
+    /// A cluster whose replicas keep their Raft logs in journals on disk.
+    fn durable(n: u64) -> Self {
+        let dir = tempfile::tempdir().unwrap();
+        let replicas: Vec<_> = (1..=n)
+            .map(|id| Some(durable_replica(dir.path(), id, n)))
+            .collect();
+        Cluster {
+            replicas,
+            storages: Vec::new(),
+            journals: Some(dir),
             committed: vec![Vec::new(); n as usize],
             cut: Vec::new(),
         }
@@ -50,7 +70,12 @@ impl Cluster {
     fn restart(&mut self, id: u64) {
         let i = id as usize - 1;
         let config = ReplicaConfig::cluster(id, self.n());
-        self.replicas[i] = Some(Replica::restart(&config, self.storages[i].clone()).unwrap());
+        // The old process is gone first: its journal's lock goes with it.
+        self.replicas[i] = None;
+        self.replicas[i] = Some(match &self.journals {
+            Some(dir) => durable_replica(dir.path(), id, self.n()),
+            None => Replica::restart(&config, self.storages[i].clone()).unwrap(),
+        });
         self.committed[i].clear();
     }
 
@@ -131,8 +156,38 @@ impl Cluster {
     }
 }
 
+/// What the coordinator proposes: an encoded round record.
 fn record(round: u64) -> Vec<u8> {
-    format!("round {round}").into_bytes()
+    let mut data = Vec::new();
+    encode_record(&round_record(round), &mut data).unwrap();
+    data
+}
+
+fn round_record(round: u64) -> Record {
+    Record::Round(RoundRecord::new(round, &[], &[]))
+}
+
+fn header() -> RunHeader {
+    RunHeader {
+        version: 0,
+        scenario_hash: 7,
+        seed: 1,
+        clock: "lockstep".into(),
+        width: 4,
+        height: 4,
+        agents: Vec::new(),
+    }
+}
+
+fn durable_replica(dir: &std::path::Path, id: u64, n: u64) -> Replica {
+    let config = ReplicaConfig::cluster(id, n);
+    Replica::durable(
+        &config,
+        &dir.join(id.to_string()),
+        header(),
+        FsyncPolicy::EveryRecord,
+    )
+    .unwrap()
 }
 
 #[test]
@@ -155,7 +210,11 @@ fn three_replicas_commit_the_same_records_in_the_same_order() {
 
 #[test]
 fn a_lost_leader_is_replaced_and_the_committed_prefix_survives() {
-    let mut c = Cluster::new(3);
+    lost_leader(Cluster::new(3));
+    lost_leader(Cluster::durable(3));
+}
+
+fn lost_leader(mut c: Cluster) {
     let (old, _) = c.elect(100);
     c.propose_rounds(old, 1..=5);
     c.kill(old);
@@ -243,7 +302,20 @@ fn five_replicas_lose_two_at_once_and_keep_committing() {
 
 #[test]
 fn a_partitioned_leader_steps_down_and_its_stale_proposal_never_commits() {
-    let mut c = Cluster::new(3);
+    partitioned_leader(Cluster::new(3));
+    let mut c = partitioned_leader(Cluster::durable(3));
+    // On disk too: the old leader's journal holds the stale entry, overwritten, and reads
+    // back as the cluster's log.
+    let want = [round_record(1), round_record(2)];
+    for id in 1..=3 {
+        c.get(id).sync().unwrap();
+        let dir = c.journals.as_ref().unwrap().path().join(id.to_string());
+        let decided = read_decided(&dir).unwrap().records;
+        assert_eq!(decided[1..], want[..], "replica {id}");
+    }
+}
+
+fn partitioned_leader(mut c: Cluster) -> Cluster {
     let (old, _) = c.elect(100);
     c.get(old).propose(&record(1)).unwrap();
     c.settle();
@@ -271,6 +343,57 @@ fn a_partitioned_leader_steps_down_and_its_stale_proposal_never_commits() {
             "replica {id}: the stale entry was overwritten"
         );
     }
+    c
+}
+
+#[test]
+fn every_replica_restarted_from_its_journal_comes_back_with_the_log() {
+    let mut c = Cluster::durable(3);
+    let (leader, _) = c.elect(100);
+    c.propose_rounds(leader, 1..=10);
+    c.run(3);
+    let terms: Vec<u64> = (1..=3).map(|id| c.get(id).term()).collect();
+    // The whole cluster dies and comes back from disk.
+    for id in 1..=3 {
+        c.kill(id);
+    }
+    for id in 1..=3 {
+        c.restart(id);
+        assert_eq!(c.get(id).term(), terms[id as usize - 1], "term of {id}");
+    }
+    let (leader, _) = c.elect(100);
+    c.propose_rounds(leader, 11..=15);
+    c.run(3);
+    let want: Vec<_> = (1..=15).map(record).collect();
+    for id in 1..=3 {
+        assert_eq!(c.data(id), want, "replica {id}");
+        c.get(id).sync().unwrap();
+        let dir = c.journals.as_ref().unwrap().path().join(id.to_string());
+        let decided = read_decided(&dir).unwrap().records;
+        let want: Vec<Record> = (1..=15).map(round_record).collect();
+        assert_eq!(decided[1..], want[..], "replica {id} on disk");
+        let report = hnav_runtime::consensus_log::verify(&dir);
+        assert!(report.problems.is_empty(), "{}", report.render());
+    }
+}
+
+#[test]
+fn a_journal_of_another_run_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    drop(durable_replica(dir.path(), 1, 3));
+    let other = RunHeader {
+        seed: 2,
+        ..header()
+    };
+    let e = Replica::durable(
+        &ReplicaConfig::cluster(1, 3),
+        &dir.path().join("1"),
+        other,
+        FsyncPolicy::EveryRecord,
+    )
+    .err()
+    .unwrap();
+    assert!(e.to_string().contains("written for another run"), "{e}");
 }
 
 #[test]

@@ -128,7 +128,7 @@ pub enum LogError {
         found: &'static str,
     },
     /// The header's format version is not [`FORMAT_VERSION`](super::FORMAT_VERSION).
-    #[error("{}: byte {offset}: log format version {found}, this build reads version {expected}", path.display())]
+    #[error("{}: byte {offset}: log format version {found}, this build reads versions 1 and {expected}", path.display())]
     Version {
         /// The segment file.
         path: PathBuf,
@@ -136,8 +136,19 @@ pub enum LogError {
         offset: u64,
         /// The version in the header.
         found: u32,
-        /// The version this build reads and writes.
+        /// The newest version this build reads (it reads every version from 1 up).
         expected: u32,
+    },
+    /// A replicated log whose Raft entries do not make a log: an entry that skips indices,
+    /// goes back in term, or holds no record.
+    #[error("{}: Raft entry {index}: {what}", dir.display())]
+    Raft {
+        /// The log directory.
+        dir: PathBuf,
+        /// The entry's index.
+        index: u64,
+        /// What is wrong.
+        what: String,
     },
     /// A record to append encodes to more than [`MAX_RECORD_LEN`](super::MAX_RECORD_LEN).
     #[error("record of {len} bytes exceeds the maximum of {max}")]

@@ -78,6 +78,23 @@ pub fn decode_payload(payload: &[u8], stored_crc: u32) -> Result<Record, FramePr
             computed,
         });
     }
+    decode_record(payload)
+}
+
+/// A record's payload encoding (a frame's payload without the frame): what a replicated log
+/// carries inside a Raft entry. On error `buf` is left as it was.
+pub fn encode_record(record: &Record, buf: &mut Vec<u8>) -> Result<(), LogError> {
+    let start = buf.len();
+    bincode::serde::encode_into_std_write(record, buf, standard())
+        .map(|_| ())
+        .map_err(|e| {
+            buf.truncate(start);
+            LogError::Encode(e)
+        })
+}
+
+/// Decodes one record's payload encoding; the whole of `payload` must be the record.
+pub fn decode_record(payload: &[u8]) -> Result<Record, FrameProblem> {
     match bincode::serde::decode_from_slice::<Record, _>(payload, limited()) {
         Ok((record, used)) if used == payload.len() => Ok(record),
         Ok((_, used)) => Err(FrameProblem::Undecodable {
@@ -108,7 +125,7 @@ fn describe_decode_error(e: &bincode::error::DecodeError) -> String {
         E::InvalidBooleanValue(v) => format!("a boolean of value {v}"),
         E::OutsideUsizeRange(v) => format!("a length of {v}, too large for this machine"),
         // Serde's own wording, e.g. "invalid value: integer `9`, expected variant index
-        // 0 <= i < 6" for an unknown record kind.
+        // 0 <= i < 8" for an unknown record kind.
         E::OtherString(s) => s.clone(),
         E::Other(s) => (*s).into(),
         _ => "not a record of this format".into(),
@@ -151,7 +168,7 @@ mod tests {
         assert_eq!(detail(&[1, 0xFF]), "a malformed integer");
         assert_eq!(
             detail(&[9]),
-            "invalid value: integer `9`, expected variant index 0 <= i < 6"
+            "invalid value: integer `9`, expected variant index 0 <= i < 8"
         );
     }
 

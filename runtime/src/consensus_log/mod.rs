@@ -21,6 +21,11 @@
 //! ([`DEFAULT_SEGMENT_BYTES`]). Only the end of the last segment can be torn by a crash; see
 //! [`reader`] for what counts as torn and what as corruption.
 //!
+//! A coordinator replica's log (version [`REPLICATED_VERSION`], a run with `replicas = 3|5`)
+//! is the same segments and frames; after its header every record is a Raft entry, which
+//! carries its term and index around an encoded record, or a Raft hard state
+//! ([`replicated`]). Readers of decisions take them through [`read_decided`].
+//!
 //! | module | what it holds |
 //! |---|---|
 //! | [`record`] | [`Record`] and its parts; conversions from `msg`; [`candidates_digest`] |
@@ -31,6 +36,7 @@
 //! | [`verify`](mod@verify) | [`verify()`]: a [`VerifyReport`] on whether a log is intact |
 //! | [`show`] | one-line text and JSON renderings of records |
 //! | [`tally`] | [`Tally`]: per-agent steps, octile length, conflicts and replans of the decisions |
+//! | [`replicated`] | a replica's log (version [`REPLICATED_VERSION`]): Raft entries and hard state in the same frames; [`resolve`], [`read_decided`] |
 //! | [`compare`](mod@compare) | [`compare()`]: two logs record by record, the first [`Divergence`] in words (`hnav log replay`) |
 //! | [`error`] | [`LogError`], [`FrameProblem`] |
 
@@ -39,6 +45,7 @@ pub mod error;
 pub mod frame;
 pub mod reader;
 pub mod record;
+pub mod replicated;
 pub mod segment;
 pub mod show;
 pub mod tally;
@@ -47,16 +54,24 @@ pub mod writer;
 
 pub use compare::{compare, Comparison, Divergence};
 pub use error::{FrameProblem, LogError};
-pub use frame::{encode_frame, FRAME_HEADER_LEN, MAGIC, MAX_RECORD_LEN};
+pub use frame::{
+    decode_record, encode_frame, encode_record, FRAME_HEADER_LEN, MAGIC, MAX_RECORD_LEN,
+};
 pub use reader::{read_log, LogContents, LogReader, RecordPos, TornTail};
 pub use record::{
-    candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision, Record,
-    ReplanRecord, RoundRecord, RunHeader, UnreachableRecord,
+    candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision,
+    RaftEntryRecord, RaftStateRecord, Record, ReplanRecord, RoundRecord, RunHeader,
+    UnreachableRecord,
 };
+pub use replicated::{is_replicated, read_decided, replica_dirs, resolve, Decided, Resolved};
 pub use segment::{list_segments, segment_name, segment_path, DEFAULT_SEGMENT_BYTES};
 pub use tally::{AgentTally, Tally};
 pub use verify::{verify, KindCounts, VerifyReport, VerifyStatus};
 pub use writer::{LogWriter, Recovered, WriterOptions, BATCH_INTERVAL, BATCH_RECORDS, WRITER_LOCK};
 
-/// The format version this build writes into [`RunHeader::version`] and accepts on reading.
+/// The format version of a single coordinator's log, in its [`RunHeader::version`].
 pub const FORMAT_VERSION: u32 = 1;
+
+/// The format version of a coordinator replica's log: after the header only Raft entries
+/// (each with its term and index) and hard states ([`replicated`]). A build reads both.
+pub const REPLICATED_VERSION: u32 = 2;

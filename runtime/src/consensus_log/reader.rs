@@ -22,7 +22,7 @@ use super::error::{FrameProblem, LogError};
 use super::frame::{decode_payload, parse_frame_header, plausible_len, FRAME_HEADER_LEN, MAGIC};
 use super::record::Record;
 use super::segment::list_segments;
-use super::{FORMAT_VERSION, MAX_RECORD_LEN};
+use super::{FORMAT_VERSION, MAX_RECORD_LEN, REPLICATED_VERSION};
 
 /// Bytes the torn-tail check checksums at most while looking for a complete frame after a
 /// bad one.
@@ -200,17 +200,19 @@ impl Iterator for LogReader {
     }
 }
 
-/// Checks that `record`, the first of a log (at `offset` of `path`), is a header of this
-/// build's [`FORMAT_VERSION`]: the reader's rule for what it reads, the writer's for what it
-/// writes.
+/// Checks that `record`, the first of a log (at `offset` of `path`), is a header of a version
+/// this build knows ([`FORMAT_VERSION`], or [`REPLICATED_VERSION`] for a replica's log): the
+/// reader's rule for what it reads, the writer's for what it writes.
 pub(super) fn check_header(path: &Path, offset: u64, record: &Record) -> Result<(), LogError> {
     match record {
-        Record::Header(h) if h.version == FORMAT_VERSION => Ok(()),
+        Record::Header(h) if h.version == FORMAT_VERSION || h.version == REPLICATED_VERSION => {
+            Ok(())
+        }
         Record::Header(h) => Err(LogError::Version {
             path: path.to_path_buf(),
             offset,
             found: h.version,
-            expected: FORMAT_VERSION,
+            expected: REPLICATED_VERSION,
         }),
         other => Err(LogError::NoHeader {
             path: path.to_path_buf(),

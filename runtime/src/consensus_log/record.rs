@@ -22,9 +22,14 @@ pub enum Record {
     Replan(ReplanRecord),
     /// The run ended.
     End(EndRecord),
-    /// An agent reported that its goal cannot be reached (logged once per agent; last in
-    /// the enum so that the encoding of the other kinds is unchanged).
+    /// An agent reported that its goal cannot be reached (logged once per agent; after the
+    /// kinds above so that their encoding is unchanged).
     Unreachable(UnreachableRecord),
+    /// A Raft log entry of a replicated log ([`REPLICATED_VERSION`](super::REPLICATED_VERSION)):
+    /// one of the kinds above, encoded, with the term and index Raft gave it.
+    Raft(RaftEntryRecord),
+    /// A replica's Raft hard state (term, vote, commit index) from this point of its log on.
+    RaftState(RaftStateRecord),
 }
 
 impl Record {
@@ -38,6 +43,8 @@ impl Record {
             Self::Replan(_) => "replan",
             Self::End(_) => "end",
             Self::Unreachable(_) => "unreachable",
+            Self::Raft(_) => "raft-entry",
+            Self::RaftState(_) => "raft-state",
         }
     }
 
@@ -50,8 +57,34 @@ impl Record {
             Self::Replan(r) => Some(r.round),
             Self::End(r) => Some(r.round),
             Self::Unreachable(r) => Some(r.round),
+            Self::Raft(_) | Self::RaftState(_) => None,
         }
     }
+}
+
+/// One Raft log entry as a replica stores it. A later entry with the same or a lower index
+/// replaces this one and every entry after it (Raft overwrote an uncommitted suffix); see
+/// [`replicated`](super::replicated).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RaftEntryRecord {
+    /// The term of the leader that proposed it.
+    pub term: u64,
+    /// Raft's log index, from 1.
+    pub index: u64,
+    /// The decided [`Record`] in the log's own payload encoding, or empty for the empty entry
+    /// a new leader appends.
+    pub data: Vec<u8>,
+}
+
+/// A replica's Raft hard state, as of this point in its log.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RaftStateRecord {
+    /// The current term.
+    pub term: u64,
+    /// Whom the replica voted for in that term (0 for nobody).
+    pub vote: u64,
+    /// The highest index known committed.
+    pub commit: u64,
 }
 
 /// The run a log belongs to.

@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 
 use serde_json::{json, Map, Value};
 
+use super::frame::decode_record;
 use super::reader::RecordPos;
 use super::record::{LoggedDecision, Record};
 use crate::msg::{ConflictKind, LifecycleEvent, Role, Verdict, NO_CELL};
@@ -103,6 +104,21 @@ pub fn describe(record: &Record, width: u32) -> String {
                 e.round,
                 e.at_goal,
                 e.reason.name()
+            );
+        }
+        Record::Raft(e) => {
+            let _ = write!(s, "raft {}.{}  ", e.term, e.index);
+            match (e.data.is_empty(), decode_record(&e.data)) {
+                (true, _) => s.push_str("(empty)"),
+                (false, Ok(inner)) => s.push_str(&describe(&inner, width)),
+                (false, Err(p)) => _ = write!(s, "undecodable: {p}"),
+            }
+        }
+        Record::RaftState(st) => {
+            let _ = write!(
+                s,
+                "raft-state term {} vote {} commit {}",
+                st.term, st.vote, st.commit
             );
         }
     }
@@ -215,6 +231,20 @@ pub fn to_json(pos: &RecordPos, record: &Record, width: u32) -> Value {
             "round": u.round,
             "agent": u.agent,
             "cell": cell(u.cell),
+        }),
+        Record::Raft(e) => json!({
+            "term": e.term,
+            "index": e.index,
+            "record": match (e.data.is_empty(), decode_record(&e.data)) {
+                (true, _) => Value::Null,
+                (false, Ok(inner)) => to_json(pos, &inner, width),
+                (false, Err(p)) => json!({ "undecodable": p.to_string() }),
+            },
+        }),
+        Record::RaftState(st) => json!({
+            "term": st.term,
+            "vote": st.vote,
+            "commit": st.commit,
         }),
     };
     let mut object = Map::new();

@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 use base64::Engine as _;
 use serde_json::{json, Value};
 
-use crate::consensus_log::{read_log, LogError, LoggedDecision, Record, RunHeader};
+use crate::consensus_log::{read_decided, LogError, LoggedDecision, Record, RunHeader};
 use crate::invocation::Invocation;
 use crate::msg::{ConflictKind, Verdict, NO_CELL};
 use crate::recording::{
@@ -102,7 +102,7 @@ struct RunInfo {
 /// to the MCAP file `out`.
 pub fn export_mcap(run_dir: &Path, out: &Path) -> Result<ExportReport, ExportError> {
     let log_dir = run_dir.join("log");
-    let records = read_log(&log_dir)?.records;
+    let records = read_decided(&log_dir)?.records;
     let header = match records.first() {
         Some(Record::Header(h)) => h.clone(),
         _ => return Err(ExportError::NoHeader { dir: log_dir }),

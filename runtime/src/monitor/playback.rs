@@ -34,7 +34,7 @@ use iceoryx2_bb_posix::signal::SignalHandler;
 
 use super::feed::{Feed, FeedError, RunEnd, Update, Waited};
 use super::state::RunInfo;
-use crate::consensus_log::reader::read_log;
+use crate::consensus_log::read_decided;
 use crate::consensus_log::record::{EndReason, Record, RunHeader};
 use crate::consensus_log::tally::Tally;
 use crate::grid::movingai::read_map_file;
@@ -79,7 +79,7 @@ impl PlaybackFeed {
                 SPEEDS.end()
             )));
         }
-        let log = read_log(dir.join("log")).map_err(|e| bad(e.to_string()))?;
+        let log = read_decided(dir.join("log")).map_err(|e| bad(e.to_string()))?;
         let mut records = log.records.into_iter();
         let Some(Record::Header(header)) = records.next() else {
             return Err(bad(

@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-use crate::consensus_log::{read_log, Record, RunHeader};
+use crate::consensus_log::{read_decided, Record, RunHeader};
 use crate::grid::read_map_file;
 use crate::msg::Verdict;
 use crate::recording::{self, MapReader, MapSnapshot, PoseSource, TrajectoryReader};
@@ -116,7 +116,7 @@ impl RunData {
 
     /// Starts, goals, committed cells, conflicts and replans from the log in `log_dir`.
     pub fn from_log(log_dir: &Path) -> Result<RunData, ReportError> {
-        let contents = read_log(log_dir)?;
+        let contents = read_decided(log_dir)?;
         let header: &RunHeader = contents
             .records
             .iter()

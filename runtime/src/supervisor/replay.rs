@@ -13,7 +13,7 @@
 use std::path::{Path, PathBuf};
 
 use super::run::{run, RunError, RunOptions};
-use crate::consensus_log::{compare, read_log, Comparison, LogError, Record, RunHeader};
+use crate::consensus_log::{compare, read_decided, Comparison, LogError, Record, RunHeader};
 use crate::invocation::{Invocation, InvocationError, FILE as INVOCATION};
 use crate::scenario::{ClockMode, ScenarioError};
 use crate::transport::RunId;
@@ -112,7 +112,7 @@ pub fn run_dir_of(dir: &Path) -> PathBuf {
 pub fn replay(opts: &ReplayOptions) -> Result<Replayed, ReplayError> {
     let dir = run_dir_of(&opts.dir);
     let log_dir = dir.join("log");
-    let logged = read_log(&log_dir)?.records;
+    let logged = read_decided(&log_dir)?.records;
     let header = match logged.first() {
         Some(Record::Header(h)) => h.clone(),
         _ => return Err(ReplayError::NoHeader { dir: log_dir }),
@@ -147,7 +147,7 @@ pub fn replay(opts: &ReplayOptions) -> Result<Replayed, ReplayError> {
         // The comparison reads the log only; a recording would cost the replay time.
         record: false,
     })?;
-    let replayed = read_log(tmp.0.join("log"))?.records;
+    let replayed = read_decided(tmp.0.join("log"))?.records;
     Ok(Replayed {
         comparison: compare(&logged, &replayed, header.width),
         header,

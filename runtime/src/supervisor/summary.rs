@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::consensus_log::{read_log, LogError, Record, Tally};
+use crate::consensus_log::{read_decided, LogError, Record, Tally};
 use crate::msg::{LifecycleEvent, Role, Truth};
 use crate::rejected::Rejections;
 
@@ -119,7 +119,7 @@ impl RunSummary {
         cell_size_m: f64,
         wall_time_s: f64,
     ) -> Result<RunSummary, LogError> {
-        let contents = read_log(log_dir)?;
+        let contents = read_decided(log_dir)?;
         let mut header = None;
         let mut tally = Tally::default();
         let mut rounds = 0;
@@ -143,7 +143,10 @@ impl RunSummary {
                 {
                     lost.push(l.index);
                 }
-                Record::Lifecycle(_) | Record::Replan(_) => {}
+                Record::Lifecycle(_)
+                | Record::Replan(_)
+                | Record::Raft(_)
+                | Record::RaftState(_) => {}
             }
         }
         let mut agents: Vec<AgentSummary> = (0u32..)

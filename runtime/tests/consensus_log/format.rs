@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 use hnav_runtime::consensus_log::{
     candidates_digest, encode_frame, read_log, segment_path, verify, EndReason, EndRecord,
-    FrameProblem, LogError, LogWriter, LoggedDecision, Record, RoundRecord, VerifyStatus,
-    FORMAT_VERSION, MAGIC,
+    FrameProblem, LogError, LogWriter, LoggedDecision, Record, RoundRecord, VerifyStatus, MAGIC,
+    REPLICATED_VERSION,
 };
 use hnav_runtime::msg::{Candidate, Decision};
 use hnav_runtime::scenario::FsyncPolicy;
@@ -270,7 +270,7 @@ fn header_rules_and_order_problems() {
     let Record::Header(mut h) = header(2) else {
         unreachable!()
     };
-    h.version = FORMAT_VERSION + 1;
+    h.version = REPLICATED_VERSION + 1;
     let seg = segment_path(&dir("version"), 0);
     let mut bytes = fs::read(&seg).unwrap();
     bytes.truncate(MAGIC.len());
@@ -278,7 +278,7 @@ fn header_rules_and_order_problems() {
     fs::write(&seg, bytes).unwrap();
     assert!(matches!(
         read_log(dir("version")),
-        Err(LogError::Version { found: 2, .. })
+        Err(LogError::Version { found: 3, .. })
     ));
 
     // The writer checks only the first record; order is the verifier's business.

@@ -7,6 +7,10 @@
 //! at corruption (records before it are printed), 2 unreadable as for `verify`.
 //! `replay` (`log_replay_cmd`): 0 identical, 1 diverged, 2 not a replayable run.
 //! `export` (`log_export_cmd`): 0 written, 1 the output cannot be written, 2 unreadable input.
+//!
+//! A run with coordinator replicas keeps one log per replica in `log/<id>/`: `verify` checks
+//! each (the exit code is the worst), `show` prints the log of the replica that decided the
+//! most (saying which on stderr); a replica's own directory can be named as well.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -14,7 +18,10 @@ use std::process::ExitCode;
 
 use clap::Subcommand;
 use hnav_runtime::consensus_log::show::{describe, to_json};
-use hnav_runtime::consensus_log::{segment_name, verify, LogReader, Record, VerifyStatus};
+use hnav_runtime::consensus_log::{
+    list_segments, read_decided, replica_dirs, segment_name, verify, LogReader, Record,
+    VerifyStatus,
+};
 
 /// `hnav log` subcommands.
 #[derive(Subcommand, Debug)]
@@ -72,21 +79,54 @@ fn log_dir(dir: &Path) -> PathBuf {
     }
 }
 
-fn verify_cmd(dir: &Path) -> ExitCode {
-    let report = verify(dir);
-    // A closed stdout must not turn into a panic; the exit code still tells.
-    let _ = std::io::stdout()
-        .lock()
-        .write_all(report.render().as_bytes());
-    match report.status() {
-        VerifyStatus::Intact => ExitCode::SUCCESS,
-        VerifyStatus::NotIntact => ExitCode::from(1),
-        VerifyStatus::Unreadable => ExitCode::from(2),
+/// The replicas' logs under `dir` when `dir` holds no segment of its own (a run with
+/// replicas), else none.
+fn replicas_in(dir: &Path) -> Vec<PathBuf> {
+    if list_segments(dir).is_ok_and(|s| !s.is_empty()) {
+        return Vec::new();
     }
+    replica_dirs(dir)
+        .map(|r| r.into_iter().map(|(_, d)| d).collect())
+        .unwrap_or_default()
+}
+
+fn verify_cmd(dir: &Path) -> ExitCode {
+    let mut dirs = replicas_in(dir);
+    if dirs.is_empty() {
+        dirs.push(dir.to_path_buf());
+    }
+    let mut worst = 0;
+    for (i, d) in dirs.iter().enumerate() {
+        let report = verify(d);
+        let sep = if i > 0 { "\n" } else { "" };
+        // A closed stdout must not turn into a panic; the exit code still tells.
+        let _ = write!(std::io::stdout().lock(), "{sep}{}", report.render());
+        worst = worst.max(match report.status() {
+            VerifyStatus::Intact => 0,
+            VerifyStatus::NotIntact => 1,
+            VerifyStatus::Unreadable => 2,
+        });
+    }
+    ExitCode::from(worst)
 }
 
 fn show_cmd(dir: &Path, json: bool) -> ExitCode {
-    let mut reader = match LogReader::open(dir) {
+    let dir = if replicas_in(dir).is_empty() {
+        dir.to_path_buf()
+    } else {
+        match read_decided(dir) {
+            Ok(d) => {
+                hnav_runtime::errln!("note: the log of the replica that decided the most:");
+                hnav_runtime::errln!("note: {}", d.dir.display());
+                d.dir
+            }
+            Err(e) => {
+                hnav_runtime::errln!("error: {e}");
+                return ExitCode::from(if e.is_unreadable() { 2 } else { 1 });
+            }
+        }
+    };
+    let mut reader = match LogReader::open(&dir) {
         Ok(r) => r,
         Err(e) => {
             hnav_runtime::errln!("error: {e}");

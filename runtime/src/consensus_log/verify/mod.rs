@@ -11,6 +11,11 @@
 //! - it has at most one end record, nothing follows it, and it closes at the last round;
 //! - every agent index in it is below the header's agent count and every verdict is known.
 //!
+//! A replica's log (version [`REPLICATED_VERSION`](super::REPLICATED_VERSION)) must also make
+//! a Raft log ([`resolve`](super::resolve): no skipped index, no falling term, nothing but
+//! entries and hard states after the header), and the rules above apply to its decided
+//! records (the committed entries), each placed at the entry it came from.
+//!
 //! A log without an end record is intact but *not closed* ([`VerifyReport::is_closed`]): the
 //! run was cut short (a crash of the whole run, a kill of the supervisor) or is still going.
 //! That is a different finding from a damaged log, so it does not change the status.
@@ -22,8 +27,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::error::LogError;
-use super::reader::{LogReader, TornTail};
-use super::record::EndRecord;
+use super::reader::{LogReader, RecordPos, TornTail};
+use super::record::{EndRecord, RaftStateRecord, Record};
+use super::replicated::{is_replicated, resolve};
 use super::segment::segment_name;
 use order::OrderCheck;
 use segments::SegmentCheck;
@@ -50,6 +56,17 @@ impl KindCounts {
     pub fn total(&self) -> u64 {
         self.header + self.round + self.lifecycle + self.replan + self.end + self.unreachable
     }
+}
+
+/// What a replica's log holds besides its decided records.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RaftSummary {
+    /// Raft entry records written (overwritten ones included).
+    pub written: u64,
+    /// The last entry's index.
+    pub last_index: u64,
+    /// The last hard state written.
+    pub state: RaftStateRecord,
 }
 
 /// The verdict of [`verify`].
@@ -80,6 +97,8 @@ pub struct VerifyReport {
     pub last_round: Option<u64>,
     /// The (first) end record, if the log has one.
     pub end: Option<EndRecord>,
+    /// For a replica's log: its Raft entries and last hard state.
+    pub raft: Option<RaftSummary>,
     /// The torn tail, if any.
     pub torn: Option<TornTail>,
     /// The error that stopped reading (corruption, header, version, gap, I/O), if any.
@@ -133,6 +152,14 @@ impl VerifyReport {
         if c.unreachable > 0 {
             s.pop();
             let _ = writeln!(s, ", {} unreachable", c.unreachable);
+        }
+        if let Some(r) = &self.raft {
+            let st = &r.state;
+            let _ = writeln!(
+                s,
+                "raft       {} entries written, last index {}, commit {}, term {}, vote {}",
+                r.written, r.last_index, st.commit, st.term, st.vote
+            );
         }
         match (self.first_round, self.last_round) {
             (Some(a), Some(b)) => _ = writeln!(s, "rounds     {a}..{b}"),
@@ -193,6 +220,7 @@ pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
         first_round: None,
         last_round: None,
         end: None,
+        raft: None,
         torn: None,
         error: None,
         problems: Vec::new(),
@@ -209,6 +237,8 @@ pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
     let mut order = OrderCheck::default();
     let mut spans = SegmentCheck::default();
     let mut last_segment = None;
+    // A replica's log is checked once resolved: its stored records, and where each entry is.
+    let mut replica: Option<(Vec<Record>, Vec<RecordPos>)> = None;
     loop {
         match reader.next_record() {
             Ok(Some((pos, record))) => {
@@ -218,7 +248,23 @@ pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
                 }
                 report.bytes += pos.len;
                 spans.record(pos);
-                order.check(&mut report, pos, &record);
+                if replica.is_none() && is_replicated(std::slice::from_ref(&record)) {
+                    replica = Some((Vec::new(), Vec::new()));
+                }
+                match &mut replica {
+                    Some((records, at)) if !matches!(record, Record::Header(_)) => {
+                        if let Record::Raft(e) = &record {
+                            at.truncate(e.index.saturating_sub(1) as usize);
+                            at.push(pos);
+                        }
+                        records.push(record);
+                    }
+                    Some((records, _)) => {
+                        order.check(&mut report, pos, &record);
+                        records.push(record);
+                    }
+                    None => order.check(&mut report, pos, &record),
+                }
             }
             Ok(None) => break,
             Err(e) => {
@@ -227,6 +273,9 @@ pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
                 break;
             }
         }
+    }
+    if let Some((records, at)) = replica {
+        check_replica(dir, records, &at, &mut order, &mut report);
     }
     if let Some(t) = reader.torn_tail() {
         report
@@ -247,4 +296,35 @@ pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
             .push(format!("... and {} more order problems", order.unlisted));
     }
     report
+}
+
+/// Resolves a replica's log and applies the order rules to its decided records, each at the
+/// position of the entry it came from.
+fn check_replica(
+    dir: &Path,
+    records: Vec<Record>,
+    at: &[RecordPos],
+    order: &mut OrderCheck,
+    report: &mut VerifyReport,
+) {
+    let written = records
+        .iter()
+        .filter(|r| matches!(r, Record::Raft(_)))
+        .count() as u64;
+    match resolve(dir, records) {
+        Ok(r) => {
+            report.raft = Some(RaftSummary {
+                written,
+                last_index: r.last_index,
+                state: r.state,
+            });
+            // The header was checked as it was read.
+            for (record, &(_, index)) in r.records.iter().skip(1).zip(&r.entries) {
+                if let Some(&pos) = at.get((index - 1) as usize) {
+                    order.check(report, pos, record);
+                }
+            }
+        }
+        Err(e) => report.problems.push(e.to_string()),
+    }
 }

@@ -132,6 +132,12 @@ impl OrderCheck {
                 }
                 self.end_seen = true;
             }
+            // Raft's records are resolved before these rules see a replica's log; in any
+            // other log they are out of place.
+            Record::Raft(_) | Record::RaftState(_) => {
+                let what = format!("a {} record in a single coordinator's log", record.kind());
+                self.problem(report, pos, what);
+            }
         }
     }
 }

@@ -1,0 +1,301 @@
+//! A replica's log (format version [`REPLICATED_VERSION`]): the Raft log of one coordinator
+//! replica, stored in the same segments, frames and writer as a single coordinator's log.
+//!
+//! After its [`Header`](Record::Header) a replica's log holds only two kinds of records:
+//! [`Record::Raft`], one Raft entry with its term and index (its data is a decided record in
+//! the payload encoding, or empty for a new leader's empty entry), and [`Record::RaftState`],
+//! the replica's hard state (term, vote, commit index) from there on. The log is append-only:
+//! when Raft overwrites an uncommitted suffix (a follower that had entries of a deposed
+//! leader), the new entry is appended with the old index, and reading takes the last entry
+//! written for each index, dropping everything after an overwritten one.
+//!
+//! [`resolve`] turns the stored records into the decided ones: the header, then the records
+//! of every entry up to the last stored commit index, in index order. That is the sequence a
+//! single coordinator logs for the same decisions, so the summary, `hnav log show`, `replay`
+//! and the exports read a replica's log as they read a single log ([`read_decided`]). A run
+//! with replicas keeps one log per replica in `DIR/log/<id>/`; [`read_decided`] given
+//! `DIR/log` takes the replica that has decided the most.
+
+use std::path::{Path, PathBuf};
+
+use super::error::LogError;
+use super::frame::decode_record;
+use super::reader::{read_log, LogContents};
+use super::record::{RaftEntryRecord, RaftStateRecord, Record};
+use super::segment::list_segments;
+use super::REPLICATED_VERSION;
+
+/// A replica's log, read and resolved.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Resolved {
+    /// The header, then the decided records in Raft order (entries up to `state.commit`).
+    pub records: Vec<Record>,
+    /// For each of `records` after the header: the (term, index) of the entry it came from.
+    pub entries: Vec<(u64, u64)>,
+    /// The last hard state stored (zeros if none was).
+    pub state: RaftStateRecord,
+    /// The last entry's index, committed or not.
+    pub last_index: u64,
+    /// The log's current Raft entries (overwritten ones dropped), for a restarted replica's
+    /// storage.
+    pub raft: Vec<RaftEntryRecord>,
+}
+
+impl Resolved {
+    /// Entries stored after the commit index: the replica holds them, but did not know them
+    /// committed when it last stored its state.
+    pub fn uncommitted(&self) -> u64 {
+        self.last_index.saturating_sub(self.state.commit)
+    }
+}
+
+/// Whether `records` (a log read whole) are a replica's log: its header says
+/// [`REPLICATED_VERSION`].
+pub fn is_replicated(records: &[Record]) -> bool {
+    matches!(records.first(), Some(Record::Header(h)) if h.version == REPLICATED_VERSION)
+}
+
+/// Resolves a replica's log read from `dir`: the current entries (the last written for each
+/// index), the last hard state, and the decided records. A log that is not a replica's comes
+/// back as it is, with no entries.
+pub fn resolve(dir: &Path, records: Vec<Record>) -> Result<Resolved, LogError> {
+    if !is_replicated(&records) {
+        return Ok(Resolved {
+            records,
+            entries: Vec::new(),
+            state: RaftStateRecord::default(),
+            last_index: 0,
+            raft: Vec::new(),
+        });
+    }
+    let bad = |index: u64, what: String| LogError::Raft {
+        dir: dir.to_path_buf(),
+        index,
+        what,
+    };
+    let mut raft: Vec<RaftEntryRecord> = Vec::new();
+    let mut state = RaftStateRecord::default();
+    let mut it = records.into_iter();
+    let header = it.next().expect("is_replicated saw a header");
+    for r in it {
+        match r {
+            Record::Raft(e) => {
+                // Entries are never compacted away: a replica's log starts at index 1.
+                let next = raft.last().map_or(1, |l| l.index + 1);
+                if e.index == 0 || e.index > next {
+                    return Err(bad(e.index, format!("skips indices (expected {next})")));
+                }
+                // An entry at an index already written replaces it and all after it.
+                raft.truncate((e.index - 1) as usize);
+                if let Some(prev) = raft.last().filter(|p| p.term > e.term) {
+                    let what =
+                        format!("term {} after term {} at {}", e.term, prev.term, prev.index);
+                    return Err(bad(e.index, what));
+                }
+                raft.push(e);
+            }
+            Record::RaftState(s) => state = s,
+            other => {
+                let what = format!("a {} record outside a Raft entry", other.kind());
+                return Err(bad(raft.last().map_or(0, |l| l.index), what));
+            }
+        }
+    }
+    let mut decided = vec![header];
+    let mut entries = Vec::new();
+    for e in raft
+        .iter()
+        .filter(|e| e.index <= state.commit && !e.data.is_empty())
+    {
+        let record = decode_record(&e.data).map_err(|p| bad(e.index, p.to_string()))?;
+        if matches!(
+            record,
+            Record::Header(_) | Record::Raft(_) | Record::RaftState(_)
+        ) {
+            let what = format!("holds a {} record, not a decision", record.kind());
+            return Err(bad(e.index, what));
+        }
+        decided.push(record);
+        entries.push((e.term, e.index));
+    }
+    Ok(Resolved {
+        records: decided,
+        entries,
+        state,
+        last_index: raft.last().map_or(0, |l| l.index),
+        raft,
+    })
+}
+
+/// The decided records of a run's log, wherever they are.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Decided {
+    /// The header, then the decided records, as a single coordinator logs them.
+    pub records: Vec<Record>,
+    /// The log they were read from (`DIR/log`, or `DIR/log/<id>` of a replica).
+    pub dir: PathBuf,
+    /// The replica's id, for a run with replicas.
+    pub replica: Option<u64>,
+    /// The raw contents of that log (torn tail included).
+    pub contents: LogContents,
+}
+
+/// The replicas' log directories under `dir` (`DIR/log/<id>/`), by id; empty for a single
+/// coordinator's log.
+pub fn replica_dirs(dir: &Path) -> Result<Vec<(u64, PathBuf)>, LogError> {
+    let entries = std::fs::read_dir(dir).map_err(|e| LogError::io(dir, e))?;
+    let mut out = Vec::new();
+    for entry in entries {
+        let entry = entry.map_err(|e| LogError::io(dir, e))?;
+        let name = entry.file_name();
+        let id = name.to_str().and_then(|n| n.parse::<u64>().ok());
+        if let Some(id) = id.filter(|_| entry.path().is_dir()) {
+            out.push((id, entry.path()));
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// Reads the decided records of the log in `dir`: a single coordinator's log as it is, a
+/// replica's log resolved; and for a directory of replica logs (`DIR/log` of a run with
+/// replicas) the replica that decided the most (the lowest id among equals).
+pub fn read_decided(dir: impl AsRef<Path>) -> Result<Decided, LogError> {
+    let dir = dir.as_ref();
+    let replicas = if list_segments(dir)?.is_empty() {
+        replica_dirs(dir)?
+    } else {
+        Vec::new()
+    };
+    if replicas.is_empty() {
+        return read_one(dir, None);
+    }
+    let mut best: Option<Decided> = None;
+    for (id, sub) in replicas {
+        let d = read_one(&sub, Some(id))?;
+        if best
+            .as_ref()
+            .is_none_or(|b| d.records.len() > b.records.len())
+        {
+            best = Some(d);
+        }
+    }
+    Ok(best.expect("at least one replica"))
+}
+
+fn read_one(dir: &Path, replica: Option<u64>) -> Result<Decided, LogError> {
+    let contents = read_log(dir)?;
+    let resolved = resolve(dir, contents.records.clone())?;
+    Ok(Decided {
+        records: resolved.records,
+        dir: dir.to_path_buf(),
+        replica,
+        contents,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::consensus_log::frame::encode_record;
+    use crate::consensus_log::{EndReason, EndRecord, RunHeader};
+
+    fn header() -> Record {
+        Record::Header(RunHeader {
+            version: REPLICATED_VERSION,
+            scenario_hash: 1,
+            seed: 2,
+            clock: "lockstep".into(),
+            width: 4,
+            height: 4,
+            agents: Vec::new(),
+        })
+    }
+
+    fn end(round: u64) -> Record {
+        Record::End(EndRecord {
+            round,
+            at_goal: 0,
+            reason: EndReason::Stopped,
+        })
+    }
+
+    fn entry(term: u64, index: u64, record: Option<&Record>) -> Record {
+        let mut data = Vec::new();
+        if let Some(r) = record {
+            encode_record(r, &mut data).unwrap();
+        }
+        Record::Raft(RaftEntryRecord { term, index, data })
+    }
+
+    fn state(term: u64, commit: u64) -> Record {
+        Record::RaftState(RaftStateRecord {
+            term,
+            vote: 1,
+            commit,
+        })
+    }
+
+    #[test]
+    fn decided_records_are_the_committed_entries_with_data_in_index_order() {
+        let log = vec![
+            header(),
+            state(1, 0),
+            entry(1, 1, None),
+            entry(1, 2, Some(&end(1))),
+            entry(1, 3, Some(&end(2))),
+            state(1, 2),
+        ];
+        let r = resolve(Path::new("d"), log).unwrap();
+        assert_eq!(r.records, vec![header(), end(1)]);
+        assert_eq!(r.entries, vec![(1, 2)]);
+        assert_eq!((r.last_index, r.uncommitted()), (3, 1));
+    }
+
+    #[test]
+    fn a_rewritten_index_replaces_the_suffix_of_a_deposed_leader() {
+        let log = vec![
+            header(),
+            entry(1, 1, Some(&end(1))),
+            entry(1, 2, Some(&end(2))),
+            entry(1, 3, Some(&end(3))),
+            entry(2, 2, Some(&end(9))),
+            state(2, 2),
+        ];
+        let r = resolve(Path::new("d"), log).unwrap();
+        assert_eq!(r.records, vec![header(), end(1), end(9)]);
+        assert_eq!(r.last_index, 2);
+    }
+
+    #[test]
+    fn gaps_falling_terms_and_loose_records_are_errors_naming_the_entry() {
+        let cases = [
+            (
+                vec![entry(1, 2, None)],
+                "Raft entry 2: skips indices (expected 1)",
+            ),
+            (
+                vec![entry(1, 1, None), entry(1, 3, None)],
+                "Raft entry 3: skips indices (expected 2)",
+            ),
+            (
+                vec![entry(2, 1, None), entry(1, 2, None)],
+                "Raft entry 2: term 1 after term 2 at 1",
+            ),
+            (
+                vec![entry(1, 1, None), end(1)],
+                "Raft entry 1: a end record",
+            ),
+            (
+                vec![entry(1, 1, Some(&header())), state(1, 1)],
+                "Raft entry 1: holds a header record",
+            ),
+        ];
+        for (mut tail, want) in cases {
+            let mut log = vec![header()];
+            log.append(&mut tail);
+            let e = resolve(Path::new("d"), log).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("d: {want}")), "{e}");
+        }
+    }
+}
