@@ -118,6 +118,7 @@ impl Invocation {
             agents: self.agents,
             seed: self.seed,
             mode: self.mode,
+            replicas: None,
             dir: Some(dir.to_path_buf()),
             resume: false,
             faults: self
@@ -148,6 +149,7 @@ mod tests {
             agents: Some(1),
             seed: Some(7),
             mode: Some(ClockMode::Realtime),
+            replicas: None,
             dir: None,
             resume: false,
             faults: vec![fault_arg::parse_process_arg("kill=agent:0@round:5").unwrap()],

@@ -35,6 +35,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use crate::msg::{Lifecycle, LifecycleEvent, Role, StartupPhase, StopReason};
+use crate::scenario::params::CoordinatorParams;
 use crate::scenario::{fault_arg, ClockMode, FaultSpec, FaultTarget, Loc, Scenario, ScenarioError};
 use crate::topics;
 use crate::transport::{Receiver, RunId, Sender, Transport, TransportError, Wake};
@@ -57,6 +58,10 @@ pub struct ProcessArgs {
     /// Clock mode [default: the scenario's sim.clock].
     #[arg(long, value_name = "lockstep|realtime")]
     pub mode: Option<ClockMode>,
+    /// Coordinator replicas agreeing by Raft: 1, 3 or 5 [default: the scenario's
+    /// coordinator.replicas].
+    #[arg(long, value_name = "N")]
+    pub replicas: Option<u32>,
     /// The run's output directory (the coordinator keeps its consensus log in DIR/log).
     #[arg(long, value_name = "DIR")]
     pub dir: Option<PathBuf>,
@@ -73,7 +78,8 @@ pub struct ProcessArgs {
 impl ProcessArgs {
     /// The scenario with the overrides applied: `--seed` replaces `sim.seed`, `--agents`
     /// takes the first N agents or adds seeded random ones, `--mode` replaces `sim.clock`,
-    /// and the command line's faults follow the scenario's.
+    /// `--replicas` replaces `coordinator.replicas`, and the command line's faults follow the
+    /// scenario's.
     pub fn scenario(&self) -> Result<Scenario, ScenarioError> {
         let mut s = Scenario::load(&self.scenario)?;
         if let Some(seed) = self.seed {
@@ -86,6 +92,16 @@ impl ProcessArgs {
         }
         if let Some(m) = self.mode {
             s.sim.clock = m;
+        }
+        if let Some(r) = self.replicas {
+            if !CoordinatorParams::REPLICAS.contains(&r) {
+                return Err(ScenarioError::InvalidParameter {
+                    at: Loc::new("the command line", 0),
+                    key: "--replicas".into(),
+                    problem: format!("{r} replicas; a cluster has 1 (no replication), 3 or 5"),
+                });
+            }
+            s.coordinator.replicas = r;
         }
         for f in &self.faults {
             if let FaultTarget::Agent(a) = f.target {
@@ -124,6 +140,9 @@ impl ProcessArgs {
         }
         if let Some(m) = self.mode {
             a.extend(["--mode".into(), m.to_string().into()]);
+        }
+        if let Some(r) = self.replicas {
+            a.extend(["--replicas".into(), r.to_string().into()]);
         }
         if let Some(d) = &self.dir {
             a.extend(["--dir".into(), d.clone().into()]);
@@ -319,6 +338,7 @@ mod tests {
             agents: Some(8),
             seed: Some(3),
             mode: Some(ClockMode::Realtime),
+            replicas: None,
             dir: Some("out".into()),
             resume: true,
             faults: vec![

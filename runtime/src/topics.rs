@@ -78,6 +78,15 @@ pub fn state_qos() -> Qos {
     Qos::latest()
 }
 
+/// QoS of the `progress` topic: superseding state like [`state_qos`], published by the
+/// coordinator that leads (see [`COORDINATOR_PUBLISHERS`]).
+pub fn progress_qos() -> Qos {
+    Qos {
+        max_publishers: COORDINATOR_PUBLISHERS,
+        ..state_qos()
+    }
+}
+
 /// QoS of the `truth` topic: superseding state like [`state_qos`], with a subscriber buffer
 /// deep enough for the supervisor's recorder, which samples truth by simulated time and so
 /// needs every message near a sampling boundary. A lockstep run publishes a truth message per
@@ -106,11 +115,17 @@ pub fn candidates_qos(agents: usize) -> Qos {
     Qos::reliable(agents)
 }
 
-/// QoS of the commit stream: one publisher (two while a restarted coordinator replaces a dead
-/// one), every agent and a few observers reading, a buffer no live reader exhausts.
+/// Publishers a coordinator's topics (commit, progress) may have at once: a single
+/// coordinator and the one restarted in its place, or every replica twice (replicas open them
+/// when they come to lead, and a frozen deposed leader keeps its ports until it is continued).
+const COORDINATOR_PUBLISHERS: usize = 2 * crate::msg::MAX_REPLICAS as usize;
+
+/// QoS of the commit stream: one publisher at a time (see [`COORDINATOR_PUBLISHERS`] for why
+/// more may be open), every agent and a few observers reading, a buffer no live reader
+/// exhausts.
 pub fn commit_qos(agents: usize) -> Qos {
     Qos {
-        max_publishers: 2,
+        max_publishers: COORDINATOR_PUBLISHERS,
         max_subscribers: agents.max(1) + Qos::EXTRA_NODES,
         buffer: 64,
         history: 1,

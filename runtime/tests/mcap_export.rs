@@ -59,6 +59,7 @@ fn run_dir(dir: &Path) {
         agents: None,
         seed: None,
         mode: None,
+        replicas: None,
         dir: None,
         resume: false,
         faults: Vec::new(),

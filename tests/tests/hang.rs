@@ -102,7 +102,7 @@ impl Observer {
                 .receiver::<Truth>(topics::TRUTH, topics::truth_qos())
                 .unwrap();
             let progress = t
-                .receiver::<Progress>(topics::PROGRESS, topics::state_qos())
+                .receiver::<Progress>(topics::PROGRESS, topics::progress_qos())
                 .unwrap();
             let waiter = t.waiter().unwrap();
             let _a = waiter.attach(&commits).unwrap();

@@ -165,6 +165,7 @@ fn session<T>(
         agents: None,
         seed: None,
         mode: None,
+        replicas: None,
         dir: Some(dir.to_path_buf()),
         resume: false,
         faults: Vec::new(),

@@ -96,7 +96,7 @@ class Commit(_Payload):
     _fields_ = [
         ("round", ctypes.c_uint64),
         ("count", ctypes.c_uint32),
-        ("reserved", ctypes.c_uint32),
+        ("term", ctypes.c_uint32),
         ("decisions", Decision * MAX_AGENTS),
     ]
 
@@ -115,7 +115,8 @@ class Progress(_Payload):
         ("conflicts", ctypes.c_uint32),
         ("replans", ctypes.c_uint32),
         ("done", ctypes.c_uint8),
-        ("reserved", ctypes.c_uint8 * 7),
+        ("leader", ctypes.c_uint8),
+        ("reserved", ctypes.c_uint8 * 6),
     ]
 
 

@@ -1,6 +1,6 @@
 //! `hnav-coordinator --run ID --scenario FILE --dir DIR [--agents N] [--seed S] [--mode M]
-//! [--resume]`: the central compute block of a run. Started by `hnav run`; see
-//! `hnav_coordinator::process`.
+//! [--replicas N --replica ID] [--resume]`: the central compute block of a run, or one replica
+//! of it. Started by `hnav run`; see `hnav_coordinator::process`.
 
 use std::process::ExitCode;
 
@@ -15,6 +15,10 @@ use hnav_runtime::transport::Transport;
 struct Args {
     #[command(flatten)]
     common: ProcessArgs,
+    /// This process is replica ID (1-based) of a replicated coordinator (the scenario's
+    /// coordinator.replicas, or --replicas, is 3 or 5).
+    #[arg(long, value_name = "ID")]
+    replica: Option<u64>,
 }
 
 fn main() -> ExitCode {
@@ -29,10 +33,25 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         .dir
         .clone()
         .ok_or("--dir is required: the consensus log lives in DIR/log")?;
+    let replicas = u64::from(scenario.coordinator.replicas);
+    match args.replica {
+        Some(id) if replicas == 1 || id == 0 || id > replicas => {
+            return Err(format!(
+                "--replica {id}: the run has {replicas} replica(s); ids run from 1 to {replicas} \
+                 when coordinator.replicas is 3 or 5"
+            )
+            .into())
+        }
+        None if replicas > 1 => {
+            return Err(format!("the run has {replicas} replicas: say which with --replica").into())
+        }
+        _ => {}
+    }
+    let index = args.replica.map_or(0, |id| id as u32);
     let transport = Transport::builder(&run)
-        .node_name(&Role::Coordinator.node_name(0))
+        .node_name(&Role::Coordinator.node_name(index))
         .create()?;
-    let mut coordinator = CoordinatorProcess::new(&transport, &scenario, &dir)?;
+    let mut coordinator = CoordinatorProcess::new(&transport, &scenario, &dir, args.replica)?;
     let out = coordinator.run(args.common.resume)?;
     tracing::info!(
         round = out.round,

@@ -21,6 +21,17 @@
 //! nothing more, so the log of a lockstep run ends at the same record whatever the
 //! supervisor's timing. In realtime the supervisor's wall clock ends the run.
 //!
+//! **Replicas** (`coordinator.replicas` 3 or 5, `--replica ID`). Each replica keeps its Raft
+//! log in `DIR/log/<id>/` and talks to the others on `raft/<id>` ([`crate::replication`]).
+//! It follows at first: it applies the leader's committed records to its own state and only
+//! listens to the supervisor. Once Raft elects it and every earlier leader's record is
+//! applied, it opens the candidate, commit and progress ports (agents resend their open
+//! candidate to the new commit publisher), republishes the last committed round and decides
+//! as a single coordinator does, except that a round's record is proposed and its Commit
+//! published only once a majority holds it. A leader that loses its term after deciding
+//! exits (`Deposed`): its state may hold a round the cluster never committed, and its
+//! restart (the supervisor's) rebuilds it from its journal as a follower.
+//!
 //! [`SimParams::rounds_in`]: hnav_runtime::scenario::params::SimParams::rounds_in
 //! [`Progress::done`]: hnav_runtime::msg::Progress::done
 
@@ -29,11 +40,12 @@ use std::time::Duration;
 
 use hnav_runtime::consensus_log::{EndReason, LogError};
 use hnav_runtime::health::Heartbeat;
-use hnav_runtime::launch::StartOutcome;
+use hnav_runtime::launch::{LifecyclePorts, StartOutcome};
 use hnav_runtime::msg::{Role, MAX_AGENTS};
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::transport::{Transport, TransportError, Waiter, Wake};
 
+mod decisions;
 mod ports;
 mod state;
 
@@ -60,6 +72,18 @@ pub enum CoordinatorError {
     /// The swarm is larger than a commit can carry.
     #[error("{0} agents; a commit carries at most {MAX_AGENTS}")]
     TooManyAgents(usize),
+    /// The replica's Raft peer, journal or link failed.
+    #[error(transparent)]
+    Replica(#[from] crate::replication::ReplicaError),
+    /// This replica decided as leader of a term it lost: it exits, to be restarted from its
+    /// journal as a follower.
+    #[error("deposed: led in term {term}, the cluster is in term {now}; restarting from the log")]
+    Deposed {
+        /// The term it led.
+        term: u64,
+        /// The term it is in now.
+        now: u64,
+    },
 }
 
 /// How the coordinator's run ended.
@@ -77,32 +101,47 @@ pub struct CoordinatorOutcome {
 /// The coordinator process.
 pub struct CoordinatorProcess<'t> {
     transport: &'t Transport,
-    ports: Ports,
+    /// The candidate, commit and progress ports: a single coordinator opens them at once, a
+    /// replica when it comes to lead.
+    ports: Option<Ports>,
+    life: LifecyclePorts,
     state: State,
     heart: Heartbeat,
+    agents: usize,
     startup_timeout: Duration,
 }
 
 impl<'t> CoordinatorProcess<'t> {
-    /// Opens the ports and the log in `run_dir/log`, replaying what the log holds.
+    /// Opens the ports and the log in `run_dir/log` (replica `id`'s in `run_dir/log/<id>`),
+    /// replaying what the log holds.
     pub fn new(
         transport: &'t Transport,
         scenario: &Scenario,
         run_dir: &Path,
+        replica: Option<u64>,
     ) -> Result<Self, CoordinatorError> {
         let n = scenario.agents.len();
         if n > MAX_AGENTS {
             return Err(CoordinatorError::TooManyAgents(n));
         }
-        let ports = Ports::open(transport, n)?;
-        let heart = Heartbeat::open(transport, Role::Coordinator, 0, n, scenario.heartbeat())?;
-        let state = State::open(scenario, run_dir)?;
+        let index = replica.map_or(0, |id| id as u32);
+        let (ports, state) = match replica {
+            None => (
+                Some(Ports::open(transport, n)?),
+                State::open(scenario, run_dir)?,
+            ),
+            Some(id) => (None, State::open_replica(transport, scenario, run_dir, id)?),
+        };
+        let life = LifecyclePorts::open(transport, Role::Coordinator, index, n)?;
+        let heart = Heartbeat::open(transport, Role::Coordinator, index, n, scenario.heartbeat())?;
         Ok(CoordinatorProcess {
             heart,
             startup_timeout: scenario.startup_timeout(),
             transport,
             ports,
+            life,
             state,
+            agents: n,
         })
     }
 
@@ -110,17 +149,25 @@ impl<'t> CoordinatorProcess<'t> {
     /// supervisor's `Stop` or a termination signal.
     pub fn run(&mut self, resume: bool) -> Result<CoordinatorOutcome, CoordinatorError> {
         let started = self
-            .ports
             .life
             .handshake(self.transport, resume, self.startup_timeout)?;
-        let (p, st) = (&self.ports, &mut self.state);
+        let st = &mut self.state;
         if started == StartOutcome::Stopped {
-            if !st.ended() {
+            if !st.ended() && self.ports.is_some() {
                 st.end(EndReason::Stopped)?;
             }
             st.report_rejections();
             return Ok(st.outcome());
         }
+        if self.ports.is_none() {
+            if let Some(reason) = follow(&self.life, st, self.transport, &self.heart)? {
+                st.sync()?;
+                tracing::info!(reason = reason.name(), "replica stops while following");
+                return Ok(st.outcome());
+            }
+            self.ports = Some(Ports::open(self.transport, self.agents)?);
+        }
+        let p = self.ports.as_ref().expect("opened above");
         // A coordinator that died between its last round and the run's end ends it now.
         st.end_if_over()?;
         // Agents that missed the dead coordinator's last commit get it again.
@@ -128,8 +175,13 @@ impl<'t> CoordinatorProcess<'t> {
         st.publish_progress(p)?;
         let waiter = self.transport.waiter()?;
         let _candidates = waiter.attach(&p.candidates)?;
-        let _lifecycle = waiter.attach(p.life.events())?;
-        let reason = rounds(p, st, &waiter, &self.heart)?;
+        let _lifecycle = waiter.attach(self.life.events())?;
+        let link = st.raft_link();
+        let _raft = link
+            .as_ref()
+            .map(|l| waiter.attach(l.inbox()))
+            .transpose()?;
+        let reason = rounds(p, &self.life, st, &waiter, &self.heart)?;
         if !st.ended() {
             st.end(reason)?;
         }
@@ -139,10 +191,47 @@ impl<'t> CoordinatorProcess<'t> {
     }
 }
 
+/// A replica follows the leader until it comes to lead (`None`) or the run stops (why).
+fn follow(
+    life: &LifecyclePorts,
+    st: &mut State,
+    transport: &Transport,
+    heart: &Heartbeat,
+) -> Result<Option<EndReason>, CoordinatorError> {
+    let waiter = transport.waiter()?;
+    let _lifecycle = waiter.attach(life.events())?;
+    let link = st.raft_link();
+    let _raft = link
+        .as_ref()
+        .map(|l| waiter.attach(l.inbox()))
+        .transpose()?;
+    if let Some((role, term)) = st.raft_role() {
+        tracing::info!(role, term, "replica up, following");
+    }
+    loop {
+        heart.beat()?;
+        st.pump()?;
+        if let Some(reason) = st.overhear(life)? {
+            return Ok(Some(reason));
+        }
+        if st.take_lead()? {
+            if let Some((_, term)) = st.raft_role() {
+                tracing::info!(term, "replica leads");
+            }
+            return Ok(None);
+        }
+        let until = st.raft_deadline();
+        if waiter.wait(heart.until(until)?)? == Wake::Stop {
+            return Ok(Some(EndReason::Stopped));
+        }
+    }
+}
+
 /// Decides rounds until the supervisor's `Stop` or a termination signal; returns why the run
 /// ends.
 fn rounds(
     p: &Ports,
+    life: &LifecyclePorts,
     st: &mut State,
     waiter: &Waiter,
     heart: &Heartbeat,
@@ -154,15 +243,17 @@ fn rounds(
     loop {
         // Every pass beats if due: a backlog of rounds closes back to back without a wait.
         heart.beat()?;
+        // A replica's Raft messages and ticks; a deposed leader stops here.
+        st.pump()?;
         // Candidates first, then the supervisor: an event sent before a candidate (an agent's
         // `Restarted` before the round the sim resumed for) is then always heard before that
         // round closes, so it is logged at the same round in every lockstep run.
         st.collect(p)?;
-        if let Some(reason) = st.hear_supervisor(p)? {
+        if let Some(reason) = st.hear_supervisor(p, life)? {
             return Ok(reason);
         }
         if st.ready() {
-            st.close_round(p, &mut tick)?;
+            st.close_round(p, waiter, &mut tick)?;
             continue;
         }
         // Lockstep has no round deadline: only candidates and liveness close a round, and
@@ -170,10 +261,14 @@ fn rounds(
         // bounds the wait; the round deadline is checked on the clock.
         let deadline = st.round_deadline();
         if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
-            st.close_round(p, &mut tick)?;
+            st.close_round(p, waiter, &mut tick)?;
             continue;
         }
-        match waiter.wait(heart.until(deadline)?)? {
+        let until = match (deadline, st.raft_deadline()) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+        match waiter.wait(heart.until(until)?)? {
             // A passed deadline closes the round on the next pass, after one more drain.
             Wake::Data | Wake::TimedOut => {}
             Wake::Stop => return Ok(EndReason::Stopped),

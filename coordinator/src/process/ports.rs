@@ -1,12 +1,13 @@
-//! The coordinator's topics: what it hears (candidates, the supervisor) and what it says
-//! (commits, progress).
+//! The coordinator's topics of the rounds: what it hears (candidates) and what it says
+//! (commits, progress). The lifecycle ports with the supervisor are opened beside them, by
+//! every replica; these only by the one that decides.
 
-use hnav_runtime::launch::LifecyclePorts;
-use hnav_runtime::msg::{Candidate, Commit, Progress, Role};
+use hnav_runtime::msg::{Candidate, Commit, Progress};
 use hnav_runtime::topics;
 use hnav_runtime::transport::{Bell, Receiver, Sender, Transport, TransportError};
 
-/// Every port of the coordinator, opened before it announces itself.
+/// The ports of the rounds: a single coordinator opens them before it announces itself, a
+/// replica when it comes to lead.
 pub(super) struct Ports {
     /// The agents' candidate steps.
     pub(super) candidates: Receiver<Candidate>,
@@ -14,8 +15,6 @@ pub(super) struct Ports {
     pub(super) commit: Sender<Commit>,
     /// The run's progress, for the supervisor and the sim.
     pub(super) progress: Sender<Progress>,
-    /// The lifecycle protocol with the supervisor.
-    pub(super) life: LifecyclePorts,
 }
 
 impl Ports {
@@ -33,8 +32,7 @@ impl Ports {
         Ok(Self {
             candidates,
             commit,
-            progress: transport.sender(topics::PROGRESS, topics::state_qos())?,
-            life: LifecyclePorts::open(transport, Role::Coordinator, 0, agents)?,
+            progress: transport.sender(topics::PROGRESS, topics::progress_qos())?,
         })
     }
 }

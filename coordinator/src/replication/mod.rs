@@ -255,6 +255,24 @@ impl Replica {
         Some(self.node.raft.leader_id).filter(|&l| l != 0)
     }
 
+    /// The index of the last entry in its log, committed or not: after a
+    /// [`propose`](Self::propose), the proposal's.
+    pub fn last_index(&self) -> u64 {
+        self.node.raft.raft_log.last_index()
+    }
+
+    /// The highest index it knows committed.
+    pub fn committed_index(&self) -> u64 {
+        self.node.raft.raft_log.committed
+    }
+
+    /// Whether it leads and has committed an entry of its own term: only then is every entry
+    /// of earlier leaders that will ever commit committed (and handed out), so the state it
+    /// applied is the cluster's and it may decide.
+    pub fn can_decide(&self) -> bool {
+        self.role() == Role::Leader && self.node.raft.commit_to_current_term()
+    }
+
     /// The storage, to keep for a restart ([`Replica::restart`]).
     pub fn storage(&self) -> &MemStorage {
         self.node.store()

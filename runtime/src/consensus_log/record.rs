@@ -147,7 +147,7 @@ impl RoundRecord {
     /// decisions reach shared memory without a copy of the whole `Commit` on the stack.
     pub fn write_commit(&self, c: &mut Commit) {
         c.round = self.round;
-        c.reserved = 0;
+        c.term = 0;
         let n = self.decisions.len().min(MAX_AGENTS);
         for (slot, d) in c.decisions.iter_mut().zip(&self.decisions) {
             *slot = Decision::from(d);

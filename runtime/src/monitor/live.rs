@@ -135,7 +135,7 @@ impl LiveFeed {
             Ok((
                 transport.receiver::<Truth>(topics::TRUTH, topics::state_qos())?,
                 transport.receiver::<Commit>(topics::COMMIT, topics::commit_qos(n))?,
-                transport.receiver::<Progress>(topics::PROGRESS, topics::state_qos())?,
+                transport.receiver::<Progress>(topics::PROGRESS, topics::progress_qos())?,
                 transport.receiver::<Lifecycle>(topics::LIFECYCLE, topics::lifecycle_qos(n))?,
                 transport.waiter()?,
             ))
@@ -277,6 +277,7 @@ mod tests {
             agents: None,
             seed: None,
             mode: None,
+            replicas: None,
             dir: Some(dir.to_path_buf()),
             resume: false,
             faults: Vec::new(),

@@ -240,7 +240,8 @@ impl PlaybackFeed {
             conflicts: self.tally.conflicts(),
             replans: self.tally.replans(),
             done,
-            reserved: [0; 7],
+            leader: 0,
+            reserved: [0; 6],
         }
     }
 }

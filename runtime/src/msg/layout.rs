@@ -120,7 +120,7 @@ pub fn layouts() -> Layouts {
         layout!(Commit {
             round: u64,
             count: u32,
-            reserved: u32,
+            term: u32,
             decisions: [Decision; MAX_AGENTS]
         }),
         layout!(Progress {
@@ -130,7 +130,8 @@ pub fn layouts() -> Layouts {
             conflicts: u32,
             replans: u32,
             done: u8,
-            reserved: [u8; 7]
+            leader: u8,
+            reserved: [u8; 6]
         }),
         layout!(WheelCommand {
             period: u64,

@@ -56,15 +56,21 @@ impl Role {
         }
     }
 
-    /// The iceoryx2 node name of the process: `sim`, `coordinator` or `agent-<index>` (what
-    /// `hnav ps` matches dead nodes against).
+    /// The iceoryx2 node name of the process: `sim`, `coordinator` (a single one, index 0),
+    /// `coordinator-<id>` (replica `id` of a replicated coordinator, 1-based) or
+    /// `agent-<index>` (what `hnav ps` matches dead nodes against).
     pub fn node_name(self, index: u32) -> String {
         match self {
             Self::Agent => format!("{}-{index}", self.name()),
+            Self::Coordinator if index > 0 => format!("{}-{index}", self.name()),
             other => other.name().to_string(),
         }
     }
 }
+
+/// The most coordinator replicas a run has (`coordinator.replicas`); a replica's index is its
+/// Raft id, 1 to this, and index 0 is a single coordinator.
+pub const MAX_REPLICAS: u32 = 5;
 
 /// In JSON (run records, `hnav ps --json`) a role is its [`Role::name`].
 impl serde::Serialize for Role {

@@ -50,7 +50,9 @@ mod motion;
 mod round;
 
 pub use health::Heartbeat;
-pub use lifecycle::{Lifecycle, LifecycleEvent, Role, RosterState, StartupPhase, StopReason};
+pub use lifecycle::{
+    Lifecycle, LifecycleEvent, Role, RosterState, StartupPhase, StopReason, MAX_REPLICAS,
+};
 pub use map::{ActivationKind, MapHeader};
 pub use motion::{Estimate, Odometry, Pose, Truth, WheelCommand};
 pub use round::{Candidate, CandidateFlags, Commit, ConflictKind, Decision, Progress, Verdict};

@@ -214,8 +214,12 @@ pub struct Commit {
     pub round: u64,
     /// How many entries of `decisions` are valid.
     pub count: u32,
-    /// Zero.
-    pub reserved: u32,
+    /// The Raft term of the coordinator replica that published it (`coordinator.replicas`
+    /// 3 or 5), 0 for a single coordinator. A replica publishes only committed rounds, so a
+    /// deposed leader can only repeat a round every agent already has: agents ignore a
+    /// commit for a round at or below the last they applied, whatever its term. Was
+    /// `reserved` (always 0) before replicas; the layout is unchanged.
+    pub term: u32,
     /// The decisions, `decisions[..count]`.
     pub decisions: [Decision; MAX_AGENTS],
 }
@@ -225,7 +229,7 @@ impl Default for Commit {
         Self {
             round: 0,
             count: 0,
-            reserved: 0,
+            term: 0,
             decisions: [Decision::default(); MAX_AGENTS],
         }
     }
@@ -259,8 +263,12 @@ pub struct Progress {
     /// it, [`Progress::TIME_LIMIT`] once a lockstep run has committed its last round, else 0:
     /// the coordinator has ended the run and decides nothing more.
     pub done: u8,
+    /// The replica that published it, the Raft leader (1-based; 0 for a single
+    /// coordinator): whom a fault aimed at "the coordinator" hits, and what `hnav ps` shows.
+    /// Was `reserved[0]`; the layout is unchanged.
+    pub leader: u8,
     /// Zero.
-    pub reserved: [u8; 7],
+    pub reserved: [u8; 6],
 }
 
 impl Progress {
@@ -306,7 +314,7 @@ mod tests {
         assert_eq!(align_of::<Commit>(), 8);
         assert_eq!(offset_of!(Commit, round), 0);
         assert_eq!(offset_of!(Commit, count), 8);
-        assert_eq!(offset_of!(Commit, reserved), 12);
+        assert_eq!(offset_of!(Commit, term), 12);
         assert_eq!(offset_of!(Commit, decisions), 16);
     }
 
@@ -320,7 +328,8 @@ mod tests {
         assert_eq!(offset_of!(Progress, conflicts), 16);
         assert_eq!(offset_of!(Progress, replans), 20);
         assert_eq!(offset_of!(Progress, done), 24);
-        assert_eq!(offset_of!(Progress, reserved), 25);
+        assert_eq!(offset_of!(Progress, leader), 25);
+        assert_eq!(offset_of!(Progress, reserved), 26);
     }
 
     #[test]

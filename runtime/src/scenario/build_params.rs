@@ -199,6 +199,61 @@ pub(super) fn build_coordinator(
             lines,
         )?,
         rules: c.rules.unwrap_or(d.rules),
+        replicas: replicas(&c.replicas, d.replicas, lines)?,
+        raft_heartbeat_ms: count(
+            &c.raft_heartbeat_ms,
+            d.raft_heartbeat_ms,
+            "coordinator.raft_heartbeat_ms",
+            lines,
+        )?,
+        election_ms: count(
+            &c.election_ms,
+            d.election_ms,
+            "coordinator.election_ms",
+            lines,
+        )?,
+    })
+    .and_then(|p| election_after_heartbeats(p, &c, lines))
+}
+
+/// `coordinator.replicas`: one of [`CoordinatorParams::REPLICAS`].
+fn replicas(
+    v: &Option<Spanned<u32>>,
+    default: u32,
+    lines: &Lines<'_>,
+) -> Result<u32, ScenarioError> {
+    match v {
+        None => Ok(default),
+        Some(s) if CoordinatorParams::REPLICAS.contains(s.get_ref()) => Ok(*s.get_ref()),
+        Some(s) => Err(ScenarioError::InvalidParameter {
+            at: lines.at(s),
+            key: "coordinator.replicas".into(),
+            problem: format!(
+                "{} replicas; a cluster has 1 (no replication), 3 or 5",
+                s.get_ref()
+            ),
+        }),
+    }
+}
+
+/// Raft needs several heartbeats per election timeout, or followers stand for election
+/// while the leader is well.
+fn election_after_heartbeats(
+    p: CoordinatorParams,
+    c: &RawCoordinator,
+    lines: &Lines<'_>,
+) -> Result<CoordinatorParams, ScenarioError> {
+    if p.election_ticks() >= 3 {
+        return Ok(p);
+    }
+    let none = Loc::new(lines.source_name, 0);
+    Err(ScenarioError::InvalidParameter {
+        at: lines.at_opt(&c.election_ms, &lines.at_opt(&c.raft_heartbeat_ms, &none)),
+        key: "coordinator.election_ms".into(),
+        problem: format!(
+            "{} ms is less than 3 heartbeats of {} ms",
+            p.election_ms, p.raft_heartbeat_ms
+        ),
     })
 }
 

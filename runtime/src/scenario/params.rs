@@ -263,6 +263,26 @@ pub struct CoordinatorParams {
     pub time_limit_s: f64,
     /// The rules of the decision round.
     pub rules: Rules,
+    /// Coordinator replicas agreeing on every round by Raft: 1 (no replication, a single
+    /// coordinator and its log), 3 or 5. Not in the scenario hash: replicas decide the same
+    /// rounds as one coordinator.
+    pub replicas: u32,
+    /// The Raft leader's heartbeat interval, the replicas' tick.
+    pub raft_heartbeat_ms: u32,
+    /// Time without a leader's heartbeat after which a follower stands for election (Raft
+    /// randomises it in `[election_ms, 2 * election_ms)`); a multiple of the heartbeat.
+    pub election_ms: u32,
+}
+
+impl CoordinatorParams {
+    /// The cluster sizes `replicas` may take: 1 (none), or an odd number of voters that
+    /// survives losing one (3) or two (5).
+    pub const REPLICAS: [u32; 3] = [1, 3, 5];
+
+    /// Raft's election timeout in ticks of `raft_heartbeat_ms`.
+    pub fn election_ticks(&self) -> usize {
+        (self.election_ms / self.raft_heartbeat_ms.max(1)) as usize
+    }
 }
 
 impl Default for CoordinatorParams {
@@ -273,6 +293,11 @@ impl Default for CoordinatorParams {
             replan_after_rounds: 3,
             time_limit_s: 120.0,
             rules: Rules::Lacam,
+            replicas: 1,
+            // Suited to one host: a lost leader is replaced within 0.5 to 1 s, and a replica
+            // stalled by a busy 2-core machine for less than 0.5 s deposes nobody.
+            raft_heartbeat_ms: 50,
+            election_ms: 500,
         }
     }
 }

@@ -79,6 +79,9 @@ pub(super) struct RawCoordinator {
     pub replan_after_rounds: Option<Spanned<u32>>,
     pub time_limit_s: Option<Spanned<f64>>,
     pub rules: Option<Rules>,
+    pub replicas: Option<Spanned<u32>>,
+    pub raft_heartbeat_ms: Option<Spanned<u32>>,
+    pub election_ms: Option<Spanned<u32>>,
 }
 
 /// `[run]`.

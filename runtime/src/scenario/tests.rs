@@ -307,6 +307,35 @@ fn structural_errors() {
 }
 
 #[test]
+fn replicas_are_one_three_or_five_and_elections_span_heartbeats() {
+    let s = parse(&format!(
+        "{BASE}[coordinator]\nreplicas = 5\nraft_heartbeat_ms = 20\nelection_ms = 300\n"
+    ))
+    .unwrap();
+    let c = &s.coordinator;
+    assert_eq!((c.replicas, c.election_ticks()), (5, 15));
+    // Replicas decide what one coordinator decides: the hash leaves them out.
+    assert_eq!(s.scenario_hash(), parse(BASE).unwrap().scenario_hash());
+    let e = parse(&format!("{BASE}[coordinator]\nreplicas = 2\n")).unwrap_err();
+    assert!(
+        matches!(&e, ScenarioError::InvalidParameter { key, .. } if key == "coordinator.replicas"),
+        "{e}"
+    );
+    assert_eq!(e.line(), Some(17));
+    assert!(e.to_string().contains("2 replicas; a cluster has 1"), "{e}");
+    let e = parse(&format!(
+        "{BASE}[coordinator]\nraft_heartbeat_ms = 100\nelection_ms = 250\n"
+    ))
+    .unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("250 ms is less than 3 heartbeats of 100 ms"),
+        "{e}"
+    );
+    assert_eq!(e.line(), Some(18));
+}
+
+#[test]
 fn parameter_errors() {
     let e = parse(&format!("{BASE}[robot]\nwheel_radius_m = -0.1\n")).unwrap_err();
     assert!(

@@ -535,6 +535,7 @@ mod tests {
             agents: Some(3),
             seed: Some(7),
             mode: None,
+            replicas: None,
             dir: Some("out".into()),
             resume: false,
             faults: Vec::new(),

@@ -30,9 +30,10 @@ pub struct Qos {
 }
 
 impl Qos {
-    /// Processes besides the agents that may open any service: sim, coordinator, supervisor,
-    /// and one observer (a viewer, `hnav ps`, a test or a benchmark).
-    pub const EXTRA_NODES: usize = 4;
+    /// Processes besides the agents that may open any service: sim, up to
+    /// [`MAX_REPLICAS`](crate::msg::MAX_REPLICAS) coordinator replicas, supervisor, and one
+    /// observer (a viewer, `hnav ps`, a test or a benchmark).
+    pub const EXTRA_NODES: usize = 3 + crate::msg::MAX_REPLICAS as usize;
 
     /// A stream where every sample counts, for a swarm of `agents`, any of which may publish
     /// and any of which may subscribe.

@@ -40,6 +40,10 @@ pub struct RunArgs {
     /// Clock mode [default: the scenario's sim.clock].
     #[arg(long, value_name = "lockstep|realtime")]
     pub mode: Option<ClockMode>,
+    /// Coordinator replicas agreeing on every round by Raft: 1, 3 or 5 [default: the
+    /// scenario's coordinator.replicas].
+    #[arg(long, value_name = "N")]
+    pub replicas: Option<u32>,
     /// Seed of the sim's noise and of generated agents [default: the scenario's sim.seed].
     #[arg(long, value_name = "S")]
     pub seed: Option<u64>,
@@ -123,6 +127,7 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
         agents: a.agents,
         seed: a.seed,
         mode: a.mode,
+        replicas: a.replicas,
         dir: None,
         resume: false,
         faults: Vec::new(),

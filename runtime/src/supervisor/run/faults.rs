@@ -34,6 +34,9 @@ pub(super) struct FaultSchedule<'s> {
     lockstep: bool,
     /// Realtime: the last round the coordinator reported committed.
     round: u64,
+    /// The coordinator a fault aimed at "the coordinator" hits: the replica that last
+    /// reported progress (the Raft leader), 0 for a single coordinator.
+    leader: u32,
     held: Option<Held>,
     thaws: Vec<Thaw>,
 }
@@ -84,6 +87,7 @@ impl<'s> FaultSchedule<'s> {
             done: vec![false; faults.len()],
             lockstep,
             round: 0,
+            leader: 0,
             held: None,
             thaws: Vec::new(),
         }
@@ -92,6 +96,12 @@ impl<'s> FaultSchedule<'s> {
     /// Realtime: the coordinator reports `round` committed.
     pub(super) fn on_round(&mut self, round: u64) {
         self.round = self.round.max(round);
+    }
+
+    /// The coordinator replica that reported progress last (0 for a single coordinator): the
+    /// leader, which "the coordinator" means to a fault.
+    pub(super) fn on_leader(&mut self, leader: u8) {
+        self.leader = u32::from(leader);
     }
 
     /// Realtime: sends the signals of the faults that are due, `since_start` after `Start`,
@@ -209,7 +219,7 @@ impl<'s> FaultSchedule<'s> {
         let f = &self.faults[i];
         let (role, index) = match f.target {
             FaultTarget::Agent(i) => (Role::Agent, i as u32),
-            FaultTarget::Coordinator => (Role::Coordinator, 0),
+            FaultTarget::Coordinator => (Role::Coordinator, self.leader),
             FaultTarget::Sim => (Role::Sim, 0),
         };
         let signal = match f.action {

@@ -23,12 +23,16 @@ use std::time::{Duration, Instant};
 
 use super::slots::Slots;
 use crate::clock::monotonic_ns;
-use crate::msg::{Heartbeat, Role};
+use crate::msg::{Heartbeat, Role, MAX_REPLICAS};
 use crate::scenario::Scenario;
 use crate::supervisor::child::Signal;
 use crate::supervisor::events::RunEvent;
 use crate::topics;
 use crate::transport::{Receiver, Transport, TransportError};
+
+/// The first agent's entry: after the sim and every possible coordinator (index 0 for a single
+/// one, 1 to [`MAX_REPLICAS`] for replicas).
+const AGENTS_FROM: usize = 2 + MAX_REPLICAS as usize;
 
 /// What the watch knows of one incarnation of a process.
 #[derive(Debug, Clone, Copy)]
@@ -106,7 +110,7 @@ impl HangWatch {
         Ok(Self {
             beats: transport.receiver(topics::HEARTBEAT, topics::heartbeat_qos(n))?,
             deadline,
-            nodes: vec![None; 2 + n],
+            nodes: vec![None; AGENTS_FROM + n],
             pause: PauseDetector::new(shortest / 2),
         })
     }
@@ -253,12 +257,14 @@ impl HangWatch {
         Self::slot_index(self.nodes.len(), role, index)
     }
 
-    /// The entry of `role`/`index` among `len` entries.
+    /// The entry of `role`/`index` among `len` entries: the sim, a single coordinator (index
+    /// 0) or replicas 1 to [`MAX_REPLICAS`], then the agents.
     fn slot_index(len: usize, role: Role, index: u32) -> Option<usize> {
         let k = match role {
             Role::Sim => 0,
-            Role::Coordinator => 1,
-            Role::Agent => 2 + index as usize,
+            Role::Coordinator if index <= MAX_REPLICAS => 1 + index as usize,
+            Role::Coordinator => return None,
+            Role::Agent => AGENTS_FROM + index as usize,
         };
         (k < len).then_some(k)
     }
@@ -267,8 +273,8 @@ impl HangWatch {
     fn node_of(k: usize) -> (Role, u32) {
         match k {
             0 => (Role::Sim, 0),
-            1 => (Role::Coordinator, 0),
-            _ => (Role::Agent, (k - 2) as u32),
+            k if k < AGENTS_FROM => (Role::Coordinator, (k - 1) as u32),
+            _ => (Role::Agent, (k - AGENTS_FROM) as u32),
         }
     }
 

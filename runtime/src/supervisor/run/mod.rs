@@ -135,7 +135,7 @@ fn run_owned(
     let n = scenario.agents.len();
     let ports = Ports {
         life: SupervisorPorts::open(&transport, n)?,
-        progress: transport.receiver(topics::PROGRESS, topics::state_qos())?,
+        progress: transport.receiver(topics::PROGRESS, topics::progress_qos())?,
         truth: transport.receiver(topics::TRUTH, topics::truth_qos())?,
     };
     // Started before any process, so the recording begins with the first truth message.
@@ -387,6 +387,7 @@ impl Watch<'_> {
         self.view.show(&p);
         self.round = p.round;
         self.faults.on_round(p.round);
+        self.faults.on_leader(p.leader);
         self.faults.fire_due(slots, self.t0.elapsed());
         Ok(match p.done {
             Progress::ALL_AT_GOAL => Some(End::AllAtGoal),

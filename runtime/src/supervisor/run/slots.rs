@@ -32,7 +32,8 @@ struct Slot {
     lost: Option<String>,
 }
 
-/// Every process of the run: the sim, the coordinator and one agent per robot, in that order.
+/// Every process of the run: the sim, the coordinator (or its replicas, index = Raft id) and
+/// one agent per robot, in that order.
 pub(super) struct Slots {
     slots: Vec<Slot>,
     /// The run directory, named when a process stops on a full disk.
@@ -72,6 +73,9 @@ impl Slots {
             if role == Role::Agent {
                 spec = spec.arg("--index").arg(index.to_string());
             }
+            if role == Role::Coordinator && index > 0 {
+                spec = spec.arg("--replica").arg(index.to_string());
+            }
             if let Some(bell) = bell.filter(|_| role != Role::Sim) {
                 spec = spec.env(BELL_ENV, bell.env_value());
             }
@@ -85,7 +89,10 @@ impl Slots {
             });
         };
         add(Role::Sim, 0, "hnav-sim");
-        add(Role::Coordinator, 0, "hnav-coordinator");
+        match scenario.coordinator.replicas {
+            1 => add(Role::Coordinator, 0, "hnav-coordinator"),
+            n => (1..=n).for_each(|id| add(Role::Coordinator, id, "hnav-coordinator")),
+        }
         for i in 0..scenario.agents.len() as u32 {
             add(Role::Agent, i, "hnav-agent");
         }
@@ -340,6 +347,10 @@ fn role_writes(role: Role, index: u32, dir: &Path) -> String {
         .join("logs")
         .join(format!("{}.log", role.node_name(index)));
     match role {
+        Role::Coordinator if index > 0 => format!(
+            "its replica's consensus log in {}",
+            dir.join("log").join(index.to_string()).display()
+        ),
         Role::Coordinator => format!("the consensus log in {}", dir.join("log").display()),
         Role::Agent => format!(
             "its checkpoint {} or its log {}",

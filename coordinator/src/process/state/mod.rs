@@ -1,5 +1,8 @@
 //! The coordinator's state between wake-ups: the open round's candidates, who is live, the
-//! last decided round and the consensus log it is made durable in.
+//! last decided round and where its decisions become final ([`Decisions`]: its consensus log,
+//! or the Raft cluster of its replicas, `replica`).
+
+mod replica;
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -9,12 +12,15 @@ use hnav_runtime::consensus_log::{
     LoggedDecision, Record, RoundRecord, RunHeader, UnreachableRecord, FORMAT_VERSION,
 };
 use hnav_runtime::grid::{reachable_from, Cell, CornerCutting, Grid};
+use hnav_runtime::launch::LifecyclePorts;
 use hnav_runtime::msg::{
     Candidate, CandidateFlags, Lifecycle, LifecycleEvent, Progress, Role, RosterState, StopReason,
 };
 use hnav_runtime::rejected::{Rejected, Rejections};
 use hnav_runtime::scenario::{ClockMode, Scenario};
+use hnav_runtime::transport::Waiter;
 
+use super::decisions::Decisions;
 use super::ports::Ports;
 use super::{CoordinatorError, CoordinatorOutcome};
 use crate::round::Arbiter;
@@ -22,7 +28,7 @@ use crate::round::Arbiter;
 /// Everything the coordinator knows of the run, restored from the log on a restart.
 pub(super) struct State {
     arbiter: Arbiter,
-    log: LogWriter,
+    log: Decisions,
     clock: ClockMode,
     deadline: Duration,
     round: u64,
@@ -52,6 +58,9 @@ pub(super) struct State {
     /// Per agent: `None` until it first reports its goal unreachable, then whether the walls
     /// confirm it. An agent stays in its connected part of the map, so one check is enough.
     unreachable: Vec<Option<bool>>,
+    /// A following replica: per agent, the last liveness the supervisor told (roster state
+    /// and restarts), reconciled with the log when the replica comes to lead.
+    heard: Vec<Option<(RosterState, u32)>>,
 }
 
 /// The header a log of `s` must start with.
@@ -84,7 +93,6 @@ impl State {
     /// Opens the log in `run_dir/log` (cutting off a torn tail), writes its header if it is
     /// new, and replays the records it already holds.
     pub(super) fn open(scenario: &Scenario, run_dir: &Path) -> Result<Self, CoordinatorError> {
-        let n = scenario.agents.len();
         let dir = run_dir.join("log");
         let (log, recovered) = LogWriter::open(&dir, scenario.coordinator.fsync)?;
         if recovered.truncated_bytes > 0 {
@@ -93,7 +101,31 @@ impl State {
                 "cut a torn tail off the consensus log"
             );
         }
-        let mut state = State {
+        let mut state = State::new(scenario, run_dir, Decisions::Log(log));
+        let expected = header(scenario);
+        match recovered.records.first() {
+            None => {
+                state.log.append(&Record::Header(expected))?;
+            }
+            Some(Record::Header(h)) if *h == expected => {}
+            Some(other) => {
+                return Err(CoordinatorError::ForeignLog {
+                    dir: dir.display().to_string(),
+                    what: format!("first record {:?}", other.kind()),
+                })
+            }
+        }
+        for r in &recovered.records {
+            state.replay(r);
+        }
+        state.say_resumed();
+        Ok(state)
+    }
+
+    /// A state with nothing decided yet, whose decisions go to `log`.
+    fn new(scenario: &Scenario, run_dir: &Path, log: Decisions) -> Self {
+        let n = scenario.agents.len();
+        State {
             arbiter: Arbiter::new(scenario),
             clock: scenario.sim.clock,
             deadline: Duration::from_millis(u64::from(scenario.coordinator.round_deadline_ms)),
@@ -115,33 +147,21 @@ impl State {
             corners: scenario.map.corner_cutting,
             goals: scenario.agents.iter().map(|a| a.goal).collect(),
             unreachable: vec![None; n],
+            heard: vec![None; n],
             log,
-        };
-        let expected = header(scenario);
-        match recovered.records.first() {
-            None => {
-                state.log.append(&Record::Header(expected))?;
-            }
-            Some(Record::Header(h)) if *h == expected => {}
-            Some(other) => {
-                return Err(CoordinatorError::ForeignLog {
-                    dir: dir.display().to_string(),
-                    what: format!("first record {:?}", other.kind()),
-                })
-            }
         }
-        for r in &recovered.records {
-            state.replay(r);
-        }
-        if state.round > 0 {
-            let down = state.live.iter().filter(|l| !**l).count();
+    }
+
+    /// Says where a restarted coordinator resumes.
+    fn say_resumed(&self) {
+        if self.round > 0 {
+            let down = self.live.iter().filter(|l| !**l).count();
             tracing::info!(
-                round = state.round,
+                round = self.round,
                 agents_down = down,
                 "resumed from the consensus log"
             );
         }
-        Ok(state)
     }
 
     /// What the run came to so far.
@@ -248,12 +268,13 @@ impl State {
     pub(super) fn hear_supervisor(
         &mut self,
         p: &Ports,
+        life: &LifecyclePorts,
     ) -> Result<Option<EndReason>, CoordinatorError> {
         // Taken out so that applying the events may borrow the state; an error ends the
         // process, so losing the buffer then costs nothing.
         let mut events = std::mem::take(&mut self.events);
         events.clear();
-        let stop = p.life.drain_samples(|_, _, l| events.push(*l))?;
+        let stop = life.drain_samples(|_, _, l| events.push(*l))?;
         let ended = self.ended();
         for l in &events {
             self.on_lifecycle(l)?;
@@ -412,7 +433,11 @@ impl State {
     /// Publishes the last logged round's commit again, if there is one.
     pub(super) fn resend_last_commit(&self, p: &Ports) -> Result<(), CoordinatorError> {
         if let Some(rec) = &self.last_record {
-            p.commit.send_in_place(|slot| rec.write_commit(slot))?;
+            let term = self.term();
+            p.commit.send_in_place(|slot| {
+                rec.write_commit(slot);
+                slot.term = term;
+            })?;
         }
         Ok(())
     }
@@ -442,6 +467,7 @@ impl State {
     pub(super) fn close_round(
         &mut self,
         p: &Ports,
+        waiter: &Waiter,
         tick: &mut dyn FnMut(),
     ) -> Result<(), CoordinatorError> {
         let round = self.round + 1;
@@ -468,13 +494,25 @@ impl State {
         let Record::Round(rec) = record else {
             unreachable!("built as a round record above")
         };
-        p.commit.send_in_place(|slot| rec.write_commit(slot))?;
+        // A replica's round is final once a majority holds it; only then may it leave.
+        let settled = self.settle(waiter, tick)?;
+        let term = self.term();
+        if settled {
+            p.commit.send_in_place(|slot| {
+                rec.write_commit(slot);
+                slot.term = term;
+            })?;
+        }
         self.last_record = Some(rec);
         self.round = round;
         self.pending.iter_mut().for_each(|c| *c = None);
         self.opened = None;
         self.end_if_over()?;
-        self.publish_progress(p)
+        // The end of the run, if this round ended it, is final before the progress says so.
+        if self.settle(waiter, tick)? {
+            self.publish_progress(p)?;
+        }
+        Ok(())
     }
 
     /// Ends the run once every agent is at its goal or, in lockstep, once the round of its
@@ -523,6 +561,7 @@ impl State {
             at_goal: self.at_goal(),
             conflicts: t.conflicts(),
             replans: t.replans(),
+            leader: self.replica_id() as u8,
             done: match self.end {
                 // Nothing is left to decide for the unreachable ones either.
                 Some(
@@ -533,7 +572,7 @@ impl State {
                 Some(EndReason::TimeLimit) => Progress::TIME_LIMIT,
                 Some(EndReason::Stopped) | None => 0,
             },
-            reserved: [0; 7],
+            reserved: [0; 6],
         })?;
         Ok(())
     }

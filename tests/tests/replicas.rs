@@ -1,0 +1,111 @@
+//! Replicated coordinators (`--replicas 3`): in lockstep the cluster decides the very rounds
+//! a single coordinator decides. Each replica's log, resolved to its committed records, must
+//! equal the single coordinator's log record for record (the header's format version aside),
+//! and must verify.
+
+use std::path::Path;
+use std::time::Duration;
+
+use hnav_runtime::consensus_log::{encode_record, read_decided, read_log, Record, FORMAT_VERSION};
+use hnav_tests::swarm::{repo_root, verify_log, SwarmRun};
+use hnav_tests::TestRun;
+
+/// Generous: a debug build of up to 36 processes on a 2-core machine.
+const RUN_TIMEOUT: Duration = Duration::from_secs(600);
+
+/// Runs `scenario` in lockstep with `extra` arguments into `dir`; every robot must reach its
+/// goal without a collision.
+fn run(tag: &str, scenario: &Path, dir: &Path, registry: &Path, extra: &[&str]) {
+    let mut run = TestRun::new(tag);
+    let mut args = vec!["--mode", "lockstep"];
+    args.extend_from_slice(extra);
+    let mut swarm =
+        SwarmRun::start(&mut run, scenario, dir, registry, &args).expect("hnav run starts");
+    let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
+    assert!(status.success(), "{status}\n{}", swarm.log_tails());
+    let s = swarm.summary().unwrap();
+    assert_eq!(s["end"], "all-at-goal", "{s}\n{}", swarm.log_tails());
+    assert_eq!(s["collisions"], 0, "{s}");
+}
+
+/// The records after the header, and the header with the single coordinator's version.
+fn decided(dir: &Path) -> Vec<Record> {
+    let mut records = read_decided(dir).unwrap().records;
+    if let Some(Record::Header(h)) = records.first_mut() {
+        h.version = FORMAT_VERSION;
+    }
+    records
+}
+
+/// A digest of the records, for the note: SHA-256 over their payload encodings.
+fn digest(records: &[Record]) -> String {
+    use sha2::{Digest, Sha256};
+    let mut h = Sha256::new();
+    let mut buf = Vec::new();
+    for r in records {
+        buf.clear();
+        encode_record(r, &mut buf).unwrap();
+        h.update(&buf);
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
+fn same_rounds_as_one_coordinator(tag: &str, scenario: &Path, agents: Option<&str>) {
+    let tmp = tempfile::tempdir().unwrap();
+    let registry = tmp.path().join("runs");
+    let mut extra: Vec<&str> = Vec::new();
+    if let Some(n) = agents {
+        extra.extend(["--agents", n]);
+    }
+    let one = tmp.path().join("one");
+    run(&format!("{tag}1"), scenario, &one, &registry, &extra);
+    let single = read_log(one.join("log")).unwrap().records;
+    assert!(single.len() > 10, "a suspiciously short log");
+    for attempt in ["a", "b"] {
+        let three = tmp.path().join(format!("three-{attempt}"));
+        let mut args = extra.clone();
+        args.extend(["--replicas", "3"]);
+        run(
+            &format!("{tag}3{attempt}"),
+            scenario,
+            &three,
+            &registry,
+            &args,
+        );
+        for id in 1..=3 {
+            let dir = three.join("log").join(id.to_string());
+            let got = decided(&dir);
+            assert_eq!(
+                got.len(),
+                single.len(),
+                "replica {id} of run {attempt} decided {} records, the single coordinator {}",
+                got.len(),
+                single.len()
+            );
+            if let Some(i) = (0..got.len()).find(|&i| got[i] != single[i]) {
+                panic!(
+                    "replica {id} of run {attempt}: record {i} differs:\n{:?}\n{:?}",
+                    got[i], single[i]
+                );
+            }
+            let (ok, report) = verify_log(&dir);
+            assert!(ok, "replica {id}'s log does not verify:\n{report}");
+        }
+    }
+    println!(
+        "{tag}: {} records, digest {} (single and every replica of both runs)",
+        single.len(),
+        digest(&single)
+    );
+}
+
+#[test]
+fn three_replicas_decide_the_demo_as_one_coordinator_does() {
+    same_rounds_as_one_coordinator("rdemo", &repo_root().join("scenarios/demo.toml"), None);
+}
+
+#[test]
+fn three_replicas_decide_a_32_agent_run_as_one_coordinator_does() {
+    let scenario = repo_root().join("scenarios/random-32-32-10.toml");
+    same_rounds_as_one_coordinator("r32", &scenario, Some("32"));
+}
