@@ -102,10 +102,24 @@ pub fn check_commits(seen: &[(u64, u64)], logged: &[(u64, u64)]) -> Result<Commi
     Ok(count)
 }
 
-/// The `(round, digest)` of every round record of the consensus log in `log_dir`.
+/// The logs of a run's `log_dir` to check the commits against, each with a name for the
+/// failure message: the log itself, or every replica's (`log/<id>/`, " of replica <id>").
+pub fn logs_of(log_dir: &Path) -> Vec<(String, std::path::PathBuf)> {
+    let replicas = hnav_runtime::consensus_log::replica_dirs(log_dir).unwrap_or_default();
+    if replicas.is_empty() {
+        return vec![(String::new(), log_dir.to_path_buf())];
+    }
+    replicas
+        .into_iter()
+        .map(|(id, dir)| (format!(" of replica {id}"), dir))
+        .collect()
+}
+
+/// The `(round, digest)` of every round record of the consensus log in `log_dir` (its
+/// committed records, for a replica's log).
 pub fn logged_commits(log_dir: &Path) -> Result<Vec<(u64, u64)>, String> {
-    use hnav_runtime::consensus_log::{read_log, Record};
-    let contents = read_log(log_dir).map_err(|e| e.to_string())?;
+    use hnav_runtime::consensus_log::{read_decided, Record};
+    let contents = read_decided(log_dir).map_err(|e| e.to_string())?;
     Ok(contents
         .records
         .iter()

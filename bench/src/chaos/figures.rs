@@ -83,6 +83,8 @@ pub struct Figures {
     pub coordinator_back: Figure,
     /// A restarted sim's `spawned` → its first ground truth.
     pub sim_back: Figure,
+    /// The Raft leader's SIGKILL → the first commit of a new round (by the new leader).
+    pub failover: Figure,
 }
 
 impl Default for Figures {
@@ -94,16 +96,35 @@ impl Default for Figures {
             agent_back: Figure::new("agent spawned -> first candidate", "<= 300 ms"),
             coordinator_back: Figure::new("coordinator spawned -> first commit", "<= 300 ms"),
             sim_back: Figure::new("sim spawned -> first truth", "<= 300 ms"),
+            failover: Figure::new("leader SIGKILL -> next leader commits", "election_ms..2x"),
         }
     }
 }
 
-/// `agent-3` → (agent, 3); `sim`, `coordinator` → index 0.
+/// `agent-3` → (agent, 3); `coordinator-2` (replica 2) → (coordinator, 2); `sim`,
+/// `coordinator` → index 0.
 fn parse_node(node: &str) -> Option<(Role, u32)> {
     match node.split_once('-') {
         Some(("agent", i)) => i.parse().ok().map(|i| (Role::Agent, i)),
+        Some(("coordinator", i)) => i.parse().ok().map(|i| (Role::Coordinator, i)),
         _ => Role::from_name(node).map(|r| (r, 0)),
     }
+}
+
+/// When the observer first saw a commit of a round later than every round committed by
+/// `t_ns`: a resend of the last round is not a decision, the next round is.
+fn first_new_round(seen: &Observed, t_ns: u64) -> Option<u64> {
+    let before = seen
+        .commits
+        .iter()
+        .filter(|c| c.t_ns <= t_ns)
+        .map(|c| c.round)
+        .max()
+        .unwrap_or(0);
+    seen.commits
+        .iter()
+        .find(|c| c.t_ns > t_ns && c.round > before)
+        .map(|c| c.t_ns)
 }
 
 impl Figures {
@@ -126,6 +147,10 @@ impl Figures {
                         })
                         .map(|l| l.t_ns);
                     self.kill_to_down.add_ns(e.t_ns, down, what);
+                    if role == Role::Coordinator && index > 0 && e.fault.is_some() {
+                        let first = first_new_round(seen, e.t_ns);
+                        self.failover.add_ns(e.t_ns, first, what);
+                    }
                 }
                 ("signalled", Some("SIGSTOP")) => {
                     let hung = events
@@ -156,20 +181,10 @@ impl Figures {
                     .map(|c| c.0);
                 self.agent_back.add_ns(spawned, first, what);
             }
+            // A restarted replica comes back as a follower: another one decides.
+            Role::Coordinator if index > 0 => {}
             Role::Coordinator => {
-                // A resend of the last logged round is not a decision; its first new round is.
-                let before = seen
-                    .commits
-                    .iter()
-                    .filter(|c| c.t_ns <= spawned)
-                    .map(|c| c.round)
-                    .max()
-                    .unwrap_or(0);
-                let first = seen
-                    .commits
-                    .iter()
-                    .find(|c| c.t_ns > spawned && c.round > before)
-                    .map(|c| c.t_ns);
+                let first = first_new_round(seen, spawned);
                 self.coordinator_back.add_ns(spawned, first, what);
             }
             Role::Sim => {
@@ -180,7 +195,7 @@ impl Figures {
     }
 
     /// Every figure, in table order.
-    pub fn all(&self) -> [&Figure; 6] {
+    pub fn all(&self) -> [&Figure; 7] {
         [
             &self.kill_to_down,
             &self.freeze_to_hung,
@@ -188,6 +203,7 @@ impl Figures {
             &self.agent_back,
             &self.coordinator_back,
             &self.sim_back,
+            &self.failover,
         ]
     }
 

@@ -36,10 +36,10 @@ use run::{run_plan, RunOutcome, RunSetup};
 /// drawn against the swarm they run.
 pub const CHAOS_SCENARIO: &str = include_str!("../../../scenarios/chaos.toml");
 
-/// Runs of the campaign the test runs (`--quick`): 30 + 10 + 5 + 5 + 5.
-pub const QUICK_RUNS: usize = 55;
+/// Runs of the campaign the test runs (`--quick`): 30 + 10 + 5 + 5 + 5 + 4.
+pub const QUICK_RUNS: usize = 59;
 /// Runs of the full campaign unless `--runs` says otherwise.
-pub const FULL_RUNS: usize = 110;
+pub const FULL_RUNS: usize = 118;
 
 /// Where the plans' faults land, for the chaos scenario: its shortest fault-free run lasts
 /// about 400 rounds (lockstep, 4 s), so every fault at rounds 20..=220 hits a run under way.
@@ -62,6 +62,8 @@ pub struct CampaignConfig {
     pub seed: u64,
     /// Only this plan (by number), to reproduce one run.
     pub only: Option<usize>,
+    /// Only runs of this class (all `runs` of them).
+    pub class: Option<Class>,
     /// Where `hnav` and the process binaries are.
     pub bin_dir: PathBuf,
 }
@@ -161,7 +163,7 @@ pub fn run_campaign(
         agents: CHAOS_SPACE.agents as usize,
         root: root.path(),
     };
-    let plans: Vec<Plan> = plan::generate(config.seed, config.runs, &CHAOS_SPACE)
+    let plans: Vec<Plan> = plan::generate(config.seed, config.runs, &CHAOS_SPACE, config.class)
         .into_iter()
         .filter(|p| config.only.is_none_or(|n| n == p.number))
         .collect();

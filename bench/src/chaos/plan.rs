@@ -20,24 +20,55 @@ pub enum Class {
     SimKill,
     /// SIGKILL of one or two agents and the coordinator at the same round.
     Mix,
+    /// SIGKILL of the Raft leader of three coordinator replicas (`--replicas 3`) at a random
+    /// round: a follower must take over and the rounds go on.
+    LeaderKill,
 }
 
 impl Class {
     /// Every class, in table order.
-    pub const ALL: [Class; 5] = [
+    pub const ALL: [Class; 6] = [
         Class::AgentKills,
         Class::CoordinatorKill,
         Class::FreezeAgent,
         Class::SimKill,
         Class::Mix,
+        Class::LeaderKill,
     ];
 
-    /// Runs of each class in the campaign of 55 the issue asks for (`--quick`).
+    /// Runs of each class in the quick campaign (`--quick`): the 55 the chaos issue asks
+    /// for, and 4 leader kills (the replication issue's 20 are `--class kill-leader`).
     pub fn quick_share(self) -> usize {
         match self {
             Class::AgentKills => 30,
             Class::CoordinatorKill => 10,
             Class::FreezeAgent | Class::SimKill | Class::Mix => 5,
+            Class::LeaderKill => 4,
+        }
+    }
+
+    /// Coordinator replicas its runs have.
+    pub fn replicas(self) -> u32 {
+        match self {
+            Class::LeaderKill => 3,
+            _ => 1,
+        }
+    }
+
+    /// The class named `name` (its [`slug`](Self::slug)).
+    pub fn from_slug(name: &str) -> Option<Class> {
+        Class::ALL.into_iter().find(|c| c.slug() == name)
+    }
+
+    /// Its name on the command line (`hnav-bench chaos --class kill-leader`).
+    pub fn slug(self) -> &'static str {
+        match self {
+            Class::AgentKills => "kill-agents",
+            Class::CoordinatorKill => "kill-coordinator",
+            Class::FreezeAgent => "freeze-agent",
+            Class::SimKill => "kill-sim",
+            Class::Mix => "kill-mix",
+            Class::LeaderKill => "kill-leader",
         }
     }
 
@@ -49,6 +80,7 @@ impl Class {
             Class::FreezeAgent => "freeze agent",
             Class::SimKill => "kill sim",
             Class::Mix => "kill mix",
+            Class::LeaderKill => "kill raft leader",
         }
     }
 }
@@ -200,6 +232,9 @@ impl Plan {
     /// The plan as `hnav run` arguments (the fault syntax of the command line).
     pub fn cli_args(&self) -> Vec<String> {
         let mut args = vec!["--mode".to_string(), self.mode.name().to_string()];
+        if self.class.replicas() > 1 {
+            args.extend(["--replicas".to_string(), self.class.replicas().to_string()]);
+        }
         args.extend(self.faults.iter().flat_map(Fault::to_cli));
         args
     }
@@ -239,15 +274,18 @@ pub struct PlanSpace {
 }
 
 /// How many runs of each class a campaign of `runs` has: the quick campaign's proportions
-/// (30:10:5:5:5), every class at least once when `runs >= 5`.
-pub fn class_counts(runs: usize) -> Vec<(Class, usize)> {
+/// (30:10:5:5:5:4), every class at least once when `runs >= 6`; or all of one `only` class.
+pub fn class_counts(runs: usize, only: Option<Class>) -> Vec<(Class, usize)> {
+    if let Some(c) = only {
+        return vec![(c, runs)];
+    }
     let total: usize = Class::ALL.iter().map(|c| c.quick_share()).sum();
     let mut counts: Vec<(Class, usize)> = Class::ALL
         .iter()
         .map(|&c| {
             (
                 c,
-                (runs * c.quick_share() / total).max(usize::from(runs >= 5)),
+                (runs * c.quick_share() / total).max(usize::from(runs >= Class::ALL.len())),
             )
         })
         .collect();
@@ -257,11 +295,12 @@ pub fn class_counts(runs: usize) -> Vec<(Class, usize)> {
     counts
 }
 
-/// The campaign's plans: `class_counts(runs)`, each class alternating lockstep and realtime,
-/// every plan drawn from its own seed derived from `seed` (so `--only N` redraws plan N).
-pub fn generate(seed: u64, runs: usize, space: &PlanSpace) -> Vec<Plan> {
+/// The campaign's plans: `class_counts(runs, only)`, each class alternating lockstep and
+/// realtime, every plan drawn from its own seed derived from `seed` (so `--only N` redraws
+/// plan N).
+pub fn generate(seed: u64, runs: usize, space: &PlanSpace, only: Option<Class>) -> Vec<Plan> {
     let mut plans = Vec::with_capacity(runs);
-    for (class, n) in class_counts(runs) {
+    for (class, n) in class_counts(runs, only) {
         for k in 0..n {
             let number = plans.len();
             let mode = if k.is_multiple_of(2) {
@@ -304,7 +343,10 @@ fn draw(class: Class, k: usize, seed: u64, space: &PlanSpace) -> Vec<Fault> {
                 .map(|a| kill(Target::Agent(a), round(&mut rng)))
                 .collect()
         }
-        Class::CoordinatorKill => vec![kill(Target::Coordinator, round(&mut rng))],
+        // "The coordinator" of a run with replicas is its leader when the fault fires.
+        Class::CoordinatorKill | Class::LeaderKill => {
+            vec![kill(Target::Coordinator, round(&mut rng))]
+        }
         Class::SimKill => vec![kill(Target::Sim, round(&mut rng))],
         Class::FreezeAgent => {
             // Alternating, so a class of any size has both sides of the deadline.
@@ -360,14 +402,23 @@ mod tests {
 
     #[test]
     fn the_quick_campaign_has_the_issues_proportions() {
-        let plans = generate(1, 55, &SPACE);
-        assert_eq!(plans.len(), 55);
+        let plans = generate(1, 59, &SPACE, None);
+        assert_eq!(plans.len(), 59);
         let count = |c| plans.iter().filter(|p| p.class == c).count();
         assert_eq!(count(Class::AgentKills), 30);
         assert_eq!(count(Class::CoordinatorKill), 10);
         assert_eq!(count(Class::FreezeAgent), 5);
         assert_eq!(count(Class::SimKill), 5);
         assert_eq!(count(Class::Mix), 5);
+        assert_eq!(count(Class::LeaderKill), 4);
+        let leader = plans.iter().find(|p| p.class == Class::LeaderKill).unwrap();
+        assert!(
+            leader.cli_args().join(" ").contains("--replicas 3"),
+            "{leader}"
+        );
+        let only = generate(1, 20, &SPACE, Some(Class::LeaderKill));
+        assert!(only.len() == 20 && only.iter().all(|p| p.class == Class::LeaderKill));
+        assert_eq!(Class::from_slug("kill-leader"), Some(Class::LeaderKill));
         for c in Class::ALL {
             let modes: Vec<Mode> = plans
                 .iter()
@@ -381,16 +432,16 @@ mod tests {
     #[test]
     fn any_campaign_size_adds_up() {
         for runs in [0, 1, 5, 7, 55, 110, 333] {
-            let counts = class_counts(runs);
+            let counts = class_counts(runs, None);
             assert_eq!(counts.iter().map(|c| c.1).sum::<usize>(), runs, "{runs}");
         }
     }
 
     #[test]
     fn plans_are_seeded_and_within_their_space() {
-        assert_eq!(generate(7, 55, &SPACE), generate(7, 55, &SPACE));
-        assert_ne!(generate(7, 55, &SPACE), generate(8, 55, &SPACE));
-        for p in generate(7, 55, &SPACE) {
+        assert_eq!(generate(7, 55, &SPACE, None), generate(7, 55, &SPACE, None));
+        assert_ne!(generate(7, 55, &SPACE, None), generate(8, 55, &SPACE, None));
+        for p in generate(7, 55, &SPACE, None) {
             assert!(!p.faults.is_empty());
             for f in &p.faults {
                 assert!((20..=120).contains(&f.at_round), "{p}");

@@ -136,7 +136,7 @@ fn execute(
     let out = dir.join("out");
     let registry = dir.join("runs");
     let hnav = setup.bin_dir.join("hnav");
-    let spec = hnav_run_spec(
+    let mut spec = hnav_run_spec(
         &hnav,
         &scenario,
         run,
@@ -145,6 +145,11 @@ fn execute(
         &registry,
         dir.join("hnav-run.log"),
     );
+    if plan.class.replicas() > 1 {
+        spec = spec
+            .arg("--replicas")
+            .arg(plan.class.replicas().to_string());
+    }
     let (child, pids) = observe(run, setup.agents, &spec, &registry, outcome)?;
     let exit = match child.wait(Some(EXIT_TIMEOUT)) {
         Some(exit) => exit,
@@ -249,11 +254,13 @@ fn check_run(
         .iter()
         .map(|c| (c.round, c.digest))
         .collect();
-    match checks::logged_commits(&out.join("log"))
-        .and_then(|logged| checks::check_commits(&seen, &logged))
-    {
-        Ok(count) => outcome.commits = Some(count),
-        Err(e) => fail.push(format!("commits: {e}")),
+    // Against the log, and with replicas against every replica's committed log.
+    for (name, log) in checks::logs_of(&out.join("log")) {
+        match checks::logged_commits(&log).and_then(|logged| checks::check_commits(&seen, &logged))
+        {
+            Ok(count) => outcome.commits = Some(count),
+            Err(e) => fail.push(format!("commits{name}: {e}")),
+        }
     }
     match checks::read_events(out) {
         Ok(events) => outcome.events = events,

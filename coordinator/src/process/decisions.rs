@@ -180,6 +180,12 @@ impl RaftLog {
         self.take_committed()
     }
 
+    /// Tells the followers the commit index now (the run's end: they stop soon after).
+    pub(super) fn ping(&mut self) -> Result<(), CoordinatorError> {
+        self.replica.ping()?;
+        self.send()
+    }
+
     /// Proposes `record`; the leader only.
     fn propose(&mut self, record: &Record) -> Result<(), CoordinatorError> {
         self.buf.clear();

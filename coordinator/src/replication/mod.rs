@@ -284,6 +284,14 @@ impl Replica {
         self.process()
     }
 
+    /// Sends a heartbeat to every follower now (a leader only; nothing otherwise): it carries
+    /// the commit index, so the followers know the last entries committed without waiting
+    /// for the next heartbeat (the end of a run).
+    pub fn ping(&mut self) -> Result<(), ReplicaError> {
+        self.node.ping();
+        self.process()
+    }
+
     /// Takes a message another replica sent.
     pub fn step(&mut self, message: Message) -> Result<(), ReplicaError> {
         self.node.step(message)?;

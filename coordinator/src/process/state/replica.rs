@@ -148,6 +148,13 @@ impl State {
                 return Ok(true);
             };
             if raft.settled() {
+                if self.end.is_some() {
+                    // The followers are stopped soon after the end: they learn now that it
+                    // is committed, not at the next heartbeat.
+                    if let Some(raft) = self.raft() {
+                        raft.ping()?;
+                    }
+                }
                 return Ok(true);
             }
             tick();

@@ -334,6 +334,11 @@ impl Watch<'_> {
             attached.push(c.watch(&waiter)?);
         }
         loop {
+            // Progress first: it names the leader of replicated coordinators, whom a fault
+            // at "the coordinator" hits when the sim holds for it below.
+            if let Some(end) = self.on_progress(ports, slots)? {
+                return Ok(Some(end));
+            }
             for period in slots.announce_restarts(&ports.life)? {
                 self.faults.on_hold(slots, period);
             }
@@ -342,9 +347,6 @@ impl Watch<'_> {
             }
             self.faults.thaw_due(slots, Instant::now());
             self.faults.fire_due(slots, self.t0.elapsed());
-            if let Some(end) = self.on_progress(ports, slots)? {
-                return Ok(Some(end));
-            }
             let left = self.limit.map(|l| l.saturating_sub(self.t0.elapsed()));
             if left.is_some_and(|l| l.is_zero()) {
                 return Ok(Some(End::TimeLimit));
