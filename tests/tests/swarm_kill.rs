@@ -90,8 +90,10 @@ impl Observer {
                 }
                 let _ = rx.drain_pending(|c| {
                     let mut m = s2.lock().unwrap();
-                    if let Some(old) = m.insert(c.round, *c) {
-                        assert_eq!(old, *c, "round {} committed twice, differently", c.round);
+                    if let Some(mut old) = m.insert(c.round, *c) {
+                        // A new leader's resend of the last round carries its own term.
+                        old.term = c.term;
+                        assert!(old == *c, "round {} committed twice, differently", c.round);
                     }
                 });
                 // Bounded, so that the thread sees `stop`.
@@ -208,6 +210,81 @@ fn a_killed_coordinator_restarts_from_its_log_and_loses_no_commit() {
         "{} commits observed, {} rounds logged, all present",
         seen.len(),
         logged.len()
+    );
+}
+
+/// A frozen (SIGSTOP) Raft leader of three coordinator replicas: the two others elect a new
+/// leader and the rounds go on; continued, the old leader finds a later term and stops
+/// deciding (it exits as deposed, or the hang watch has killed it), and comes back as a
+/// follower. Every commit the observer saw is one the cluster committed, and every replica's
+/// log holds the same rounds.
+#[test]
+fn a_frozen_leader_is_replaced_and_steps_down_when_continued() {
+    use hnav_runtime::consensus_log::{read_decided, read_log as raw, resolve};
+    let (swarm, seen, _map, _run) = run_with_fault(
+        "freezeleader",
+        "replicas = 3\ntime_limit_s = 600\n",
+        "[[faults]]\nat_round = 300\naction = \"freeze\"\nfor_s = 1.5\nrole = \"coordinator\"\n",
+    );
+    let s = swarm.summary().unwrap();
+    for a in s["agents"].as_array().unwrap() {
+        assert_eq!(a["reached_goal"], true, "{a}\n{}", swarm.log_tails());
+    }
+    assert_eq!(s["collisions"], 0, "{s}");
+    let (ok, report) = verify_log(&swarm.dir.join("log"));
+    assert!(ok, "a replica's log does not verify:\n{report}");
+    let mut logs = Vec::new();
+    for id in 1..=3 {
+        let dir = swarm.dir.join("log").join(id.to_string());
+        let decided: BTreeMap<u64, Commit> = read_decided(&dir)
+            .unwrap()
+            .records
+            .iter()
+            .filter_map(|r| match r {
+                Record::Round(rec) => Some((rec.round, rec.commit())),
+                _ => None,
+            })
+            .collect();
+        for (round, commit) in &seen {
+            let mut logged = decided.get(round).copied();
+            if let Some(l) = &mut logged {
+                l.term = commit.term;
+            }
+            assert_eq!(
+                logged.as_ref(),
+                Some(commit),
+                "replica {id}: round {round} was published but not committed as sent"
+            );
+        }
+        let resolved = resolve(&dir, raw(&dir).unwrap().records).unwrap();
+        let top = resolved.entries.iter().map(|e| e.0).max().unwrap_or(0);
+        assert!(top >= 2, "replica {id}: no later term decided a round");
+        logs.push(decided);
+    }
+    assert!(
+        logs[0] == logs[1] && logs[1] == logs[2],
+        "the replicas' rounds differ"
+    );
+    let terms: std::collections::BTreeSet<u32> = seen.values().map(|c| c.term).collect();
+    assert!(terms.len() >= 2, "commits of one term only: {terms:?}");
+    let events = std::fs::read_to_string(swarm.dir.join("events.jsonl")).unwrap();
+    let frozen = events
+        .lines()
+        .find(|l| l.contains("\"SIGSTOP\""))
+        .and_then(|l| l.split("\"node\":\"").nth(1))
+        .and_then(|r| r.split('"').next())
+        .expect("the leader was frozen")
+        .to_string();
+    assert!(
+        events
+            .lines()
+            .any(|l| l.contains("\"exited\"") && l.contains(&format!("\"{frozen}\""))),
+        "the frozen leader {frozen} never stepped down:\n{events}"
+    );
+    println!(
+        "{} commits observed in terms {terms:?}, {} rounds on every replica",
+        seen.len(),
+        logs[0].len()
     );
 }
 
