@@ -118,7 +118,7 @@ pub fn candidates_qos(agents: usize) -> Qos {
 /// Publishers a coordinator's topics (commit, progress) may have at once: a single
 /// coordinator and the one restarted in its place, or every replica twice (replicas open them
 /// when they come to lead, and a frozen deposed leader keeps its ports until it is continued).
-const COORDINATOR_PUBLISHERS: usize = 2 * crate::msg::MAX_REPLICAS as usize;
+pub const COORDINATOR_PUBLISHERS: usize = 2 * crate::msg::MAX_REPLICAS as usize;
 
 /// QoS of the commit stream: one publisher at a time (see [`COORDINATOR_PUBLISHERS`] for why
 /// more may be open), every agent and a few observers reading, a buffer no live reader

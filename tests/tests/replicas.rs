@@ -101,3 +101,47 @@ fn three_replicas_decide_a_32_agent_run_as_one_coordinator_does() {
     let scenario = repo_root().join("scenarios/random-32-32-10.toml");
     same_rounds_as_one_coordinator("r32", &scenario, Some("32"));
 }
+
+/// `hnav ps` shows each replica's Raft role and term: one leader among three.
+#[test]
+fn hnav_ps_shows_each_replicas_role_and_term() {
+    use hnav_tests::swarm::wait_for_ps;
+    let tmp = tempfile::tempdir().unwrap();
+    let registry = tmp.path().join("runs");
+    let mut test_run = TestRun::new("rps");
+    let scenario = repo_root().join("scenarios/demo.toml");
+    let mut swarm = SwarmRun::start(
+        &mut test_run,
+        &scenario,
+        &tmp.path().join("out"),
+        &registry,
+        &["--mode", "realtime", "--replicas", "3"],
+    )
+    .expect("hnav run starts");
+    let replicas = |run: &serde_json::Value| -> Vec<serde_json::Value> {
+        run["processes"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter(|p| p["role"] == "coordinator")
+            .cloned()
+            .collect()
+    };
+    let listed = wait_for_ps(
+        &registry,
+        test_run.run.as_str(),
+        Duration::from_secs(60),
+        |run| {
+            let r = replicas(run);
+            r.len() == 3
+                && r.iter().all(|p| p["raft"]["term"].as_u64() >= Some(1))
+                && r.iter().filter(|p| p["raft"]["role"] == "leader").count() == 1
+        },
+    );
+    let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
+    let listed = listed.unwrap_or_else(|e| panic!("{e}\n{}", swarm.log_tails()));
+    assert!(status.success(), "{status}\n{}", swarm.log_tails());
+    let r = replicas(&listed);
+    let indices: Vec<u64> = r.iter().filter_map(|p| p["index"].as_u64()).collect();
+    assert_eq!(indices, [1, 2, 3], "{listed}");
+}

@@ -103,7 +103,7 @@ pub fn check_commits(seen: &[(u64, u64)], logged: &[(u64, u64)]) -> Result<Commi
 }
 
 /// The logs of a run's `log_dir` to check the commits against, each with a name for the
-/// failure message: the log itself, or every replica's (`log/<id>/`, " of replica <id>").
+/// failure message: the log itself, or every replica's (`log/<id>/`, `" of replica <id>"`).
 pub fn logs_of(log_dir: &Path) -> Vec<(String, std::path::PathBuf)> {
     let replicas = hnav_runtime::consensus_log::replica_dirs(log_dir).unwrap_or_default();
     if replicas.is_empty() {

@@ -7,10 +7,13 @@
 //! Commit leave. A replica that follows takes the leader's committed records
 //! ([`RaftLog::pump`]) and applies them to its own state, so that it is ready to lead.
 
+use std::path::PathBuf;
 use std::rc::Rc;
 use std::time::{Duration, Instant};
 
-use hnav_runtime::consensus_log::{decode_record, encode_record, LogWriter, Record, RunHeader};
+use hnav_runtime::consensus_log::{
+    decode_record, encode_record, LogWriter, Record, ReplicaRole, RunHeader, ROLE_FILE,
+};
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::transport::Transport;
 
@@ -63,6 +66,10 @@ pub(super) struct RaftLog {
     next_tick: Instant,
     /// Records committed by other leaders, in log order, for the state to apply.
     pub(super) applied: Vec<Record>,
+    /// The replica's log directory, where its role file is kept for `hnav ps`.
+    dir: PathBuf,
+    /// The role and term the role file says.
+    shown: Option<(Role, u64)>,
 }
 
 impl RaftLog {
@@ -83,6 +90,8 @@ impl RaftLog {
         };
         let dir = run_dir.join("log").join(id.to_string());
         let replica = Replica::durable(&config, &dir, header, c.fsync)?;
+        // A role file of an earlier incarnation says nothing of this one.
+        let _ = std::fs::remove_file(dir.join(ROLE_FILE));
         let link = Rc::new(RaftLink::open(transport, id, &config.voters)?);
         let tick = Duration::from_millis(u64::from(c.raft_heartbeat_ms));
         let mut raft = RaftLog {
@@ -94,6 +103,8 @@ impl RaftLog {
             tick,
             next_tick: Instant::now() + tick,
             applied: Vec::new(),
+            dir,
+            shown: None,
         };
         // The journal's committed entries: the state before this process.
         raft.take_committed()?;
@@ -177,7 +188,25 @@ impl RaftLog {
             self.next_tick = now + self.tick;
         }
         self.send()?;
+        self.show_role();
         self.take_committed()
+    }
+
+    /// Rewrites the role file when the role or the term changed (rarely: elections). It only
+    /// informs `hnav ps`, so a failed write is a warning.
+    fn show_role(&mut self) {
+        let now = (self.replica.role(), self.replica.term());
+        if self.shown == Some(now) {
+            return;
+        }
+        self.shown = Some(now);
+        let role = ReplicaRole {
+            role: now.0.name().to_string(),
+            term: now.1,
+        };
+        if let Err(e) = role.write(&self.dir) {
+            tracing::warn!("{}: {e}", self.dir.join(ROLE_FILE).display());
+        }
     }
 
     /// Tells the followers the commit index now (the run's end: they stop soon after).

@@ -63,7 +63,9 @@ pub use record::{
     RaftEntryRecord, RaftStateRecord, Record, ReplanRecord, RoundRecord, RunHeader,
     UnreachableRecord,
 };
-pub use replicated::{is_replicated, read_decided, replica_dirs, resolve, Decided, Resolved};
+pub use replicated::{
+    is_replicated, read_decided, replica_dirs, resolve, Decided, ReplicaRole, Resolved, ROLE_FILE,
+};
 pub use segment::{list_segments, segment_name, segment_path, DEFAULT_SEGMENT_BYTES};
 pub use tally::{AgentTally, Tally};
 pub use verify::{verify, KindCounts, VerifyReport, VerifyStatus};

@@ -194,6 +194,33 @@ fn read_one(dir: &Path, replica: Option<u64>) -> Result<Decided, LogError> {
     })
 }
 
+/// The file in a replica's log directory saying its Raft role and term, as it last saw them
+/// (`hnav ps` shows it; the log's readers ignore it).
+pub const ROLE_FILE: &str = "raft-role.json";
+
+/// A replica's Raft role and term ([`ROLE_FILE`]).
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct ReplicaRole {
+    /// `leader`, `follower`, `candidate` or `pre-candidate`.
+    pub role: String,
+    /// Its term.
+    pub term: u64,
+}
+
+impl ReplicaRole {
+    /// Replaces the role file in the replica's log directory `dir`, whole or not at all.
+    pub fn write(&self, dir: &Path) -> std::io::Result<()> {
+        let text = serde_json::to_string(self).map_err(std::io::Error::other)?;
+        crate::supervisor::summary::write_atomically(&dir.join(ROLE_FILE), text.as_bytes())
+    }
+
+    /// The role file of the replica's log directory `dir`, if there is a readable one.
+    pub fn read(dir: &Path) -> Option<ReplicaRole> {
+        let text = std::fs::read_to_string(dir.join(ROLE_FILE)).ok()?;
+        serde_json::from_str(&text).ok()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,6 +13,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 
 use super::registry::{process_alive, RunEntry, RunRegistry};
+use crate::consensus_log::ReplicaRole;
 use crate::msg::Role;
 use crate::transport::{NodeLiveness, RunId, Transport};
 
@@ -52,6 +53,10 @@ pub struct ProcessStatus {
     pub state: ProcessState,
     /// Restarts so far.
     pub restarts: u32,
+    /// A coordinator replica's Raft role and term, as it last wrote them (absent for a
+    /// single coordinator and for other roles).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub raft: Option<ReplicaRole>,
 }
 
 /// A dead iceoryx2 node of a run that no recorded process accounts for (an earlier
@@ -123,12 +128,16 @@ impl RunStatus {
                 } else {
                     ProcessState::Exited
                 };
+                let raft = (p.role == Role::Coordinator && p.index > 0)
+                    .then(|| ReplicaRole::read(&record.dir.join("log").join(p.index.to_string())))
+                    .flatten();
                 ProcessStatus {
                     role: p.role,
                     index: p.index,
                     pid: p.pid,
                     state,
                     restarts: p.restarts,
+                    raft,
                 }
             })
             .collect();
@@ -169,7 +178,8 @@ impl PsReport {
         serde_json::to_string_pretty(self).unwrap_or_else(|_| r#"{"runs": []}"#.to_string())
     }
 
-    /// A table with the columns RUN, DIR, ROLE, INDEX, PID, STATE, one row per process and
+    /// A table with the columns RUN, DIR, ROLE, INDEX, PID, STATE (with a replica's Raft role
+    /// and term: `running (leader, term 2)`), one row per process and
     /// per unmatched dead node; a dead run (its supervisor gone) is marked after its id, and
     /// a note under the table names `hnav clean RUN` for each.
     pub fn render_table(&self) -> String {
@@ -194,10 +204,13 @@ impl PsReport {
             let dir = run.dir.display().to_string();
             for p in &run.processes {
                 any_dead |= p.state == ProcessState::Dead;
-                let state = match p.state {
+                let mut state = match p.state {
                     ProcessState::Dead => "dead *".to_string(),
                     s => s.as_str().to_string(),
                 };
+                if let Some(r) = p.raft.as_ref().filter(|_| p.state == ProcessState::Running) {
+                    state += &format!(" ({}, term {})", r.role, r.term);
+                }
                 rows.push([
                     id.clone(),
                     dir.clone(),

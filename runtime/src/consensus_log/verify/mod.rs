@@ -12,7 +12,7 @@
 //! - every agent index in it is below the header's agent count and every verdict is known.
 //!
 //! A replica's log (version [`REPLICATED_VERSION`](super::REPLICATED_VERSION)) must also make
-//! a Raft log ([`resolve`](super::resolve): no skipped index, no falling term, nothing but
+//! a Raft log ([`resolve`]: no skipped index, no falling term, nothing but
 //! entries and hard states after the header), and the rules above apply to its decided
 //! records (the committed entries), each placed at the entry it came from.
 //!
