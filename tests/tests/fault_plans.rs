@@ -210,7 +210,7 @@ fn hnav_kill_restarts_an_agent_of_a_live_run_and_refuses_what_it_cannot_do() {
     assert_eq!(o.status.code(), Some(2), "{o:?}");
     assert_eq!(
         o.stderr.trim(),
-        "error: robot:1: unknown target `robot:1`: expected agent:N, coordinator or sim"
+        "error: robot:1: unknown target `robot:1`: expected agent:N, coordinator, coordinator:ID or sim"
     );
     let o = hnav(&["kill", "no-such-run", "agent:0"], &registry);
     assert_eq!(o.status.code(), Some(2), "{o:?}");

@@ -50,6 +50,8 @@ type Snapshot = Option<(MapHeader, f32, usize)>;
 /// snapshot, recorded by a thread of the test.
 struct Observer {
     seen: Arc<Mutex<BTreeMap<u64, Commit>>>,
+    /// Every commit's receipt: (monotonic ns, round), the clock of `events.jsonl`.
+    times: Arc<Mutex<Vec<(u64, u64)>>>,
     map: Arc<Mutex<Snapshot>>,
     stop: Arc<AtomicBool>,
     thread: Option<std::thread::JoinHandle<()>>,
@@ -58,6 +60,8 @@ struct Observer {
 impl Observer {
     fn start(run: &RunId, agents: usize) -> Observer {
         let seen = Arc::new(Mutex::new(BTreeMap::new()));
+        let times = Arc::new(Mutex::new(Vec::new()));
+        let t2 = times.clone();
         let map: Arc<Mutex<Snapshot>> = Arc::new(Mutex::new(None));
         let stop = Arc::new(AtomicBool::new(false));
         let (s2, st2, m2, run) = (seen.clone(), stop.clone(), map.clone(), run.clone());
@@ -89,6 +93,8 @@ impl Observer {
                     *m2.lock().unwrap() = Some((h, v, s.payload().len()));
                 }
                 let _ = rx.drain_pending(|c| {
+                    let now = hnav_runtime::clock::monotonic_ns();
+                    t2.lock().unwrap().push((now, c.round));
                     let mut m = s2.lock().unwrap();
                     if let Some(mut old) = m.insert(c.round, *c) {
                         // A new leader's resend of the last round carries its own term.
@@ -105,19 +111,21 @@ impl Observer {
             .expect("observer up");
         Observer {
             seen,
+            times,
             map,
             stop,
             thread: Some(thread),
         }
     }
 
-    fn finish(mut self) -> (BTreeMap<u64, Commit>, Snapshot) {
+    fn finish(mut self) -> (BTreeMap<u64, Commit>, Snapshot, Vec<(u64, u64)>) {
         self.stop.store(true, Ordering::Relaxed);
         if let Some(t) = self.thread.take() {
             t.join().expect("observer thread");
         }
         let map = *self.map.lock().unwrap();
-        (std::mem::take(&mut *self.seen.lock().unwrap()), map)
+        let times = std::mem::take(&mut *self.times.lock().unwrap());
+        (std::mem::take(&mut *self.seen.lock().unwrap()), map, times)
     }
 }
 
@@ -125,11 +133,17 @@ impl Observer {
 /// lockstep rounds crawl, and none of these tests is about contention.
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 
-fn run_with_fault(
-    tag: &str,
-    coordinator: &str,
-    fault: &str,
-) -> (SwarmRun, BTreeMap<u64, Commit>, Snapshot, TestRun) {
+/// The run, every commit by round, agent 0's last map, every commit's receipt (monotonic ns,
+/// round), and the test run (whose drop cleans up).
+type Faulted = (
+    SwarmRun,
+    BTreeMap<u64, Commit>,
+    Snapshot,
+    Vec<(u64, u64)>,
+    TestRun,
+);
+
+fn run_with_fault(tag: &str, coordinator: &str, fault: &str) -> Faulted {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let tmp = tempfile::tempdir().unwrap().keep();
     let scenario = scenario_with_fault(&tmp, coordinator, fault);
@@ -145,18 +159,18 @@ fn run_with_fault(
     )
     .expect("hnav run starts");
     let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
-    let (seen, map) = observer.finish();
+    let (seen, map, times) = observer.finish();
     assert!(
         status.success(),
         "run failed: {status}\n{}",
         swarm.log_tails()
     );
-    (swarm, seen, map, run)
+    (swarm, seen, map, times, run)
 }
 
 #[test]
 fn a_killed_coordinator_restarts_from_its_log_and_loses_no_commit() {
-    let (swarm, seen, map, _run) = run_with_fault(
+    let (swarm, seen, map, _times, _run) = run_with_fault(
         "killcoord",
         "fsync = \"every-record\"\ntime_limit_s = 600\n",
         "[[faults]]\nat_round = 400\naction = \"kill\"\nrole = \"coordinator\"\n",
@@ -220,8 +234,7 @@ fn a_killed_coordinator_restarts_from_its_log_and_loses_no_commit() {
 /// log holds the same rounds.
 #[test]
 fn a_frozen_leader_is_replaced_and_steps_down_when_continued() {
-    use hnav_runtime::consensus_log::{read_decided, read_log as raw, resolve};
-    let (swarm, seen, _map, _run) = run_with_fault(
+    let (swarm, seen, _map, _times, _run) = run_with_fault(
         "freezeleader",
         "replicas = 3\ntime_limit_s = 600\n",
         "[[faults]]\nat_round = 300\naction = \"freeze\"\nfor_s = 1.5\nrole = \"coordinator\"\n",
@@ -231,40 +244,7 @@ fn a_frozen_leader_is_replaced_and_steps_down_when_continued() {
         assert_eq!(a["reached_goal"], true, "{a}\n{}", swarm.log_tails());
     }
     assert_eq!(s["collisions"], 0, "{s}");
-    let (ok, report) = verify_log(&swarm.dir.join("log"));
-    assert!(ok, "a replica's log does not verify:\n{report}");
-    let mut logs = Vec::new();
-    for id in 1..=3 {
-        let dir = swarm.dir.join("log").join(id.to_string());
-        let decided: BTreeMap<u64, Commit> = read_decided(&dir)
-            .unwrap()
-            .records
-            .iter()
-            .filter_map(|r| match r {
-                Record::Round(rec) => Some((rec.round, rec.commit())),
-                _ => None,
-            })
-            .collect();
-        for (round, commit) in &seen {
-            let mut logged = decided.get(round).copied();
-            if let Some(l) = &mut logged {
-                l.term = commit.term;
-            }
-            assert_eq!(
-                logged.as_ref(),
-                Some(commit),
-                "replica {id}: round {round} was published but not committed as sent"
-            );
-        }
-        let resolved = resolve(&dir, raw(&dir).unwrap().records).unwrap();
-        let top = resolved.entries.iter().map(|e| e.0).max().unwrap_or(0);
-        assert!(top >= 2, "replica {id}: no later term decided a round");
-        logs.push(decided);
-    }
-    assert!(
-        logs[0] == logs[1] && logs[1] == logs[2],
-        "the replicas' rounds differ"
-    );
+    let rounds = check_replicas(&swarm, &seen, 3, true);
     let terms: std::collections::BTreeSet<u32> = seen.values().map(|c| c.term).collect();
     assert!(terms.len() >= 2, "commits of one term only: {terms:?}");
     let events = std::fs::read_to_string(swarm.dir.join("events.jsonl")).unwrap();
@@ -284,13 +264,152 @@ fn a_frozen_leader_is_replaced_and_steps_down_when_continued() {
     println!(
         "{} commits observed in terms {terms:?}, {} rounds on every replica",
         seen.len(),
-        logs[0].len()
+        rounds
+    );
+}
+
+/// The checks of a run with `n` replicas: every robot home without a collision, every
+/// replica's log verifies, every published round is committed as published on every replica
+/// (the term aside: a new leader resends with its own), the replicas hold the same rounds, and
+/// with `new_term` a later term than the first decided some. Returns the rounds.
+fn check_replicas(swarm: &SwarmRun, seen: &BTreeMap<u64, Commit>, n: u64, new_term: bool) -> usize {
+    use hnav_runtime::consensus_log::{read_decided, read_log as raw, resolve};
+    let s = swarm.summary().unwrap();
+    for a in s["agents"].as_array().unwrap() {
+        assert_eq!(a["reached_goal"], true, "{a}\n{}", swarm.log_tails());
+    }
+    assert_eq!(s["collisions"], 0, "{s}");
+    let (ok, report) = verify_log(&swarm.dir.join("log"));
+    assert!(ok, "a replica's log does not verify:\n{report}");
+    let mut logs = Vec::new();
+    for id in 1..=n {
+        let dir = swarm.dir.join("log").join(id.to_string());
+        let decided: BTreeMap<u64, Commit> = read_decided(&dir)
+            .unwrap()
+            .records
+            .iter()
+            .filter_map(|r| match r {
+                Record::Round(rec) => Some((rec.round, rec.commit())),
+                _ => None,
+            })
+            .collect();
+        for (round, commit) in seen {
+            let mut logged = decided.get(round).copied();
+            if let Some(l) = &mut logged {
+                l.term = commit.term;
+            }
+            assert!(
+                logged.as_ref() == Some(commit),
+                "replica {id}: round {round} was published but not committed as sent"
+            );
+        }
+        let resolved = resolve(&dir, raw(&dir).unwrap().records).unwrap();
+        let top = resolved.entries.iter().map(|e| e.0).max().unwrap_or(0);
+        assert!(
+            !new_term || top >= 2,
+            "replica {id}: no later term decided a round"
+        );
+        logs.push(decided);
+    }
+    assert!(
+        logs.windows(2).all(|w| w[0] == w[1]),
+        "the replicas' rounds differ"
+    );
+    logs[0].len()
+}
+
+/// Five replicas, two of them (1 and 2, the leader among them or not) SIGKILLed at once: the
+/// other three keep a majority, and the rounds go on.
+#[test]
+fn five_replicas_lose_two_at_once_and_the_rounds_go_on() {
+    let kill = |id: u32| {
+        format!(
+            "[[faults]]\nat_round = 300\naction = \"kill\"\nrole = \"coordinator\"\nindex = {id}\n"
+        )
+    };
+    let (swarm, seen, _map, _times, _run) = run_with_fault(
+        "fivelosetwo",
+        "replicas = 5\ntime_limit_s = 600\n",
+        &format!("{}\n{}", kill(1), kill(2)),
+    );
+    let rounds = check_replicas(&swarm, &seen, 5, false);
+    println!(
+        "{} commits observed, {rounds} rounds on every replica",
+        seen.len()
+    );
+}
+
+/// Three replicas, two of them (1 and 2) frozen at once for 1.5 s: no majority, so nothing is
+/// published from just after the freeze until one of them is back (continued, or killed as
+/// hung and restarted); then the rounds resume and every robot gets home.
+#[test]
+fn three_replicas_without_a_majority_publish_nothing_until_one_is_back() {
+    let freeze = |id: u32| {
+        format!("[[faults]]\nat_round = 300\naction = \"freeze\"\nfor_s = 1.5\nrole = \"coordinator\"\nindex = {id}\n")
+    };
+    let (swarm, seen, _map, times, _run) = run_with_fault(
+        "threelosetwo",
+        "replicas = 3\ntime_limit_s = 600\n",
+        &format!("{}\n{}", freeze(1), freeze(2)),
+    );
+    check_replicas(&swarm, &seen, 3, false);
+    let events = std::fs::read_to_string(swarm.dir.join("events.jsonl")).unwrap();
+    let field = |line: &str, key: &str| -> Option<String> {
+        let v: serde_json::Value = serde_json::from_str(line).ok()?;
+        v.get(key)
+            .map(|x| x.as_str().map_or_else(|| x.to_string(), str::to_string))
+    };
+    let frozen = |l: &&str| {
+        matches!(
+            field(l, "node").as_deref(),
+            Some("coordinator-1" | "coordinator-2")
+        )
+    };
+    let t = |l: &str| {
+        field(l, "t_ns")
+            .and_then(|t| t.parse::<u64>().ok())
+            .unwrap()
+    };
+    let stopped = events
+        .lines()
+        .filter(frozen)
+        .filter(|l| field(l, "signal").as_deref() == Some("SIGSTOP"))
+        .map(t)
+        .max()
+        .expect("both replicas were frozen");
+    let back = events
+        .lines()
+        .filter(frozen)
+        .filter(|l| {
+            field(l, "signal").as_deref() == Some("SIGCONT")
+                || field(l, "event").as_deref() == Some("up")
+        })
+        .map(t)
+        .filter(|&at| at > stopped)
+        .min()
+        .expect("a replica came back");
+    // A round whose acknowledgement left before the freeze may still commit just after it.
+    let quiet_from = stopped + 50_000_000;
+    let published: Vec<u64> = times
+        .iter()
+        .filter(|&&(at, _)| at > quiet_from && at < back)
+        .map(|&(_, round)| round)
+        .collect();
+    assert!(
+        published.is_empty(),
+        "rounds {published:?} published without a majority"
+    );
+    let after = times.iter().filter(|&&(at, _)| at > back).count();
+    assert!(after > 0, "no round after the majority was back");
+    println!(
+        "no commit for {:.2} s without a majority; {after} commits after",
+        (back - quiet_from) as f64 / 1e9
     );
 }
 
 #[test]
 fn a_killed_agent_resumes_from_its_checkpoint_and_arrives() {
-    let (swarm, _seen, _map, _run) = run_with_fault(
+    let (swarm, _seen, _map, _times, _run) = run_with_fault(
         "killagent",
         "time_limit_s = 600\n",
         "[[faults]]\nat_round = 300\naction = \"kill\"\nrole = \"agent\"\nindex = 1\n",

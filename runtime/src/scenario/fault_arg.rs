@@ -94,7 +94,8 @@ fn parse_value(flag: FaultFlag, value: &str) -> Result<FaultSpec, String> {
     Ok(FaultSpec { at, action, target })
 }
 
-/// Parses `agent:N`, `coordinator` or `sim`; the error says what is wrong.
+/// Parses `agent:N`, `coordinator`, `coordinator:ID` (a replica) or `sim`; the error says
+/// what is wrong.
 pub fn parse_target(text: &str) -> Result<FaultTarget, String> {
     match text {
         "coordinator" => return Ok(FaultTarget::Coordinator),
@@ -102,13 +103,22 @@ pub fn parse_target(text: &str) -> Result<FaultTarget, String> {
         "agent" => return Err("`agent` needs its number: agent:N, e.g. agent:3".into()),
         _ => {}
     }
+    if let Some(id) = text.strip_prefix("coordinator:") {
+        return match id.parse() {
+            Ok(id) if (1..=crate::msg::MAX_REPLICAS).contains(&id) => Ok(FaultTarget::Replica(id)),
+            _ => Err(format!(
+                "`{id}` is not a coordinator replica: coordinator:ID, ID 1 to {}",
+                crate::msg::MAX_REPLICAS
+            )),
+        };
+    }
     match text.strip_prefix("agent:") {
         Some(n) => n
             .parse()
             .map(FaultTarget::Agent)
             .map_err(|_| format!("`{n}` is not an agent number")),
         None => Err(format!(
-            "unknown target `{text}`: expected agent:N, coordinator or sim"
+            "unknown target `{text}`: expected agent:N, coordinator, coordinator:ID or sim"
         )),
     }
 }
@@ -213,6 +223,7 @@ pub fn target_arg(target: FaultTarget) -> String {
     match target {
         FaultTarget::Agent(i) => format!("agent:{i}"),
         FaultTarget::Coordinator => "coordinator".into(),
+        FaultTarget::Replica(id) => format!("coordinator:{id}"),
         FaultTarget::Sim => "sim".into(),
     }
 }

@@ -58,6 +58,7 @@ fn fault(h: &mut Fnv1a64, f: &FaultSpec) {
         FaultTarget::Agent(i) => h.u64(0).u64(i as u64),
         FaultTarget::Coordinator => h.u64(1),
         FaultTarget::Sim => h.u64(2),
+        FaultTarget::Replica(id) => h.u64(3).u64(u64::from(id)),
     };
     match f.action {
         FaultAction::Kill(FaultSignal::Kill) => h.u64(9),

@@ -234,8 +234,10 @@ pub enum FaultTime {
 pub enum FaultTarget {
     /// The agent with this number.
     Agent(usize),
-    /// The coordinator.
+    /// The coordinator; with replicas, the Raft leader when the fault fires.
     Coordinator,
+    /// Coordinator replica `id` (1-based) of a run with replicas, leader or not.
+    Replica(u32),
     /// The simulator.
     Sim,
 }

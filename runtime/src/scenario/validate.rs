@@ -249,11 +249,25 @@ pub(super) fn build_fault(
                 }
             }
         }
+        (RawRole::Coordinator, Some(ix)) => match u32::try_from(*ix.get_ref()) {
+            Ok(id) if (1..=crate::msg::MAX_REPLICAS).contains(&id) => FaultTarget::Replica(id),
+            _ => {
+                return Err(ScenarioError::BadFault {
+                    at: lines.at(ix),
+                    fault: i,
+                    problem: format!(
+                        "a coordinator's `index` names a replica, 1 to {}",
+                        crate::msg::MAX_REPLICAS
+                    ),
+                })
+            }
+        },
         (_, Some(ix)) => {
             return Err(ScenarioError::BadFault {
                 at: lines.at(ix),
                 fault: i,
-                problem: "`index` is only meaningful with role = \"agent\"".into(),
+                problem: "`index` is only meaningful with role = \"agent\" or \"coordinator\""
+                    .into(),
             })
         }
         (RawRole::Coordinator, None) => FaultTarget::Coordinator,

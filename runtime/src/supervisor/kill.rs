@@ -95,6 +95,7 @@ pub fn kill(
     let (role, index) = match target {
         FaultTarget::Agent(i) => (Role::Agent, u32::try_from(i).unwrap_or(u32::MAX)),
         FaultTarget::Coordinator => (Role::Coordinator, 0),
+        FaultTarget::Replica(id) => (Role::Coordinator, id),
         FaultTarget::Sim => (Role::Sim, 0),
     };
     let name = target_arg(target);

@@ -45,7 +45,7 @@ impl KillSignal {
 pub struct KillArgs {
     /// The run id, as `hnav ps` lists it.
     pub run: String,
-    /// The process: agent:N, coordinator or sim.
+    /// The process: agent:N, coordinator, coordinator:ID (a replica) or sim.
     pub target: String,
     /// The signal to send.
     #[arg(long, value_enum, default_value = "KILL", ignore_case = true)]

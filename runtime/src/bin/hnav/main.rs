@@ -61,7 +61,7 @@ enum Command {
     Run(run_cmd::RunArgs),
     /// List the live runs on this machine and their processes.
     Ps(ps_cmd::PsArgs),
-    /// Send a signal to one process of a live run (agent:N, coordinator or sim).
+    /// Send a signal to one process of a live run (agent:N, coordinator, coordinator:ID or sim).
     Kill(kill_cmd::KillArgs),
     /// List a live run's topics with their publishers and subscribers.
     Services(services_cmd::ServicesArgs),

@@ -74,7 +74,7 @@ fn every_bad_form_gets_its_error() {
         (
             Kill,
             "robot:3@round:4",
-            "--kill robot:3@round:4: unknown target `robot:3`: expected agent:N, coordinator or sim",
+            "--kill robot:3@round:4: unknown target `robot:3`: expected agent:N, coordinator, coordinator:ID or sim",
         ),
         (
             Kill,
@@ -158,6 +158,12 @@ fn targets_alone_parse_for_hnav_kill() {
     assert_eq!(parse_target("agent:0"), Ok(FaultTarget::Agent(0)));
     assert_eq!(parse_target("coordinator"), Ok(FaultTarget::Coordinator));
     assert_eq!(parse_target("sim"), Ok(FaultTarget::Sim));
+    assert_eq!(parse_target("coordinator:2"), Ok(FaultTarget::Replica(2)));
+    assert_eq!(target_arg(FaultTarget::Replica(2)), "coordinator:2");
+    assert!(parse_target("coordinator:0")
+        .unwrap_err()
+        .contains("not a coordinator replica"));
+    assert!(parse_target("coordinator:6").is_err());
     assert_eq!(
         parse_target("agent:3@round:4").unwrap_err(),
         "`3@round:4` is not an agent number"

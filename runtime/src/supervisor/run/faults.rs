@@ -220,6 +220,7 @@ impl<'s> FaultSchedule<'s> {
         let (role, index) = match f.target {
             FaultTarget::Agent(i) => (Role::Agent, i as u32),
             FaultTarget::Coordinator => (Role::Coordinator, self.leader),
+            FaultTarget::Replica(id) => (Role::Coordinator, id),
             FaultTarget::Sim => (Role::Sim, 0),
         };
         let signal = match f.action {
