@@ -239,11 +239,6 @@ fn a_frozen_leader_is_replaced_and_steps_down_when_continued() {
         "replicas = 3\ntime_limit_s = 600\n",
         "[[faults]]\nat_round = 300\naction = \"freeze\"\nfor_s = 1.5\nrole = \"coordinator\"\n",
     );
-    let s = swarm.summary().unwrap();
-    for a in s["agents"].as_array().unwrap() {
-        assert_eq!(a["reached_goal"], true, "{a}\n{}", swarm.log_tails());
-    }
-    assert_eq!(s["collisions"], 0, "{s}");
     let rounds = check_replicas(&swarm, &seen, 3, true);
     let terms: std::collections::BTreeSet<u32> = seen.values().map(|c| c.term).collect();
     assert!(terms.len() >= 2, "commits of one term only: {terms:?}");
