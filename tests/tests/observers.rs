@@ -236,7 +236,7 @@ fn services_lists_the_topics_with_their_publishers_and_subscribers() {
         "{text}"
     );
     assert!(
-        text.contains("  publishers 1/2: coordinator (pid "),
+        text.contains("  publishers 1/10: coordinator (pid "),
         "{text}"
     );
 
