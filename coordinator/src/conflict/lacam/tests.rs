@@ -146,14 +146,38 @@ proptest! {
         let mut w = World::with_lacam(grid.clone(), &starts, &goals);
         let rounds = w.run(200_000).map_err(|e| TestCaseError::fail(format!("seed {seed}: {e}\n{:?}", stats(&w))))?;
         let s = stats(&w);
-        prop_assert_eq!((s.plans, s.failed, s.broken), (1, 0, 0), "seed {}: {:?}", seed, s);
-        prop_assert!(rounds <= 2 * u64::from(s.moves) + 1, "seed {}: {} rounds for {:?}", seed, rounds, s);
+        prop_assert_eq!(s.broken, 0, "seed {}: {:?}", seed, s);
+        // A search over its budget falls back to online PIBT and retries (see the test of
+        // seed 2617570749669679981 below): home within `run`'s bound, not the one plan's.
+        if s.failed == 0 {
+            prop_assert_eq!(s.plans, 1, "seed {}: {:?}", seed, s);
+            prop_assert!(rounds <= 2 * u64::from(s.moves) + 1, "seed {}: {} rounds for {:?}", seed, rounds, s);
+        }
         let mut paced = World::with_lacam(grid, &starts, &goals);
         paced.pace = Some(ChaCha8Rng::seed_from_u64(seed ^ 1));
         paced.run(200_000).map_err(|e| TestCaseError::fail(format!("seed {seed}, paced: {e}")))?;
         eprintln!("lacam props: {n} agents on {} free cells: home at round {rounds}, plan of \
             {} steps, {} configurations searched", free, s.steps, s.visited);
     }
+}
+
+/// Found by the property test above in a full run (2026-12-04): a dense random instance whose
+/// first search runs out of its budget. The fallback (online PIBT, then a new search) still
+/// brings every robot home without a collision.
+#[test]
+fn a_search_over_its_budget_falls_back_and_still_brings_everyone_home() {
+    let seed = 2_617_570_749_669_679_981;
+    let props::Instance {
+        grid,
+        starts,
+        goals,
+        ..
+    } = props::instance(seed).expect("the seed draws an instance");
+    let mut w = World::with_lacam(grid, &starts, &goals);
+    w.run(200_000)
+        .unwrap_or_else(|e| panic!("{e}\n{:?}", stats(&w)));
+    let s = stats(&w);
+    assert!(s.failed >= 1 && s.plans >= 1 && s.broken == 0, "{s:?}");
 }
 
 #[test]
