@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 
 use super::error::LogError;
 use super::frame::decode_record;
-use super::reader::{read_log, LogContents};
+use super::reader::read_log;
 use super::record::{RaftEntryRecord, RaftStateRecord, Record};
 use super::segment::list_segments;
 use super::REPLICATED_VERSION;
@@ -136,8 +136,6 @@ pub struct Decided {
     pub dir: PathBuf,
     /// The replica's id, for a run with replicas.
     pub replica: Option<u64>,
-    /// The raw contents of that log (torn tail included).
-    pub contents: LogContents,
 }
 
 /// The replicas' log directories under `dir` (`DIR/log/<id>/`), by id; empty for a single
@@ -184,13 +182,11 @@ pub fn read_decided(dir: impl AsRef<Path>) -> Result<Decided, LogError> {
 }
 
 fn read_one(dir: &Path, replica: Option<u64>) -> Result<Decided, LogError> {
-    let contents = read_log(dir)?;
-    let resolved = resolve(dir, contents.records.clone())?;
+    let resolved = resolve(dir, read_log(dir)?.records)?;
     Ok(Decided {
         records: resolved.records,
         dir: dir.to_path_buf(),
         replica,
-        contents,
     })
 }
 
