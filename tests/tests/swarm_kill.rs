@@ -239,7 +239,7 @@ fn a_frozen_leader_is_replaced_and_steps_down_when_continued() {
         "replicas = 3\ntime_limit_s = 600\n",
         "[[faults]]\nat_round = 300\naction = \"freeze\"\nfor_s = 1.5\nrole = \"coordinator\"\n",
     );
-    let rounds = check_replicas(&swarm, &seen, 3, true);
+    let rounds = check_replicas(&swarm, &seen, &[1, 2, 3], true);
     let terms: std::collections::BTreeSet<u32> = seen.values().map(|c| c.term).collect();
     assert!(terms.len() >= 2, "commits of one term only: {terms:?}");
     let events = std::fs::read_to_string(swarm.dir.join("events.jsonl")).unwrap();
@@ -267,7 +267,12 @@ fn a_frozen_leader_is_replaced_and_steps_down_when_continued() {
 /// replica's log verifies, every published round is committed as published on every replica
 /// (the term aside: a new leader resends with its own), the replicas hold the same rounds, and
 /// with `new_term` a later term than the first decided some. Returns the rounds.
-fn check_replicas(swarm: &SwarmRun, seen: &BTreeMap<u64, Commit>, n: u64, new_term: bool) -> usize {
+fn check_replicas(
+    swarm: &SwarmRun,
+    seen: &BTreeMap<u64, Commit>,
+    ids: &[u64],
+    new_term: bool,
+) -> usize {
     use hnav_runtime::consensus_log::{read_decided, read_log as raw, resolve};
     let s = swarm.summary().unwrap();
     for a in s["agents"].as_array().unwrap() {
@@ -277,7 +282,7 @@ fn check_replicas(swarm: &SwarmRun, seen: &BTreeMap<u64, Commit>, n: u64, new_te
     let (ok, report) = verify_log(&swarm.dir.join("log"));
     assert!(ok, "a replica's log does not verify:\n{report}");
     let mut logs = Vec::new();
-    for id in 1..=n {
+    for &id in ids {
         let dir = swarm.dir.join("log").join(id.to_string());
         let decided: BTreeMap<u64, Commit> = read_decided(&dir)
             .unwrap()
@@ -327,11 +332,35 @@ fn five_replicas_lose_two_at_once_and_the_rounds_go_on() {
         "replicas = 5\ntime_limit_s = 600\n",
         &format!("{}\n{}", kill(1), kill(2)),
     );
-    let rounds = check_replicas(&swarm, &seen, 5, false);
+    let rounds = check_replicas(&swarm, &seen, &[1, 2, 3, 4, 5], false);
     println!(
         "{} commits observed, {rounds} rounds on every replica",
         seen.len()
     );
+}
+
+/// Three replicas, one of them (3, the leader or not) SIGKILLed and never restarted
+/// (`[restart] coordinator = { policy = "never" }`): the supervisor gives it up, and the run
+/// goes on with the majority left instead of ending as one that cannot.
+#[test]
+fn a_replica_lost_for_good_leaves_the_majority_deciding() {
+    let fault = "[restart]\ncoordinator = { policy = \"never\" }\n\n[[faults]]\nat_round = 300\n\
+                 action = \"kill\"\nrole = \"coordinator\"\nindex = 3\n";
+    let (swarm, seen, _map, _times, _run) =
+        run_with_fault("replicalost", "replicas = 3\ntime_limit_s = 600\n", fault);
+    let rounds = check_replicas(&swarm, &seen, &[1, 2], false);
+    let events = std::fs::read_to_string(swarm.dir.join("events.jsonl")).unwrap();
+    let gave_up: Vec<&str> = events
+        .lines()
+        .filter(|l| l.contains("\"coordinator-3\"") && l.contains("gave_up"))
+        .collect();
+    assert_eq!(gave_up.len(), 1, "{events}");
+    assert!(
+        gave_up[0].contains("the cluster goes on while a majority of it is left"),
+        "{}",
+        gave_up[0]
+    );
+    println!("replica 3 lost at round 300; {rounds} rounds on replicas 1 and 2");
 }
 
 /// Three replicas, two of them (1 and 2) frozen at once for 1.5 s: no majority, so nothing is
@@ -347,7 +376,7 @@ fn three_replicas_without_a_majority_publish_nothing_until_one_is_back() {
         "replicas = 3\ntime_limit_s = 600\n",
         &format!("{}\n{}", freeze(1), freeze(2)),
     );
-    check_replicas(&swarm, &seen, 3, false);
+    check_replicas(&swarm, &seen, &[1, 2, 3], false);
     let events = std::fs::read_to_string(swarm.dir.join("events.jsonl")).unwrap();
     let field = |line: &str, key: &str| -> Option<String> {
         let v: serde_json::Value = serde_json::from_str(line).ok()?;

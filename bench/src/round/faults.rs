@@ -38,7 +38,7 @@ use hnav_runtime::topics;
 use hnav_runtime::transport::{purge_run, RunId, Sender, Transport, Wake};
 
 use super::report::{Dist, FaultPoint};
-use super::session::with_coordinator;
+use super::session::{with_coordinator, CoordinatorSetup};
 use super::swarm::keep_going;
 
 /// Agents of the rejoin measurement.
@@ -292,14 +292,15 @@ fn kill_once(
 /// the latencies, how many trials needed more than one round, and how many were left out
 /// because a round stalled.
 fn rejoin(program: &Path, fsync: FsyncPolicy, trials: usize) -> Result<(Vec<u64>, usize, usize)> {
-    with_coordinator(program, REJOIN_AGENTS, fsync, |session, swarm| {
+    let setup = CoordinatorSetup { fsync, replicas: 1 };
+    with_coordinator(program, REJOIN_AGENTS, setup, |session, swarm| {
         if let Some(t) = session.startup() {
             hnav_runtime::errln!(
                 "for scale, not in (c): this hnav-coordinator took {:.1} ms from spawn to Up",
                 t.as_secs_f64() * 1e3
             );
         }
-        let (coordinator, life) = (session.child(), session.lifecycle());
+        let (coordinator, life) = (session.coordinators(), session.lifecycle());
         swarm.play(coordinator, life, REJOIN_WARMUP, |_| Ok(()), keep_going)?;
         let mut samples = Vec::with_capacity(trials);
         let mut late = 0;

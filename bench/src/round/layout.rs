@@ -112,9 +112,9 @@ impl Layout {
         }
     }
 
-    /// The scenario file's text: the open map, the agents, the coordinator's fsync policy,
-    /// the lockstep clock, a time limit no bench reaches.
-    pub fn scenario_toml(&self, fsync: FsyncPolicy) -> String {
+    /// The scenario file's text: the open map, the agents, the coordinator's fsync policy
+    /// and its number of Raft replicas, the lockstep clock, a time limit no bench reaches.
+    pub fn scenario_toml(&self, fsync: FsyncPolicy, replicas: u32) -> String {
         let mut s = String::from("# Written by `hnav-bench round`.\nname = \"bench-round\"\n\n");
         s.push_str("[map]\nrows = [\n");
         let row = ".".repeat(SIDE as usize);
@@ -123,6 +123,7 @@ impl Layout {
         }
         s.push_str("]\n\n[sim]\nclock = \"lockstep\"\n\n[coordinator]\n");
         let _ = writeln!(s, "fsync = \"{}\"", fsync_name(fsync));
+        let _ = writeln!(s, "replicas = {replicas}");
         s.push_str("replan_after_rounds = 3\n");
         // The layout's conflicts (one loser per pair, every other round) are the dissertation
         // rules' decisions; the default `lacam` would plan them away.
@@ -223,7 +224,7 @@ mod tests {
         for n in [1, 8, 128] {
             let l = Layout::new(n).unwrap();
             let s = Scenario::from_str(
-                &l.scenario_toml(FsyncPolicy::None),
+                &l.scenario_toml(FsyncPolicy::None, 1),
                 "bench.toml",
                 std::path::Path::new("."),
             )
@@ -260,7 +261,7 @@ mod tests {
     fn the_scenario_parses_with_the_layout() {
         let l = Layout::new(9).unwrap();
         let s = Scenario::from_str(
-            &l.scenario_toml(FsyncPolicy::None),
+            &l.scenario_toml(FsyncPolicy::None, 1),
             "bench.toml",
             std::path::Path::new("."),
         )
@@ -268,7 +269,17 @@ mod tests {
         assert_eq!(s.agents.len(), 9);
         assert_eq!(s.coordinator.fsync, FsyncPolicy::None);
         assert_eq!(s.map.grid.width(), SIDE);
+        assert_eq!(s.coordinator.replicas, 1);
         let (x, y) = l.start(8);
         assert_eq!((s.agents[8].start.x, s.agents[8].start.y), (x, y));
+        for n in [3, 5] {
+            let s = Scenario::from_str(
+                &l.scenario_toml(FsyncPolicy::EveryRecord, n),
+                "bench.toml",
+                std::path::Path::new("."),
+            )
+            .unwrap();
+            assert_eq!(s.coordinator.replicas, n);
+        }
     }
 }

@@ -46,6 +46,7 @@ use clap::Args;
 use hnav_runtime::scenario::FsyncPolicy;
 
 use report::{Dist, RoundPoint};
+use session::CoordinatorSetup;
 use swarm::keep_going;
 
 pub use layout::MAX_AGENTS;
@@ -80,6 +81,11 @@ pub struct RoundArgs {
     #[arg(long, value_delimiter = ',', value_name = "POLICY",
           default_values = ["every-record", "none"], value_parser = parse_fsync)]
     pub fsync: Vec<FsyncPolicy>,
+    /// Coordinator cluster sizes (comma-separated: 1 = one coordinator, 3 or 5 = Raft
+    /// replicas; the leader commits a round once a majority has it durable).
+    #[arg(long, value_delimiter = ',', value_name = "N", default_values_t = [1u32],
+          value_parser = parse_replicas, conflicts_with = "faults")]
+    pub replicas: Vec<u32>,
     /// One JSON object per line instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -105,6 +111,17 @@ fn parse_fsync(s: &str) -> Result<FsyncPolicy, String> {
     }
 }
 
+fn parse_replicas(s: &str) -> Result<u32, String> {
+    match s {
+        "1" => Ok(1),
+        "3" => Ok(3),
+        "5" => Ok(5),
+        other => Err(format!(
+            "{other:?} replicas: a coordinator cluster has 1, 3 or 5 members"
+        )),
+    }
+}
+
 /// Runs `hnav-bench round` with `args`, printing as it goes.
 pub fn main(args: RoundArgs) -> Result<()> {
     if let Some(&n) = args.agents.iter().find(|&&n| n == 0 || n > MAX_AGENTS) {
@@ -112,6 +129,9 @@ pub fn main(args: RoundArgs) -> Result<()> {
     }
     if args.fsync.is_empty() {
         bail!("--fsync needs at least one policy");
+    }
+    if args.replicas.is_empty() {
+        bail!("--replicas needs at least one cluster size");
     }
     if args.rounds == Some(0) {
         bail!("--rounds must be at least 1");
@@ -171,18 +191,22 @@ fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
     let mut points = Vec::new();
     for &agents in &args.agents {
         for &fsync in &args.fsync {
-            hnav_runtime::errln!(
-                "round: {agents} agents, fsync {}: {} warm-up + {rounds} measured rounds",
-                layout::fsync_name(fsync),
-                args.warmup
-            );
-            let point = measure_point(program, agents, fsync, args.warmup, rounds)?;
-            if args.json {
-                hnav_runtime::outln!("{}", point.json());
-            } else {
-                hnav_runtime::outln!("{}", point.row());
+            for &replicas in &args.replicas {
+                hnav_runtime::errln!(
+                    "round: {agents} agents, fsync {}, {replicas} coordinator(s): {} warm-up \
+                     + {rounds} measured rounds",
+                    layout::fsync_name(fsync),
+                    args.warmup
+                );
+                let setup = CoordinatorSetup { fsync, replicas };
+                let point = measure_point(program, agents, setup, args.warmup, rounds)?;
+                if args.json {
+                    hnav_runtime::outln!("{}", point.json());
+                } else {
+                    hnav_runtime::outln!("{}", point.row());
+                }
+                points.push(point);
             }
-            points.push(point);
         }
     }
     if !args.json {
@@ -192,7 +216,10 @@ fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
              includes \
              the coordinator's wake-up, conflict resolution, consensus-log append and its \
              fdatasync under every-record (log in {}), the commit's publish + N notifications, \
-             one thread taking the N commits; excludes the agents' planning. stalled: rounds \
+             one thread taking the N commits; with 3 or 5 replicas also the leader's Raft \
+             round trip (append to the followers over shared memory, each follower's durable \
+             append, the majority's acknowledgement) before the commit is published; \
+             excludes the agents' planning. stalled: rounds \
              with no commit for 1 s that completed only when an unrelated lifecycle event woke \
              the coordinator (lost wake-up); left out of the percentiles)",
             std::env::temp_dir().display()
@@ -230,18 +257,18 @@ fn fdatasync_baseline() -> Result<Dist> {
     Dist::from_ns(&ns)
 }
 
-/// Runs one coordinator for `agents` agents and `fsync`, plays `warmup` + `rounds` rounds.
+/// Runs one coordinator (or cluster) for `agents` agents, plays `warmup` + `rounds` rounds.
 fn measure_point(
     program: &std::path::Path,
     agents: usize,
-    fsync: FsyncPolicy,
+    setup: CoordinatorSetup,
     warmup: u64,
     rounds: u64,
 ) -> Result<RoundPoint> {
     let ns = |d: std::time::Duration| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX);
     let (all, first, stalled) =
-        session::with_coordinator(program, agents, fsync, |session, swarm| {
-            let (coordinator, life) = (session.child(), session.lifecycle());
+        session::with_coordinator(program, agents, setup, |session, swarm| {
+            let (coordinator, life) = (session.coordinators(), session.lifecycle());
             if warmup > 0 {
                 swarm.play(coordinator, life, warmup, |_| Ok(()), keep_going)?;
             }
@@ -267,7 +294,8 @@ fn measure_point(
         })?;
     Ok(RoundPoint {
         agents,
-        fsync,
+        fsync: setup.fsync,
+        replicas: setup.replicas,
         dist: Dist::from_ns(&all)?,
         first: Dist::from_ns(&first)?,
         stalled,

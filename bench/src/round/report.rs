@@ -29,6 +29,8 @@ pub struct RoundPoint {
     pub agents: usize,
     /// The coordinator's fsync policy.
     pub fsync: FsyncPolicy,
+    /// Coordinator processes: 1, or 3 or 5 Raft replicas.
+    pub replicas: u32,
     /// Round latencies (to the last agent's commit).
     pub dist: Dist,
     /// Latencies to the first agent's commit.
@@ -40,8 +42,17 @@ pub struct RoundPoint {
 /// The table header of the round benchmark.
 pub fn round_header() -> String {
     format!(
-        "{:>7}  {:<13} {:>7} {:>10} {:>10} {:>10} | {:>10} {:>10} | {:>7}",
-        "agents", "fsync", "rounds", "p50 µs", "p99 µs", "max µs", "1st p50", "1st p99", "stalled"
+        "{:>7}  {:<13} {:>8} {:>7} {:>10} {:>10} {:>10} | {:>10} {:>10} | {:>7}",
+        "agents",
+        "fsync",
+        "replicas",
+        "rounds",
+        "p50 µs",
+        "p99 µs",
+        "max µs",
+        "1st p50",
+        "1st p99",
+        "stalled"
     )
 }
 
@@ -50,9 +61,10 @@ impl RoundPoint {
     pub fn row(&self) -> String {
         let d = &self.dist;
         format!(
-            "{:>7}  {:<13} {:>7} {:>10.1} {:>10.1} {:>10.1} | {:>10.1} {:>10.1} | {:>7}",
+            "{:>7}  {:<13} {:>8} {:>7} {:>10.1} {:>10.1} {:>10.1} | {:>10.1} {:>10.1} | {:>7}",
             self.agents,
             fsync_name(self.fsync),
+            self.replicas,
             d.n,
             us(d.p50_ns),
             us(d.p99_ns),
@@ -70,6 +82,7 @@ impl RoundPoint {
             "bench": "round",
             "agents": self.agents,
             "fsync": fsync_name(self.fsync),
+            "replicas": self.replicas,
             "p50_us": us1(d.p50_ns),
             "p99_us": us1(d.p99_ns),
             "max_us": us1(d.max_ns),
@@ -142,20 +155,22 @@ impl FaultPoint {
 
 /// The CSV header of `round.csv` and `faults.csv`.
 pub const CSV_HEADER: &str =
-    "date,platform,bench,measure,agents,fsync,n,mean_us,p50_us,p90_us,p99_us,max_us,stalled";
+    "date,platform,bench,measure,agents,fsync,replicas,n,mean_us,p50_us,p90_us,p99_us,max_us,stalled";
 
 fn csv_row(
     info: &crate::latency::RunInfo,
     bench: &str,
     measure: &str,
-    coordinator: Option<(usize, FsyncPolicy)>,
+    coordinator: Option<(usize, FsyncPolicy, u32)>,
     d: &Dist,
     stalled: usize,
 ) -> String {
-    let (agents, fsync) =
-        coordinator.map_or((String::new(), ""), |(a, f)| (a.to_string(), fsync_name(f)));
+    let (agents, fsync, replicas) = coordinator
+        .map_or((String::new(), "", String::new()), |(a, f, r)| {
+            (a.to_string(), fsync_name(f), r.to_string())
+        });
     format!(
-        "{},{},{bench},{measure},{agents},{fsync},{},{:.3},{:.3},{:.3},{:.3},{:.3},{stalled}",
+        "{},{},{bench},{measure},{agents},{fsync},{replicas},{},{:.3},{:.3},{:.3},{:.3},{:.3},{stalled}",
         info.date,
         info.platform,
         d.n,
@@ -171,7 +186,7 @@ fn csv_row(
 pub fn write_round_csv(dir: &Path, points: &[RoundPoint]) -> Result<std::path::PathBuf> {
     let info = crate::latency::RunInfo::now();
     let rows = points.iter().flat_map(|p| {
-        let c = Some((p.agents, p.fsync));
+        let c = Some((p.agents, p.fsync, p.replicas));
         [
             csv_row(
                 &info,
@@ -202,7 +217,8 @@ pub fn write_fault_csv(dir: &Path, points: &[FaultPoint]) -> Result<std::path::P
             &info,
             "faults",
             p.measure,
-            p.coordinator,
+            // The fault measurements run against one coordinator.
+            p.coordinator.map(|(a, f)| (a, f, 1)),
             &p.dist,
             p.stalled,
         )
@@ -247,6 +263,7 @@ mod tests {
         let p = RoundPoint {
             agents: 8,
             fsync: FsyncPolicy::None,
+            replicas: 3,
             dist: d,
             first: d,
             stalled: 0,
@@ -255,6 +272,7 @@ mod tests {
         assert_eq!(v["bench"], "round");
         assert_eq!(v["agents"], 8);
         assert_eq!(v["fsync"], "none");
+        assert_eq!(v["replicas"], 3);
         assert_eq!(v["rounds"], 3);
         assert_eq!(v["max_us"], 30.0);
         for k in ["p50_us", "p99_us", "first_p50_us", "first_p99_us"] {

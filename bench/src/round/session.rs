@@ -1,6 +1,6 @@
-//! A real `hnav-coordinator` under a stand-in supervisor: scenario file, spawn, start-up
-//! handshake (`Up` on `ready`, `Start` on `lifecycle`), lifecycle events, polite stop, and
-//! removal of the run's shared memory.
+//! A real `hnav-coordinator` (or a cluster of 3 or 5 replicas) under a stand-in supervisor:
+//! scenario file, spawn, start-up handshake (`Up` on `ready`, `Start` on `lifecycle`),
+//! lifecycle events, polite stop, and removal of the run's shared memory.
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
@@ -43,24 +43,24 @@ pub fn coordinator_binary() -> Result<PathBuf> {
     Ok(program)
 }
 
-/// A running coordinator and the supervisor's ports of its run.
+/// A running coordinator (or its replicas) and the supervisor's ports of its run.
 pub struct Session {
-    child: Child,
+    children: Vec<Child>,
     spawned: Instant,
     startup: std::cell::Cell<Option<Duration>>,
-    log_file: PathBuf,
     life: SupervisorPorts,
     transport: Transport,
 }
 
 impl Session {
-    /// The coordinator process (its exit descriptor wakes a `Waiter` when it dies).
-    pub fn child(&self) -> &Child {
-        &self.child
+    /// The coordinator processes: one, or every replica (their exit descriptors wake a
+    /// `Waiter` when they die).
+    pub fn coordinators(&self) -> &[Child] {
+        &self.children
     }
 
-    /// How long the coordinator took from just before `spawn` to its `Up` on `ready`
-    /// (exec, scenario, ports, consensus log).
+    /// How long the coordinators took from just before the first `spawn` to the last `Up` on
+    /// `ready` (exec, scenario, ports, consensus log).
     pub fn startup(&self) -> Option<Duration> {
         self.startup.get()
     }
@@ -71,11 +71,12 @@ impl Session {
         &self.life
     }
 
-    /// The supervisor's start-up handshake with the coordinator, as `hnav run` does it.
+    /// The supervisor's start-up handshake with the coordinators, as `hnav run` does it.
     fn handshake(&self) -> Result<()> {
+        let children: Vec<&Child> = self.children.iter().collect();
         match self
             .life
-            .start(&self.transport, &[&self.child], STARTUP_TIMEOUT)?
+            .start(&self.transport, &children, STARTUP_TIMEOUT)?
         {
             Startup::Started { all_up } => {
                 self.startup.set(Some(all_up - self.spawned));
@@ -85,41 +86,74 @@ impl Session {
         }
     }
 
-    /// `Stop` on `lifecycle`, then waits for the exit (bounded; SIGKILL after the bound).
+    /// `Stop` on `lifecycle`, then waits for every exit (bounded; SIGKILL after the bound).
+    /// Every coordinator is waited for (or killed) even when an earlier one failed.
     fn stop(&self) -> Result<()> {
-        self.life
+        let published = self
+            .life
             .publish(Lifecycle::stop(StopReason::Requested))
-            .context("publish Stop on lifecycle")?;
-        match self.child.wait(Some(STOP_TIMEOUT)) {
-            Some(ExitInfo::Exited(0)) => Ok(()),
-            Some(exit) => bail!("hnav-coordinator ended with {exit}"),
-            None => {
-                self.child.signal_group(Signal::SIGKILL)?;
-                let exit = self.child.wait(Some(STOP_TIMEOUT));
-                bail!(
-                    "hnav-coordinator did not exit within {STOP_TIMEOUT:?} of Stop; killed ({})",
-                    exit.map_or("not reaped".to_string(), |e| e.to_string())
-                )
+            .context("publish Stop on lifecycle");
+        let deadline = Instant::now() + STOP_TIMEOUT;
+        let mut failed = Vec::new();
+        for child in &self.children {
+            let node = child.spec().role.node_name(child.spec().index);
+            let left = deadline.saturating_duration_since(Instant::now());
+            match child.wait(Some(left)) {
+                Some(ExitInfo::Exited(0)) => {}
+                Some(exit) => failed.push(format!("{node} ended with {exit}")),
+                None => {
+                    let _ = child.signal_group(Signal::SIGKILL);
+                    let exit = child.wait(Some(STOP_TIMEOUT));
+                    failed.push(format!(
+                        "{node} did not exit within {STOP_TIMEOUT:?} of Stop; killed ({})",
+                        exit.map_or("not reaped".to_string(), |e| e.to_string())
+                    ));
+                }
             }
         }
+        published?;
+        if failed.is_empty() {
+            Ok(())
+        } else {
+            bail!("{}", failed.join("; "))
+        }
+    }
+
+    /// The end of every coordinator's log, for an error message.
+    fn log_tails(&self) -> String {
+        let tails: Vec<String> = self
+            .children
+            .iter()
+            .map(|c| log_tail(&c.spec().log_file))
+            .collect();
+        tails.join("\n")
     }
 }
 
-/// Starts a coordinator for `agents` agents and the given fsync policy, hands it and the
-/// agents' ports to `f`, then stops it and removes the run's shared memory. The run's files
-/// (scenario, consensus log, coordinator log) live in a temporary directory that is removed
-/// afterwards, or kept and named when something failed.
+/// What the coordinator of a benchmark run is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CoordinatorSetup {
+    /// The consensus log's fsync policy (every replica's).
+    pub fsync: FsyncPolicy,
+    /// 1 (one coordinator, today's behaviour), 3 or 5 Raft replicas.
+    pub replicas: u32,
+}
+
+/// Starts the coordinator (or its replicas) for `agents` agents, hands the session and the
+/// agents' ports to `f`, then stops every coordinator and removes the run's shared memory.
+/// The run's files (scenario, consensus logs, coordinator logs) live in a temporary
+/// directory that is removed afterwards, or kept and named when something failed.
 pub fn with_coordinator<T>(
     program: &Path,
     agents: usize,
-    fsync: FsyncPolicy,
+    setup: CoordinatorSetup,
     f: impl FnOnce(&Session, &mut Swarm) -> Result<T>,
 ) -> Result<T> {
     let layout = Layout::new(agents).map_err(|e| anyhow!(e))?;
     let run = RunId::unique("round");
     let dir = std::env::temp_dir().join(format!("hnav-bench-{}", run.as_str()));
     std::fs::create_dir_all(&dir).with_context(|| format!("create {}", dir.display()))?;
-    let result = session(program, &run, &dir, layout, fsync, f);
+    let result = session(program, &run, &dir, layout, setup, f);
     // Every node of the run is gone now (ours dropped, the coordinator reaped or killed).
     let purged = purge_run(&run);
     match &result {
@@ -138,11 +172,11 @@ fn session<T>(
     run: &RunId,
     dir: &Path,
     layout: Layout,
-    fsync: FsyncPolicy,
+    setup: CoordinatorSetup,
     f: impl FnOnce(&Session, &mut Swarm) -> Result<T>,
 ) -> Result<T> {
     let scenario = dir.join("scenario.toml");
-    std::fs::write(&scenario, layout.scenario_toml(fsync))
+    std::fs::write(&scenario, layout.scenario_toml(setup.fsync, setup.replicas))
         .with_context(|| format!("write {}", scenario.display()))?;
     let n = layout.agents();
     let transport = Transport::builder(run).node_name("supervisor").create()?;
@@ -152,7 +186,7 @@ fn session<T>(
         Some(v) if v == "1" => None,
         _ => Some(Bell::create()?),
     };
-    let env = bell
+    let env: Vec<(OsString, OsString)> = bell
         .as_ref()
         .map(|b| (OsString::from(BELL_ENV), OsString::from(b.env_value())))
         .into_iter()
@@ -170,35 +204,56 @@ fn session<T>(
         resume: false,
         faults: Vec::new(),
     };
-    let log_file = dir.join("coordinator.log");
-    let spec = ChildSpec {
-        role: Role::Coordinator,
-        index: 0,
-        program: program.to_path_buf(),
-        args: args.to_args(),
-        log_file: log_file.clone(),
-        env,
+    // As the supervisor numbers them: index 0 for one coordinator, Raft ids 1..=n for
+    // replicas (each told its id with `--replica`).
+    let indices: Vec<u32> = match setup.replicas {
+        1 => vec![0],
+        n => (1..=n).collect(),
     };
     let spawned = Instant::now();
-    let child = Child::spawn(&spec).context("start hnav-coordinator")?;
+    let mut children = Vec::with_capacity(indices.len());
+    let mut spawn_failed = None;
+    for index in indices {
+        let mut args = args.to_args();
+        if index > 0 {
+            args.extend([
+                OsString::from("--replica"),
+                OsString::from(index.to_string()),
+            ]);
+        }
+        let spec = ChildSpec {
+            role: Role::Coordinator,
+            index,
+            program: program.to_path_buf(),
+            args,
+            log_file: dir.join(format!("{}.log", Role::Coordinator.node_name(index))),
+            env: env.clone(),
+        };
+        match Child::spawn(&spec) {
+            Ok(child) => children.push(child),
+            Err(e) => {
+                spawn_failed = Some(anyhow!(e).context("start hnav-coordinator"));
+                break;
+            }
+        }
+    }
     let session = Session {
-        child,
+        children,
         spawned,
         startup: std::cell::Cell::new(None),
-        log_file,
         life,
         transport,
     };
-    let out = session.handshake().and_then(|()| f(&session, &mut swarm));
+    let out = match spawn_failed {
+        Some(e) => Err(e),
+        None => session.handshake().and_then(|()| f(&session, &mut swarm)),
+    };
     let stopped = session.stop();
     drop(swarm);
     match (out, stopped) {
         (Ok(v), Ok(())) => Ok(v),
-        (Ok(_), Err(e)) => Err(anyhow!("{e:#}\n{}", log_tail(&session.log_file))),
-        (Err(e), Err(s)) => Err(anyhow!(
-            "{e:#}; then {s:#}\n{}",
-            log_tail(&session.log_file)
-        )),
+        (Ok(_), Err(e)) => Err(anyhow!("{e:#}\n{}", session.log_tails())),
+        (Err(e), Err(s)) => Err(anyhow!("{e:#}; then {s:#}\n{}", session.log_tails())),
         (Err(e), Ok(())) => Err(e),
     }
 }

@@ -130,10 +130,11 @@ impl Swarm {
         Ok(())
     }
 
-    /// Plays up to `rounds` rounds from the next one on against the `coordinator` process:
+    /// Plays up to `rounds` rounds from the next one on against the `coordinators` (one
+    /// process, or every replica of a cluster):
     /// `before_send(round)`, every live agent's candidate (one `send` per agent, through its
     /// own publisher), then a wait in the transport's `Waiter` until every live agent's subscriber has taken
-    /// commit `round`; `after(obs)` may end early. Returns the rounds played. Fails if the
+    /// commit `round`; `after(obs)` may end early. Returns the rounds played. Fails if a
     /// coordinator exits or a round takes longer than 10 s.
     ///
     /// **Stalls.** If no commit comes for [`STALL_AFTER`], the coordinator is poked once
@@ -144,7 +145,7 @@ impl Swarm {
     /// notifier/listener hand-over of iceoryx2's event service).
     pub fn play(
         &mut self,
-        coordinator: &Child,
+        coordinators: &[Child],
         life: &SupervisorPorts,
         rounds: u64,
         mut before_send: impl FnMut(u64) -> Result<()>,
@@ -152,8 +153,11 @@ impl Swarm {
     ) -> Result<u64> {
         let n = self.layout.agents();
         let waiter = self.transport.waiter()?;
-        let exit = coordinator.watch(&waiter)?;
-        let exit_id = exit.id();
+        let exits = coordinators
+            .iter()
+            .map(|c| c.watch(&waiter))
+            .collect::<Result<Vec<_>, _>>()?;
+        let exit_ids: Vec<AttachmentId> = exits.iter().map(|e| e.id()).collect();
         let mut attached = Vec::with_capacity(n);
         let mut owner: HashMap<AttachmentId, usize> = HashMap::with_capacity(n);
         let mut live = 0;
@@ -209,15 +213,15 @@ impl Swarm {
                     );
                 }
                 fired.clear();
-                let mut coordinator_exited = false;
+                let mut exited = None;
                 let wait = if !stalled && missing == live {
                     left.min((sent + STALL_AFTER).saturating_duration_since(now))
                 } else {
                     left
                 };
                 let wake = waiter.wait_with(Some(now + wait), |id| {
-                    if id == exit_id {
-                        coordinator_exited = true;
+                    if let Some(k) = exit_ids.iter().position(|e| *e == id) {
+                        exited = Some(k);
                     } else if let Some(&i) = owner.get(&id) {
                         fired.push(i);
                     }
@@ -226,22 +230,24 @@ impl Swarm {
                     Wake::Stop => bail!("interrupted"),
                     // Nothing named: an interrupted wait or the waiter's lost-wake-up
                     // re-check. Look at every receiver, or a lost wake-up stays lost.
-                    Wake::Data if fired.is_empty() && !coordinator_exited => {
+                    Wake::Data if fired.is_empty() && exited.is_none() => {
                         fired.extend(owner.values().copied());
                     }
                     Wake::Data | Wake::TimedOut => {}
                 }
-                if coordinator_exited {
-                    let exit = coordinator.try_reap();
+                if let Some(k) = exited {
+                    let c = &coordinators[k];
                     bail!(
-                        "round {round}: hnav-coordinator exited ({})",
-                        exit.map_or("not reaped".to_string(), |e| e.to_string())
+                        "round {round}: {} exited ({})",
+                        c.spec().role.node_name(c.spec().index),
+                        c.try_reap()
+                            .map_or("not reaped".to_string(), |e| e.to_string())
                     );
                 }
                 for &i in &fired {
                     let Some(rx) = &self.rx[i] else { continue };
                     let mut late = None;
-                    rx.drain_pending(|c| {
+                    let drained = rx.drain_pending(|c| {
                         if c.round == round && got[i].is_none() {
                             let now = Instant::now();
                             let decided = c.decisions().iter().any(|d| d.agent as usize == i);
@@ -255,6 +261,13 @@ impl Swarm {
                     })?;
                     if let Some(r) = late {
                         bail!("agent {i} got commit {r} while round {round} is open");
+                    }
+                    // A coordinator came to lead (or back) after this round's candidates
+                    // went out: like a real agent, resend the open candidate to it.
+                    if drained.wakeup.peer_up && got[i].is_none() {
+                        if let Some(tx) = &self.tx[i] {
+                            tx.send(self.layout.candidate(i, round))?;
+                        }
                     }
                 }
             }

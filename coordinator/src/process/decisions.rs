@@ -89,10 +89,11 @@ impl RaftLog {
             ..ReplicaConfig::cluster(id, u64::from(c.replicas))
         };
         let dir = run_dir.join("log").join(id.to_string());
-        let replica = Replica::durable(&config, &dir, header, c.fsync)?;
+        let mut replica = Replica::durable(&config, &dir, header, c.fsync)?;
         // A role file of an earlier incarnation says nothing of this one.
         let _ = std::fs::remove_file(dir.join(ROLE_FILE));
         let link = Rc::new(RaftLink::open(transport, id, &config.voters)?);
+        replica.send_early(Rc::clone(&link));
         let tick = Duration::from_millis(u64::from(c.raft_heartbeat_ms));
         let mut raft = RaftLog {
             replica,

@@ -8,9 +8,14 @@
 //! supervisor then reacts as to any other death or freeze: it reaps and restarts a killed
 //! process under its role's policy, and hang detection deals with one stopped too long.
 //!
+//! In a run with coordinator replicas, `coordinator` names the replica that leads: the one
+//! whose role file (`DIR/log/<id>/raft-role.json`, what `hnav ps` shows) says `leader` in the
+//! highest term. `coordinator:ID` names one replica whatever its role.
+//!
 //! The signal is recorded in the run's journal `DIR/events.jsonl` as a `signalled` line with
 //! no fault index, appended next to the supervisor's own lines ([`RunEvents::append`]); its
-//! `round` is the last round the run's consensus log holds at that moment.
+//! `round` is the last round the run's consensus log holds at that moment (a replicated run:
+//! the replica that decided the most).
 
 use std::path::{Path, PathBuf};
 
@@ -20,8 +25,8 @@ use nix::unistd::Pid;
 
 use super::child::Signal;
 use super::events::{RunEvent, RunEvents};
-use super::registry::{process_alive, LiveRunError, RunRegistry};
-use crate::consensus_log::reader::LogReader;
+use super::registry::{process_alive, LiveRunError, RunRecord, RunRegistry};
+use crate::consensus_log::{read_decided, ReplicaRole};
 use crate::msg::Role;
 use crate::scenario::fault_arg::target_arg;
 use crate::scenario::FaultTarget;
@@ -40,6 +45,15 @@ pub enum KillError {
         /// The target as written: `agent:9`.
         target: String,
         /// What the run has: `its agents are 0-7`.
+        has: String,
+    },
+    /// `coordinator` of a run with replicas, none of which says it leads (an election is
+    /// under way, or the majority is gone).
+    #[error("no coordinator replica of run `{run}` leads right now (an election may be under way); name one: {has}")]
+    NoLeader {
+        /// The run id.
+        run: String,
+        /// The replicas: `coordinator:1-3`.
         has: String,
     },
     /// The target is between a death and its restart, or gone for good.
@@ -94,7 +108,7 @@ pub fn kill(
     let (_, record) = registry.find_live(run)?;
     let (role, index) = match target {
         FaultTarget::Agent(i) => (Role::Agent, u32::try_from(i).unwrap_or(u32::MAX)),
-        FaultTarget::Coordinator => (Role::Coordinator, 0),
+        FaultTarget::Coordinator => (Role::Coordinator, coordinator_index(run, &record)?),
         FaultTarget::Replica(id) => (Role::Coordinator, id),
         FaultTarget::Sim => (Role::Sim, 0),
     };
@@ -160,17 +174,48 @@ pub fn kill(
     })
 }
 
-/// The last round of the consensus log in `dir` (0 if it has none or cannot be read: the
-/// signal is sent either way, and the journal's stamp says when).
-fn last_round(dir: &Path) -> u64 {
-    let Ok(mut reader) = LogReader::open(dir) else {
-        return 0;
-    };
-    let mut last = 0;
-    while let Ok(Some((_, record))) = reader.next_record() {
-        last = last.max(record.round().unwrap_or(0));
+/// The index of the process `coordinator` names: 0 for a single coordinator, else the
+/// replica that leads in the highest term its role file shows.
+fn coordinator_index(run: &str, record: &RunRecord) -> Result<u32, KillError> {
+    let replicas: Vec<u32> = record
+        .processes
+        .iter()
+        .filter(|p| p.role == Role::Coordinator)
+        .map(|p| p.index)
+        .collect();
+    if replicas.is_empty() || replicas.contains(&0) {
+        return Ok(0);
     }
-    last
+    let log = record.dir.join("log");
+    replicas
+        .iter()
+        .filter_map(|&id| {
+            let shown = ReplicaRole::read(&log.join(id.to_string()))?;
+            (shown.role == "leader").then_some((shown.term, id))
+        })
+        .max()
+        .map(|(_, id)| id)
+        .ok_or_else(|| KillError::NoLeader {
+            run: run.into(),
+            has: format!(
+                "coordinator:{}-{}",
+                replicas.iter().min().unwrap_or(&1),
+                replicas.iter().max().unwrap_or(&1)
+            ),
+        })
+}
+
+/// The last round of the consensus log in `dir`, a single coordinator's or the replicas'
+/// (0 if it has none or cannot be read: the signal is sent either way, and the journal's
+/// stamp says when).
+fn last_round(dir: &Path) -> u64 {
+    read_decided(dir).map_or(0, |d| {
+        d.records
+            .iter()
+            .filter_map(|r| r.round())
+            .max()
+            .unwrap_or(0)
+    })
 }
 
 #[cfg(test)]
@@ -223,6 +268,59 @@ mod tests {
         assert_eq!(line["node"], "agent-1");
         assert_eq!(line["signal"], "SIGKILL");
         assert!(line["fault"].is_null());
+    }
+
+    #[test]
+    fn coordinator_names_the_replica_that_leads_in_the_highest_term() {
+        let tmp = tempfile::tempdir().unwrap();
+        let mut sleeper = std::process::Command::new("sleep")
+            .arg("30")
+            .spawn()
+            .unwrap();
+        let registry = RunRegistry::at(tmp.path().join("runs"));
+        let run = RunId::new("kill-leader").unwrap();
+        let dir = tmp.path().join("dir");
+        let mut record = registry.new_record(&run, dir.clone());
+        let gone = exited_pid();
+        record.set_process(Role::Coordinator, 1, gone, 0);
+        record.set_process(Role::Coordinator, 2, sleeper.id(), 0);
+        record.set_process(Role::Coordinator, 3, gone, 0);
+        record.write().unwrap();
+        let show = |id: u32, role: &str, term: u64| {
+            let d = dir.join("log").join(id.to_string());
+            std::fs::create_dir_all(&d).unwrap();
+            let role = role.to_string();
+            ReplicaRole { role, term }.write(&d).unwrap();
+        };
+        show(1, "follower", 3);
+        show(2, "candidate", 3);
+        show(3, "follower", 3);
+        let e = kill(
+            &registry,
+            "kill-leader",
+            FaultTarget::Coordinator,
+            Signal::SIGKILL,
+        )
+        .unwrap_err()
+        .to_string();
+        assert_eq!(
+            e,
+            "no coordinator replica of run `kill-leader` leads right now (an election may be \
+             under way); name one: coordinator:1-3"
+        );
+        // A deposed leader that has not noticed yet shows an older term.
+        show(1, "leader", 2);
+        show(2, "leader", 3);
+        let k = kill(
+            &registry,
+            "kill-leader",
+            FaultTarget::Coordinator,
+            Signal::SIGKILL,
+        )
+        .unwrap();
+        assert_eq!((k.node.as_str(), k.pid), ("coordinator-2", sleeper.id()));
+        use std::os::unix::process::ExitStatusExt;
+        assert_eq!(sleeper.wait().unwrap().signal(), Some(9));
     }
 
     #[test]

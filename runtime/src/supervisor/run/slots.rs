@@ -204,17 +204,18 @@ impl Slots {
 
     /// Reaps exited children, tells the others (`Down`), and restarts what is due. Returns
     /// why the run cannot go on, if it cannot: the sim or the coordinator is down and not
-    /// restarted, or no agent is left. A child that stopped on a full disk ends the run
-    /// instead: [`RunError::NoSpace`].
+    /// restarted, coordinator replicas are lost until no majority is left, or no agent is
+    /// left. A child that stopped on a full disk ends the run instead: [`RunError::NoSpace`].
     pub(super) fn reap_and_restart(
         &mut self,
         transport: &Transport,
         life: &SupervisorPorts,
     ) -> Result<Option<String>, RunError> {
         let mut died = false;
-        // The sim or the coordinator gone for good ends the run; an agent only if it was
-        // the last one.
-        let (mut core_gone, mut agent_gone) = (None, None);
+        // The sim or the coordinator gone for good ends the run; a replica only once no
+        // majority is left (Raft's cluster goes on without a minority); an agent only if it
+        // was the last one.
+        let (mut core_gone, mut replica_gone, mut agent_gone) = (None, None, None);
         for s in &mut self.slots {
             let Some(exit) = s.child.as_ref().and_then(|c| c.try_reap()) else {
                 continue;
@@ -241,7 +242,12 @@ impl Slots {
                     tracing::warn!(node = role.node_name(index), %why, "not restarted");
                     life.publish(Lifecycle::lost(role, index, s.tracker.restarts()))?;
                     let ended = not_restarted(role, index, &exit, why);
-                    let gone = format!("{ended}: the run cannot go on");
+                    let replica = role == Role::Coordinator && index > 0;
+                    let gone = if replica {
+                        format!("{ended}: the cluster goes on while a majority of it is left")
+                    } else {
+                        format!("{ended}: the run cannot go on")
+                    };
                     self.events.record(RunEvent::GaveUp {
                         node: role.node_name(index),
                         why: gone.clone(),
@@ -253,6 +259,7 @@ impl Slots {
                             ));
                         }
                         Role::Agent => agent_gone = Some(gone),
+                        Role::Coordinator if replica => replica_gone = Some(ended.clone()),
                         Role::Sim | Role::Coordinator => core_gone = Some(gone),
                     }
                     s.lost = Some(ended);
@@ -267,6 +274,11 @@ impl Slots {
         }
         if core_gone.is_some() {
             return Ok(core_gone);
+        }
+        if let Some(gone) = replica_gone.filter(|_| !self.replica_majority_left()) {
+            return Ok(Some(format!(
+                "no majority of the coordinator replicas is left; the last lost: {gone}"
+            )));
         }
         if let Some(gone) = agent_gone.filter(|_| !self.any_agent_left()) {
             return Ok(Some(format!("no agent is left; the last: {gone}")));
@@ -292,6 +304,19 @@ impl Slots {
             }
         }
         Ok(None)
+    }
+
+    /// Whether more than half of the coordinator replicas are not lost for good (running, or
+    /// to be restarted): Raft can still commit. True for a single coordinator.
+    fn replica_majority_left(&self) -> bool {
+        let replicas = self
+            .slots
+            .iter()
+            .filter(|s| s.spec.role == Role::Coordinator && s.spec.index > 0);
+        let (total, left) = replicas.fold((0, 0), |(t, l), s| {
+            (t + 1, l + usize::from(s.lost.is_none()))
+        });
+        total == 0 || 2 * left > total
     }
 
     /// Publishes `Restarted` for every restarted process that has announced itself up;
