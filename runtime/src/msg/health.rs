@@ -11,7 +11,9 @@ use super::Role;
 /// the supervisor judges a process's silence by when it last beat, not by when the supervisor
 /// happened to read it: a supervisor that was itself paused does not mistake its own pause for
 /// its children's.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
+)]
 #[repr(C)]
 #[type_name("hnav::Heartbeat")]
 pub struct Heartbeat {

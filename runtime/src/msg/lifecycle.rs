@@ -239,7 +239,9 @@ impl StopReason {
 /// Built by the constructors ([`Lifecycle::up`], [`Lifecycle::down`],
 /// [`Lifecycle::restarted`], [`Lifecycle::start`], [`Lifecycle::stop`]), which stamp the
 /// wall-clock time and leave every byte they do not set zero.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
+)]
 #[repr(C)]
 #[type_name("hnav::Lifecycle")]
 pub struct Lifecycle {

@@ -29,7 +29,9 @@ impl ActivationKind {
 }
 
 /// The user header of a neural-map snapshot (`[f32]` slice, one activation per cell).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
+)]
 #[repr(C)]
 #[type_name("hnav::MapHeader")]
 pub struct MapHeader {

@@ -41,6 +41,7 @@
 //! | `map` | the neural-map snapshot: [`MapHeader`], [`ActivationKind`] |
 //! | `health` | a process's proof of life: [`Heartbeat`] |
 //! | [`layout`] | the table of every payload's size, alignment and field offsets, for clients in other languages (`hnav layout --json`) |
+//! | [`wire`] | a payload as its bytes, checked on arrival, for links that leave the host ([`Wire`]) |
 
 mod health;
 pub mod layout;
@@ -48,6 +49,7 @@ mod lifecycle;
 mod map;
 mod motion;
 mod round;
+pub mod wire;
 
 pub use health::Heartbeat;
 pub use lifecycle::{
@@ -56,6 +58,7 @@ pub use lifecycle::{
 pub use map::{ActivationKind, MapHeader};
 pub use motion::{Estimate, Odometry, Pose, Truth, WheelCommand};
 pub use round::{Candidate, CandidateFlags, Commit, ConflictKind, Decision, Progress, Verdict};
+pub use wire::{Wire, WireError};
 
 /// The largest swarm one [`Commit`] or [`Truth`] sample can describe.
 pub const MAX_AGENTS: usize = 256;

@@ -6,7 +6,9 @@ use iceoryx2::prelude::ZeroCopySend;
 use super::MAX_AGENTS;
 
 /// Wheel speed set-points for one robot and one control period.
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
+)]
 #[repr(C)]
 #[type_name("hnav::WheelCommand")]
 pub struct WheelCommand {
@@ -23,7 +25,9 @@ pub struct WheelCommand {
 }
 
 /// Cumulative Hall-sensor counts of one robot, as a motor driver reports them.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
+)]
 #[repr(C)]
 #[type_name("hnav::Odometry")]
 pub struct Odometry {
@@ -42,7 +46,9 @@ pub struct Odometry {
 }
 
 /// A planar pose in metres and radians (x right, y down the map's rows, as the grid).
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
+)]
 #[repr(C)]
 #[type_name("hnav::Pose")]
 pub struct Pose {
@@ -55,7 +61,7 @@ pub struct Pose {
 }
 
 /// Ground truth from the sim: every robot's pose and the collision count so far.
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C)]
 #[type_name("hnav::Truth")]
 pub struct Truth {
@@ -86,7 +92,9 @@ impl Default for Truth {
 /// An agent's dead-reckoned pose: where it believes its robot is, published at most once
 /// per control period (`estimate` topic) for the recorder and viewers; nothing in the swarm
 /// decides by it.
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
+)]
 #[repr(C)]
 #[type_name("hnav::Estimate")]
 pub struct Estimate {

@@ -5,7 +5,7 @@ use iceoryx2::prelude::ZeroCopySend;
 use super::{MAX_AGENTS, NO_CELL};
 
 /// One agent's row of the dissertation's `shared_paths` table, proposed for a decision round.
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C)]
 #[type_name("hnav::Candidate")]
 pub struct Candidate {
@@ -169,7 +169,7 @@ impl ConflictKind {
 }
 
 /// One agent's entry in a [`Commit`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C)]
 #[type_name("hnav::Decision")]
 pub struct Decision {
@@ -206,7 +206,7 @@ impl Default for Decision {
 }
 
 /// One decision round's outcome, published only after it is durable in the consensus log.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C)]
 #[type_name("hnav::Commit")]
 pub struct Commit {
@@ -245,7 +245,9 @@ impl Commit {
 
 /// The coordinator's running tally, published after every round (latest value only) for the
 /// supervisor's progress bar and for viewers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
+)]
 #[repr(C)]
 #[type_name("hnav::Progress")]
 pub struct Progress {

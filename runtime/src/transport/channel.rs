@@ -198,6 +198,11 @@ pub struct Drained {
     pub samples: usize,
 }
 
+/// Which publisher a sample came from: a bridge skips what its own senders published, so
+/// that nothing it brought in goes back out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PublisherId(iceoryx2::identifiers::UniquePublisherId);
+
 /// The sending half of a topic: a publisher of `P` (a fixed-size type, or `[E]` for a slice
 /// topic, see [`SliceSender`](super::SliceSender)) with user header `H`, plus a notifier that
 /// wakes receivers.
@@ -303,6 +308,11 @@ where
     pub fn publisher(&self) -> &Publisher<Ipc, P, H> {
         &self.publisher
     }
+
+    /// This sender's publisher, as its samples name it ([`Receiver::drain_pending_except`]).
+    pub fn id(&self) -> PublisherId {
+        PublisherId(self.publisher.id())
+    }
 }
 
 impl<T: Debug + ZeroCopySend + 'static> Sender<T> {
@@ -352,6 +362,23 @@ impl<T: Debug + ZeroCopySend + 'static> Sender<T> {
         let mut sample = self.publisher.loan().map_err(|e| self.loan_error(e))?;
         fill(sample.payload_mut());
         self.publish(sample)
+    }
+
+    /// [`Sender::send_in_place`] for a payload that may turn out invalid while it is written
+    /// (bytes from another host): when `fill` fails the loan is returned unsent and its error
+    /// comes back inside the `Ok`.
+    pub fn try_send_in_place<E>(
+        &self,
+        fill: impl FnOnce(&mut T) -> Result<(), E>,
+    ) -> Result<Result<usize, E>, TransportError>
+    where
+        T: Default,
+    {
+        let mut sample = self.publisher.loan().map_err(|e| self.loan_error(e))?;
+        match fill(sample.payload_mut()) {
+            Ok(()) => self.publish(sample).map(Ok),
+            Err(e) => Ok(Err(e)),
+        }
     }
 }
 
@@ -464,6 +491,24 @@ impl<T: Debug + ZeroCopySend + 'static> Receiver<T> {
     pub fn drain_pending(&self, f: impl FnMut(&T)) -> Result<Drained, TransportError> {
         let wakeup = self.take_wakeup()?;
         let samples = self.drain(f)?;
+        Ok(Drained { wakeup, samples })
+    }
+
+    /// [`Receiver::drain_pending`] that passes over the samples of the publishers in `skip`
+    /// (taken and dropped, not handed to `f`); `samples` counts only those handed on.
+    pub fn drain_pending_except(
+        &self,
+        skip: &[PublisherId],
+        mut f: impl FnMut(&T),
+    ) -> Result<Drained, TransportError> {
+        let wakeup = self.take_wakeup()?;
+        let mut samples = 0;
+        while let Some(sample) = self.receive()? {
+            if !skip.contains(&PublisherId(sample.header().publisher_id())) {
+                f(sample.payload());
+                samples += 1;
+            }
+        }
         Ok(Drained { wakeup, samples })
     }
 }

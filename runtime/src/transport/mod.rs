@@ -48,12 +48,13 @@ mod slice;
 mod waiter;
 
 pub use bell::{Bell, BellWatch, BELL_ENV, BELL_LISTENER};
-pub use channel::{Drained, Receiver, Sender, Wakeup};
+pub use channel::{Drained, PublisherId, Receiver, Sender, Wakeup};
 pub use error::TransportError;
 pub use node::{CleanupReport, NodeInfo, NodeLiveness, Transport, TransportBuilder};
 pub use qos::{Delivery, Qos};
 pub use run::{
-    ipc_root, purge_run, run_config, run_iceoryx2_files, run_shm_files, RunId, IPC_ROOT_ENV,
+    ipc_root, purge_run, run_config, run_iceoryx2_files, run_shm_files, RunId, DOMAIN_ENV,
+    IPC_ROOT_ENV,
 };
 pub use slice::{SliceLoan, SliceReceiver, SliceSender};
 pub use waiter::{stop_requested, Attachment, AttachmentId, Waiter, Wake};

@@ -12,12 +12,18 @@ use super::{Ipc, TransportError};
 /// Where POSIX shared memory lives on Linux; iceoryx2 names its segments with the config prefix.
 const SHM_DIR: &str = "/dev/shm";
 
+/// The environment variable naming this process's iceoryx2 domain: processes of one run
+/// meet only within one domain. Unset on a single host. Two "hosts" on one machine (the
+/// bridge's tests) set it apart, so that only the Zenoh bridge links them.
+pub const DOMAIN_ENV: &str = "HNAV_DOMAIN";
+
 /// The identity of one swarm run.
 ///
 /// It scopes service names (`hnav/<run-id>/<topic>`) and the iceoryx2 file prefix
-/// (`hnav_<run-id>_`), so runs never meet. Allowed: 1 to 48 ASCII letters, digits, `-`, `_`.
+/// (`hnav_<run-id>_`, or `hnav_<run-id>.<domain>_` in a [domain](DOMAIN_ENV)), so runs never
+/// meet. Allowed: 1 to 48 ASCII letters, digits, `-`, `_` (a domain: 1 to 16 of them).
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
-pub struct RunId(String);
+pub struct RunId(String, Option<String>);
 
 impl RunId {
     /// Longest accepted id: keeps file names of the form `<prefix><hash>...` far below 255 bytes.
@@ -41,7 +47,18 @@ impl RunId {
         {
             return Err(bad("only ASCII letters, digits, '-' and '_' are allowed"));
         }
-        Ok(Self(id.to_string()))
+        Ok(Self(id.to_string(), domain_from_env()?))
+    }
+
+    /// The same run in iceoryx2 domain `domain` instead of the environment's.
+    pub fn in_domain(self, domain: &str) -> Result<Self, TransportError> {
+        valid_domain(domain)?;
+        Ok(Self(self.0, Some(domain.to_string())))
+    }
+
+    /// The iceoryx2 domain this id is in, if any.
+    pub fn domain(&self) -> Option<&str> {
+        self.1.as_deref()
     }
 
     /// A fresh id that no other run on this machine uses: `<tag>-<pid>-<nanoseconds>`.
@@ -55,7 +72,8 @@ impl RunId {
             .filter(|c| c.is_ascii_alphanumeric())
             .take(16)
             .collect();
-        Self(format!("{tag}-{}-{:x}", std::process::id(), nanos))
+        let id = format!("{tag}-{}-{:x}", std::process::id(), nanos);
+        Self(id, domain_from_env().ok().flatten())
     }
 
     /// The id as text.
@@ -72,9 +90,40 @@ impl RunId {
         })
     }
 
-    /// The iceoryx2 file prefix of this run.
+    /// The iceoryx2 file prefix of this run (in its domain).
     pub fn prefix(&self) -> String {
-        format!("hnav_{}_", self.0)
+        match &self.1 {
+            None => format!("hnav_{}_", self.0),
+            // `.` is in no run id, so no other run's prefix starts like this one.
+            Some(domain) => format!("hnav_{}.{domain}_", self.0),
+        }
+    }
+}
+
+/// The domain [`DOMAIN_ENV`] names, if it is set and not empty.
+fn domain_from_env() -> Result<Option<String>, TransportError> {
+    match std::env::var(DOMAIN_ENV) {
+        Ok(d) if !d.is_empty() => valid_domain(&d).map(|()| Some(d)),
+        Ok(_) | Err(std::env::VarError::NotPresent) => Ok(None),
+        Err(std::env::VarError::NotUnicode(d)) => Err(TransportError::InvalidRunId {
+            id: d.to_string_lossy().into_owned(),
+            why: "HNAV_DOMAIN is not UTF-8",
+        }),
+    }
+}
+
+fn valid_domain(d: &str) -> Result<(), TransportError> {
+    let ok = !d.is_empty()
+        && d.len() <= 16
+        && d.bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_');
+    if ok {
+        Ok(())
+    } else {
+        Err(TransportError::InvalidRunId {
+            id: d.to_string(),
+            why: "a domain (HNAV_DOMAIN) is 1 to 16 ASCII letters, digits, '-' and '_'",
+        })
     }
 }
 
@@ -338,6 +387,19 @@ mod tests {
         let b = RunId::unique("t e/st");
         assert_ne!(a, b);
         assert!(RunId::new(a.as_str()).is_ok());
+    }
+
+    #[test]
+    fn a_domain_gets_a_prefix_of_its_own() {
+        let plain = RunId::new("a").unwrap().in_domain("x").unwrap();
+        assert_eq!(plain.prefix(), "hnav_a.x_");
+        assert_eq!(plain.as_str(), "a");
+        assert_eq!(plain.domain(), Some("x"));
+        assert!(!belongs_to_run(b"hnav_a.x_node.details", "hnav_a_"));
+        assert!(!belongs_to_run(b"hnav_a_node.details", &plain.prefix()));
+        for bad in ["", "a.b", "seventeen-chars-x"] {
+            assert!(RunId::new("a").unwrap().in_domain(bad).is_err(), "{bad:?}");
+        }
     }
 
     #[test]

@@ -1,0 +1,205 @@
+//! One host's end of a run's bridge: a node in the host's iceoryx2 domain, a Zenoh session,
+//! a port per forwarded topic, and the loop that moves samples both ways.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
+
+use hnav_runtime::transport::{Bell, RunId, Transport, TransportError, Wake};
+use zenoh::pubsub::{Publisher, Subscriber};
+use zenoh::qos::CongestionControl;
+use zenoh::sample::{Locality, Sample};
+use zenoh::{Session, Wait};
+
+use crate::port::{self, Moved, Port};
+use crate::session::{self, Endpoints, SessionError};
+use crate::topics::TopicSpec;
+
+/// Samples from Zenoh waiting for the bridge's loop; past this they are dropped and counted
+/// (a host that cannot keep up must not grow without bound).
+const INBOX: usize = 4096;
+/// Invalid samples named in the log one by one; after that only counted.
+const LOGGED_DROPS: u64 = 20;
+
+/// Why a bridge stopped or did not start.
+#[derive(Debug, thiserror::Error)]
+pub enum BridgeError {
+    /// The host's iceoryx2 side failed.
+    #[error(transparent)]
+    Transport(#[from] TransportError),
+    /// The Zenoh session did not open.
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    /// A Zenoh publisher or subscriber was not declared.
+    #[error("zenoh: declare {what} on {key}: {why}")]
+    Declare {
+        /// `publisher` or `subscriber`.
+        what: &'static str,
+        /// The key expression.
+        key: String,
+        /// Zenoh's words.
+        why: String,
+    },
+}
+
+/// What a bridge has moved so far.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct Counts {
+    /// Samples of this host's processes sent to Zenoh.
+    pub out: u64,
+    /// Samples of other hosts published into this host's iceoryx2.
+    pub r#in: u64,
+    /// Samples from Zenoh dropped as invalid (wrong type name, size or field range).
+    pub dropped: u64,
+    /// Samples from Zenoh dropped because the inbox was full.
+    pub overflow: u64,
+    /// Puts Zenoh refused.
+    pub failed: u64,
+}
+
+impl core::fmt::Display for Counts {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "out={} in={} dropped={} overflow={} failed={}",
+            self.out, self.r#in, self.dropped, self.overflow, self.failed
+        )
+    }
+}
+
+/// One host's end of a run's bridge. See the [crate docs](crate).
+pub struct Bridge {
+    transport: Transport,
+    ports: Vec<Box<dyn Port>>,
+    publishers: Vec<Publisher<'static>>,
+    _subscribers: Vec<Subscriber<()>>,
+    inbox: crossbeam_channel::Receiver<(usize, Sample)>,
+    bell: hnav_runtime::transport::BellWatch,
+    overflow: Arc<AtomicU64>,
+    counts: Counts,
+    // Declared last: dropped after the publishers and subscribers that live in it.
+    _session: Session,
+}
+
+impl Bridge {
+    /// Joins `run` on this host (node `bridge`) and a Zenoh session on `endpoints`, and
+    /// opens a port for each of `topics`.
+    pub fn open(
+        run: &RunId,
+        topics: &[TopicSpec],
+        endpoints: &Endpoints,
+    ) -> Result<Self, BridgeError> {
+        let transport = Transport::builder(run).node_name("bridge").create()?;
+        let session = session::open(endpoints)?;
+        let bell = Bell::create()?;
+        let (tx, inbox) = crossbeam_channel::bounded(INBOX);
+        let overflow = Arc::new(AtomicU64::new(0));
+        let mut ports = Vec::with_capacity(topics.len());
+        let mut publishers = Vec::with_capacity(topics.len());
+        let mut subscribers = Vec::with_capacity(topics.len());
+        for (i, spec) in topics.iter().enumerate() {
+            ports.push(port::open(&transport, spec)?);
+            let key = format!("hnav/{}/{}", run.as_str(), spec.topic);
+            let declare = |what, e: zenoh::Error| BridgeError::Declare {
+                what,
+                key: key.clone(),
+                why: e.to_string(),
+            };
+            publishers.push(
+                session
+                    .declare_publisher(key.clone())
+                    // Reliable: a full queue holds the bridge rather than losing a round.
+                    .congestion_control(CongestionControl::Block)
+                    .express(true)
+                    .allowed_destination(Locality::Remote)
+                    .wait()
+                    .map_err(|e| declare("publisher", e))?,
+            );
+            let (tx, ring, overflow) = (tx.clone(), bell.try_clone()?, Arc::clone(&overflow));
+            subscribers.push(
+                session
+                    .declare_subscriber(key.clone())
+                    // Only other sessions: this bridge's own puts never come back.
+                    .allowed_origin(Locality::Remote)
+                    .callback(move |sample| match tx.try_send((i, sample)) {
+                        Ok(()) => {
+                            let _ = ring.ring();
+                        }
+                        Err(_) => {
+                            overflow.fetch_add(1, Ordering::Relaxed);
+                        }
+                    })
+                    .wait()
+                    .map_err(|e| declare("subscriber", e))?,
+            );
+        }
+        Ok(Bridge {
+            transport,
+            ports,
+            publishers,
+            _subscribers: subscribers,
+            inbox,
+            bell: bell.into_watch()?,
+            overflow,
+            counts: Counts::default(),
+            _session: session,
+        })
+    }
+
+    /// What it has moved so far.
+    pub fn counts(&self) -> Counts {
+        Counts {
+            overflow: self.overflow.load(Ordering::Relaxed),
+            ..self.counts
+        }
+    }
+
+    /// Forwards until a termination signal or `until`; returns the counts.
+    pub fn run(&mut self, until: Option<Instant>) -> Result<Counts, BridgeError> {
+        let waiter = self.transport.waiter()?;
+        let mut attached = Vec::with_capacity(self.ports.len() + 1);
+        for p in &self.ports {
+            attached.push(p.attach(&waiter)?);
+        }
+        attached.push(waiter.attach_bell(&self.bell)?);
+        loop {
+            let mut moved = Moved::default();
+            for (p, out) in self.ports.iter().zip(&self.publishers) {
+                p.send_out(out, &mut moved)?;
+            }
+            // Take the edge before draining: a sample queued after the drain rings again.
+            self.bell.take();
+            while let Ok((i, sample)) = self.inbox.try_recv() {
+                let name = sample.attachment().and_then(|a| a.try_to_string().ok());
+                match self.ports[i].bring_in(sample.payload(), name.as_deref())? {
+                    Ok(()) => {
+                        moved.r#in += 1;
+                        // The bridge's own receiver of the topic holds what it just
+                        // published (skipped, never forwarded); on a reliable topic a full
+                        // buffer of its own would hold its next publish for ever.
+                        self.ports[i].send_out(&self.publishers[i], &mut moved)?;
+                    }
+                    Err(why) => {
+                        moved.dropped += 1;
+                        if self.counts.dropped + moved.dropped <= LOGGED_DROPS {
+                            let topic = self.ports[i].topic();
+                            tracing::warn!(topic, "dropped a sample from another host: {why}");
+                        }
+                    }
+                }
+            }
+            self.counts.out += moved.out;
+            self.counts.r#in += moved.r#in;
+            self.counts.dropped += moved.dropped;
+            self.counts.failed += moved.failed;
+            if until.is_some_and(|u| Instant::now() >= u) {
+                break;
+            }
+            if waiter.wait(until)? == Wake::Stop {
+                break;
+            }
+        }
+        drop(attached);
+        Ok(self.counts())
+    }
+}

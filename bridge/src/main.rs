@@ -1,0 +1,62 @@
+//! `hnav-bridge --run ID --agents N [--listen EP]... [--connect EP]...`: forwards run ID's
+//! topics between this host's iceoryx2 domain and the other hosts' bridges over Zenoh, until
+//! SIGTERM or SIGINT; then prints what it moved (`out=.. in=.. dropped=.. overflow=..
+//! failed=..`). See `hnav_bridge`.
+
+use std::process::ExitCode;
+
+use clap::Parser;
+use hnav_bridge::session::Endpoints;
+use hnav_bridge::{topics, Bridge};
+use hnav_runtime::transport::RunId;
+
+#[derive(Parser)]
+#[command(about = "HNAV bridge: a run's topics between hosts over Zenoh")]
+struct Args {
+    /// The run id (the same on every host).
+    #[arg(long)]
+    run: String,
+    /// The run's agent count (which `odom/<i>` and `wheels/<i>` topics exist).
+    #[arg(long)]
+    agents: usize,
+    /// Zenoh endpoint to listen on (`tcp/10.0.0.1:7447`); repeatable.
+    #[arg(long)]
+    listen: Vec<String>,
+    /// Zenoh endpoint of another host's bridge (`tcp/10.0.0.2:7447`); repeatable.
+    #[arg(long)]
+    connect: Vec<String>,
+}
+
+fn main() -> ExitCode {
+    hnav_runtime::logging::init();
+    let args = Args::parse();
+    match run(&args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            hnav_runtime::errln!("hnav-bridge: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    if args.agents == 0 || args.agents > hnav_runtime::msg::MAX_AGENTS {
+        return Err(format!(
+            "--agents {}: a run has 1 to {} agents",
+            args.agents,
+            hnav_runtime::msg::MAX_AGENTS
+        )
+        .into());
+    }
+    let run = RunId::new(&args.run)?;
+    let endpoints = Endpoints {
+        listen: args.listen.clone(),
+        connect: args.connect.clone(),
+    };
+    let mut bridge = Bridge::open(&run, &topics::run_topics(args.agents), &endpoints)?;
+    tracing::info!(run = run.as_str(), domain = ?run.domain(), "bridge up");
+    hnav_runtime::outln!("ready");
+    let counts = bridge.run(None)?;
+    hnav_runtime::outln!("{counts}");
+    Ok(())
+}

@@ -1,0 +1,96 @@
+//! The topics a bridge forwards: the run's decision round, lifecycle and state, and each
+//! robot's wheels and odometry. Each with the payload type and QoS its processes open it with
+//! (a different QoS would not open).
+//!
+//! Left out: the neural-map snapshots (`map/<i>`, up to megabytes each; a viewer on another
+//! host is not built yet), heartbeats and estimates (each host's supervisor watches its own
+//! processes).
+
+use hnav_runtime::topics;
+use hnav_runtime::transport::Qos;
+
+/// A forwarded topic's payload type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Payload {
+    /// `candidates`.
+    Candidate,
+    /// `commit`.
+    Commit,
+    /// `ready` and `lifecycle`.
+    Lifecycle,
+    /// `progress`.
+    Progress,
+    /// `truth`.
+    Truth,
+    /// `odom/<i>`.
+    Odometry,
+    /// `wheels/<i>`.
+    WheelCommand,
+}
+
+/// One forwarded topic.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TopicSpec {
+    /// The topic below `hnav/<run>/`.
+    pub topic: String,
+    /// Its payload type.
+    pub payload: Payload,
+    /// Its QoS, as the run's processes open it.
+    pub qos: Qos,
+}
+
+/// Every topic a run of `agents` agents forwards.
+pub fn run_topics(agents: usize) -> Vec<TopicSpec> {
+    let spec = |topic: &str, payload, qos| TopicSpec {
+        topic: topic.to_string(),
+        payload,
+        qos,
+    };
+    let mut out = vec![
+        spec(
+            topics::CANDIDATES,
+            Payload::Candidate,
+            topics::candidates_qos(agents),
+        ),
+        spec(topics::COMMIT, Payload::Commit, topics::commit_qos(agents)),
+        spec(
+            topics::LIFECYCLE,
+            Payload::Lifecycle,
+            topics::lifecycle_qos(agents),
+        ),
+        spec(
+            topics::READY,
+            Payload::Lifecycle,
+            topics::lifecycle_qos(agents),
+        ),
+        spec(topics::PROGRESS, Payload::Progress, topics::progress_qos()),
+        spec(topics::TRUTH, Payload::Truth, topics::truth_qos()),
+    ];
+    for i in 0..agents {
+        out.push(spec(
+            &topics::odometry(i),
+            Payload::Odometry,
+            topics::state_qos(),
+        ));
+        out.push(spec(
+            &topics::wheels(i),
+            Payload::WheelCommand,
+            topics::state_qos(),
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_run_forwards_six_topics_and_two_per_robot() {
+        let t = run_topics(3);
+        assert_eq!(t.len(), 6 + 2 * 3);
+        assert_eq!(t[0].topic, "candidates");
+        assert!(t.iter().any(|s| s.topic == "wheels/2"));
+        assert!(!t.iter().any(|s| s.topic.starts_with("map/")));
+    }
+}

@@ -1,0 +1,269 @@
+//! Payloads as bytes, for the links that leave shared memory (the Zenoh bridge between hosts).
+//!
+//! Inside a host a payload never becomes bytes: it is loaned, written in place and read in
+//! place. Between hosts it travels as exactly the bytes of its `#[repr(C)]` layout (the table
+//! in [the module docs](super)), little-endian on every target HNAV builds for. That is
+//! sound because every payload is [`bytemuck::Pod`] (derived: no implicit padding, every bit
+//! pattern of every field valid), so a byte string of the right length is always *some*
+//! value. Whether it is a *sensible* value is [`Wire::check`]'s question: a receiver drops
+//! what fails it instead of handing a process an agent index past the swarm or a NaN speed.
+
+use core::fmt::Debug;
+
+use iceoryx2::prelude::ZeroCopySend;
+
+use super::{
+    Candidate, Commit, Estimate, Heartbeat, LifecycleEvent, MapHeader, Odometry, Progress, Role,
+    Truth, Verdict, WheelCommand, MAX_AGENTS,
+};
+use crate::msg::Lifecycle;
+
+/// Why bytes from a link are not a payload of the expected type.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum WireError {
+    /// The sender named another type.
+    #[error("type {got:?} where {expected:?} was expected")]
+    TypeName {
+        /// The type the topic carries.
+        expected: &'static str,
+        /// The type the sender named.
+        got: String,
+    },
+    /// The byte count is not the type's size.
+    #[error("{len} bytes for {type_name}, which has {size}")]
+    Size {
+        /// The type.
+        type_name: &'static str,
+        /// Its size.
+        size: usize,
+        /// The bytes that came.
+        len: usize,
+    },
+    /// A field is out of its range.
+    #[error("{type_name}: {what}")]
+    Field {
+        /// The type.
+        type_name: &'static str,
+        /// Which field, and why.
+        what: String,
+    },
+}
+
+/// A payload that may travel as its bytes. See the [module docs](self).
+pub trait Wire: bytemuck::Pod + ZeroCopySend + Debug {
+    /// Whether the fields a receiver relies on are in range.
+    fn check(&self) -> Result<(), String>;
+
+    /// The iceoryx2 type name (`hnav::Candidate`), which also names it on a link.
+    fn wire_name() -> &'static str {
+        // SAFETY: `type_name` only returns the constant given in `#[type_name(...)]`; the
+        // layout it vouches for is the one `Pod` guarantees here.
+        unsafe { <Self as ZeroCopySend>::type_name() }
+    }
+
+    /// The value's bytes, borrowed (no copy).
+    fn bytes(&self) -> &[u8] {
+        bytemuck::bytes_of(self)
+    }
+
+    /// Overwrites `self` with `bytes` (a loaned sample, written in place) and checks the
+    /// result. On an error `self` holds the bytes but must not be sent.
+    fn assign(&mut self, bytes: &[u8]) -> Result<(), WireError> {
+        let size = core::mem::size_of::<Self>();
+        if bytes.len() != size {
+            return Err(WireError::Size {
+                type_name: Self::wire_name(),
+                size,
+                len: bytes.len(),
+            });
+        }
+        bytemuck::bytes_of_mut(self).copy_from_slice(bytes);
+        self.check().map_err(|what| WireError::Field {
+            type_name: Self::wire_name(),
+            what,
+        })
+    }
+}
+
+fn agent(name: &str, agent: u32) -> Result<(), String> {
+    if (agent as usize) < MAX_AGENTS {
+        Ok(())
+    } else {
+        Err(format!("{name} {agent} is not below {MAX_AGENTS}"))
+    }
+}
+
+fn finite(name: &str, v: f64) -> Result<(), String> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(format!("{name} is {v}"))
+    }
+}
+
+impl Wire for Candidate {
+    fn check(&self) -> Result<(), String> {
+        agent("agent", self.agent)?;
+        finite("priority", f64::from(self.priority))?;
+        finite("speed", f64::from(self.speed))
+    }
+}
+
+impl Wire for Commit {
+    fn check(&self) -> Result<(), String> {
+        if self.count as usize > MAX_AGENTS {
+            return Err(format!("count {} is over {MAX_AGENTS}", self.count));
+        }
+        for d in self.decisions() {
+            agent("a decision's agent", d.agent)?;
+            if Verdict::from_u8(d.verdict).is_none() {
+                return Err(format!("verdict {} is none of the known ones", d.verdict));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Wire for Progress {
+    fn check(&self) -> Result<(), String> {
+        if self.agents as usize > MAX_AGENTS || self.at_goal > self.agents {
+            return Err(format!("{} agents, {} at goal", self.agents, self.at_goal));
+        }
+        Ok(())
+    }
+}
+
+impl Wire for Lifecycle {
+    fn check(&self) -> Result<(), String> {
+        if Role::from_u8(self.role).is_none() {
+            return Err(format!("role {} is none of the known ones", self.role));
+        }
+        if LifecycleEvent::from_u8(self.event).is_none() {
+            return Err(format!("event {} is none of the known ones", self.event));
+        }
+        Ok(())
+    }
+}
+
+impl Wire for Heartbeat {
+    fn check(&self) -> Result<(), String> {
+        match Role::from_u8(self.role) {
+            Some(_) => Ok(()),
+            None => Err(format!("role {} is none of the known ones", self.role)),
+        }
+    }
+}
+
+impl Wire for WheelCommand {
+    fn check(&self) -> Result<(), String> {
+        agent("agent", self.agent)?;
+        finite("left_rad_s", self.left_rad_s)?;
+        finite("right_rad_s", self.right_rad_s)
+    }
+}
+
+impl Wire for Odometry {
+    fn check(&self) -> Result<(), String> {
+        agent("agent", self.agent)
+    }
+}
+
+impl Wire for Truth {
+    fn check(&self) -> Result<(), String> {
+        if self.robots as usize > MAX_AGENTS {
+            return Err(format!("{} robots, over {MAX_AGENTS}", self.robots));
+        }
+        for p in &self.poses[..self.robots as usize] {
+            finite("a pose's x_m", p.x_m)?;
+            finite("a pose's y_m", p.y_m)?;
+            finite("a pose's theta_rad", p.theta_rad)?;
+        }
+        Ok(())
+    }
+}
+
+impl Wire for Estimate {
+    fn check(&self) -> Result<(), String> {
+        agent("agent", self.agent)?;
+        finite("pose x_m", self.pose.x_m)?;
+        finite("pose y_m", self.pose.y_m)
+    }
+}
+
+impl Wire for MapHeader {
+    fn check(&self) -> Result<(), String> {
+        agent("agent", self.agent)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::msg::{Decision, Pose};
+
+    #[test]
+    fn a_payload_comes_back_from_its_bytes() {
+        let c = Candidate {
+            round: 7,
+            agent: 3,
+            priority: 2.0,
+            speed: 0.5,
+            ..Candidate::default()
+        };
+        let mut back = Candidate::default();
+        back.assign(c.bytes()).unwrap();
+        assert_eq!(back, c);
+        assert_eq!(Candidate::wire_name(), "hnav::Candidate");
+    }
+
+    #[test]
+    fn bytes_of_the_wrong_size_or_range_are_refused() {
+        let mut c = Candidate::default();
+        assert_eq!(
+            c.assign(&[0u8; 39]),
+            Err(WireError::Size {
+                type_name: "hnav::Candidate",
+                size: 40,
+                len: 39
+            })
+        );
+        let bad = Candidate {
+            agent: MAX_AGENTS as u32,
+            ..Candidate::default()
+        };
+        let e = c.assign(bad.bytes()).unwrap_err().to_string();
+        assert_eq!(e, "hnav::Candidate: agent 256 is not below 256");
+        let nan = Candidate {
+            speed: f32::NAN,
+            ..Candidate::default()
+        };
+        assert!(c.assign(nan.bytes()).is_err());
+
+        let mut commit = Commit {
+            count: 1,
+            ..Commit::default()
+        };
+        commit.decisions[0] = Decision {
+            verdict: 200,
+            ..Decision::default()
+        };
+        let e = Commit::default().assign(commit.bytes()).unwrap_err();
+        assert!(e.to_string().contains("verdict 200"), "{e}");
+
+        let l = Lifecycle {
+            role: 9,
+            ..Lifecycle::default()
+        };
+        assert!(Lifecycle::default().assign(l.bytes()).is_err());
+
+        let mut t = Truth {
+            robots: 1,
+            ..Truth::default()
+        };
+        t.poses[0] = Pose {
+            x_m: f64::INFINITY,
+            ..Pose::default()
+        };
+        assert!(Truth::default().assign(t.bytes()).is_err());
+    }
+}
