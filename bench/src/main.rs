@@ -395,7 +395,8 @@ struct LatencyArgs {
     /// Directory for latency.csv, latency.md and latency.svg (created if missing).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
-    /// Measure only these transports (iceoryx2, hnav, uds, tcp, crossbeam, futex;
+    /// Measure only these transports (iceoryx2, hnav, uds, tcp, crossbeam, futex, and
+    /// hnav-bridge, which is measured only when named here;
     /// comma-separated).
     #[arg(long, value_delimiter = ',', value_name = "TRANSPORT")]
     only: Vec<TransportKind>,

@@ -1,9 +1,9 @@
 //! One host's end of a run's bridge: a node in the host's iceoryx2 domain, a Zenoh session,
 //! a port per forwarded topic, and the loop that moves samples both ways.
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use hnav_runtime::transport::{Bell, RunId, Transport, TransportError, Wake};
 use zenoh::pubsub::{Publisher, Subscriber};
@@ -67,6 +67,21 @@ impl core::fmt::Display for Counts {
     }
 }
 
+/// Ends a [`Bridge::run`] from another thread (a bridge inside a benchmark or a test).
+#[derive(Clone)]
+pub struct Stopper {
+    flag: Arc<AtomicBool>,
+    bell: Arc<Bell>,
+}
+
+impl Stopper {
+    /// Asks the bridge to stop; its `run` returns after the pass under way.
+    pub fn stop(&self) {
+        self.flag.store(true, Ordering::Release);
+        let _ = self.bell.ring();
+    }
+}
+
 /// One host's end of a run's bridge. See the [crate docs](crate).
 pub struct Bridge {
     transport: Transport,
@@ -76,6 +91,7 @@ pub struct Bridge {
     inbox: crossbeam_channel::Receiver<(usize, Sample)>,
     bell: hnav_runtime::transport::BellWatch,
     overflow: Arc<AtomicU64>,
+    stopper: Stopper,
     counts: Counts,
     // Declared last: dropped after the publishers and subscribers that live in it.
     _session: Session,
@@ -133,6 +149,10 @@ impl Bridge {
                     .map_err(|e| declare("subscriber", e))?,
             );
         }
+        let stopper = Stopper {
+            flag: Arc::new(AtomicBool::new(false)),
+            bell: Arc::new(bell.try_clone()?),
+        };
         Ok(Bridge {
             transport,
             ports,
@@ -141,9 +161,37 @@ impl Bridge {
             inbox,
             bell: bell.into_watch()?,
             overflow,
+            stopper,
             counts: Counts::default(),
             _session: session,
         })
+    }
+
+    /// A handle that ends [`run`](Self::run) from another thread.
+    pub fn stopper(&self) -> Stopper {
+        self.stopper.clone()
+    }
+
+    /// Waits until each of its Zenoh publishers has a subscriber on another host (their
+    /// bridges are connected), for at most `timeout`; returns whether they all have. A put
+    /// before that reaches nobody.
+    pub fn wait_connected(&self, timeout: Duration) -> bool {
+        let deadline = Instant::now() + timeout;
+        loop {
+            let matched = self.publishers.iter().all(|p| {
+                p.matching_status()
+                    .wait()
+                    .is_ok_and(|status| status.matching())
+            });
+            if matched {
+                return true;
+            }
+            if Instant::now() >= deadline {
+                return false;
+            }
+            // Zenoh announces a peer's subscribers on its own threads; a set-up wait only.
+            std::thread::sleep(Duration::from_millis(5));
+        }
     }
 
     /// What it has moved so far.
@@ -171,7 +219,7 @@ impl Bridge {
             self.bell.take();
             while let Ok((i, sample)) = self.inbox.try_recv() {
                 let name = sample.attachment().and_then(|a| a.try_to_string().ok());
-                match self.ports[i].bring_in(sample.payload(), name.as_deref())? {
+                match self.ports[i].bring_in(&self.transport, sample.payload(), name.as_deref())? {
                     Ok(()) => {
                         moved.r#in += 1;
                         // The bridge's own receiver of the topic holds what it just
@@ -192,10 +240,11 @@ impl Bridge {
             self.counts.r#in += moved.r#in;
             self.counts.dropped += moved.dropped;
             self.counts.failed += moved.failed;
-            if until.is_some_and(|u| Instant::now() >= u) {
+            let stop = || self.stopper.flag.load(Ordering::Acquire);
+            if stop() || until.is_some_and(|u| Instant::now() >= u) {
                 break;
             }
-            if waiter.wait(until)? == Wake::Stop {
+            if waiter.wait(until)? == Wake::Stop || stop() {
                 break;
             }
         }

@@ -22,4 +22,4 @@ mod port;
 pub mod session;
 pub mod topics;
 
-pub use bridge::{Bridge, BridgeError, Counts};
+pub use bridge::{Bridge, BridgeError, Counts, Stopper};

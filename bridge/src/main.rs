@@ -1,4 +1,4 @@
-//! `hnav-bridge --run ID --agents N [--listen EP]... [--connect EP]...`: forwards run ID's
+//! `hnav-bridge --run ID --agents N [--listen EP]... [--connect EP]... [--maps]`: forwards run ID's
 //! topics between this host's iceoryx2 domain and the other hosts' bridges over Zenoh, until
 //! SIGTERM or SIGINT; then prints what it moved (`out=.. in=.. dropped=.. overflow=..
 //! failed=..`). See `hnav_bridge`.
@@ -25,6 +25,9 @@ struct Args {
     /// Zenoh endpoint of another host's bridge (`tcp/10.0.0.2:7447`); repeatable.
     #[arg(long)]
     connect: Vec<String>,
+    /// Also forward each agent's neural-map snapshots (`map/<i>`, up to megabytes each).
+    #[arg(long)]
+    maps: bool,
 }
 
 fn main() -> ExitCode {
@@ -53,7 +56,11 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         listen: args.listen.clone(),
         connect: args.connect.clone(),
     };
-    let mut bridge = Bridge::open(&run, &topics::run_topics(args.agents), &endpoints)?;
+    let mut bridge = Bridge::open(
+        &run,
+        &topics::run_topics(args.agents, args.maps),
+        &endpoints,
+    )?;
     tracing::info!(run = run.as_str(), domain = ?run.domain(), "bridge up");
     hnav_runtime::outln!("ready");
     let counts = bridge.run(None)?;

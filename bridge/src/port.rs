@@ -1,11 +1,16 @@
 //! One forwarded topic on one host: a receiver of what the host's processes publish (out to
 //! Zenoh) and a sender of what other hosts published (in from Zenoh).
 
+use std::cell::RefCell;
+use std::io::Write;
+
 use hnav_runtime::msg::{
-    Candidate, Commit, Lifecycle, Odometry, Progress, Truth, WheelCommand, Wire, WireError,
+    Candidate, Commit, Lifecycle, MapHeader, Odometry, Progress, Truth, WheelCommand, Wire,
+    WireError,
 };
 use hnav_runtime::transport::{
-    Attachment, PublisherId, Receiver, Sender, Transport, TransportError, Waiter,
+    Attachment, PublisherId, Qos, Receiver, Sender, SliceReceiver, SliceSender, Transport,
+    TransportError, Waiter,
 };
 use zenoh::bytes::ZBytes;
 use zenoh::pubsub::Publisher;
@@ -34,13 +39,26 @@ pub(crate) trait Port {
     fn attach<'w>(&'w self, waiter: &'w Waiter) -> Result<Attachment<'w, 'w>, TransportError>;
     /// Forwards what the host's processes published since the last call to `out`.
     fn send_out(&self, out: &Publisher<'static>, moved: &mut Moved) -> Result<(), TransportError>;
-    /// Publishes `payload` from another host into iceoryx2, checked; `Err` is why it was
-    /// dropped.
+    /// Publishes `payload` from another host into iceoryx2 on `transport`, checked; `Err` is
+    /// why it was dropped.
     fn bring_in(
         &self,
+        transport: &Transport,
         payload: &ZBytes,
         type_name: Option<&str>,
     ) -> Result<Result<(), WireError>, TransportError>;
+}
+
+/// `Err` unless the sender named `T`.
+fn expect_type<T: Wire>(type_name: Option<&str>) -> Result<(), WireError> {
+    if type_name == Some(T::wire_name()) {
+        Ok(())
+    } else {
+        Err(WireError::TypeName {
+            expected: T::wire_name(),
+            got: type_name.unwrap_or("(none)").to_string(),
+        })
+    }
 }
 
 /// The port of a topic of `T`.
@@ -77,18 +95,114 @@ impl<T: Wire + Default> Port for Typed<T> {
 
     fn bring_in(
         &self,
+        _: &Transport,
         payload: &ZBytes,
         type_name: Option<&str>,
     ) -> Result<Result<(), WireError>, TransportError> {
-        if type_name != Some(T::wire_name()) {
-            return Ok(Err(WireError::TypeName {
-                expected: T::wire_name(),
-                got: type_name.unwrap_or("(none)").to_string(),
-            }));
+        if let Err(e) = expect_type::<T>(type_name) {
+            return Ok(Err(e));
         }
         // Contiguous (one Zenoh slice, the usual case below the MTU): borrowed, no copy.
         let bytes = payload.to_bytes();
         Ok(self.tx.try_send_in_place(|v| v.assign(&bytes))?.map(|_| ()))
+    }
+}
+
+/// The port of a neural-map topic (`map/<i>`): `f32` activations with a [`MapHeader`],
+/// on a link as the header's bytes followed by the activations'.
+struct Map {
+    topic: String,
+    qos: Qos,
+    rx: SliceReceiver<f32, MapHeader>,
+    /// Opened with the first snapshot from another host, as long as it (a map keeps its
+    /// size for a run); a longer one is dropped.
+    tx: RefCell<Option<SliceSender<f32, MapHeader>>>,
+    own: RefCell<Vec<PublisherId>>,
+}
+
+const HEADER: usize = core::mem::size_of::<MapHeader>();
+
+impl Port for Map {
+    fn topic(&self) -> &str {
+        &self.topic
+    }
+
+    fn attach<'w>(&'w self, waiter: &'w Waiter) -> Result<Attachment<'w, 'w>, TransportError> {
+        waiter.attach(&self.rx)
+    }
+
+    fn send_out(&self, out: &Publisher<'static>, moved: &mut Moved) -> Result<(), TransportError> {
+        let own = self.own.borrow();
+        self.rx.drain_pending_except(&own, |h, values| {
+            let mut w = ZBytes::writer();
+            // Copied once, into Zenoh's buffer: the header, then the activations.
+            let written = w
+                .write_all(h.bytes())
+                .and_then(|()| w.write_all(bytemuck::cast_slice(values)));
+            let put = written.map_err(|e| e.to_string()).and_then(|()| {
+                out.put(w.finish())
+                    .attachment(MapHeader::wire_name())
+                    .wait()
+                    .map_err(|e| e.to_string())
+            });
+            match put {
+                Ok(()) => moved.out += 1,
+                Err(e) => {
+                    moved.failed += 1;
+                    tracing::debug!(topic = %self.topic, "zenoh put failed: {e}");
+                }
+            }
+        })?;
+        Ok(())
+    }
+
+    fn bring_in(
+        &self,
+        transport: &Transport,
+        payload: &ZBytes,
+        type_name: Option<&str>,
+    ) -> Result<Result<(), WireError>, TransportError> {
+        if let Err(e) = expect_type::<MapHeader>(type_name) {
+            return Ok(Err(e));
+        }
+        let bytes = payload.to_bytes();
+        let field = |what: String| WireError::Field {
+            type_name: MapHeader::wire_name(),
+            what,
+        };
+        if bytes.len() < HEADER || !(bytes.len() - HEADER).is_multiple_of(4) {
+            return Ok(Err(field(format!(
+                "{} bytes are no header and whole f32 activations",
+                bytes.len()
+            ))));
+        }
+        let mut header = MapHeader::default();
+        if let Err(e) = header.assign(&bytes[..HEADER]) {
+            return Ok(Err(e));
+        }
+        let values = &bytes[HEADER..];
+        let len = values.len() / 4;
+        let mut tx = self.tx.borrow_mut();
+        if tx.is_none() {
+            let sender = transport.slice_sender::<f32, MapHeader>(&self.topic, len, self.qos)?;
+            self.own.borrow_mut().push(sender.id());
+            *tx = Some(sender);
+        }
+        let tx = tx.as_ref().expect("opened above");
+        if len > tx.max_len() {
+            return Ok(Err(field(format!(
+                "{len} activations, over the {} this host's map topic was opened for",
+                tx.max_len()
+            ))));
+        }
+        let mut loan = tx.loan(len)?;
+        *loan.header_mut() = header;
+        // Each element written once, straight from the link's bytes (no memset first).
+        loan.fill_and_send(|i| {
+            let b = &values[4 * i..4 * i + 4];
+            f32::from_ne_bytes([b[0], b[1], b[2], b[3]])
+        })?;
+        Ok(Ok(()))
     }
 }
 
@@ -118,5 +232,12 @@ pub(crate) fn open(
         Payload::Truth => typed::<Truth>(transport, spec),
         Payload::Odometry => typed::<Odometry>(transport, spec),
         Payload::WheelCommand => typed::<WheelCommand>(transport, spec),
+        Payload::Map => Ok(Box::new(Map {
+            topic: spec.topic.clone(),
+            qos: spec.qos,
+            rx: transport.slice_receiver::<f32, MapHeader>(&spec.topic, spec.qos)?,
+            tx: RefCell::new(None),
+            own: RefCell::new(Vec::new()),
+        })),
     }
 }

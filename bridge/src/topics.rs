@@ -2,9 +2,9 @@
 //! robot's wheels and odometry. Each with the payload type and QoS its processes open it with
 //! (a different QoS would not open).
 //!
-//! Left out: the neural-map snapshots (`map/<i>`, up to megabytes each; a viewer on another
-//! host is not built yet), heartbeats and estimates (each host's supervisor watches its own
-//! processes).
+//! The neural-map snapshots (`map/<i>`, up to megabytes each) only on request
+//! ([`run_topics`]'s `maps`). Left out: heartbeats and estimates (each host's supervisor
+//! watches its own processes).
 
 use hnav_runtime::topics;
 use hnav_runtime::transport::Qos;
@@ -26,6 +26,8 @@ pub enum Payload {
     Odometry,
     /// `wheels/<i>`.
     WheelCommand,
+    /// `map/<i>`: a neural-map snapshot (`f32` activations with a `MapHeader`).
+    Map,
 }
 
 /// One forwarded topic.
@@ -39,8 +41,9 @@ pub struct TopicSpec {
     pub qos: Qos,
 }
 
-/// Every topic a run of `agents` agents forwards.
-pub fn run_topics(agents: usize) -> Vec<TopicSpec> {
+/// Every topic a run of `agents` agents forwards; with `maps`, each agent's neural-map
+/// snapshots too.
+pub fn run_topics(agents: usize, maps: bool) -> Vec<TopicSpec> {
     let spec = |topic: &str, payload, qos| TopicSpec {
         topic: topic.to_string(),
         payload,
@@ -77,6 +80,9 @@ pub fn run_topics(agents: usize) -> Vec<TopicSpec> {
             Payload::WheelCommand,
             topics::state_qos(),
         ));
+        if maps {
+            out.push(spec(&topics::map(i), Payload::Map, topics::state_qos()));
+        }
     }
     out
 }
@@ -87,10 +93,12 @@ mod tests {
 
     #[test]
     fn a_run_forwards_six_topics_and_two_per_robot() {
-        let t = run_topics(3);
+        let t = run_topics(3, false);
         assert_eq!(t.len(), 6 + 2 * 3);
         assert_eq!(t[0].topic, "candidates");
         assert!(t.iter().any(|s| s.topic == "wheels/2"));
         assert!(!t.iter().any(|s| s.topic.starts_with("map/")));
+        let t = run_topics(3, true);
+        assert_eq!(t.iter().filter(|s| s.payload == Payload::Map).count(), 3);
     }
 }

@@ -11,7 +11,7 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use hnav_runtime::msg::{Candidate, Commit, Lifecycle, Role, Wire};
+use hnav_runtime::msg::{Candidate, Commit, Lifecycle, MapHeader, Role, Wire};
 use hnav_runtime::topics;
 use hnav_runtime::transport::{purge_run, Receiver, RunId, Transport};
 
@@ -153,10 +153,10 @@ fn two_hosts_exchange_the_run_s_topics_once_and_drop_what_is_invalid() {
     let endpoint = format!("tcp/127.0.0.1:{}", free_port());
     hosts
         .bridges
-        .push(start(&run, "ha", &["--listen", &endpoint]));
+        .push(start(&run, "ha", &["--listen", &endpoint, "--maps"]));
     hosts
         .bridges
-        .push(start(&run, "hb", &["--connect", &endpoint]));
+        .push(start(&run, "hb", &["--connect", &endpoint, "--maps"]));
 
     // The two sessions find each other in their own time: probe (round 0) until B hears one.
     let deadline = Instant::now() + TIMEOUT;
@@ -208,6 +208,41 @@ fn two_hosts_exchange_the_run_s_topics_once_and_drop_what_is_invalid() {
         "the invalid candidate reached host B"
     );
 
+    // A neural-map snapshot (--maps) crosses A -> B as its header and activations.
+    let (map_a, map_b) = (
+        a.slice_sender::<f32, MapHeader>(&topics::map(1), 1000, topics::state_qos())
+            .unwrap(),
+        b.slice_receiver::<f32, MapHeader>(&topics::map(1), topics::state_qos())
+            .unwrap(),
+    );
+    let values: Vec<f32> = (0..1000).map(|v| v as f32 * 0.5).collect();
+    let mut loan = map_a.loan(values.len()).unwrap();
+    *loan.header_mut() = MapHeader {
+        round: 7,
+        agent: 1,
+        width: 40,
+        height: 25,
+        ..MapHeader::default()
+    };
+    loan.copy_and_send(&values).unwrap();
+    let waiter = b.waiter().unwrap();
+    let attached = waiter.attach(&map_b).unwrap();
+    let deadline = Instant::now() + TIMEOUT;
+    let mut snapshot = None;
+    while snapshot.is_none() {
+        assert!(Instant::now() < deadline, "no map snapshot reached B");
+        map_b
+            .drain_pending(|h, v| snapshot = Some((*h, v.to_vec())))
+            .unwrap();
+        if snapshot.is_none() {
+            waiter.wait(Some(deadline)).unwrap();
+        }
+    }
+    drop(attached);
+    let (h, v) = snapshot.unwrap();
+    assert_eq!((h.round, h.agent, h.width, h.height), (7, 1, 40, 25));
+    assert_eq!(v, values);
+
     // Nothing came back to A: its own candidates only, each once.
     cand_a_seen.drain_pending(|v| mine.push(*v)).unwrap();
     let mut rounds: Vec<u64> = mine.iter().map(|c| c.round).filter(|&r| r > 0).collect();
@@ -216,7 +251,7 @@ fn two_hosts_exchange_the_run_s_topics_once_and_drop_what_is_invalid() {
 
     let counts_b = stop(&mut hosts.bridges[1]);
     let counts_a = stop(&mut hosts.bridges[0]);
-    assert_eq!(counts_a["out"], probes + 102, "{counts_a:?}");
+    assert_eq!(counts_a["out"], probes + 102 + 1, "{counts_a:?}");
     assert_eq!(counts_a["in"], 21, "{counts_a:?}");
     assert_eq!(counts_a["dropped"], 0, "{counts_a:?}");
     assert_eq!(counts_b["dropped"], 1, "{counts_b:?}");

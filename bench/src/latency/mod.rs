@@ -24,6 +24,7 @@
 //! `DIR/latency.md` (the same as a markdown table) and `DIR/latency.svg` (one-way p50 and p99
 //! against size, [`plot`]).
 
+mod bridge;
 pub mod csv;
 mod hnav;
 mod inproc;
@@ -106,6 +107,10 @@ pub enum TransportKind {
     /// dora-rs nodes (node to node over Zenoh, shared memory from 4 KiB), measured by
     /// `bench/peers/dora`.
     Dora,
+    /// HNAV between hosts: iceoryx2 → `hnav-bridge` → Zenoh (loopback TCP) → `hnav-bridge` →
+    /// iceoryx2, with neural-map payloads (`latency::bridge`). Measured only when named
+    /// (`--only hnav-bridge`), at sizes that are whole `f32` maps up to 4 MiB.
+    HnavBridge,
 }
 
 impl TransportKind {
@@ -123,6 +128,10 @@ impl TransportKind {
     /// `--peers` reads ([`peers`]): they need toolchains the workspace build does not pay for.
     pub const PEERS: [TransportKind; 3] = [Self::Zenoh, Self::ZenohShm, Self::Dora];
 
+    /// Measured here, but only when named in `--only`: they start Zenoh sessions and
+    /// threads of their own, which the default suite does not pay for.
+    pub const OPT_IN: [TransportKind; 1] = [Self::HnavBridge];
+
     /// The name used in output (`iceoryx2`, `hnav`, `uds`, `tcp`, `crossbeam`, `futex`).
     pub fn name(self) -> &'static str {
         match self {
@@ -135,6 +144,7 @@ impl TransportKind {
             Self::Zenoh => "zenoh",
             Self::ZenohShm => "zenoh-shm",
             Self::Dora => "dora",
+            Self::HnavBridge => "hnav-bridge",
         }
     }
 
@@ -142,16 +152,24 @@ impl TransportKind {
     pub fn modes(self) -> &'static [Mode] {
         match self {
             Self::Iceoryx2 | Self::Hnav | Self::Crossbeam => &[Mode::Poll, Mode::Event],
-            Self::Uds | Self::Tcp | Self::Futex | Self::Zenoh | Self::ZenohShm | Self::Dora => {
-                &[Mode::Event]
-            }
+            Self::Uds
+            | Self::Tcp
+            | Self::Futex
+            | Self::Zenoh
+            | Self::ZenohShm
+            | Self::Dora
+            | Self::HnavBridge => &[Mode::Event],
         }
     }
 
     /// Whether it is measured at `size`: the futex moves no payload, so it is measured once,
     /// at the smallest sizes (up to 64 B), as the wake-up reference.
     pub fn measures(self, size: usize) -> bool {
-        self != Self::Futex || size <= 64
+        match self {
+            Self::Futex => size <= 64,
+            Self::HnavBridge => size.is_multiple_of(4) && size <= 4 << 20,
+            _ => true,
+        }
     }
 }
 
@@ -159,7 +177,7 @@ impl core::str::FromStr for TransportKind {
     type Err = String;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let all = Self::ALL.into_iter().chain(Self::PEERS);
+        let all = Self::ALL.into_iter().chain(Self::PEERS).chain(Self::OPT_IN);
         all.clone().find(|t| t.name() == s).ok_or_else(|| {
             let names: Vec<&str> = all.map(|t| t.name()).collect();
             format!(
@@ -384,6 +402,11 @@ fn measure_all(opts: &Options, run: &RunId) -> Result<Vec<Point>> {
     let transports: Vec<_> = TransportKind::ALL
         .into_iter()
         .filter(|&t| opts.selected(t))
+        .chain(
+            TransportKind::OPT_IN
+                .into_iter()
+                .filter(|t| opts.only.contains(t)),
+        )
         .collect();
     let modes = [Mode::Poll, Mode::Event]
         .into_iter()
@@ -462,6 +485,7 @@ fn measure(
                 |pp| inproc::futex_side(pp, Role::Pong, &pair),
             )
         }
+        TransportKind::HnavBridge => bridge::measure(run, &prefix, size, w, n),
         TransportKind::Zenoh | TransportKind::ZenohShm | TransportKind::Dora => {
             bail!("{} is measured by bench/peers/, not here", transport.name())
         }

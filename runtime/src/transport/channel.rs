@@ -201,7 +201,7 @@ pub struct Drained {
 /// Which publisher a sample came from: a bridge skips what its own senders published, so
 /// that nothing it brought in goes back out.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PublisherId(iceoryx2::identifiers::UniquePublisherId);
+pub struct PublisherId(pub(crate) iceoryx2::identifiers::UniquePublisherId);
 
 /// The sending half of a topic: a publisher of `P` (a fixed-size type, or `[E]` for a slice
 /// topic, see [`SliceSender`](super::SliceSender)) with user header `H`, plus a notifier that

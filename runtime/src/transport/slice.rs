@@ -14,7 +14,7 @@ use iceoryx2::sample::Sample;
 use iceoryx2::sample_mut_uninit::SampleMutUninit;
 
 use super::channel::{backpressure, open_pubsub};
-use super::{Drained, Ipc, Qos, Receiver, Sender, TransportError};
+use super::{Drained, Ipc, PublisherId, Qos, Receiver, Sender, TransportError};
 
 /// The sending half of a slice topic: `[E]` payloads with a header `H`.
 ///
@@ -192,6 +192,24 @@ where
         while let Some(sample) = self.receive()? {
             f(sample.user_header(), sample.payload());
             samples += 1;
+        }
+        Ok(Drained { wakeup, samples })
+    }
+
+    /// [`drain_pending`](Self::drain_pending) that passes over the samples of the publishers
+    /// in `skip` (see [`Receiver::drain_pending_except`]).
+    pub fn drain_pending_except(
+        &self,
+        skip: &[PublisherId],
+        mut f: impl FnMut(&H, &[E]),
+    ) -> Result<Drained, TransportError> {
+        let wakeup = self.take_wakeup()?;
+        let mut samples = 0;
+        while let Some(sample) = self.receive()? {
+            if !skip.contains(&PublisherId(sample.header().publisher_id())) {
+                f(sample.user_header(), sample.payload());
+                samples += 1;
+            }
         }
         Ok(Drained { wakeup, samples })
     }
