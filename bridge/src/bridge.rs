@@ -11,7 +11,7 @@ use zenoh::qos::CongestionControl;
 use zenoh::sample::{Locality, Sample};
 use zenoh::{Session, Wait};
 
-use crate::port::{self, Moved, Port};
+use crate::port::{self, Port};
 use crate::session::{self, Endpoints, SessionError};
 use crate::topics::TopicSpec;
 
@@ -55,6 +55,19 @@ pub struct Counts {
     pub overflow: u64,
     /// Puts Zenoh refused.
     pub failed: u64,
+}
+
+impl Counts {
+    /// Counts one put to Zenoh, sent or refused.
+    pub(crate) fn put(&mut self, topic: &str, put: Result<(), String>) {
+        match put {
+            Ok(()) => self.out += 1,
+            Err(e) => {
+                self.failed += 1;
+                tracing::debug!(topic, "zenoh put failed: {e}");
+            }
+        }
+    }
 }
 
 impl core::fmt::Display for Counts {
@@ -177,21 +190,24 @@ impl Bridge {
     /// before that reaches nobody.
     pub fn wait_connected(&self, timeout: Duration) -> bool {
         let deadline = Instant::now() + timeout;
-        loop {
-            let matched = self.publishers.iter().all(|p| {
-                p.matching_status()
-                    .wait()
-                    .is_ok_and(|status| status.matching())
-            });
-            if matched {
+        self.publishers.iter().all(|p| {
+            // Listen first, then look: a match announced in between is not missed.
+            let Ok(listener) = p.matching_listener().wait() else {
+                return false;
+            };
+            if p.matching_status().wait().is_ok_and(|s| s.matching()) {
                 return true;
             }
-            if Instant::now() >= deadline {
-                return false;
+            // Zenoh announces a peer's subscribers on its own threads; block until it does.
+            loop {
+                let left = deadline.saturating_duration_since(Instant::now());
+                match listener.recv_timeout(left) {
+                    Ok(Some(status)) if status.matching() => return true,
+                    Ok(Some(_)) if !left.is_zero() => continue,
+                    _ => return false,
+                }
             }
-            // Zenoh announces a peer's subscribers on its own threads; a set-up wait only.
-            std::thread::sleep(Duration::from_millis(5));
-        }
+        })
     }
 
     /// What it has moved so far.
@@ -211,35 +227,32 @@ impl Bridge {
         }
         attached.push(waiter.attach_bell(&self.bell)?);
         loop {
-            let mut moved = Moved::default();
+            let counts = &mut self.counts;
             for (p, out) in self.ports.iter().zip(&self.publishers) {
-                p.send_out(out, &mut moved)?;
+                p.send_out(out, counts)?;
             }
             // Take the edge before draining: a sample queued after the drain rings again.
             self.bell.take();
             while let Ok((i, sample)) = self.inbox.try_recv() {
                 let name = sample.attachment().and_then(|a| a.try_to_string().ok());
-                match self.ports[i].bring_in(&self.transport, sample.payload(), name.as_deref())? {
+                let port = &self.ports[i];
+                match port.bring_in(&self.transport, sample.payload(), name.as_deref())? {
                     Ok(()) => {
-                        moved.r#in += 1;
+                        counts.r#in += 1;
                         // The bridge's own receiver of the topic holds what it just
                         // published (skipped, never forwarded); on a reliable topic a full
                         // buffer of its own would hold its next publish for ever.
-                        self.ports[i].send_out(&self.publishers[i], &mut moved)?;
+                        port.send_out(&self.publishers[i], counts)?;
                     }
                     Err(why) => {
-                        moved.dropped += 1;
-                        if self.counts.dropped + moved.dropped <= LOGGED_DROPS {
-                            let topic = self.ports[i].topic();
+                        counts.dropped += 1;
+                        if counts.dropped <= LOGGED_DROPS {
+                            let topic = port.topic();
                             tracing::warn!(topic, "dropped a sample from another host: {why}");
                         }
                     }
                 }
             }
-            self.counts.out += moved.out;
-            self.counts.r#in += moved.r#in;
-            self.counts.dropped += moved.dropped;
-            self.counts.failed += moved.failed;
             let stop = || self.stopper.flag.load(Ordering::Acquire);
             if stop() || until.is_some_and(|u| Instant::now() >= u) {
                 break;

@@ -16,20 +16,8 @@ use zenoh::bytes::ZBytes;
 use zenoh::pubsub::Publisher;
 use zenoh::Wait;
 
+use crate::bridge::Counts;
 use crate::topics::{Payload, TopicSpec};
-
-/// What one pass of a port did.
-#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct Moved {
-    /// Samples sent to Zenoh.
-    pub out: u64,
-    /// Samples published into iceoryx2.
-    pub r#in: u64,
-    /// Samples from Zenoh dropped as invalid.
-    pub dropped: u64,
-    /// Puts Zenoh refused.
-    pub failed: u64,
-}
 
 /// A topic's two directions, whatever its payload type.
 pub(crate) trait Port {
@@ -38,7 +26,8 @@ pub(crate) trait Port {
     /// Attaches the receiver to `waiter`.
     fn attach<'w>(&'w self, waiter: &'w Waiter) -> Result<Attachment<'w, 'w>, TransportError>;
     /// Forwards what the host's processes published since the last call to `out`.
-    fn send_out(&self, out: &Publisher<'static>, moved: &mut Moved) -> Result<(), TransportError>;
+    fn send_out(&self, out: &Publisher<'static>, counts: &mut Counts)
+        -> Result<(), TransportError>;
     /// Publishes `payload` from another host into iceoryx2 on `transport`, checked; `Err` is
     /// why it was dropped.
     fn bring_in(
@@ -79,16 +68,15 @@ impl<T: Wire + Default> Port for Typed<T> {
         waiter.attach(&self.rx)
     }
 
-    fn send_out(&self, out: &Publisher<'static>, moved: &mut Moved) -> Result<(), TransportError> {
+    fn send_out(
+        &self,
+        out: &Publisher<'static>,
+        counts: &mut Counts,
+    ) -> Result<(), TransportError> {
         self.rx.drain_pending_except(&self.own, |v| {
             // The sample is read in place; its bytes are copied once, into Zenoh's buffer.
-            match out.put(v.bytes()).attachment(T::wire_name()).wait() {
-                Ok(()) => moved.out += 1,
-                Err(e) => {
-                    moved.failed += 1;
-                    tracing::debug!(topic = %self.topic, "zenoh put failed: {e}");
-                }
-            }
+            let put = out.put(v.bytes()).attachment(T::wire_name()).wait();
+            counts.put(&self.topic, put.map_err(|e| e.to_string()));
         })?;
         Ok(())
     }
@@ -131,7 +119,11 @@ impl Port for Map {
         waiter.attach(&self.rx)
     }
 
-    fn send_out(&self, out: &Publisher<'static>, moved: &mut Moved) -> Result<(), TransportError> {
+    fn send_out(
+        &self,
+        out: &Publisher<'static>,
+        counts: &mut Counts,
+    ) -> Result<(), TransportError> {
         let own = self.own.borrow();
         self.rx.drain_pending_except(&own, |h, values| {
             let mut w = ZBytes::writer();
@@ -145,13 +137,7 @@ impl Port for Map {
                     .wait()
                     .map_err(|e| e.to_string())
             });
-            match put {
-                Ok(()) => moved.out += 1,
-                Err(e) => {
-                    moved.failed += 1;
-                    tracing::debug!(topic = %self.topic, "zenoh put failed: {e}");
-                }
-            }
+            counts.put(&self.topic, put);
         })?;
         Ok(())
     }
