@@ -489,9 +489,7 @@ impl<T: Debug + ZeroCopySend + 'static> Receiver<T> {
     /// Consumes the listener's events, then hands every unread sample to `f`: the drain order
     /// a [`Waiter`](super::Waiter) wake-up needs, in one call.
     pub fn drain_pending(&self, f: impl FnMut(&T)) -> Result<Drained, TransportError> {
-        let wakeup = self.take_wakeup()?;
-        let samples = self.drain(f)?;
-        Ok(Drained { wakeup, samples })
+        self.drain_pending_except(&[], f)
     }
 
     /// [`Receiver::drain_pending`] that passes over the samples of the publishers in `skip`

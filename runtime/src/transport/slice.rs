@@ -186,14 +186,8 @@ where
 
     /// Consumes the listener's events, then hands every unread sample's header and elements
     /// to `f`, read in place: the drain order a [`Waiter`](super::Waiter) wake-up needs.
-    pub fn drain_pending(&self, mut f: impl FnMut(&H, &[E])) -> Result<Drained, TransportError> {
-        let wakeup = self.take_wakeup()?;
-        let mut samples = 0;
-        while let Some(sample) = self.receive()? {
-            f(sample.user_header(), sample.payload());
-            samples += 1;
-        }
-        Ok(Drained { wakeup, samples })
+    pub fn drain_pending(&self, f: impl FnMut(&H, &[E])) -> Result<Drained, TransportError> {
+        self.drain_pending_except(&[], f)
     }
 
     /// [`drain_pending`](Self::drain_pending) that passes over the samples of the publishers
