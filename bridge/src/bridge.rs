@@ -5,12 +5,17 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use hnav_runtime::transport::{Bell, RunId, Transport, TransportError, Wake};
+use hnav_runtime::msg::Lifecycle;
+use hnav_runtime::topics as run_topics;
+use hnav_runtime::transport::{Bell, RunId, Sender, Transport, TransportError, Wake};
+use zenoh::liveliness::LivelinessToken;
 use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::qos::CongestionControl;
-use zenoh::sample::{Locality, Sample};
+use zenoh::sample::{Locality, Sample, SampleKind};
 use zenoh::{Session, Wait};
 
+use crate::delay::{Delay, DelayLine};
+use crate::hosts::{self, HostsView, Peers};
 use crate::port::{self, Port};
 use crate::session::{self, Endpoints, SessionError};
 use crate::topics::TopicSpec;
@@ -30,6 +35,9 @@ pub enum BridgeError {
     /// The Zenoh session did not open.
     #[error(transparent)]
     Session(#[from] SessionError),
+    /// The test-only delay ([`crate::delay::DELAY_ENV`]) is malformed.
+    #[error("{0}")]
+    Delay(String),
     /// A Zenoh publisher or subscriber was not declared.
     #[error("zenoh: declare {what} on {key}: {why}")]
     Declare {
@@ -95,12 +103,44 @@ impl Stopper {
     }
 }
 
+/// Where the Zenoh callbacks put a sample for the bridge's loop: its inbox, or the test-only
+/// delay line in front of it.
+#[derive(Clone)]
+enum Entry {
+    Direct(crossbeam_channel::Sender<(usize, Sample)>),
+    Delayed(crossbeam_channel::Sender<(Instant, (usize, Sample))>),
+}
+
+impl Entry {
+    /// Whether it was taken (else the queue is full).
+    fn put(&self, item: (usize, Sample)) -> bool {
+        match self {
+            Entry::Direct(tx) => tx.try_send(item).is_ok(),
+            Entry::Delayed(tx) => tx.try_send((Instant::now(), item)).is_ok(),
+        }
+    }
+}
+
+/// The other hosts of a placed run: this bridge's token, the subscriber to everyone's, and
+/// what it publishes into its own host about them.
+struct HostWatch {
+    view: HostsView,
+    events: crossbeam_channel::Receiver<(String, bool)>,
+    ready: Sender<Lifecycle>,
+    lifecycle: Sender<Lifecycle>,
+    _subscriber: Subscriber<()>,
+    _token: LivelinessToken,
+}
+
 /// One host's end of a run's bridge. See the [crate docs](crate).
 pub struct Bridge {
     transport: Transport,
     ports: Vec<Box<dyn Port>>,
     publishers: Vec<Publisher<'static>>,
     _subscribers: Vec<Subscriber<()>>,
+    hosts: Option<HostWatch>,
+    // After the subscribers, whose callbacks feed it: it ends once they are gone.
+    _delay: Option<DelayLine<(usize, Sample)>>,
     inbox: crossbeam_channel::Receiver<(usize, Sample)>,
     bell: hnav_runtime::transport::BellWatch,
     overflow: Arc<AtomicU64>,
@@ -112,16 +152,29 @@ pub struct Bridge {
 
 impl Bridge {
     /// Joins `run` on this host (node `bridge`) and a Zenoh session on `endpoints`, and
-    /// opens a port for each of `topics`.
+    /// opens a port for each of `topics`. With `peers` (a placed run), it follows the other
+    /// hosts (see [`crate::hosts`]).
     pub fn open(
         run: &RunId,
         topics: &[TopicSpec],
         endpoints: &Endpoints,
+        peers: Option<Peers>,
     ) -> Result<Self, BridgeError> {
         let transport = Transport::builder(run).node_name("bridge").create()?;
         let session = session::open(endpoints)?;
         let bell = Bell::create()?;
-        let (tx, inbox) = crossbeam_channel::bounded(INBOX);
+        let (inbox_tx, inbox) = crossbeam_channel::bounded(INBOX);
+        let (delay, tx) = match Delay::from_env().map_err(BridgeError::Delay)? {
+            None => (None, Entry::Direct(inbox_tx)),
+            Some(d) => {
+                tracing::warn!(?d, "test-only delay on every sample from another host");
+                let ring = bell.try_clone()?;
+                let (line, tx) = DelayLine::start(d, inbox_tx, move || {
+                    let _ = ring.ring();
+                });
+                (Some(line), Entry::Delayed(tx))
+            }
+        };
         let overflow = Arc::new(AtomicU64::new(0));
         let mut ports = Vec::with_capacity(topics.len());
         let mut publishers = Vec::with_capacity(topics.len());
@@ -150,18 +203,24 @@ impl Bridge {
                     .declare_subscriber(key.clone())
                     // Only other sessions: this bridge's own puts never come back.
                     .allowed_origin(Locality::Remote)
-                    .callback(move |sample| match tx.try_send((i, sample)) {
-                        Ok(()) => {
-                            let _ = ring.ring();
-                        }
-                        Err(_) => {
+                    .callback(move |sample| {
+                        if !tx.put((i, sample)) {
                             overflow.fetch_add(1, Ordering::Relaxed);
+                        } else if matches!(tx, Entry::Direct(_)) {
+                            // A delayed sample rings once it is released.
+                            let _ = ring.ring();
                         }
                     })
                     .wait()
                     .map_err(|e| declare("subscriber", e))?,
             );
         }
+        let hosts = match peers {
+            None => None,
+            Some(p) => Some(watch_hosts(
+                &session, &transport, run, p, &bell, &mut ports, topics,
+            )?),
+        };
         let stopper = Stopper {
             flag: Arc::new(AtomicBool::new(false)),
             bell: Arc::new(bell.try_clone()?),
@@ -171,6 +230,8 @@ impl Bridge {
             ports,
             publishers,
             _subscribers: subscribers,
+            hosts,
+            _delay: delay,
             inbox,
             bell: bell.into_watch()?,
             overflow,
@@ -233,6 +294,9 @@ impl Bridge {
             }
             // Take the edge before draining: a sample queued after the drain rings again.
             self.bell.take();
+            if let Some(h) = &mut self.hosts {
+                h.pass()?;
+            }
             while let Ok((i, sample)) = self.inbox.try_recv() {
                 let name = sample.attachment().and_then(|a| a.try_to_string().ok());
                 let port = &self.ports[i];
@@ -263,5 +327,86 @@ impl Bridge {
         }
         drop(attached);
         Ok(self.counts())
+    }
+}
+
+/// Declares this host's token and follows every host's (see [`crate::hosts`]); opens the
+/// senders it tells its own host with, which the ports of `ready` and `lifecycle` then
+/// never forward.
+fn watch_hosts(
+    session: &Session,
+    transport: &Transport,
+    run: &RunId,
+    peers: Peers,
+    bell: &Bell,
+    ports: &mut [Box<dyn Port>],
+    topics: &[TopicSpec],
+) -> Result<HostWatch, BridgeError> {
+    let mut sender = |topic: &str| -> Result<Sender<Lifecycle>, BridgeError> {
+        let at = topics.iter().position(|t| t.topic == topic);
+        let qos = at.map_or_else(|| run_topics::lifecycle_qos(1), |i| topics[i].qos);
+        let tx = transport.sender::<Lifecycle>(topic, qos)?;
+        if let Some(i) = at {
+            ports[i].skip(tx.id());
+        }
+        Ok(tx)
+    };
+    let ready = sender(run_topics::READY)?;
+    let lifecycle = sender(run_topics::LIFECYCLE)?;
+    let declare = |what, key: &str, e: zenoh::Error| BridgeError::Declare {
+        what,
+        key: key.to_string(),
+        why: e.to_string(),
+    };
+    let (tx, events) = crossbeam_channel::unbounded();
+    let ring = bell.try_clone()?;
+    let all = hosts::all_tokens(run.as_str());
+    let prefix = hosts::token_key(run.as_str(), "");
+    let subscriber = session
+        .liveliness()
+        .declare_subscriber(all.clone())
+        .history(true)
+        .callback(move |s: Sample| {
+            if let Some(name) = s.key_expr().as_str().strip_prefix(&prefix) {
+                let alive = s.kind() == SampleKind::Put;
+                if tx.send((name.to_string(), alive)).is_ok() {
+                    let _ = ring.ring();
+                }
+            }
+        })
+        .wait()
+        .map_err(|e| declare("liveliness subscriber", &all, e))?;
+    // Declared after every data subscriber: a host that sees this token can be heard.
+    let key = hosts::token_key(run.as_str(), &peers.me);
+    let token = session
+        .liveliness()
+        .declare_token(key.clone())
+        .wait()
+        .map_err(|e| declare("liveliness token", &key, e))?;
+    Ok(HostWatch {
+        view: HostsView::new(peers),
+        events,
+        ready,
+        lifecycle,
+        _subscriber: subscriber,
+        _token: token,
+    })
+}
+
+impl HostWatch {
+    /// Takes in what changed among the other hosts and tells this host.
+    fn pass(&mut self) -> Result<(), TransportError> {
+        while let Ok((name, alive)) = self.events.try_recv() {
+            for event in self.view.on_token(&name, alive) {
+                self.lifecycle.send(event)?;
+            }
+        }
+        if let Some(up) = self.view.take_up() {
+            tracing::info!("every other host heard: bridge up");
+            self.ready.send(up)?;
+        } else if !self.view.unheard().is_empty() {
+            tracing::debug!(waiting = ?self.view.unheard(), "hosts not heard yet");
+        }
+        Ok(())
     }
 }

@@ -8,6 +8,10 @@
 //!
 //! - [`topics`]: which topics cross, with their payload types and QoS.
 //! - [`session`]: the Zenoh session (endpoints, no multicast scouting).
+//! - [`hosts`]: the other hosts of a placed run, followed by Zenoh liveliness tokens: the
+//!   bridge's `Up` once all are heard, `Down`/`Restarted` for the robots of a host cut off
+//!   and back.
+//! - [`delay`]: a test-only delay on every sample from another host.
 //! - [`Bridge`]: one host's end: the ports, the loop, the counters.
 //!
 //! Out of iceoryx2 a sample is read in place and its bytes go straight into Zenoh's buffer;
@@ -18,6 +22,8 @@
 //! [`Wire`]: hnav_runtime::msg::Wire
 
 mod bridge;
+pub mod delay;
+pub mod hosts;
 mod port;
 pub mod session;
 pub mod topics;

@@ -1,13 +1,19 @@
-//! `hnav-bridge --run ID --agents N [--listen EP]... [--connect EP]... [--maps]`: forwards run ID's
-//! topics between this host's iceoryx2 domain and the other hosts' bridges over Zenoh, until
-//! SIGTERM or SIGINT; then prints what it moved (`out=.. in=.. dropped=.. overflow=..
-//! failed=..`). See `hnav_bridge`.
+//! `hnav-bridge --run ID --agents N [--hosts FILE --host NAME] [--listen EP]... [--connect EP]...
+//! [--maps]`: forwards run ID's topics between this host's iceoryx2 domain and the other
+//! hosts' bridges over Zenoh, until SIGTERM or SIGINT; then prints what it moved (`out=..
+//! in=.. dropped=.. overflow=.. failed=..`). See `hnav_bridge`.
+//!
+//! With `--hosts FILE --host NAME` (what `hnav run --host` starts) the endpoints come from the
+//! placement, and the bridge follows the other hosts: it announces itself `Up` on its host's
+//! `ready` once it hears all of them, and tells its host when one is cut off and back.
 
 use std::process::ExitCode;
 
 use clap::Parser;
+use hnav_bridge::hosts::{PeerHost, Peers};
 use hnav_bridge::session::Endpoints;
 use hnav_bridge::{topics, Bridge};
+use hnav_runtime::placement::Placement;
 use hnav_runtime::transport::RunId;
 
 #[derive(Parser)]
@@ -28,6 +34,12 @@ struct Args {
     /// Also forward each agent's neural-map snapshots (`map/<i>`, up to megabytes each).
     #[arg(long)]
     maps: bool,
+    /// The run's placement (`hosts.toml`): endpoints and the other hosts from there.
+    #[arg(long, value_name = "FILE", requires = "host")]
+    hosts: Option<std::path::PathBuf>,
+    /// This host's name in the placement.
+    #[arg(long, value_name = "NAME", requires = "hosts")]
+    host: Option<String>,
 }
 
 fn main() -> ExitCode {
@@ -52,14 +64,35 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         .into());
     }
     let run = RunId::new(&args.run)?;
-    let endpoints = Endpoints {
+    let mut endpoints = Endpoints {
         listen: args.listen.clone(),
         connect: args.connect.clone(),
     };
+    let mut peers = None;
+    if let (Some(file), Some(name)) = (&args.hosts, &args.host) {
+        let placement = Placement::load(file, args.agents)?;
+        let me = placement.index_of(name)?;
+        endpoints
+            .listen
+            .extend(placement.hosts()[me].listen.iter().cloned());
+        endpoints.connect.extend(placement.connect_of(me));
+        peers = Some(Peers {
+            me: name.clone(),
+            index: me as u32,
+            others: (placement.hosts().iter())
+                .filter(|h| &h.name != name)
+                .map(|h| PeerHost {
+                    name: h.name.clone(),
+                    agents: h.agents.clone(),
+                })
+                .collect(),
+        });
+    }
     let mut bridge = Bridge::open(
         &run,
         &topics::run_topics(args.agents, args.maps),
         &endpoints,
+        peers,
     )?;
     tracing::info!(run = run.as_str(), domain = ?run.domain(), "bridge up");
     hnav_runtime::outln!("ready");

@@ -25,6 +25,8 @@ pub(crate) trait Port {
     fn topic(&self) -> &str;
     /// Attaches the receiver to `waiter`.
     fn attach<'w>(&'w self, waiter: &'w Waiter) -> Result<Attachment<'w, 'w>, TransportError>;
+    /// Never forwards what publisher `id` sends (one of the bridge's own, on this topic).
+    fn skip(&mut self, id: PublisherId);
     /// Forwards what the host's processes published since the last call to `out`.
     fn send_out(&self, out: &Publisher<'static>, counts: &mut Counts)
         -> Result<(), TransportError>;
@@ -55,8 +57,9 @@ struct Typed<T: Wire> {
     topic: String,
     rx: Receiver<T>,
     tx: Sender<T>,
-    /// The bridge's own sender: what it published came from Zenoh, and must not go back.
-    own: [PublisherId; 1],
+    /// The bridge's own senders: what they published came from Zenoh (or from the bridge
+    /// about this host), and must not go out.
+    own: Vec<PublisherId>,
 }
 
 impl<T: Wire + Default> Port for Typed<T> {
@@ -66,6 +69,10 @@ impl<T: Wire + Default> Port for Typed<T> {
 
     fn attach<'w>(&'w self, waiter: &'w Waiter) -> Result<Attachment<'w, 'w>, TransportError> {
         waiter.attach(&self.rx)
+    }
+
+    fn skip(&mut self, id: PublisherId) {
+        self.own.push(id);
     }
 
     fn send_out(
@@ -117,6 +124,10 @@ impl Port for Map {
 
     fn attach<'w>(&'w self, waiter: &'w Waiter) -> Result<Attachment<'w, 'w>, TransportError> {
         waiter.attach(&self.rx)
+    }
+
+    fn skip(&mut self, id: PublisherId) {
+        self.own.get_mut().push(id);
     }
 
     fn send_out(
@@ -205,7 +216,7 @@ pub(crate) fn open(
         let rx = transport.receiver::<T>(&spec.topic, spec.qos)?;
         Ok(Box::new(Typed {
             topic: spec.topic.clone(),
-            own: [tx.id()],
+            own: vec![tx.id()],
             rx,
             tx,
         }))

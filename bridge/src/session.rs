@@ -25,7 +25,14 @@ pub enum SessionError {
     Open(String),
 }
 
+/// How long a link may stay silent before Zenoh declares it dead, in ms (Zenoh's default is
+/// 10 s): a host cut off is noticed within this, and its robots stand.
+pub const LEASE_MS: u64 = 1000;
+
 /// The session's configuration as JSON5; everything not set is zenoh 1.10.2's default.
+/// Besides the endpoints: the lease ([`LEASE_MS`], with 4 keep-alives in it), and a lost
+/// connection retried every 100 ms doubling to at most 500 ms, so that a healed link is used
+/// again within about half a second.
 pub fn config_json5(endpoints: &Endpoints) -> String {
     let quote = |v: &[String]| {
         v.iter()
@@ -37,8 +44,12 @@ pub fn config_json5(endpoints: &Endpoints) -> String {
         r#"{{
   mode: "peer",
   listen: {{ endpoints: [{}] }},
-  connect: {{ endpoints: [{}] }},
+  connect: {{
+    endpoints: [{}],
+    retry: {{ period_init_ms: 100, period_max_ms: 500, period_increase_factor: 2 }},
+  }},
   scouting: {{ multicast: {{ enabled: false }}, gossip: {{ enabled: false }} }},
+  transport: {{ link: {{ tx: {{ lease: {LEASE_MS}, keep_alive: 4 }} }} }},
 }}"#,
         quote(&endpoints.listen),
         quote(&endpoints.connect)

@@ -16,6 +16,7 @@
 //! | [`report`] | the run report `DIR/report.svg` (plotters, SVG): map, committed cells, true trajectories, conflicts, replans, collisions, neural-map heatmaps |
 //! | [`rejected`] | the classes of hostile or malformed messages a receiver drops, and their counts for the run summary |
 //! | [`plan`] | [`PlanResult`](plan::PlanResult), the answer to one planning query, whichever planner gave it |
+//! | [`placement`] | `hosts.toml`: which host runs which process of a run across hosts, and how their bridges reach each other |
 //! | [`launch`] | the command line every process of a run shares, and the start-up handshake with the supervisor |
 //! | [`transport`] | run-scoped iceoryx2 services: publisher+notifier, subscriber+listener, the one [`Waiter`](transport::Waiter) every process blocks in |
 //! | [`supervisor`] | starting, watching, restarting and stopping a run's processes; the registry behind `hnav ps`. It sits on top: only `monitor` uses it |
@@ -44,6 +45,7 @@ pub mod launch;
 pub mod logging;
 pub mod monitor;
 pub mod msg;
+pub mod placement;
 pub mod plan;
 pub mod recording;
 pub mod rejected;

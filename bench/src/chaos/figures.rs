@@ -191,6 +191,8 @@ impl Figures {
                 let first = seen.truths.iter().copied().find(|&t| t > spawned);
                 self.sim_back.add_ns(spawned, first, what);
             }
+            // Chaos runs on one host: no bridge.
+            Role::Bridge => {}
         }
     }
 

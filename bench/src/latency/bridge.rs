@@ -89,7 +89,7 @@ pub(crate) fn measure(
             // Spawned from this (unpinned) thread: the bridges and Zenoh's own threads are
             // free to run on either CPU beside the two pinned benchmark sides.
             threads.push(s.spawn(move || -> Result<()> {
-                let mut bridge = match Bridge::open(r, specs, e) {
+                let mut bridge = match Bridge::open(r, specs, e, None) {
                     Ok(b) => b,
                     Err(err) => {
                         let _ = tx.send(Err(anyhow!("open the bridge: {err}")));

@@ -85,7 +85,8 @@ impl Sampler {
         };
         for &(role, hwm, pss) in self.seen.values() {
             let slot = match role {
-                None => &mut m.supervisor,
+                // A bridge is the supervisor's helper (MAPF runs on one host have none).
+                None | Some(Role::Bridge) => &mut m.supervisor,
                 Some(Role::Sim) => &mut m.sim,
                 Some(Role::Coordinator) => &mut m.coordinator,
                 Some(Role::Agent) => &mut m.agent,

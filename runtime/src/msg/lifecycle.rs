@@ -23,6 +23,9 @@ pub enum Role {
     Coordinator = 2,
     /// One robot's `hnav-agent`.
     Agent = 3,
+    /// One host's `hnav-bridge` in a run across hosts (index: the host's place in the
+    /// placement). It announces `Up` once it hears every other host's bridge.
+    Bridge = 4,
 }
 
 impl Role {
@@ -32,17 +35,19 @@ impl Role {
             1 => Some(Self::Sim),
             2 => Some(Self::Coordinator),
             3 => Some(Self::Agent),
+            4 => Some(Self::Bridge),
             _ => None,
         }
     }
 
-    /// The role's name: `sim`, `coordinator` or `agent`, the one spelling used by node names,
+    /// The role's name: `sim`, `coordinator`, `agent` or `bridge`, the one spelling used by node names,
     /// the run registry, `hnav ps` and `hnav log show`.
     pub fn name(self) -> &'static str {
         match self {
             Self::Sim => "sim",
             Self::Coordinator => "coordinator",
             Self::Agent => "agent",
+            Self::Bridge => "bridge",
         }
     }
 
@@ -52,6 +57,7 @@ impl Role {
             "sim" => Some(Self::Sim),
             "coordinator" => Some(Self::Coordinator),
             "agent" => Some(Self::Agent),
+            "bridge" => Some(Self::Bridge),
             _ => None,
         }
     }

@@ -111,6 +111,9 @@ pub(super) fn hang_deadline(
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
             default_agent_hang_ms(width, height, agents, cores).max(2 * params.heartbeat_ms)
         }),
+        // A bridge beats no heartbeat (its loop blocks on Zenoh as much as on iceoryx2): its
+        // exit is watched, not its pace.
+        Role::Bridge => HealthParams::MAX_HANG_MS,
     };
     Duration::from_millis(ms.into())
 }

@@ -146,6 +146,7 @@ pub fn replay(opts: &ReplayOptions) -> Result<Replayed, ReplayError> {
         force: false,
         // The comparison reads the log only; a recording would cost the replay time.
         record: false,
+        host: None,
     })?;
     let replayed = read_decided(tmp.0.join("log"))?.records;
     Ok(Replayed {

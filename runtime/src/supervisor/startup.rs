@@ -118,20 +118,50 @@ impl SupervisorPorts {
         children: &[&Child],
         timeout: Duration,
     ) -> Result<Startup, StartupError> {
+        let mut roll = Roll::of(children);
+        self.start_roll(transport, children, &mut roll, timeout)
+    }
+
+    /// [`start`](Self::start) for a `roll` that may name processes of other hosts too: their
+    /// `Up` crosses the bridge.
+    pub fn start_roll(
+        &self,
+        transport: &Transport,
+        children: &[&Child],
+        roll: &mut Roll,
+        timeout: Duration,
+    ) -> Result<Startup, StartupError> {
+        match self.wait_up(transport, children, roll, None, Instant::now() + timeout)? {
+            Some(all_up) => {
+                self.publish(Lifecycle::start())?;
+                Ok(Startup::Started { all_up })
+            }
+            None => Ok(Startup::Interrupted),
+        }
+    }
+
+    /// Waits until every process of `roll` (of role `only`, if given) has announced `Up`;
+    /// returns when the last was taken, `None` on a termination signal. Every `Up` of the
+    /// roll is kept, also one not waited for yet (a host's bridge is waited for first, and
+    /// other hosts' processes may already announce themselves meanwhile).
+    pub fn wait_up(
+        &self,
+        transport: &Transport,
+        children: &[&Child],
+        roll: &mut Roll,
+        only: Option<Role>,
+        deadline: Instant,
+    ) -> Result<Option<Instant>, StartupError> {
         let waiter = transport.waiter()?;
         let mut attached = vec![waiter.attach(&self.ready)?];
         for c in children {
             attached.push(c.watch(&waiter)?);
         }
-        let mut up = vec![false; children.len()];
-        let mut phases = vec![None; children.len()];
-        let deadline = Instant::now() + timeout;
+        let wanted = |e: &Expected| only.is_none_or(|r| r == e.role);
         loop {
-            self.take_ups(children, &mut up, &mut phases)?;
-            if up.iter().all(|&u| u) {
-                let all_up = Instant::now();
-                self.publish(Lifecycle::start())?;
-                return Ok(Startup::Started { all_up });
+            self.take_ups(roll)?;
+            if roll.entries.iter().filter(|e| wanted(e)).all(|e| e.up) {
+                return Ok(Some(Instant::now()));
             }
             for c in children {
                 if let Some(exit) = c.try_reap() {
@@ -143,54 +173,96 @@ impl SupervisorPorts {
                     });
                 }
             }
-            let left = deadline.saturating_duration_since(Instant::now());
-            if left.is_zero() {
-                let missing = children
+            if Instant::now() >= deadline {
+                let missing = roll
+                    .entries
                     .iter()
-                    .zip(up.iter().zip(&phases))
-                    .filter(|(_, (&u, _))| !u)
-                    .map(|(c, (_, &phase))| LateProcess {
-                        node: c.spec().role.node_name(c.spec().index),
-                        phase,
+                    .filter(|e| wanted(e) && !e.up)
+                    .map(|e| LateProcess {
+                        node: match &e.host {
+                            None => e.role.node_name(e.index),
+                            Some(h) => format!("{} on host {h}", e.role.node_name(e.index)),
+                        },
+                        phase: e.phase,
                     })
                     .collect();
+                let timeout = deadline.saturating_duration_since(roll.since);
                 return Err(StartupError::NotUp { timeout, missing });
             }
             if waiter.wait(Some(deadline))? == Wake::Stop {
-                return Ok(Startup::Interrupted);
+                return Ok(None);
             }
         }
     }
 
-    /// Marks in `up` every child whose `Up` is pending on `ready`, and keeps in `phases` the
-    /// last start-up phase each child reported.
-    fn take_ups(
-        &self,
-        children: &[&Child],
-        up: &mut [bool],
-        phases: &mut [Option<(StartupPhase, u32)>],
-    ) -> Result<(), TransportError> {
+    /// Marks up every process of `roll` whose `Up` is pending on `ready`, and keeps the last
+    /// start-up phase each reported.
+    fn take_ups(&self, roll: &mut Roll) -> Result<(), TransportError> {
         self.ready.drain_pending(|l| {
             let (Some(role), Some(event)) =
                 (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
             else {
                 return;
             };
-            let found = children
-                .iter()
-                .position(|c| c.spec().role == role && c.spec().index == l.index);
-            let Some(i) = found else { return };
+            let found = roll
+                .entries
+                .iter_mut()
+                .find(|e| e.role == role && e.index == l.index);
+            let Some(e) = found else { return };
             match event {
-                LifecycleEvent::Up => up[i] = true,
+                LifecycleEvent::Up => e.up = true,
                 LifecycleEvent::Phase => {
                     if let Some(p) = StartupPhase::from_u8(l.reason) {
-                        phases[i] = Some((p, l.restarts));
+                        e.phase = Some((p, l.restarts));
                     }
                 }
                 _ => {}
             }
         })?;
         Ok(())
+    }
+}
+
+/// The processes a start-up handshake waits for: the supervisor's children and, in a run
+/// across hosts, the processes of the other hosts.
+#[derive(Debug, Clone)]
+pub struct Roll {
+    entries: Vec<Expected>,
+    since: Instant,
+}
+
+#[derive(Debug, Clone)]
+struct Expected {
+    role: Role,
+    index: u32,
+    /// The other host that runs it; `None`: a child of this supervisor.
+    host: Option<String>,
+    up: bool,
+    phase: Option<(StartupPhase, u32)>,
+}
+
+impl Roll {
+    /// A roll of `children`.
+    pub fn of(children: &[&Child]) -> Self {
+        let mut roll = Self {
+            entries: Vec::with_capacity(children.len()),
+            since: Instant::now(),
+        };
+        for c in children {
+            roll.push(c.spec().role, c.spec().index, None);
+        }
+        roll
+    }
+
+    /// Adds process `role`/`index`, run by another host `host` (`None`: a child).
+    pub fn push(&mut self, role: Role, index: u32, host: Option<&str>) {
+        self.entries.push(Expected {
+            role,
+            index,
+            host: host.map(str::to_string),
+            up: false,
+            phase: None,
+        });
     }
 }
 

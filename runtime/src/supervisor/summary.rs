@@ -188,6 +188,61 @@ impl RunSummary {
         })
     }
 
+    /// The summary of a host of a run across hosts that does not run the coordinator: the
+    /// consensus log is on another host, so only what crossed the bridge is known here (the
+    /// last ground truth and the coordinator's last progress). Steps, conflicts and replans
+    /// are zero: `hnav log show` on the coordinator's host has them.
+    pub fn from_truth(
+        run_id: &str,
+        scenario: &crate::scenario::Scenario,
+        truth: Option<&Truth>,
+        progress: Option<&crate::msg::Progress>,
+        wall_time_s: f64,
+    ) -> RunSummary {
+        let cell = scenario.robot.cell_size_m;
+        let reached = |i: usize| {
+            let (Some(t), Some(a)) = (truth, scenario.agents.get(i)) else {
+                return false;
+            };
+            t.poses().get(i).is_some_and(|p| {
+                (p.x_m / cell).floor() == f64::from(a.goal.x)
+                    && (p.y_m / cell).floor() == f64::from(a.goal.y)
+            })
+        };
+        let agents = (0..scenario.agents.len())
+            .map(|i| AgentSummary {
+                id: i as u32,
+                reached_goal: reached(i),
+                steps: 0,
+                length: 0.0,
+                conflicts: 0,
+                replans: 0,
+                unreachable: false,
+                lost: false,
+            })
+            .collect();
+        let end = match progress.map(|p| p.done) {
+            Some(crate::msg::Progress::ALL_AT_GOAL) => "all-at-goal",
+            Some(crate::msg::Progress::TIME_LIMIT) => "time-limit",
+            _ => "incomplete",
+        };
+        RunSummary {
+            run_id: run_id.to_string(),
+            mode: scenario.sim.clock.to_string(),
+            agents,
+            collisions: truth.map_or(0, |t| t.collisions),
+            rounds: progress.map_or(0, |p| p.round),
+            wall_time_s,
+            end: end.to_string(),
+            log: PathBuf::new(),
+            cannot_go_on: None,
+            rejected: BTreeMap::new(),
+            lost: Vec::new(),
+            recording: None,
+            report_error: None,
+        }
+    }
+
     /// Writes `summary.json` into `dir` atomically; returns its path.
     ///
     /// The text goes to a temporary file in `dir`, is synced, and is renamed over

@@ -1,5 +1,6 @@
 //! `hnav run SCENARIO [--agents N] [--mode lockstep|realtime] [--seed S] [--out DIR]
-//! [--force] [--no-record] [--kill|--term|--freeze TARGET@WHEN[+SECONDSs]]...`: the supervisor. The work
+//! [--force] [--no-record] [--kill|--term|--freeze TARGET@WHEN[+SECONDSs]]...
+//! [--host NAME [--hosts FILE]]`: the supervisor. The work
 //! is in `hnav_runtime::supervisor::run`; the faults' syntax in
 //! `hnav_runtime::scenario::fault_arg`.
 //!
@@ -20,7 +21,9 @@ use clap::ArgMatches;
 use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::scenario::fault_arg::{self, FaultArgError, FaultFlag};
 use hnav_runtime::scenario::{ClockMode, FaultSpec, Scenario};
-use hnav_runtime::supervisor::run::{default_run_dir, new_run_id, run, RunError, RunOptions};
+use hnav_runtime::supervisor::run::{
+    default_run_dir, new_run_id, run, HostPart, RunError, RunOptions,
+};
 
 /// The exit code of a run that started but could not go on (a process stopped on a full
 /// disk): neither a finished run (0, 1) nor one that never started (2).
@@ -76,6 +79,14 @@ pub struct RunArgs {
     /// agent:5@round:60+3s (repeatable).
     #[arg(long, value_name = "TARGET@WHEN[+SECONDSs]")]
     pub freeze: Vec<String>,
+    /// Run this host's part of a run across hosts: its processes and its bridge, as the
+    /// placement file says (every host runs the same command with its own NAME and the same
+    /// --run ID).
+    #[arg(long, value_name = "NAME")]
+    pub host: Option<String>,
+    /// The placement file for --host [default: hosts.toml beside the scenario].
+    #[arg(long, value_name = "FILE", requires = "host")]
+    pub hosts: Option<PathBuf>,
 }
 
 /// The command line's faults in the order they were written (`matches` says where each
@@ -138,8 +149,25 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
         let faults = parse_faults(&written, &s).map_err(|e| e.to_string())?;
         Ok((s, faults))
     });
-    let (name, faults) = match checked {
-        Ok((s, faults)) => (default_run_dir(&s), faults),
+    let placed = checked.and_then(|(s, faults)| {
+        let host = match &a.host {
+            None => None,
+            Some(name) => {
+                let file = a.hosts.clone().unwrap_or_else(|| {
+                    let dir = args.scenario.parent().unwrap_or(std::path::Path::new(""));
+                    dir.join(hnav_runtime::placement::DEFAULT_FILE)
+                });
+                let part = HostPart::load(&file, name, s.agents.len()).map_err(|e| e.to_string())?;
+                if !faults.is_empty() || !s.faults.is_empty() {
+                    return Err("faults (--kill, --term, --freeze, [[faults]]) are not supported in a run across hosts yet".to_string());
+                }
+                Some(part)
+            }
+        };
+        Ok((s, faults, host))
+    });
+    let (name, faults, host) = match placed {
+        Ok((s, faults, host)) => (default_run_dir(&s), faults, host),
         Err(e) => {
             hnav_runtime::errln!("error: {e}");
             return ExitCode::from(2);
@@ -157,13 +185,19 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
         progress: std::io::stderr().is_terminal(),
         force: a.force,
         record: !a.no_record,
+        host,
     };
     match run(&opts) {
         Ok(summary) => {
             hnav_runtime::out!("{}", summary.render());
             hnav_runtime::outln!("summary   {}", dir.join("summary.json").display());
-            hnav_runtime::outln!("log       {}", summary.log.display());
-            if summary.report_error.is_none() {
+            if summary.log.as_os_str().is_empty() {
+                // A host of a run across hosts without the coordinator.
+                hnav_runtime::outln!("log       on the coordinator's host");
+            } else {
+                hnav_runtime::outln!("log       {}", summary.log.display());
+            }
+            if summary.report_error.is_none() && !summary.log.as_os_str().is_empty() {
                 let report = dir.join(hnav_runtime::report::FILE);
                 hnav_runtime::outln!("report    {}", report.display());
             }

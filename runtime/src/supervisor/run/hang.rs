@@ -263,7 +263,7 @@ impl HangWatch {
         let k = match role {
             Role::Sim => 0,
             Role::Coordinator if index <= MAX_REPLICAS => 1 + index as usize,
-            Role::Coordinator => return None,
+            Role::Coordinator | Role::Bridge => return None,
             Role::Agent => AGENTS_FROM + index as usize,
         };
         (k < len).then_some(k)
@@ -283,7 +283,8 @@ impl HangWatch {
         match role {
             Role::Sim => 0,
             Role::Coordinator => 1,
-            Role::Agent => 2,
+            // A bridge has no entry (`slot_index`), so it is never asked for.
+            Role::Agent | Role::Bridge => 2,
         }
     }
 }

@@ -34,6 +34,7 @@
 mod error;
 mod faults;
 mod hang;
+mod host;
 mod progress;
 mod slots;
 
@@ -45,12 +46,12 @@ use super::clean::clean_dead_runs;
 use super::recorder::{Recorder, RecordingSummary};
 use super::registry::{RunRecord, RunRegistry};
 use super::run_dir::RunDir;
-use super::startup::{Startup, SupervisorPorts};
+use super::startup::{Roll, Startup, SupervisorPorts};
 use super::stop::stop_all;
 use super::summary::RunSummary;
 use crate::invocation::Invocation;
 use crate::launch::ProcessArgs;
-use crate::msg::{Lifecycle, Progress, StopReason, Truth};
+use crate::msg::{Lifecycle, Progress, Role, StopReason, Truth};
 use crate::scenario::{ClockMode, Scenario};
 use crate::topics;
 use crate::transport::{purge_run, Bell, Receiver, RunId, Transport, Wake};
@@ -61,6 +62,7 @@ use progress::ProgressView;
 use slots::Slots;
 
 pub use error::RunError;
+pub use host::HostPart;
 
 /// How long a child gets after `Stop`, and again after SIGTERM.
 pub const STOP_GRACE: Duration = Duration::from_secs(3);
@@ -81,6 +83,9 @@ pub struct RunOptions {
     pub force: bool,
     /// Record trajectories and neural maps into `DIR/recording/` (off: `--no-record`).
     pub record: bool,
+    /// In a run across hosts, this host's part (`--host NAME`): only its processes and its
+    /// bridge are started here.
+    pub host: Option<HostPart>,
 }
 
 struct Ports {
@@ -139,8 +144,9 @@ fn run_owned(
         truth: transport.receiver(topics::TRUTH, topics::truth_qos())?,
     };
     // Started before any process, so the recording begins with the first truth message.
-    let recorder = opts
-        .record
+    // In a run across hosts, on the sim's host only.
+    let sim_here = opts.host.as_ref().is_none_or(|h| h.this().sim);
+    let recorder = (opts.record && sim_here)
         .then(|| Recorder::start(&run, &scenario, &dir))
         .map(|r| {
             r.map_err(|e| {
@@ -160,10 +166,18 @@ fn run_owned(
         Some(v) if v == "1" => None,
         _ => Some(Bell::create()?),
     };
-    let mut slots = Slots::new(&opts.args, &opts.bin_dir, &scenario, &dir, bell.as_ref());
+    let host = opts.host.as_ref();
+    let mut slots = Slots::new(
+        &opts.args,
+        &opts.bin_dir,
+        &scenario,
+        &dir,
+        bell.as_ref(),
+        host,
+    );
     // The last ground truth seen: a sample does not outlive its publisher, so a sim that is
     // down at the end (or gone for good) leaves only what was taken while it ran.
-    let mut truth = None;
+    let mut seen = Seen::default();
     let result = supervise(
         &transport,
         &ports,
@@ -171,11 +185,11 @@ fn run_owned(
         &mut slots,
         &mut record,
         opts.progress,
-        &mut truth,
+        &mut seen,
     );
     // Taken while the sim still runs; after the end of the run nothing moves any more in
     // lockstep.
-    ports.truth.drain(|t| truth = Some(*t))?;
+    ports.truth.drain(|t| seen.truth = Some(*t))?;
     let recording = recorder.map(|r| r.map_or_else(|failed| failed, Recorder::finish));
     let reason = match result {
         Ok(End::TimeLimit) => StopReason::TimeLimit,
@@ -197,10 +211,22 @@ fn run_owned(
         tracing::warn!("run registry entry not removed: {e}");
     }
     let end = result?;
+    if host.is_some_and(|h| !h.this().coordinator) {
+        // The log is on the coordinator's host: say what crossed the bridge.
+        let summary = RunSummary::from_truth(
+            run.as_str(),
+            &scenario,
+            seen.truth.as_ref(),
+            seen.progress.as_ref(),
+            started.elapsed().as_secs_f64(),
+        );
+        summary.write_json(&dir).map_err(io(&dir))?;
+        return Ok(summary);
+    }
     let mut summary = RunSummary::from_log(
         run.as_str(),
         &dir.join("log"),
-        truth.as_ref(),
+        seen.truth.as_ref(),
         scenario.robot.cell_size_m,
         started.elapsed().as_secs_f64(),
     )?;
@@ -231,6 +257,13 @@ fn prepare_dir(dir: &Path, scenario: &Scenario) -> Result<(), RunError> {
     Ok(())
 }
 
+/// The latest of what the run's processes published that the summary needs.
+#[derive(Default)]
+struct Seen {
+    truth: Option<Truth>,
+    progress: Option<Progress>,
+}
+
 /// How the watched part of a run ended.
 #[derive(Debug, Clone, PartialEq, Eq)]
 enum End {
@@ -250,16 +283,37 @@ fn supervise(
     slots: &mut Slots,
     record: &mut RunRecord,
     show_progress: bool,
-    truth: &mut Option<Truth>,
+    seen: &mut Seen,
 ) -> Result<End, RunError> {
     // Open before any process starts, so that no beat finds the topic missing.
     let hang = HangWatch::open(transport, scenario)?;
-    slots.spawn_all()?;
+    let deadline = Instant::now() + scenario.startup_timeout();
+    let mut roll = Roll::of(&[]);
+    if let Some(h) = slots.host().cloned() {
+        // The bridge first: nothing of this host may announce itself before the other hosts
+        // can hear it.
+        slots.spawn_all(Some(Role::Bridge))?;
+        let bridge: Vec<&Child> = slots.children().collect();
+        roll = Roll::of(&bridge);
+        h.add_remote(&mut roll, scenario);
+        if ports
+            .life
+            .wait_up(transport, &bridge, &mut roll, Some(Role::Bridge), deadline)?
+            .is_none()
+        {
+            return Ok(End::Signalled);
+        }
+    }
+    slots.spawn_all(None)?;
     slots.write_record(record);
     let children: Vec<&Child> = slots.children().collect();
+    for c in children.iter().filter(|c| c.spec().role != Role::Bridge) {
+        roll.push(c.spec().role, c.spec().index, None);
+    }
+    let left = deadline.saturating_duration_since(Instant::now());
     if ports
         .life
-        .start(transport, &children, scenario.startup_timeout())?
+        .start_roll(transport, &children, &mut roll, left)?
         == Startup::Interrupted
     {
         return Ok(End::Signalled);
@@ -267,7 +321,7 @@ fn supervise(
     let lockstep = scenario.sim.clock == ClockMode::Lockstep;
     let mut watch = Watch {
         view: ProgressView::new(show_progress, scenario.agents.len()),
-        truth,
+        seen,
         faults: FaultSchedule::new(&scenario.faults, lockstep, &scenario.sim),
         hang,
         round: 0,
@@ -289,8 +343,8 @@ fn supervise(
 /// The state of the watch between two changes of the set of running processes.
 struct Watch<'s> {
     view: ProgressView,
-    /// The latest ground truth taken in.
-    truth: &'s mut Option<Truth>,
+    /// The latest ground truth and progress taken in.
+    seen: &'s mut Seen,
     faults: FaultSchedule<'s>,
     hang: HangWatch,
     /// The last committed round the coordinator reported.
@@ -379,13 +433,14 @@ impl Watch<'_> {
     /// Shows the coordinator's latest progress and, in realtime, fires the faults due by its
     /// round (or by the time since `Start`); `AllAtGoal` or `TimeLimit` once it reports that it ended the run.
     fn on_progress(&mut self, ports: &Ports, slots: &Slots) -> Result<Option<End>, RunError> {
-        let truth = &mut *self.truth;
-        ports.truth.drain_pending(|t| *truth = Some(*t))?;
+        let seen = &mut *self.seen;
+        ports.truth.drain_pending(|t| seen.truth = Some(*t))?;
         let mut last = None;
         ports.progress.drain_pending(|p| last = Some(*p))?;
         let Some(p) = last else {
             return Ok(None);
         };
+        self.seen.progress = Some(p);
         self.view.show(&p);
         self.round = p.round;
         self.faults.on_round(p.round);

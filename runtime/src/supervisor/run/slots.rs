@@ -2,14 +2,14 @@
 //! run registry, and its restarts under its role's policy.
 
 use std::cell::Cell;
-use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::error::RunError;
+use super::host::HostPart;
 use crate::launch::ProcessArgs;
 use crate::msg::{Lifecycle, LifecycleEvent, Role, RosterState};
-use crate::scenario::{GiveUpAction, Scenario};
+use crate::scenario::{GiveUpAction, RestartPolicy, RestartRule, Scenario};
 use crate::supervisor::child::{Child, ChildError, ChildSpec, ExitInfo};
 use crate::supervisor::events::{RunEvent, RunEvents};
 use crate::supervisor::registry::RunRecord;
@@ -42,33 +42,47 @@ pub(super) struct Slots {
     events: RunEvents,
     /// What an agent gone for good does to the run.
     on_give_up: GiveUpAction,
+    /// In a run across hosts, this host's part.
+    host: Option<HostPart>,
 }
 
 impl Slots {
     /// The slots of `scenario`'s processes, started from `bin_dir` with `args` (and agents
     /// with their `--index`), each one's output appended to `dir/logs/<node>.log`; the
-    /// coordinator and the agents are handed the commit `bell`, if any. Nothing is spawned yet.
+    /// coordinator and the agents are handed the commit `bell`, if any. In a run across hosts
+    /// (`host`), only this host's processes, and its bridge first. Nothing is spawned yet.
     pub(super) fn new(
         args: &ProcessArgs,
         bin_dir: &Path,
         scenario: &Scenario,
         dir: &Path,
         bell: Option<&Bell>,
+        host: Option<&HostPart>,
     ) -> Self {
-        let mut slots = Vec::with_capacity(2 + scenario.agents.len());
+        let mut slots = Vec::with_capacity(3 + scenario.agents.len());
+        let here = |role, index| host.is_none_or(|h| h.this().runs(role, index));
         let mut add = |role: Role, index: u32, program: &str| {
+            if role != Role::Bridge && !here(role, index) {
+                return;
+            }
             let rule = match role {
                 Role::Sim => scenario.restart.sim,
                 Role::Coordinator => scenario.restart.coordinator,
                 Role::Agent => scenario.restart.agent,
+                // A host without its bridge is cut off: restart it whatever the processes'
+                // rules say.
+                Role::Bridge => RestartRule::with_policy(RestartPolicy::OnFailure),
             };
             let log = dir
                 .join("logs")
                 .join(format!("{}.log", role.node_name(index)));
             let mut spec = ChildSpec::new(role, index, bin_dir.join(program), log);
-            let argv: Vec<OsString> = args.to_args();
-            for a in argv {
-                spec = spec.arg(a);
+            if let (Role::Bridge, Some(h)) = (role, host) {
+                spec = h.bridge_args(spec, &args.run, scenario.agents.len());
+            } else {
+                for a in args.to_args() {
+                    spec = spec.arg(a);
+                }
             }
             if role == Role::Agent {
                 spec = spec.arg("--index").arg(index.to_string());
@@ -76,7 +90,7 @@ impl Slots {
             if role == Role::Coordinator && index > 0 {
                 spec = spec.arg("--replica").arg(index.to_string());
             }
-            if let Some(bell) = bell.filter(|_| role != Role::Sim) {
+            if let Some(bell) = bell.filter(|_| matches!(role, Role::Coordinator | Role::Agent)) {
                 spec = spec.env(BELL_ENV, bell.env_value());
             }
             slots.push(Slot {
@@ -88,6 +102,9 @@ impl Slots {
                 lost: None,
             });
         };
+        if let Some(h) = host {
+            add(Role::Bridge, h.index() as u32, "hnav-bridge");
+        }
         add(Role::Sim, 0, "hnav-sim");
         match scenario.coordinator.replicas {
             1 => add(Role::Coordinator, 0, "hnav-coordinator"),
@@ -101,7 +118,13 @@ impl Slots {
             dir: dir.to_path_buf(),
             events: RunEvents::create(dir),
             on_give_up: scenario.restart.on_give_up,
+            host: host.cloned(),
         }
+    }
+
+    /// In a run across hosts, this host's part.
+    pub(super) fn host(&self) -> Option<&HostPart> {
+        self.host.as_ref()
     }
 
     /// The run's event journal.
@@ -109,10 +132,12 @@ impl Slots {
         &self.events
     }
 
-    /// Starts every process.
-    pub(super) fn spawn_all(&mut self) -> Result<(), ChildError> {
+    /// Starts every process of `role` (every process: `None`) not started yet.
+    pub(super) fn spawn_all(&mut self, role: Option<Role>) -> Result<(), ChildError> {
         for s in &mut self.slots {
-            s.child = Some(Child::spawn(&s.spec)?);
+            if s.child.is_none() && role.is_none_or(|r| r == s.spec.role) {
+                s.child = Some(Child::spawn(&s.spec)?);
+            }
         }
         Ok(())
     }
@@ -260,7 +285,7 @@ impl Slots {
                         }
                         Role::Agent => agent_gone = Some(gone),
                         Role::Coordinator if replica => replica_gone = Some(ended.clone()),
-                        Role::Sim | Role::Coordinator => core_gone = Some(gone),
+                        Role::Sim | Role::Coordinator | Role::Bridge => core_gone = Some(gone),
                     }
                     s.lost = Some(ended);
                 }
@@ -387,5 +412,6 @@ fn role_writes(role: Role, index: u32, dir: &Path) -> String {
             dir.join("sim.ckpt.{0,1}").display(),
             log.display()
         ),
+        Role::Bridge => format!("its log {}", log.display()),
     }
 }

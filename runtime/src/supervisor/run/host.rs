@@ -1,0 +1,84 @@
+//! This host's part of a run across hosts (`hnav run --host NAME`): which of the run's
+//! processes it starts, its bridge's command line, and which processes of other hosts its
+//! start-up handshake waits for.
+//!
+//! Every host's supervisor waits for the `Up` of every process of the run (those of other
+//! hosts cross the bridges) and then publishes `Start`; a process takes the first `Start` and
+//! ignores the others. Nothing but the bridge is spawned before the bridge is up, and a bridge
+//! is up only once it hears every other host's bridge, so no `Up` is sent before the far
+//! side can hear it.
+
+use std::path::{Path, PathBuf};
+
+use crate::msg::Role;
+use crate::placement::{Host, Placement, PlacementError};
+use crate::scenario::Scenario;
+use crate::supervisor::child::ChildSpec;
+use crate::supervisor::startup::Roll;
+
+/// This host's part of a run across hosts.
+#[derive(Debug, Clone)]
+pub struct HostPart {
+    file: PathBuf,
+    placement: Placement,
+    index: usize,
+}
+
+impl HostPart {
+    /// Host `name` of the placement in `file`, checked for a run of `agents` agents.
+    pub fn load(file: &Path, name: &str, agents: usize) -> Result<Self, PlacementError> {
+        let placement = Placement::load(file, agents)?;
+        let index = placement.index_of(name)?;
+        Ok(Self {
+            file: file.to_path_buf(),
+            placement,
+            index,
+        })
+    }
+
+    /// This host.
+    pub fn this(&self) -> &Host {
+        &self.placement.hosts()[self.index]
+    }
+
+    /// This host's place in the placement (its bridge's index).
+    pub fn index(&self) -> usize {
+        self.index
+    }
+
+    /// The whole placement.
+    pub fn placement(&self) -> &Placement {
+        &self.placement
+    }
+
+    /// `spec` (of `hnav-bridge`) with the arguments for run `run` of `agents` agents.
+    pub(super) fn bridge_args(&self, spec: ChildSpec, run: &str, agents: usize) -> ChildSpec {
+        spec.arg("--run")
+            .arg(run)
+            .arg("--agents")
+            .arg(agents.to_string())
+            .arg("--hosts")
+            .arg(&self.file)
+            .arg("--host")
+            .arg(&self.this().name)
+    }
+
+    /// Adds to `roll` every process of `scenario`'s run that another host runs.
+    pub(super) fn add_remote(&self, roll: &mut Roll, scenario: &Scenario) {
+        let mut add = |role, index| {
+            if let Some(h) = self.placement.host_of(role, index) {
+                if h.name != self.this().name {
+                    roll.push(role, index, Some(&h.name));
+                }
+            }
+        };
+        add(Role::Sim, 0);
+        match scenario.coordinator.replicas {
+            1 => add(Role::Coordinator, 0),
+            n => (1..=n).for_each(|id| add(Role::Coordinator, id)),
+        }
+        for i in 0..scenario.agents.len() as u32 {
+            add(Role::Agent, i);
+        }
+    }
+}
