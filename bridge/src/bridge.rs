@@ -10,7 +10,7 @@ use hnav_runtime::topics as run_topics;
 use hnav_runtime::transport::{Bell, RunId, Sender, Transport, TransportError, Wake};
 use zenoh::liveliness::LivelinessToken;
 use zenoh::pubsub::{Publisher, Subscriber};
-use zenoh::qos::CongestionControl;
+use zenoh::qos::{CongestionControl, Priority};
 use zenoh::sample::{Locality, Sample, SampleKind};
 use zenoh::{Session, Wait};
 
@@ -187,11 +187,20 @@ impl Bridge {
                 key: key.clone(),
                 why: e.to_string(),
             };
+            // A droppable (state) sample waits at most 100 µs for room in a full queue and
+            // goes in the data queue; everything else waits (a lost decision could hold a
+            // lockstep round for ever), in a queue ahead of it when state is droppable.
+            let (congestion, priority) = match (spec.droppable, topics.iter().any(|t| t.droppable))
+            {
+                (true, _) => (CongestionControl::Drop, Priority::Data),
+                (false, true) => (CongestionControl::Block, Priority::InteractiveHigh),
+                (false, false) => (CongestionControl::Block, Priority::Data),
+            };
             publishers.push(
                 session
                     .declare_publisher(key.clone())
-                    // Reliable: a full queue holds the bridge rather than losing a round.
-                    .congestion_control(CongestionControl::Block)
+                    .congestion_control(congestion)
+                    .priority(priority)
                     .express(true)
                     .allowed_destination(Locality::Remote)
                     .wait()

@@ -29,10 +29,16 @@ pub enum SessionError {
 /// 10 s): a host cut off is noticed within this, and its robots stand.
 pub const LEASE_MS: u64 = 1000;
 
+/// How long a reliable put may wait for room in a link's queue before Zenoh gives the link
+/// up, in µs (Zenoh's default is 5 s): a link cut off fills its queue, and the bridge's loop
+/// must not stand still for every host meanwhile.
+const BLOCK_BEFORE_CLOSE_US: u64 = LEASE_MS * 1000;
+
 /// The session's configuration as JSON5; everything not set is zenoh 1.10.2's default.
-/// Besides the endpoints: the lease ([`LEASE_MS`], with 4 keep-alives in it), and a lost
+/// Besides the endpoints: the lease ([`LEASE_MS`], with 4 keep-alives in it); a lost
 /// connection retried every 100 ms doubling to at most 500 ms, so that a healed link is used
-/// again within about half a second.
+/// again within about half a second; a state sample (droppable: the next one supersedes it)
+/// waits at most 100 µs for room in a full queue, a decision at most one lease.
 pub fn config_json5(endpoints: &Endpoints) -> String {
     let quote = |v: &[String]| {
         v.iter()
@@ -49,7 +55,14 @@ pub fn config_json5(endpoints: &Endpoints) -> String {
     retry: {{ period_init_ms: 100, period_max_ms: 500, period_increase_factor: 2 }},
   }},
   scouting: {{ multicast: {{ enabled: false }}, gossip: {{ enabled: false }} }},
-  transport: {{ link: {{ tx: {{ lease: {LEASE_MS}, keep_alive: 4 }} }} }},
+  transport: {{ link: {{ tx: {{
+    lease: {LEASE_MS},
+    keep_alive: 4,
+    queue: {{ congestion_control: {{
+      drop: {{ wait_before_drop: 100 }},
+      block: {{ wait_before_close: {BLOCK_BEFORE_CLOSE_US} }},
+    }} }},
+  }} }} }},
 }}"#,
         quote(&endpoints.listen),
         quote(&endpoints.connect)

@@ -39,6 +39,30 @@ pub struct TopicSpec {
     pub payload: Payload,
     /// Its QoS, as the run's processes open it.
     pub qos: Qos,
+    /// Whether a sample may be dropped when a link cannot take it (see
+    /// [`best_effort_state`]); otherwise the bridge waits for room.
+    pub droppable: bool,
+}
+
+impl TopicSpec {
+    /// Whether its samples are state that the next sample supersedes: truth, progress,
+    /// odometry, wheel commands, neural maps (not decisions or lifecycle events).
+    pub fn is_state(&self) -> bool {
+        !matches!(
+            self.payload,
+            Payload::Candidate | Payload::Commit | Payload::Lifecycle
+        )
+    }
+}
+
+/// Makes the state topics of `specs` droppable: for a realtime run, where a robot acts on
+/// the newest odometry and command anyway and an agent resends an unanswered candidate, a
+/// link cut off must not hold the bridge (and every other host's samples) while its queue
+/// is full. A lockstep run waits for every sample, so it keeps them all reliable.
+pub fn best_effort_state(specs: &mut [TopicSpec]) {
+    for s in specs.iter_mut().filter(|s| s.is_state()) {
+        s.droppable = true;
+    }
 }
 
 /// Every topic a run of `agents` agents forwards; with `maps`, each agent's neural-map
@@ -48,6 +72,7 @@ pub fn run_topics(agents: usize, maps: bool) -> Vec<TopicSpec> {
         topic: topic.to_string(),
         payload,
         qos,
+        droppable: false,
     };
     let mut out = vec![
         spec(
@@ -98,7 +123,13 @@ mod tests {
         assert_eq!(t[0].topic, "candidates");
         assert!(t.iter().any(|s| s.topic == "wheels/2"));
         assert!(!t.iter().any(|s| s.topic.starts_with("map/")));
-        let t = run_topics(3, true);
+        let mut t = run_topics(3, true);
         assert_eq!(t.iter().filter(|s| s.payload == Payload::Map).count(), 3);
+        assert!(t.iter().all(|s| !s.droppable));
+        best_effort_state(&mut t);
+        let kept: Vec<&str> = (t.iter().filter(|s| !s.droppable))
+            .map(|s| s.topic.as_str())
+            .collect();
+        assert_eq!(kept, ["candidates", "commit", "lifecycle", "ready"]);
     }
 }

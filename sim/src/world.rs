@@ -55,6 +55,9 @@ pub struct World {
     cmd_r: Vec<f64>,
     cmd_at: Vec<Option<u64>>,
     cmd_period: Vec<Option<u64>>,
+    // Whether the watchdog brakes each robot, as of the last step: a change is logged (a
+    // robot whose agent went silent, its host cut off, say, and its rejoining).
+    braked: Vec<bool>,
     // Wheel angles since the start (what the Hall sensors see), rad.
     phil: Vec<f64>,
     phir: Vec<f64>,
@@ -114,6 +117,7 @@ impl World {
             cmd_r: vec![0.0; n],
             cmd_at: vec![None; n],
             cmd_period: vec![None; n],
+            braked: vec![true; n],
             phil: vec![0.0; n],
             phir: vec![0.0; n],
             slip_l: vec![0.0; n],
@@ -262,7 +266,12 @@ impl World {
         let redraw = self.slip_on && self.steps.is_multiple_of(self.steps_per_slip);
         for i in 0..self.pos.len() {
             let (l0, r0) = (self.wl[i], self.wr[i]);
-            let (l1, r1) = if self.watchdog.expired(self.cmd_at[i], now) {
+            let expired = self.watchdog.expired(self.cmd_at[i], now);
+            if expired != self.braked[i] {
+                self.braked[i] = expired;
+                log_brake(i, expired, now, self.cmd_at[i]);
+            }
+            let (l1, r1) = if expired {
                 (m.brake_step(l0), m.brake_step(r0))
             } else {
                 (
@@ -369,5 +378,22 @@ impl World {
     /// and both positions. `Truth::collisions` is the length of this list.
     pub fn collisions(&self) -> &[Collision] {
         &self.collisions
+    }
+}
+
+/// Logs that robot `i`'s watchdog started (`braking`) or stopped braking at sim time `now`.
+#[cold]
+fn log_brake(i: usize, braking: bool, now: u64, last_cmd: Option<u64>) {
+    let sim_time_s = now as f64 / 1e9;
+    if braking {
+        let silent_ms = last_cmd.map_or(0.0, |t| now.saturating_sub(t) as f64 / 1e6);
+        tracing::warn!(
+            robot = i,
+            sim_time_s,
+            silent_ms,
+            "watchdog: no fresh wheel command, braking"
+        );
+    } else {
+        tracing::info!(robot = i, sim_time_s, "watchdog: wheel commands again");
     }
 }

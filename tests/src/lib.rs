@@ -13,12 +13,15 @@
 //! - [`lost_wakeup`]: both halves of the lost-wake-up reproducer (`tests/lost_wakeup.rs`);
 //! - [`tick`]: a discrete-time multi-agent run (neural maps, path constructor, conflict
 //!   resolver) for the papers' conflict experiments;
-//! - [`tmux`]: a terminal of a test's own for full-screen programs (`hnav top`, playback).
+//! - [`tmux`]: a terminal of a test's own for full-screen programs (`hnav top`, playback);
+//! - [`netns`]: hosts on one machine (network namespaces, a switch, loss, partitions) for the
+//!   multi-host tests (`tests/multi_host.rs`).
 //!
 //! Tests that SIGKILL processes live in their own test binaries (`tests/*_kill.rs`).
 //! Tests that send other signals do too (`tests/waiter_signals.rs`).
 
 pub mod lost_wakeup;
+pub mod netns;
 pub mod pattern;
 pub mod rogue;
 pub mod swarm;

@@ -86,22 +86,27 @@ impl SwarmRun {
 
     /// The last lines of every process log of the run, for failure messages.
     pub fn log_tails(&self) -> String {
-        let mut out = String::new();
-        let Ok(entries) = std::fs::read_dir(self.dir.join("logs")) else {
-            return out;
-        };
-        let mut paths: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
-        paths.sort();
-        for p in paths {
-            let text = std::fs::read_to_string(&p).unwrap_or_default();
-            let lines: Vec<&str> = text.lines().collect();
-            let tail = &lines[lines.len().saturating_sub(8)..];
-            if !tail.is_empty() {
-                out += &format!("--- {}\n{}\n", p.display(), tail.join("\n"));
-            }
-        }
-        out
+        log_tails(&self.dir)
     }
+}
+
+/// The last lines of every process log in run directory `dir`, for failure messages.
+pub fn log_tails(dir: &Path) -> String {
+    let mut out = String::new();
+    let Ok(entries) = std::fs::read_dir(dir.join("logs")) else {
+        return out;
+    };
+    let mut paths: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
+    paths.sort();
+    for p in paths {
+        let text = std::fs::read_to_string(&p).unwrap_or_default();
+        let lines: Vec<&str> = text.lines().collect();
+        let tail = &lines[lines.len().saturating_sub(8)..];
+        if !tail.is_empty() {
+            out += &format!("--- {}\n{}\n", p.display(), tail.join("\n"));
+        }
+    }
+    out
 }
 
 /// Runs `hnav log verify DIR` and returns whether it exited 0, with its output.

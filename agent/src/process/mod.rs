@@ -176,9 +176,9 @@ impl<'t> AgentProcess<'t> {
             if let Err(e) = p.map.update_connections() {
                 tracing::warn!("neural-map viewers not connected: {e}");
             }
-            // The agent only ever reacts to its inputs; its one deadline is the next beat,
-            // after which `TimedOut` only means "look again".
-            match waiter.wait(self.heart.until(None)?)? {
+            // The agent reacts to its inputs; its deadlines are the next beat and, in
+            // realtime, the resend of an unanswered candidate. `TimedOut` means "look again".
+            match waiter.wait(self.heart.until(core.resend_due())?)? {
                 Wake::Data | Wake::TimedOut => {}
                 Wake::Stop => break,
             }

@@ -3,6 +3,8 @@
 //! Kept apart from the [`Ports`] so that the loop can borrow the ports (attached to its
 //! waiter) while it mutates the state.
 
+use std::time::{Duration, Instant};
+
 use hnav_runtime::diag::is_no_space_io;
 use hnav_runtime::grid::geometry::{cell_centre_m, cell_centre_pose, cell_index};
 use hnav_runtime::grid::Cell;
@@ -19,6 +21,13 @@ use crate::navigator::{Guidance, Navigator, Task};
 use crate::odometry::{DeadReckoning, OdometryParams};
 use crate::pso::{PsoOptions, PsoPlanner};
 
+/// How long a realtime agent waits for the commit of its open candidate before it sends it
+/// again: four round deadlines (a round closes within one), and no less than 200 ms.
+fn resend_after(scenario: &Scenario) -> Duration {
+    let deadline = Duration::from_millis(u64::from(scenario.coordinator.round_deadline_ms));
+    (4 * deadline).max(Duration::from_millis(200))
+}
+
 /// One agent's state: its navigator, dead reckoning and wheel controller, and where it stands
 /// in the rounds.
 pub(super) struct Core {
@@ -32,6 +41,11 @@ pub(super) struct Core {
     checkpoint: Option<CheckpointFile>,
     last_commit: u64,
     outstanding: Option<u64>,
+    /// When the open candidate was (last) sent: in realtime it is sent again if no commit
+    /// answers it within `resend_after` (a candidate or its commit lost on a link between
+    /// hosts; the coordinator answers a candidate for a decided round with the last commit).
+    sent_at: Option<Instant>,
+    resend_after: Duration,
     last_period: Option<u64>,
     wheel_due: Option<u64>,
     /// The last wheel command sent, for a restarted sim that asks for it again.
@@ -95,6 +109,8 @@ impl Core {
             checkpoint,
             last_commit,
             outstanding: None,
+            sent_at: None,
+            resend_after: resend_after(scenario),
             last_period: None,
             wheel_due: None,
             last_wheels: None,
@@ -134,7 +150,31 @@ impl Core {
         self.on_commits(p)?;
         self.on_odometry(p)?;
         self.send_candidate(p)?;
+        self.resend_if_unanswered(p)?;
         self.send_wheels(p)
+    }
+
+    /// When the open candidate is due to be sent again (realtime only).
+    pub(super) fn resend_due(&self) -> Option<Instant> {
+        match (self.clock, self.outstanding, self.sent_at) {
+            (ClockMode::Realtime, Some(_), Some(at)) => Some(at + self.resend_after),
+            _ => None,
+        }
+    }
+
+    /// Sends the open candidate again once no commit answered it in time.
+    fn resend_if_unanswered(&mut self, p: &Ports) -> Result<(), AgentError> {
+        let (Some(due), Some(r)) = (self.resend_due(), self.outstanding) else {
+            return Ok(());
+        };
+        let now = Instant::now();
+        if now < due {
+            return Ok(());
+        }
+        tracing::debug!(round = r, "no commit for the open candidate: sent again");
+        p.candidates.send(self.nav.candidate(r))?;
+        self.sent_at = Some(now);
+        Ok(())
     }
 
     /// Applies every new commit; resends the open candidate to a coordinator that just came up.
@@ -156,6 +196,7 @@ impl Core {
             // the rounds it missed; it goes on from the round that was decided.
             if self.outstanding.is_some_and(|r| r <= c.round) {
                 self.outstanding = None;
+                self.sent_at = None;
             }
         }
         if rebuilt {
@@ -244,6 +285,7 @@ impl Core {
         let cand = self.nav.candidate(round);
         p.candidates.send(cand)?;
         self.outstanding = Some(round);
+        self.sent_at = Some(Instant::now());
         if self.nav.take_replanned() {
             self.publish_map(p)?;
         }

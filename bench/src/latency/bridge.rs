@@ -64,6 +64,8 @@ pub(crate) fn measure(
             topic: format!("{prefix}/{t}"),
             payload: Payload::Map,
             qos: topics::state_qos(),
+            // Every sample is measured: none may be dropped.
+            droppable: false,
         })
         .collect();
     let port = {

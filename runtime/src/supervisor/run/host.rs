@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use crate::msg::Role;
 use crate::placement::{Host, Placement, PlacementError};
-use crate::scenario::Scenario;
+use crate::scenario::{ClockMode, Scenario};
 use crate::supervisor::child::ChildSpec;
 use crate::supervisor::startup::Roll;
 
@@ -51,16 +51,22 @@ impl HostPart {
         &self.placement
     }
 
-    /// `spec` (of `hnav-bridge`) with the arguments for run `run` of `agents` agents.
-    pub(super) fn bridge_args(&self, spec: ChildSpec, run: &str, agents: usize) -> ChildSpec {
-        spec.arg("--run")
+    /// `spec` (of `hnav-bridge`) with the arguments for run `run` of `scenario`: in
+    /// realtime, state samples a link cannot take are dropped rather than waited for.
+    pub(super) fn bridge_args(&self, spec: ChildSpec, run: &str, scenario: &Scenario) -> ChildSpec {
+        let spec = spec
+            .arg("--run")
             .arg(run)
             .arg("--agents")
-            .arg(agents.to_string())
+            .arg(scenario.agents.len().to_string())
             .arg("--hosts")
             .arg(&self.file)
             .arg("--host")
-            .arg(&self.this().name)
+            .arg(&self.this().name);
+        match scenario.sim.clock {
+            ClockMode::Realtime => spec.arg("--best-effort-state"),
+            ClockMode::Lockstep => spec,
+        }
     }
 
     /// Adds to `roll` every process of `scenario`'s run that another host runs.

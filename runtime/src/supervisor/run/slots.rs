@@ -78,7 +78,7 @@ impl Slots {
                 .join(format!("{}.log", role.node_name(index)));
             let mut spec = ChildSpec::new(role, index, bin_dir.join(program), log);
             if let (Role::Bridge, Some(h)) = (role, host) {
-                spec = h.bridge_args(spec, &args.run, scenario.agents.len());
+                spec = h.bridge_args(spec, &args.run, scenario);
             } else {
                 for a in args.to_args() {
                     spec = spec.arg(a);

@@ -1,0 +1,360 @@
+//! Runs across hosts on one machine (issue 17): three "hosts" in Linux network namespaces
+//! joined by a switch (`hnav_tests::netns`), each with its own iceoryx2 domain
+//! (`HNAV_DOMAIN`) and run registry, so that only the hosts' bridges (Zenoh over TCP) link
+//! them. The coordinator and the sim run on host 0, the agents are split between hosts 1
+//! and 2; each host runs `hnav run --host NAME` as a robotics lab would on three computers.
+//!
+//! - In lockstep the consensus log is the one-host run's, record for record.
+//! - In realtime with 5 ± 2 ms of delay (the bridge's test-only delay layer) and 1 % loss
+//!   (nftables) on every link, every robot still gets home without a collision.
+//! - A robot host cut off for 2 s stands (the sim's watchdog brakes its robots, the
+//!   coordinator logs them down) and rejoins when the link is back.
+//!
+//! Where namespaces cannot be created (no root, a locked-down kernel) each test says so and
+//! skips, unless `HNAV_REQUIRE_NETNS=1` (set by `.ci/run` where its probe could make one).
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use hnav_runtime::consensus_log::{encode_record, read_log, Record};
+use hnav_runtime::msg::{LifecycleEvent, Role};
+use hnav_runtime::transport::{purge_run, RunId};
+use hnav_tests::netns::Net;
+use hnav_tests::swarm::{lifecycle_records, log_tails, repo_root, workspace_bin, SwarmRun};
+use hnav_tests::{Peer, TestRun};
+
+/// Generous: debug builds of up to 20 processes and three bridges on a 2-core machine.
+const RUN_TIMEOUT: Duration = Duration::from_secs(600);
+/// The hosts' names: the base station, then two robot computers.
+const HOSTS: [&str; 3] = ["base", "robots-a", "robots-b"];
+
+/// The namespaces for test `tag`, or `None` (said on stderr) where they cannot be made.
+fn net_or_skip(tag: &str) -> Option<Net> {
+    match Net::create(tag, HOSTS.len()) {
+        Ok(net) => Some(net),
+        Err(e) if std::env::var_os("HNAV_REQUIRE_NETNS").is_some_and(|v| v == "1") => {
+            panic!("HNAV_REQUIRE_NETNS=1 but no network namespace could be made: {e}")
+        }
+        Err(e) => {
+            eprintln!("skipped: no network namespaces here ({e})");
+            None
+        }
+    }
+}
+
+/// Removes what the run left in each host's iceoryx2 domain, after its processes are gone
+/// (declared before the [`TestRun`], so dropped after it kills them).
+struct DomainPurge(RunId);
+
+impl Drop for DomainPurge {
+    fn drop(&mut self) {
+        for h in HOSTS {
+            if let Ok(run) = self.0.clone().in_domain(h) {
+                if let Err(e) = purge_run(&run) {
+                    eprintln!("cleanup of run {run} in domain {h} failed: {e}");
+                }
+            }
+        }
+    }
+}
+
+/// Writes a placement of `agents` agents into `dir`: sim and coordinator on host 0, the
+/// first half of the agents on host 1, the rest on host 2.
+fn placement(dir: &Path, agents: usize) -> PathBuf {
+    let half = agents / 2;
+    let host = |i: usize, what: &str| {
+        format!(
+            "[[host]]\nname = \"{}\"\nlisten = [\"tcp/{}:7447\"]\n{what}\n\n",
+            HOSTS[i],
+            Net::addr(i)
+        )
+    };
+    let text = host(0, "sim = true\ncoordinator = true")
+        + &host(1, &format!("agents = \"0-{}\"", half - 1))
+        + &host(2, &format!("agents = \"{half}-{}\"", agents - 1));
+    let file = dir.join("hosts.toml");
+    std::fs::write(&file, text).unwrap();
+    file
+}
+
+/// One run across the three hosts.
+struct Across {
+    supervisors: Vec<Peer>,
+    dirs: Vec<PathBuf>,
+}
+
+impl Across {
+    /// Starts `hnav run SCENARIO --host H` in each host's namespace, with `extra` arguments
+    /// and `env` on top of each host's domain and registry.
+    fn start(
+        run: &mut TestRun,
+        net: &Net,
+        scenario: &Path,
+        tmp: &Path,
+        extra: &[&str],
+        env: &[(&str, &Path)],
+    ) -> Across {
+        let agents = extra
+            .windows(2)
+            .find(|w| w[0] == "--agents")
+            .map_or(6, |w| w[1].parse().unwrap());
+        let hosts = placement(tmp, agents);
+        let hnav = workspace_bin("hnav").display().to_string();
+        let mut across = Across {
+            supervisors: Vec::new(),
+            dirs: Vec::new(),
+        };
+        for (i, name) in HOSTS.iter().enumerate() {
+            let dir = tmp.join(name);
+            let mut args: Vec<String> = ["netns", "exec", net.ns(i), &hnav, "run"]
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
+            args.push(scenario.display().to_string());
+            for a in ["--run", run.run.as_str(), "--host", name, "--no-record"] {
+                args.push(a.to_string());
+            }
+            args.extend(["--hosts".into(), hosts.display().to_string()]);
+            args.extend(["--out".into(), dir.display().to_string()]);
+            args.extend(extra.iter().map(|s| s.to_string()));
+            let registry = tmp.join(format!("runs-{name}"));
+            let domain = PathBuf::from(name);
+            let mut all: Vec<(&str, &Path)> =
+                vec![("HNAV_DOMAIN", &domain), ("HNAV_RUNS_DIR", &registry)];
+            all.extend_from_slice(env);
+            let peer = run
+                .spawn_exact_env("ip", &args, &all)
+                .expect("ip netns exec");
+            across.supervisors.push(peer);
+            across.dirs.push(dir);
+        }
+        across
+    }
+
+    /// Waits for every supervisor; each must exit 0 (every robot home, no collision).
+    fn finish(&mut self) {
+        let deadline = Instant::now() + RUN_TIMEOUT;
+        for (i, p) in self.supervisors.iter_mut().enumerate() {
+            let left = deadline.saturating_duration_since(Instant::now());
+            let status = p
+                .wait_exit(left)
+                .unwrap_or_else(|e| panic!("{}: {e}", HOSTS[i]));
+            assert!(
+                status.success(),
+                "host {} exited {status}\n{}",
+                HOSTS[i],
+                self.tails()
+            );
+        }
+        for d in &self.dirs {
+            let s = summary(d);
+            assert_eq!(s["end"], "all-at-goal", "{}: {s}", d.display());
+            assert_eq!(s["collisions"], 0, "{}: {s}", d.display());
+        }
+    }
+
+    fn tails(&self) -> String {
+        self.dirs.iter().map(|d| log_tails(d)).collect()
+    }
+}
+
+/// A supervisor still running when the test ends (it failed) is asked to stop, so that it
+/// stops its children (a SIGKILL would orphan them) before the run's memory is purged.
+impl Drop for Across {
+    fn drop(&mut self) {
+        for p in &mut self.supervisors {
+            let running = p.wait_exit(Duration::ZERO).is_err();
+            if running && p.signal(nix::sys::signal::Signal::SIGTERM).is_ok() {
+                let _ = p.wait_exit(Duration::from_secs(20));
+            }
+        }
+    }
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    let p = dir.join("summary.json");
+    let text = std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+    serde_json::from_str(&text).unwrap()
+}
+
+/// A one-host run of `scenario` with `extra` arguments into `dir`; returns its wall time.
+fn one_host(tag: &str, scenario: &Path, dir: &Path, extra: &[&str]) -> f64 {
+    let mut run = TestRun::new(tag);
+    let registry = dir.with_extension("runs");
+    let mut args = vec!["--no-record"];
+    args.extend_from_slice(extra);
+    let mut swarm = SwarmRun::start(&mut run, scenario, dir, &registry, &args).unwrap();
+    let status = swarm.finish(RUN_TIMEOUT).unwrap();
+    assert!(status.success(), "{status}\n{}", swarm.log_tails());
+    let s = swarm.summary().unwrap();
+    assert_eq!(s["end"], "all-at-goal", "{s}");
+    s["wall_time_s"].as_f64().unwrap()
+}
+
+/// SHA-256 over the records' encodings, for the note.
+fn digest(records: &[Record]) -> String {
+    use sha2::{Digest, Sha256};
+    let mut h = Sha256::new();
+    let mut buf = Vec::new();
+    for r in records {
+        buf.clear();
+        encode_record(r, &mut buf).unwrap();
+        h.update(&buf);
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// In lockstep, `scenario` across the three hosts logs what it logs on one host.
+fn same_log_as_one_host(tag: &str, scenario: &Path, extra: &[&str]) {
+    let Some(net) = net_or_skip(tag) else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let mut args = vec!["--mode", "lockstep"];
+    args.extend_from_slice(extra);
+    let one = tmp.path().join("one");
+    one_host(&format!("{tag}1"), scenario, &one, &args);
+    let reference = read_log(one.join("log")).unwrap().records;
+    assert!(reference.len() > 10, "a suspiciously short log");
+
+    let mut run = TestRun::new(tag);
+    let _purge = DomainPurge(run.run.clone());
+    let mut across = Across::start(&mut run, &net, scenario, tmp.path(), &args, &[]);
+    across.finish();
+    let got = read_log(across.dirs[0].join("log")).unwrap().records;
+    assert_eq!(
+        got.len(),
+        reference.len(),
+        "records across hosts vs one host"
+    );
+    if let Some(i) = (0..got.len()).find(|&i| got[i] != reference[i]) {
+        panic!("record {i} differs:\n{:?}\n{:?}", got[i], reference[i]);
+    }
+    println!(
+        "{tag}: {} records, digest {} (one host and three)",
+        got.len(),
+        digest(&got)
+    );
+}
+
+#[test]
+fn the_demo_across_three_hosts_logs_what_one_host_logs() {
+    let scenario = repo_root().join("scenarios/demo.toml");
+    same_log_as_one_host("demo", &scenario, &[]);
+}
+
+#[test]
+fn sixteen_agents_across_three_hosts_log_what_one_host_logs() {
+    let scenario = repo_root().join("scenarios/random-32-32-10.toml");
+    same_log_as_one_host("r16", &scenario, &["--agents", "16"]);
+}
+
+#[test]
+fn delay_and_loss_on_every_link_still_bring_every_robot_home() {
+    let Some(net) = net_or_skip("lossy") else {
+        return;
+    };
+    net.set_loss(1)
+        .expect("nftables (the nftables package) makes the loss");
+    let scenario = repo_root().join("scenarios/demo.toml");
+    let tmp = tempfile::tempdir().unwrap();
+    let one = tmp.path().join("one");
+    let one_wall = one_host("lossy1", &scenario, &one, &["--mode", "realtime"]);
+    let one_rounds = summary(&one)["rounds"].as_u64().unwrap();
+
+    let mut run = TestRun::new("lossy");
+    let _purge = DomainPurge(run.run.clone());
+    let delay = PathBuf::from("5:2");
+    let env = [("HNAV_BRIDGE_DELAY_MS", delay.as_path())];
+    let mut across = Across::start(
+        &mut run,
+        &net,
+        &scenario,
+        tmp.path(),
+        &["--mode", "realtime"],
+        &env,
+    );
+    across.finish();
+    let s = summary(&across.dirs[0]);
+    let rounds = s["rounds"].as_u64().unwrap();
+    let wall = s["wall_time_s"].as_f64().unwrap();
+    println!(
+        "realtime demo: one host {one_rounds} rounds in {one_wall:.1} s ({:.1}/s); three hosts \
+         with 5 +- 2 ms delay and 1 % loss per link {rounds} rounds in {wall:.1} s ({:.1}/s)",
+        one_rounds as f64 / one_wall,
+        rounds as f64 / wall
+    );
+}
+
+#[test]
+fn a_robot_host_cut_off_for_two_seconds_stands_and_rejoins() {
+    let Some(net) = net_or_skip("cut") else {
+        return;
+    };
+    let scenario = repo_root().join("scenarios/demo.toml");
+    let tmp = tempfile::tempdir().unwrap();
+    let mut run = TestRun::new("cut");
+    let _purge = DomainPurge(run.run.clone());
+    let mut across = Across::start(
+        &mut run,
+        &net,
+        &scenario,
+        tmp.path(),
+        &["--mode", "realtime"],
+        &[],
+    );
+    // The middle of the run: once the coordinator has logged 300 rounds (about 3 s).
+    let log = across.dirs[0].join("log");
+    let deadline = Instant::now() + RUN_TIMEOUT;
+    loop {
+        let rounds = read_log(&log).map_or(0, |l| {
+            l.records
+                .iter()
+                .filter(|r| matches!(r, Record::Round(_)))
+                .count()
+        });
+        if rounds >= 300 {
+            break;
+        }
+        assert!(Instant::now() < deadline, "the run never reached round 300");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    net.cut(2, false).unwrap();
+    // The partition itself lasts 2 s: this sleep is the fault, not a synchronisation.
+    std::thread::sleep(Duration::from_secs(2));
+    net.cut(2, true).unwrap();
+    across.finish();
+
+    // Host 2 runs agents 3, 4 and 5: each logged down, then back, in that order.
+    let events = lifecycle_records(&log);
+    for agent in 3..6u32 {
+        let of: Vec<_> = events
+            .iter()
+            .filter(|e| e.1 == Some(Role::Agent) && e.2 == agent)
+            .map(|e| (e.0, e.3))
+            .collect();
+        let down = of.iter().position(|e| e.1 == Some(LifecycleEvent::Down));
+        let back = of
+            .iter()
+            .position(|e| e.1 == Some(LifecycleEvent::Restarted));
+        assert!(
+            matches!((down, back), (Some(d), Some(b)) if d < b),
+            "agent {agent}: {of:?}"
+        );
+        println!("agent {agent}: lifecycle records (round, event) {of:?}");
+    }
+    // The sim's watchdog braked each robot of the cut host.
+    let sim_log = std::fs::read_to_string(across.dirs[0].join("logs/sim.log")).unwrap();
+    for robot in 3..6 {
+        let braked = sim_log
+            .lines()
+            .any(|l| l.contains("braking") && l.contains(&format!("robot={robot} ")));
+        assert!(braked, "robot {robot} never braked:\n{sim_log}");
+    }
+    for l in sim_log.lines().filter(|l| l.contains("watchdog")) {
+        println!("sim: {l}");
+    }
+    let s = summary(&across.dirs[0]);
+    println!(
+        "cut run: {} rounds in {} s, end {}",
+        s["rounds"], s["wall_time_s"], s["end"]
+    );
+}
