@@ -187,9 +187,9 @@ impl Bridge {
                 key: key.clone(),
                 why: e.to_string(),
             };
-            // A droppable (state) sample waits at most 100 µs for room in a full queue and
-            // goes in the data queue; everything else waits (a lost decision could hold a
-            // lockstep round for ever), in a queue ahead of it when state is droppable.
+            // A droppable sample waits at most 100 µs for room in a full queue and goes in the
+            // data queue; everything else waits (a lost decision could hold a lockstep round
+            // for ever), in a queue ahead of the droppable ones when there are any.
             let (congestion, priority) = match (spec.droppable, topics.iter().any(|t| t.droppable))
             {
                 (true, _) => (CongestionControl::Drop, Priority::Data),

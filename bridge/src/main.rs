@@ -40,10 +40,10 @@ struct Args {
     /// This host's name in the placement.
     #[arg(long, value_name = "NAME", requires = "hosts")]
     host: Option<String>,
-    /// Drop state samples (truth, odometry, wheels, progress, maps) a link cannot take
-    /// instead of waiting: for realtime runs (`hnav run` passes it), never for lockstep.
+    /// Drop samples other than lifecycle events that a link cannot take instead of waiting:
+    /// for realtime runs (`hnav run` passes it), never for lockstep.
     #[arg(long)]
-    best_effort_state: bool,
+    best_effort: bool,
 }
 
 fn main() -> ExitCode {
@@ -93,8 +93,8 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         });
     }
     let mut specs = topics::run_topics(args.agents, args.maps);
-    if args.best_effort_state {
-        topics::best_effort_state(&mut specs);
+    if args.best_effort {
+        topics::best_effort(&mut specs);
     }
     let mut bridge = Bridge::open(&run, &specs, &endpoints, peers)?;
     tracing::info!(run = run.as_str(), domain = ?run.domain(), "bridge up");

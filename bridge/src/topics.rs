@@ -39,28 +39,27 @@ pub struct TopicSpec {
     pub payload: Payload,
     /// Its QoS, as the run's processes open it.
     pub qos: Qos,
-    /// Whether a sample may be dropped when a link cannot take it (see
-    /// [`best_effort_state`]); otherwise the bridge waits for room.
+    /// Whether a sample may be dropped when a link cannot take it (see [`best_effort`]);
+    /// otherwise the bridge waits for room.
     pub droppable: bool,
 }
 
 impl TopicSpec {
-    /// Whether its samples are state that the next sample supersedes: truth, progress,
-    /// odometry, wheel commands, neural maps (not decisions or lifecycle events).
-    pub fn is_state(&self) -> bool {
-        !matches!(
-            self.payload,
-            Payload::Candidate | Payload::Commit | Payload::Lifecycle
-        )
+    /// Whether a realtime run may lose its samples on a link that cannot take them: all but
+    /// the lifecycle events. State (truth, progress, odometry, wheels, maps) is superseded
+    /// by the next sample; a realtime agent resends an unanswered candidate, and the
+    /// coordinator answers a candidate for a decided round with the last commit.
+    pub fn is_recoverable(&self) -> bool {
+        self.payload != Payload::Lifecycle
     }
 }
 
-/// Makes the state topics of `specs` droppable: for a realtime run, where a robot acts on
-/// the newest odometry and command anyway and an agent resends an unanswered candidate, a
-/// link cut off must not hold the bridge (and every other host's samples) while its queue
-/// is full. A lockstep run waits for every sample, so it keeps them all reliable.
-pub fn best_effort_state(specs: &mut [TopicSpec]) {
-    for s in specs.iter_mut().filter(|s| s.is_state()) {
+/// Makes the recoverable topics of `specs` droppable ([`TopicSpec::is_recoverable`]): for a
+/// realtime run, where a link cut off must not hold the bridge (and every other host's
+/// samples) while its queue is full. A lockstep run waits for every sample, so it keeps
+/// them all reliable.
+pub fn best_effort(specs: &mut [TopicSpec]) {
+    for s in specs.iter_mut().filter(|s| s.is_recoverable()) {
         s.droppable = true;
     }
 }
@@ -126,10 +125,10 @@ mod tests {
         let mut t = run_topics(3, true);
         assert_eq!(t.iter().filter(|s| s.payload == Payload::Map).count(), 3);
         assert!(t.iter().all(|s| !s.droppable));
-        best_effort_state(&mut t);
+        best_effort(&mut t);
         let kept: Vec<&str> = (t.iter().filter(|s| !s.droppable))
             .map(|s| s.topic.as_str())
             .collect();
-        assert_eq!(kept, ["candidates", "commit", "lifecycle", "ready"]);
+        assert_eq!(kept, ["lifecycle", "ready"]);
     }
 }

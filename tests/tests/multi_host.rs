@@ -20,7 +20,9 @@ use hnav_runtime::consensus_log::{encode_record, read_log, Record};
 use hnav_runtime::msg::{LifecycleEvent, Role};
 use hnav_runtime::transport::{purge_run, RunId};
 use hnav_tests::netns::Net;
-use hnav_tests::swarm::{lifecycle_records, log_tails, repo_root, workspace_bin, SwarmRun};
+use hnav_tests::swarm::{
+    hnav_output, lifecycle_records, log_tails, repo_root, workspace_bin, SwarmRun,
+};
 use hnav_tests::{Peer, TestRun};
 
 /// Generous: debug builds of up to 20 processes and three bridges on a 2-core machine.
@@ -284,6 +286,54 @@ fn delay_and_loss_on_every_link_still_bring_every_robot_home() {
     );
 }
 
+/// `hnav ps` on host 1 lists every process of the run: its own running, the others on
+/// their hosts.
+fn every_host_shows_the_whole_run(tmp: &Path) {
+    let registry = tmp.join(format!("runs-{}", HOSTS[1]));
+    let ps = |json: bool| {
+        let mut args = vec!["ps".to_string()];
+        if json {
+            args.push("--json".into());
+        }
+        hnav_output(&args, &registry, Duration::from_secs(60))
+            .unwrap()
+            .stdout
+    };
+    let v: serde_json::Value = serde_json::from_str(&ps(true)).unwrap();
+    let procs = v["runs"][0]["processes"].as_array().unwrap().clone();
+    let state = |role: &str, index: u32| {
+        let p = procs
+            .iter()
+            .find(|p| p["role"] == role && p["index"] == index)
+            .unwrap_or_else(|| panic!("no {role} {index} in {procs:?}"));
+        (
+            p["state"].as_str().unwrap().to_string(),
+            p["host"].as_str().map(str::to_string),
+        )
+    };
+    assert_eq!(state("sim", 0), ("remote".into(), Some("base".into())));
+    assert_eq!(
+        state("coordinator", 0),
+        ("remote".into(), Some("base".into()))
+    );
+    assert_eq!(state("bridge", 1), ("running".into(), None));
+    for a in 0..3 {
+        assert_eq!(state("agent", a), ("running".into(), None));
+    }
+    for a in 3..6 {
+        assert_eq!(
+            state("agent", a),
+            ("remote".into(), Some("robots-b".into()))
+        );
+    }
+    assert_eq!(
+        procs.len(),
+        9,
+        "sim, coordinator, 6 agents and the bridge: {procs:?}"
+    );
+    println!("hnav ps on host {}:\n{}", HOSTS[1], ps(false));
+}
+
 #[test]
 fn a_robot_host_cut_off_for_two_seconds_stands_and_rejoins() {
     let Some(net) = net_or_skip("cut") else {
@@ -317,6 +367,7 @@ fn a_robot_host_cut_off_for_two_seconds_stands_and_rejoins() {
         assert!(Instant::now() < deadline, "the run never reached round 300");
         std::thread::sleep(Duration::from_millis(100));
     }
+    every_host_shows_the_whole_run(tmp.path());
     net.cut(2, false).unwrap();
     // The partition itself lasts 2 s: this sleep is the fault, not a synchronisation.
     std::thread::sleep(Duration::from_secs(2));

@@ -66,6 +66,16 @@ pub enum KillError {
         /// Its last recorded pid.
         pid: u32,
     },
+    /// In a run across hosts, another host runs the target.
+    #[error("{target} of run `{run}` runs on host {host}: run `hnav kill` there")]
+    Remote {
+        /// The run id.
+        run: String,
+        /// The target as written.
+        target: String,
+        /// The host that runs it.
+        host: String,
+    },
     /// `kill(2)` refused.
     #[error("cannot send {signal} to {target} (pid {pid}) of run `{run}`: {source}")]
     Signal {
@@ -134,6 +144,13 @@ pub fn kill(
             has,
         });
     };
+    if let Some(host) = &p.host {
+        return Err(KillError::Remote {
+            run: run.into(),
+            target: name,
+            host: host.clone(),
+        });
+    }
     let not_running = || KillError::NotRunning {
         run: run.into(),
         target: name.clone(),

@@ -27,6 +27,8 @@ pub enum ProcessState {
     Exited,
     /// iceoryx2 lists the process's node as dead: it died without leaving the run.
     Dead,
+    /// Another host runs it (a run across hosts): its supervisor watches it.
+    Remote,
 }
 
 impl ProcessState {
@@ -36,6 +38,7 @@ impl ProcessState {
             ProcessState::Running => "running",
             ProcessState::Exited => "exited",
             ProcessState::Dead => "dead",
+            ProcessState::Remote => "remote",
         }
     }
 }
@@ -57,6 +60,9 @@ pub struct ProcessStatus {
     /// single coordinator and for other roles).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub raft: Option<ReplicaRole>,
+    /// The other host that runs it, in a run across hosts.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub host: Option<String>,
 }
 
 /// A dead iceoryx2 node of a run that no recorded process accounts for (an earlier
@@ -120,7 +126,9 @@ impl RunStatus {
                 let found = dead
                     .iter()
                     .position(|d| d.pid.and_then(|x| u32::try_from(x).ok()) == Some(p.pid));
-                let state = if let Some(i) = found {
+                let state = if p.host.is_some() {
+                    ProcessState::Remote
+                } else if let Some(i) = found {
                     dead.remove(i);
                     ProcessState::Dead
                 } else if process_alive(p.pid, p.start_ticks) {
@@ -138,6 +146,7 @@ impl RunStatus {
                     state,
                     restarts: p.restarts,
                     raft,
+                    host: p.host.clone(),
                 }
             })
             .collect();
@@ -204,9 +213,14 @@ impl PsReport {
             let dir = run.dir.display().to_string();
             for p in &run.processes {
                 any_dead |= p.state == ProcessState::Dead;
-                let mut state = match p.state {
-                    ProcessState::Dead => "dead *".to_string(),
-                    s => s.as_str().to_string(),
+                let mut state = match (p.state, &p.host) {
+                    (ProcessState::Dead, _) => "dead *".to_string(),
+                    (ProcessState::Remote, Some(h)) => format!("on host {h}"),
+                    (s, _) => s.as_str().to_string(),
+                };
+                let pid = match p.state {
+                    ProcessState::Remote => "-".to_string(),
+                    _ => p.pid.to_string(),
                 };
                 if let Some(r) = p.raft.as_ref().filter(|_| p.state == ProcessState::Running) {
                     state += &format!(" ({}, term {})", r.role, r.term);
@@ -216,7 +230,7 @@ impl PsReport {
                     dir.clone(),
                     p.role.name().into(),
                     p.index.to_string(),
-                    p.pid.to_string(),
+                    pid,
                     state,
                 ]);
             }

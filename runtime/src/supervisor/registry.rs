@@ -257,6 +257,10 @@ pub struct ProcessRecord {
     pub start_ticks: Option<u64>,
     /// Restarts so far.
     pub restarts: u32,
+    /// In a run across hosts, the other host that runs it (its pid is then 0: this
+    /// supervisor only knows that it is there).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub host: Option<String>,
 }
 
 /// The registry file of one run.
@@ -326,12 +330,29 @@ impl RunRecord {
             pid,
             start_ticks,
             restarts,
+            host: None,
         };
         match self
             .processes
             .iter_mut()
             .find(|p| p.role == role && p.index == index)
         {
+            Some(p) => *p = new,
+            None => self.processes.push(new),
+        }
+    }
+
+    /// Records process `role`/`index` as run by another host, `host`.
+    pub fn set_remote(&mut self, role: Role, index: u32, host: &str) {
+        let new = ProcessRecord {
+            role,
+            index,
+            pid: 0,
+            start_ticks: None,
+            restarts: 0,
+            host: Some(host.to_string()),
+        };
+        match (self.processes.iter_mut()).find(|p| p.role == role && p.index == index) {
             Some(p) => *p = new,
             None => self.processes.push(new),
         }

@@ -157,7 +157,7 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
                     let dir = args.scenario.parent().unwrap_or(std::path::Path::new(""));
                     dir.join(hnav_runtime::placement::DEFAULT_FILE)
                 });
-                let part = HostPart::load(&file, name, s.agents.len()).map_err(|e| e.to_string())?;
+                let part = HostPart::load(&file, name, &s).map_err(|e| e.to_string())?;
                 if !faults.is_empty() || !s.faults.is_empty() {
                     return Err("faults (--kill, --term, --freeze, [[faults]]) are not supported in a run across hosts yet".to_string());
                 }

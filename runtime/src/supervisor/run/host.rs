@@ -22,15 +22,18 @@ pub struct HostPart {
     file: PathBuf,
     placement: Placement,
     index: usize,
+    /// The processes of the run that other hosts run.
+    remote: Vec<(Role, u32, String)>,
 }
 
 impl HostPart {
-    /// Host `name` of the placement in `file`, checked for a run of `agents` agents.
-    pub fn load(file: &Path, name: &str, agents: usize) -> Result<Self, PlacementError> {
-        let placement = Placement::load(file, agents)?;
+    /// Host `name` of the placement in `file`, checked for a run of `scenario`.
+    pub fn load(file: &Path, name: &str, scenario: &Scenario) -> Result<Self, PlacementError> {
+        let placement = Placement::load(file, scenario.agents.len())?;
         let index = placement.index_of(name)?;
         Ok(Self {
             file: file.to_path_buf(),
+            remote: remote_of(&placement, index, scenario),
             placement,
             index,
         })
@@ -52,7 +55,8 @@ impl HostPart {
     }
 
     /// `spec` (of `hnav-bridge`) with the arguments for run `run` of `scenario`: in
-    /// realtime, state samples a link cannot take are dropped rather than waited for.
+    /// realtime, samples other than lifecycle events that a link cannot take are dropped
+    /// rather than waited for.
     pub(super) fn bridge_args(&self, spec: ChildSpec, run: &str, scenario: &Scenario) -> ChildSpec {
         let spec = spec
             .arg("--run")
@@ -64,27 +68,41 @@ impl HostPart {
             .arg("--host")
             .arg(&self.this().name);
         match scenario.sim.clock {
-            ClockMode::Realtime => spec.arg("--best-effort-state"),
+            ClockMode::Realtime => spec.arg("--best-effort"),
             ClockMode::Lockstep => spec,
         }
     }
 
-    /// Adds to `roll` every process of `scenario`'s run that another host runs.
-    pub(super) fn add_remote(&self, roll: &mut Roll, scenario: &Scenario) {
-        let mut add = |role, index| {
-            if let Some(h) = self.placement.host_of(role, index) {
-                if h.name != self.this().name {
-                    roll.push(role, index, Some(&h.name));
-                }
-            }
-        };
-        add(Role::Sim, 0);
-        match scenario.coordinator.replicas {
-            1 => add(Role::Coordinator, 0),
-            n => (1..=n).for_each(|id| add(Role::Coordinator, id)),
-        }
-        for i in 0..scenario.agents.len() as u32 {
-            add(Role::Agent, i);
+    /// Every process of the run that another host runs: role, index and that host.
+    pub(super) fn remote(&self) -> impl Iterator<Item = (Role, u32, &str)> + '_ {
+        self.remote.iter().map(|(r, i, h)| (*r, *i, h.as_str()))
+    }
+
+    /// Adds to `roll` every process of the run that another host runs.
+    pub(super) fn add_remote(&self, roll: &mut Roll) {
+        for (role, index, host) in self.remote() {
+            roll.push(role, index, Some(host));
         }
     }
+}
+
+/// Every process of a run of `scenario` that a host other than `me` of `placement` runs.
+fn remote_of(placement: &Placement, me: usize, scenario: &Scenario) -> Vec<(Role, u32, String)> {
+    let mut out = Vec::new();
+    let mut add = |role, index| {
+        if let Some(h) = placement.host_of(role, index) {
+            if h.name != placement.hosts()[me].name {
+                out.push((role, index, h.name.clone()));
+            }
+        }
+    };
+    add(Role::Sim, 0);
+    match scenario.coordinator.replicas {
+        1 => add(Role::Coordinator, 0),
+        n => (1..=n).for_each(|id| add(Role::Coordinator, id)),
+    }
+    for i in 0..scenario.agents.len() as u32 {
+        add(Role::Agent, i);
+    }
+    out
 }

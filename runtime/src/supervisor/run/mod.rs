@@ -295,7 +295,7 @@ fn supervise(
         slots.spawn_all(Some(Role::Bridge))?;
         let bridge: Vec<&Child> = slots.children().collect();
         roll = Roll::of(&bridge);
-        h.add_remote(&mut roll, scenario);
+        h.add_remote(&mut roll);
         if ports
             .life
             .wait_up(transport, &bridge, &mut roll, Some(Role::Bridge), deadline)?

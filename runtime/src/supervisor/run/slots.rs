@@ -222,6 +222,12 @@ impl Slots {
                 record.set_process(s.spec.role, s.spec.index, c.pid(), s.tracker.restarts());
             }
         }
+        // In a run across hosts, the other hosts' processes too: `hnav ps` shows the run.
+        if let Some(h) = &self.host {
+            for (role, index, host) in h.remote() {
+                record.set_remote(role, index, host);
+            }
+        }
         if let Err(e) = record.write() {
             tracing::warn!("run registry entry not written: {e}");
         }
