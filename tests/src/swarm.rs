@@ -109,6 +109,21 @@ pub fn log_tails(dir: &Path) -> String {
     out
 }
 
+/// A digest of consensus-log records, for notes and test output: SHA-256 over their
+/// payload encodings, in hex.
+pub fn records_digest(records: &[hnav_runtime::consensus_log::Record]) -> String {
+    use sha2::{Digest, Sha256};
+    let mut h = Sha256::new();
+    let mut buf = Vec::new();
+    for r in records {
+        buf.clear();
+        hnav_runtime::consensus_log::encode_record(r, &mut buf)
+            .expect("a record read from a log encodes");
+        h.update(&buf);
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
 /// Runs `hnav log verify DIR` and returns whether it exited 0, with its output.
 pub fn verify_log(dir: &Path) -> (bool, String) {
     match std::process::Command::new(workspace_bin("hnav"))

@@ -16,12 +16,12 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use hnav_runtime::consensus_log::{encode_record, read_log, Record};
+use hnav_runtime::consensus_log::{read_log, Record};
 use hnav_runtime::msg::{LifecycleEvent, Role};
 use hnav_runtime::transport::{purge_run, RunId};
 use hnav_tests::netns::Net;
 use hnav_tests::swarm::{
-    hnav_output, lifecycle_records, log_tails, repo_root, workspace_bin, SwarmRun,
+    hnav_output, lifecycle_records, log_tails, records_digest, repo_root, workspace_bin, SwarmRun,
 };
 use hnav_tests::{Peer, TestRun};
 
@@ -133,6 +133,17 @@ impl Across {
         across
     }
 
+    /// [`Across::start`] in realtime.
+    fn realtime(
+        run: &mut TestRun,
+        net: &Net,
+        scenario: &Path,
+        tmp: &Path,
+        env: &[(&str, &Path)],
+    ) -> Across {
+        Self::start(run, net, scenario, tmp, &["--mode", "realtime"], env)
+    }
+
     /// Waits for every supervisor; each must exit 0 (every robot home, no collision).
     fn finish(&mut self) {
         let deadline = Instant::now() + RUN_TIMEOUT;
@@ -193,19 +204,6 @@ fn one_host(tag: &str, scenario: &Path, dir: &Path, extra: &[&str]) -> f64 {
     s["wall_time_s"].as_f64().unwrap()
 }
 
-/// SHA-256 over the records' encodings, for the note.
-fn digest(records: &[Record]) -> String {
-    use sha2::{Digest, Sha256};
-    let mut h = Sha256::new();
-    let mut buf = Vec::new();
-    for r in records {
-        buf.clear();
-        encode_record(r, &mut buf).unwrap();
-        h.update(&buf);
-    }
-    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
-}
-
 /// In lockstep, `scenario` across the three hosts logs what it logs on one host.
 fn same_log_as_one_host(tag: &str, scenario: &Path, extra: &[&str]) {
     let Some(net) = net_or_skip(tag) else { return };
@@ -233,7 +231,7 @@ fn same_log_as_one_host(tag: &str, scenario: &Path, extra: &[&str]) {
     println!(
         "{tag}: {} records, digest {} (one host and three)",
         got.len(),
-        digest(&got)
+        records_digest(&got)
     );
 }
 
@@ -266,14 +264,7 @@ fn delay_and_loss_on_every_link_still_bring_every_robot_home() {
     let _purge = DomainPurge(run.run.clone());
     let delay = PathBuf::from("5:2");
     let env = [("HNAV_BRIDGE_DELAY_MS", delay.as_path())];
-    let mut across = Across::start(
-        &mut run,
-        &net,
-        &scenario,
-        tmp.path(),
-        &["--mode", "realtime"],
-        &env,
-    );
+    let mut across = Across::realtime(&mut run, &net, &scenario, tmp.path(), &env);
     across.finish();
     let s = summary(&across.dirs[0]);
     let rounds = s["rounds"].as_u64().unwrap();
@@ -343,14 +334,7 @@ fn a_robot_host_cut_off_for_two_seconds_stands_and_rejoins() {
     let tmp = tempfile::tempdir().unwrap();
     let mut run = TestRun::new("cut");
     let _purge = DomainPurge(run.run.clone());
-    let mut across = Across::start(
-        &mut run,
-        &net,
-        &scenario,
-        tmp.path(),
-        &["--mode", "realtime"],
-        &[],
-    );
+    let mut across = Across::realtime(&mut run, &net, &scenario, tmp.path(), &[]);
     // The middle of the run: once the coordinator has logged 1000 rounds (about 10 s in;
     // the robots need 30 to 45 s to get home).
     let log = across.dirs[0].join("log");

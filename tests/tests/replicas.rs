@@ -6,8 +6,8 @@
 use std::path::Path;
 use std::time::Duration;
 
-use hnav_runtime::consensus_log::{encode_record, read_decided, read_log, Record, FORMAT_VERSION};
-use hnav_tests::swarm::{repo_root, verify_log, SwarmRun};
+use hnav_runtime::consensus_log::{read_decided, read_log, Record, FORMAT_VERSION};
+use hnav_tests::swarm::{records_digest, repo_root, verify_log, SwarmRun};
 use hnav_tests::TestRun;
 
 /// Generous: a debug build of up to 36 processes on a 2-core machine.
@@ -35,19 +35,6 @@ fn decided(dir: &Path) -> Vec<Record> {
         h.version = FORMAT_VERSION;
     }
     records
-}
-
-/// A digest of the records, for the note: SHA-256 over their payload encodings.
-fn digest(records: &[Record]) -> String {
-    use sha2::{Digest, Sha256};
-    let mut h = Sha256::new();
-    let mut buf = Vec::new();
-    for r in records {
-        buf.clear();
-        encode_record(r, &mut buf).unwrap();
-        h.update(&buf);
-    }
-    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
 }
 
 fn same_rounds_as_one_coordinator(tag: &str, scenario: &Path, agents: Option<&str>) {
@@ -87,7 +74,7 @@ fn same_rounds_as_one_coordinator(tag: &str, scenario: &Path, agents: Option<&st
     println!(
         "{tag}: {} records, digest {} (the single coordinator and every replica)",
         single.len(),
-        digest(&single)
+        records_digest(&single)
     );
 }
 
