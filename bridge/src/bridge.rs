@@ -405,7 +405,9 @@ fn watch_hosts(
 impl HostWatch {
     /// Takes in what changed among the other hosts and tells this host.
     fn pass(&mut self) -> Result<(), TransportError> {
+        let mut heard = false;
         while let Ok((name, alive)) = self.events.try_recv() {
+            heard = true;
             for event in self.view.on_token(&name, alive) {
                 self.lifecycle.send(event)?;
             }
@@ -413,8 +415,8 @@ impl HostWatch {
         if let Some(up) = self.view.take_up() {
             tracing::info!("every other host heard: bridge up");
             self.ready.send(up)?;
-        } else if !self.view.unheard().is_empty() {
-            tracing::debug!(waiting = ?self.view.unheard(), "hosts not heard yet");
+        } else if heard && !self.view.is_up() {
+            tracing::info!(waiting = ?self.view.unheard(), "hosts not heard yet");
         }
         Ok(())
     }

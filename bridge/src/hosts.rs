@@ -105,6 +105,11 @@ impl HostsView {
         Some(Lifecycle::up(Role::Bridge, self.peers.index))
     }
 
+    /// Whether this bridge has announced itself up.
+    pub(crate) fn is_up(&self) -> bool {
+        self.announced
+    }
+
     /// The other hosts not heard yet, by name (for the log while waiting).
     pub(crate) fn unheard(&self) -> Vec<&str> {
         (self.peers.others.iter().zip(&self.heard))
