@@ -140,7 +140,7 @@ pub struct Bridge {
     _subscribers: Vec<Subscriber<()>>,
     hosts: Option<HostWatch>,
     // After the subscribers, whose callbacks feed it: it ends once they are gone.
-    _delay: Option<DelayLine<(usize, Sample)>>,
+    _delay: Option<DelayLine>,
     inbox: crossbeam_channel::Receiver<(usize, Sample)>,
     bell: hnav_runtime::transport::BellWatch,
     overflow: Arc<AtomicU64>,

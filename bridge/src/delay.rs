@@ -66,15 +66,14 @@ impl Delay {
 
 /// A thread between the Zenoh callbacks and the bridge's inbox that holds each item for its
 /// delay. Ends when every sender into it is dropped.
-pub(crate) struct DelayLine<T> {
+pub(crate) struct DelayLine {
     thread: Option<JoinHandle<()>>,
-    _marker: std::marker::PhantomData<T>,
 }
 
-impl<T: Send + 'static> DelayLine<T> {
+impl DelayLine {
     /// Starts the thread; returns it and the sender the callbacks put into (with the time of
     /// arrival). What it releases goes to `out`, and `release` runs after each.
-    pub(crate) fn start(
+    pub(crate) fn start<T: Send + 'static>(
         delay: Delay,
         out: Sender<T>,
         release: impl Fn() + Send + 'static,
@@ -96,17 +95,11 @@ impl<T: Send + 'static> DelayLine<T> {
                 }
             })
             .ok();
-        (
-            Self {
-                thread,
-                _marker: std::marker::PhantomData,
-            },
-            tx,
-        )
+        (Self { thread }, tx)
     }
 }
 
-impl<T> Drop for DelayLine<T> {
+impl Drop for DelayLine {
     fn drop(&mut self) {
         // Its senders are gone by now (the subscribers are dropped first), so it ends.
         if let Some(t) = self.thread.take() {

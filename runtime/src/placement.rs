@@ -28,7 +28,9 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use crate::msg::Role;
+use crate::scenario::lines::Lines;
 use crate::scenario::Loc;
+use crate::transport::is_domain_name;
 
 /// The file `hnav run --host` reads when no `--hosts` is given: `hosts.toml` beside the
 /// scenario.
@@ -154,8 +156,8 @@ impl Placement {
 
     /// Parses and checks `text` (named `file` in errors) for a run of `agents` agents.
     pub fn parse(text: &str, file: &str, agents: usize) -> Result<Self, PlacementError> {
-        let line = |offset: usize| text[..offset.min(text.len())].matches('\n').count() + 1;
-        let at = |offset: usize| Loc::new(file, line(offset));
+        let lines = Lines::new(text, file);
+        let at = |offset: usize| Loc::new(file, lines.line(offset));
         let raw: RawFile = toml::from_str(text).map_err(|e| PlacementError::Toml {
             at: at(e.span().map_or(0, |s| s.start)),
             message: e.message().trim().to_string(),
@@ -171,7 +173,7 @@ impl Placement {
             let start = h.span().start;
             let h = h.get_ref();
             let name = h.name.get_ref();
-            if !valid_name(name) {
+            if !is_domain_name(name) {
                 return Err(invalid(
                     h.name.span().start,
                     format!("host name `{name}`: 1 to 16 ASCII letters, digits, '-' and '_'"),
@@ -279,14 +281,6 @@ impl Placement {
             .flat_map(|h| h.listen.iter().cloned())
             .collect()
     }
-}
-
-/// 1 to 16 ASCII letters, digits, `-` and `_`.
-fn valid_name(name: &str) -> bool {
-    (1..=16).contains(&name.len())
-        && name
-            .bytes()
-            .all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_')
 }
 
 /// The agents of `raw`, ascending and each once, all below `agents`.

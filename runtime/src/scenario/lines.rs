@@ -10,13 +10,13 @@ use toml::Spanned;
 use super::error::{Loc, ScenarioError};
 
 /// Byte offset to 1-based line.
-pub(super) struct Lines<'a> {
-    pub(super) source_name: &'a str,
+pub(crate) struct Lines<'a> {
+    pub(crate) source_name: &'a str,
     starts: Vec<usize>,
 }
 
 impl<'a> Lines<'a> {
-    pub(super) fn new(text: &str, source_name: &'a str) -> Self {
+    pub(crate) fn new(text: &str, source_name: &'a str) -> Self {
         let starts = std::iter::once(0)
             .chain(text.match_indices('\n').map(|(i, _)| i + 1))
             .collect();
@@ -26,11 +26,11 @@ impl<'a> Lines<'a> {
         }
     }
 
-    pub(super) fn line(&self, offset: usize) -> usize {
+    pub(crate) fn line(&self, offset: usize) -> usize {
         self.starts.partition_point(|&s| s <= offset).max(1)
     }
 
-    pub(super) fn at<T>(&self, s: &Spanned<T>) -> Loc {
+    pub(crate) fn at<T>(&self, s: &Spanned<T>) -> Loc {
         Loc::new(self.source_name, self.line(s.span().start))
     }
 

@@ -133,7 +133,7 @@ pub mod error;
 pub mod fault_arg;
 mod hash;
 pub mod health;
-mod lines;
+pub(crate) mod lines;
 pub mod params;
 mod raw;
 pub mod record;

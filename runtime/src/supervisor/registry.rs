@@ -324,35 +324,32 @@ impl RunRecord {
             Some(p) if p.start_ticks.is_some() => p.start_ticks,
             _ => process_start_ticks(pid),
         };
-        let new = ProcessRecord {
+        self.put(ProcessRecord {
             role,
             index,
             pid,
             start_ticks,
             restarts,
             host: None,
-        };
-        match self
-            .processes
-            .iter_mut()
-            .find(|p| p.role == role && p.index == index)
-        {
-            Some(p) => *p = new,
-            None => self.processes.push(new),
-        }
+        });
     }
 
     /// Records process `role`/`index` as run by another host, `host`.
     pub fn set_remote(&mut self, role: Role, index: u32, host: &str) {
-        let new = ProcessRecord {
+        self.put(ProcessRecord {
             role,
             index,
             pid: 0,
             start_ticks: None,
             restarts: 0,
             host: Some(host.to_string()),
-        };
-        match (self.processes.iter_mut()).find(|p| p.role == role && p.index == index) {
+        });
+    }
+
+    /// Replaces the entry of `new`'s role and index, or adds it.
+    fn put(&mut self, new: ProcessRecord) {
+        let same = |p: &&mut ProcessRecord| p.role == new.role && p.index == new.index;
+        match self.processes.iter_mut().find(same) {
             Some(p) => *p = new,
             None => self.processes.push(new),
         }

@@ -248,10 +248,22 @@ impl Roll {
             entries: Vec::with_capacity(children.len()),
             since: Instant::now(),
         };
-        for c in children {
-            roll.push(c.spec().role, c.spec().index, None);
-        }
+        roll.add(children);
         roll
+    }
+
+    /// Adds each of `children` the roll does not have yet.
+    pub fn add(&mut self, children: &[&Child]) {
+        for c in children {
+            let (role, index) = (c.spec().role, c.spec().index);
+            if !self
+                .entries
+                .iter()
+                .any(|e| e.role == role && e.index == index)
+            {
+                self.push(role, index, None);
+            }
+        }
     }
 
     /// Adds process `role`/`index`, run by another host `host` (`None`: a child).

@@ -53,8 +53,8 @@ pub use error::TransportError;
 pub use node::{CleanupReport, NodeInfo, NodeLiveness, Transport, TransportBuilder};
 pub use qos::{Delivery, Qos};
 pub use run::{
-    ipc_root, purge_run, run_config, run_iceoryx2_files, run_shm_files, RunId, DOMAIN_ENV,
-    IPC_ROOT_ENV,
+    ipc_root, is_domain_name, purge_run, run_config, run_iceoryx2_files, run_shm_files, RunId,
+    DOMAIN_ENV, IPC_ROOT_ENV,
 };
 pub use slice::{SliceLoan, SliceReceiver, SliceSender};
 pub use waiter::{stop_requested, Attachment, AttachmentId, Waiter, Wake};

@@ -112,12 +112,17 @@ fn domain_from_env() -> Result<Option<String>, TransportError> {
     }
 }
 
-fn valid_domain(d: &str) -> Result<(), TransportError> {
-    let ok = !d.is_empty()
-        && d.len() <= 16
+/// Whether `d` can name an iceoryx2 domain ([`DOMAIN_ENV`]): 1 to 16 ASCII letters, digits,
+/// `-` and `_`. A host of a run across hosts is named so too, so that hosts sharing a
+/// machine can take their names as their domains.
+pub fn is_domain_name(d: &str) -> bool {
+    (1..=16).contains(&d.len())
         && d.bytes()
-            .all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_');
-    if ok {
+            .all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_')
+}
+
+fn valid_domain(d: &str) -> Result<(), TransportError> {
+    if is_domain_name(d) {
         Ok(())
     } else {
         Err(TransportError::InvalidRunId {

@@ -10,6 +10,7 @@
 
 use std::path::{Path, PathBuf};
 
+use super::slots::processes_of;
 use crate::msg::Role;
 use crate::placement::{Host, Placement, PlacementError};
 use crate::scenario::{ClockMode, Scenario};
@@ -49,11 +50,6 @@ impl HostPart {
         self.index
     }
 
-    /// The whole placement.
-    pub fn placement(&self) -> &Placement {
-        &self.placement
-    }
-
     /// `spec` (of `hnav-bridge`) with the arguments for run `run` of `scenario`: in
     /// realtime, samples other than lifecycle events that a link cannot take are dropped
     /// rather than waited for.
@@ -88,21 +84,11 @@ impl HostPart {
 
 /// Every process of a run of `scenario` that a host other than `me` of `placement` runs.
 fn remote_of(placement: &Placement, me: usize, scenario: &Scenario) -> Vec<(Role, u32, String)> {
-    let mut out = Vec::new();
-    let mut add = |role, index| {
-        if let Some(h) = placement.host_of(role, index) {
-            if h.name != placement.hosts()[me].name {
-                out.push((role, index, h.name.clone()));
-            }
-        }
-    };
-    add(Role::Sim, 0);
-    match scenario.coordinator.replicas {
-        1 => add(Role::Coordinator, 0),
-        n => (1..=n).for_each(|id| add(Role::Coordinator, id)),
-    }
-    for i in 0..scenario.agents.len() as u32 {
-        add(Role::Agent, i);
-    }
-    out
+    let me = &placement.hosts()[me].name;
+    processes_of(scenario)
+        .filter_map(|(role, index)| {
+            let host = &placement.host_of(role, index)?.name;
+            (host != me).then(|| (role, index, host.clone()))
+        })
+        .collect()
 }

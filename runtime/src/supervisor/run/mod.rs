@@ -289,13 +289,15 @@ fn supervise(
     let hang = HangWatch::open(transport, scenario)?;
     let deadline = Instant::now() + scenario.startup_timeout();
     let mut roll = Roll::of(&[]);
-    if let Some(h) = slots.host().cloned() {
+    if let Some(h) = slots.host() {
+        h.add_remote(&mut roll);
+    }
+    if slots.host().is_some() {
         // The bridge first: nothing of this host may announce itself before the other hosts
         // can hear it.
         slots.spawn_all(Some(Role::Bridge))?;
         let bridge: Vec<&Child> = slots.children().collect();
-        roll = Roll::of(&bridge);
-        h.add_remote(&mut roll);
+        roll.add(&bridge);
         if ports
             .life
             .wait_up(transport, &bridge, &mut roll, Some(Role::Bridge), deadline)?
@@ -307,9 +309,7 @@ fn supervise(
     slots.spawn_all(None)?;
     slots.write_record(record);
     let children: Vec<&Child> = slots.children().collect();
-    for c in children.iter().filter(|c| c.spec().role != Role::Bridge) {
-        roll.push(c.spec().role, c.spec().index, None);
-    }
+    roll.add(&children);
     let left = deadline.saturating_duration_since(Instant::now());
     if ports
         .life

@@ -60,11 +60,8 @@ impl Slots {
         host: Option<&HostPart>,
     ) -> Self {
         let mut slots = Vec::with_capacity(3 + scenario.agents.len());
-        let here = |role, index| host.is_none_or(|h| h.this().runs(role, index));
-        let mut add = |role: Role, index: u32, program: &str| {
-            if role != Role::Bridge && !here(role, index) {
-                return;
-            }
+        let runs_here = |role, index| host.is_none_or(|h| h.this().runs(role, index));
+        let mut add = |role: Role, index: u32| {
             let rule = match role {
                 Role::Sim => scenario.restart.sim,
                 Role::Coordinator => scenario.restart.coordinator,
@@ -76,7 +73,8 @@ impl Slots {
             let log = dir
                 .join("logs")
                 .join(format!("{}.log", role.node_name(index)));
-            let mut spec = ChildSpec::new(role, index, bin_dir.join(program), log);
+            let program = bin_dir.join(format!("hnav-{}", role.name()));
+            let mut spec = ChildSpec::new(role, index, program, log);
             if let (Role::Bridge, Some(h)) = (role, host) {
                 spec = h.bridge_args(spec, &args.run, scenario);
             } else {
@@ -102,16 +100,10 @@ impl Slots {
                 lost: None,
             });
         };
-        if let Some(h) = host {
-            add(Role::Bridge, h.index() as u32, "hnav-bridge");
-        }
-        add(Role::Sim, 0, "hnav-sim");
-        match scenario.coordinator.replicas {
-            1 => add(Role::Coordinator, 0, "hnav-coordinator"),
-            n => (1..=n).for_each(|id| add(Role::Coordinator, id, "hnav-coordinator")),
-        }
-        for i in 0..scenario.agents.len() as u32 {
-            add(Role::Agent, i, "hnav-agent");
+        let bridge = host.map(|h| (Role::Bridge, h.index() as u32));
+        let local = processes_of(scenario).filter(|&(role, index)| runs_here(role, index));
+        for (role, index) in bridge.into_iter().chain(local) {
+            add(role, index);
         }
         Self {
             slots,
@@ -385,6 +377,19 @@ impl Slots {
         }
         Ok(holds)
     }
+}
+
+/// Every process of a run of `scenario` but the bridges, in the order they start: the sim,
+/// the coordinator (index 0) or its replicas (1 to n, their Raft ids), the agents. Each runs
+/// the binary `hnav-<role>`.
+pub(super) fn processes_of(scenario: &Scenario) -> impl Iterator<Item = (Role, u32)> {
+    let coordinators = match scenario.coordinator.replicas {
+        1 => 0..=0,
+        n => 1..=n,
+    };
+    std::iter::once((Role::Sim, 0))
+        .chain(coordinators.map(|id| (Role::Coordinator, id)))
+        .chain((0..scenario.agents.len() as u32).map(|i| (Role::Agent, i)))
 }
 
 /// That `role`/`index` ended with `exit` and is not restarted for `why`, in words.
