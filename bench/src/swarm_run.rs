@@ -5,8 +5,8 @@
 
 use std::path::{Path, PathBuf};
 
+use hnav_operator::supervisor::child::ChildSpec;
 use hnav_runtime::msg::Role;
-use hnav_runtime::supervisor::child::ChildSpec;
 use hnav_runtime::transport::RunId;
 
 /// The directory of the running executable, where cargo also puts `hnav` and the process

@@ -94,6 +94,16 @@ impl Net {
         format!("10.77.0.{}", i + 1)
     }
 
+    /// `Ok` when [`Net::set_loss`] can work here: `nft` (Debian's nftables) is installed. The
+    /// README's test command does not ask for it, so a test that needs it skips without it.
+    pub fn loss_tool() -> Result<(), String> {
+        match Command::new("nft").arg("--version").output() {
+            Ok(out) if out.status.success() => Ok(()),
+            Ok(out) => Err(format!("`nft --version` failed: {}", out.status)),
+            Err(e) => Err(format!("nftables (`nft`) is not installed here ({e})")),
+        }
+    }
+
     /// Drops `percent` % of the packets every host receives, at random (nftables).
     pub fn set_loss(&self, percent: u32) -> Result<(), String> {
         let rules = format!(

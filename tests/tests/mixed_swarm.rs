@@ -5,8 +5,8 @@
 
 use std::path::Path;
 
+use hnav_operator::recording::MapReader;
 use hnav_runtime::msg::ActivationKind;
-use hnav_runtime::recording::MapReader;
 use hnav_tests::swarm::{lockstep_all_home, repo_root};
 
 /// Runs the scenario in lockstep into `dir`; returns the log segment's bytes.

@@ -8,12 +8,12 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
+use hnav_operator::monitor::feed::{Feed, RunEnd, Waited};
+use hnav_operator::monitor::map::agent_label;
+use hnav_operator::monitor::playback::PlaybackFeed;
+use hnav_operator::monitor::state::{AgentState, ViewState};
+use hnav_operator::monitor::view::{self, Hints};
 use hnav_runtime::consensus_log::{read_log, Record};
-use hnav_runtime::monitor::feed::{Feed, RunEnd, Waited};
-use hnav_runtime::monitor::map::agent_label;
-use hnav_runtime::monitor::playback::PlaybackFeed;
-use hnav_runtime::monitor::state::{AgentState, ViewState};
-use hnav_runtime::monitor::view::{self, Hints};
 use hnav_tests::swarm::{hnav_output, repo_root, workspace_bin, SwarmRun};
 use hnav_tests::tmux::Tmux;
 use hnav_tests::TestRun;
@@ -27,7 +27,7 @@ fn extent(dir: &Path) -> (u64, u64) {
     let records = read_log(dir.join("log")).unwrap().records;
     let last = records.iter().filter_map(Record::round).max().unwrap();
     let (samples, _) =
-        hnav_runtime::recording::TrajectoryReader::open(&dir.join("recording/trajectories.bin"))
+        hnav_operator::recording::TrajectoryReader::open(&dir.join("recording/trajectories.bin"))
             .unwrap()
             .read_all()
             .unwrap();
@@ -126,7 +126,7 @@ fn play_in_the_library(dir: &Path, summary: &serde_json::Value) {
 /// The recording's control period, s.
 fn feed_period_s(dir: &Path) -> f64 {
     let r =
-        hnav_runtime::recording::TrajectoryReader::open(&dir.join("recording/trajectories.bin"))
+        hnav_operator::recording::TrajectoryReader::open(&dir.join("recording/trajectories.bin"))
             .unwrap();
     f64::from(r.header().control_period_us) * 1e-6
 }

@@ -167,7 +167,7 @@ fn a_realtime_run_is_refused() {
 
 #[test]
 fn the_demo_run_exports_to_mcap_with_every_channel() {
-    use hnav_runtime::recording::{self, MapReader, PoseSource, TrajectoryReader};
+    use hnav_operator::recording::{self, MapReader, PoseSource, TrajectoryReader};
     use std::collections::BTreeMap;
 
     let tmp = tempfile::tempdir().unwrap();

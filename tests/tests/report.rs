@@ -6,8 +6,8 @@
 use std::path::Path;
 use std::time::Duration;
 
-use hnav_runtime::recording::{self, MapReader, PoseSource, TrajectoryReader};
-use hnav_runtime::report::{layout::Panel, Layout};
+use hnav_operator::recording::{self, MapReader, PoseSource, TrajectoryReader};
+use hnav_operator::report::{layout::Panel, Layout};
 use hnav_runtime::scenario::Scenario;
 use hnav_tests::swarm::{hnav_output, repo_root, SwarmRun};
 use hnav_tests::TestRun;

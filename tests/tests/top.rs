@@ -5,12 +5,12 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use hnav_runtime::monitor::feed::{Feed, FeedError, Waited};
-use hnav_runtime::monitor::live::LiveFeed;
-use hnav_runtime::monitor::map::agent_label;
-use hnav_runtime::monitor::state::ViewState;
-use hnav_runtime::monitor::view::{self, Hints};
-use hnav_runtime::supervisor::registry::RunRegistry;
+use hnav_operator::monitor::feed::{Feed, FeedError, Waited};
+use hnav_operator::monitor::live::LiveFeed;
+use hnav_operator::monitor::map::agent_label;
+use hnav_operator::monitor::state::ViewState;
+use hnav_operator::monitor::view::{self, Hints};
+use hnav_operator::supervisor::registry::RunRegistry;
 use hnav_tests::swarm::{hnav_output, repo_root, SwarmRun};
 use hnav_tests::tmux::Tmux;
 use hnav_tests::TestRun;

@@ -29,7 +29,7 @@ pub struct EventLine {
 
 /// Reads `DIR/events.jsonl`; a line that does not parse is an error naming it.
 pub fn read_events(dir: &Path) -> Result<Vec<EventLine>, String> {
-    let path = dir.join(hnav_runtime::supervisor::events::EVENTS_FILE);
+    let path = dir.join(hnav_operator::supervisor::events::EVENTS_FILE);
     let text = std::fs::read_to_string(&path)
         .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
     text.lines()

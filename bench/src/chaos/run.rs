@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use hnav_runtime::supervisor::child::{Child, ChildSpec, ExitInfo, Signal};
-use hnav_runtime::supervisor::registry::RunRegistry;
+use hnav_operator::supervisor::child::{Child, ChildSpec, ExitInfo, Signal};
+use hnav_operator::supervisor::registry::RunRegistry;
 use hnav_runtime::transport::{purge_run, RunId, Wake};
 
 use super::checks::{self, CommitCount, EventLine};

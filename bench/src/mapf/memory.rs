@@ -6,8 +6,8 @@
 use std::collections::HashMap;
 use std::path::Path;
 
+use hnav_operator::supervisor::registry::RunRegistry;
 use hnav_runtime::msg::Role;
-use hnav_runtime::supervisor::registry::RunRegistry;
 use hnav_runtime::transport::RunId;
 use serde::{Deserialize, Serialize};
 

@@ -5,8 +5,8 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
+use hnav_operator::supervisor::child::{Child, ExitInfo, Signal};
 use hnav_runtime::consensus_log::{read_log, EndReason, Record, Tally};
-use hnav_runtime::supervisor::child::{Child, ExitInfo, Signal};
 use hnav_runtime::transport::{purge_run, RunId};
 
 use super::instance::{Instance, RunSettings};

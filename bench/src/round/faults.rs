@@ -30,10 +30,10 @@ use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Context, Result};
 
+use hnav_operator::supervisor::child::{Child, ChildSpec, ExitInfo, Signal};
+use hnav_operator::supervisor::exit_fd::WatchMode;
 use hnav_runtime::msg::{Lifecycle, LifecycleEvent, Role};
 use hnav_runtime::scenario::FsyncPolicy;
-use hnav_runtime::supervisor::child::{Child, ChildSpec, ExitInfo, Signal};
-use hnav_runtime::supervisor::exit_fd::WatchMode;
 use hnav_runtime::topics;
 use hnav_runtime::transport::{purge_run, RunId, Sender, Transport, Wake};
 

@@ -8,12 +8,12 @@ use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Context, Result};
 
+use hnav_operator::supervisor::child::{Child, ChildSpec, ExitInfo, Signal};
+use hnav_operator::supervisor::run::NO_BELL_ENV;
+use hnav_operator::supervisor::startup::{Startup, SupervisorPorts};
 use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::msg::{Lifecycle, Role, StopReason};
 use hnav_runtime::scenario::FsyncPolicy;
-use hnav_runtime::supervisor::child::{Child, ChildSpec, ExitInfo, Signal};
-use hnav_runtime::supervisor::run::NO_BELL_ENV;
-use hnav_runtime::supervisor::startup::{Startup, SupervisorPorts};
 use hnav_runtime::transport::{purge_run, Bell, RunId, Transport, BELL_ENV};
 
 use super::layout::Layout;

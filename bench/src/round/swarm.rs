@@ -7,9 +7,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::{bail, Result};
 
+use hnav_operator::supervisor::child::Child;
+use hnav_operator::supervisor::startup::SupervisorPorts;
 use hnav_runtime::msg::{Candidate, CandidateFlags, Commit, Lifecycle, Role};
-use hnav_runtime::supervisor::child::Child;
-use hnav_runtime::supervisor::startup::SupervisorPorts;
 use hnav_runtime::topics;
 use hnav_runtime::transport::{
     AttachmentId, Bell, BellWatch, Receiver, RunId, Sender, Transport, Wake,

@@ -207,7 +207,7 @@ impl ReplicaRole {
     /// Replaces the role file in the replica's log directory `dir`, whole or not at all.
     pub fn write(&self, dir: &Path) -> std::io::Result<()> {
         let text = serde_json::to_string(self).map_err(std::io::Error::other)?;
-        crate::supervisor::summary::write_atomically(&dir.join(ROLE_FILE), text.as_bytes())
+        crate::durable::replace_file(&dir.join(ROLE_FILE), text.as_bytes())
     }
 
     /// The role file of the replica's log directory `dir`, if there is a readable one.

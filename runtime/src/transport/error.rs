@@ -51,7 +51,9 @@ pub enum TransportError {
 }
 
 impl TransportError {
-    pub(crate) fn ipc(op: &'static str, service: &str, e: impl core::fmt::Debug) -> Self {
+    /// An iceoryx2 call `op` on `service` that failed with `e` (also for the operator's
+    /// direct iceoryx2 calls: `hnav services` lists nodes and services).
+    pub fn ipc(op: &'static str, service: &str, e: impl core::fmt::Debug) -> Self {
         Self::Iceoryx {
             op,
             service: service.to_string(),

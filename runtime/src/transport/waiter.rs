@@ -287,8 +287,9 @@ impl Waiter {
         Ok(attachment)
     }
 
-    /// Wakes the waiter when `fd` becomes readable (the supervisor's child exit descriptors).
-    pub(crate) fn attach_fd<'a, T>(&self, fd: &'a T) -> Result<Attachment<'_, 'a>, TransportError>
+    /// Wakes the waiter when `fd` becomes readable (the supervisor's child exit descriptors, a
+    /// recorder's stop pipe).
+    pub fn attach_fd<'a, T>(&self, fd: &'a T) -> Result<Attachment<'_, 'a>, TransportError>
     where
         T: SynchronousMultiplexing + Debug + ?Sized,
     {
@@ -397,7 +398,6 @@ impl Waiter {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::supervisor::exit_fd::{ExitFd, WatchMode};
     use crate::transport::{purge_run, RunId, Transport};
 
     /// A run of one test, purged even when the test fails.
@@ -407,22 +407,6 @@ mod tests {
         fn drop(&mut self) {
             let _ = purge_run(&self.0);
         }
-    }
-
-    #[test]
-    fn a_child_exit_descriptor_wakes_the_waiter() {
-        let run = Run(RunId::unique("waitfd"));
-        let t = Transport::builder(&run.0)
-            .handle_signals(false)
-            .create()
-            .unwrap();
-        let waiter = t.waiter().unwrap().with_recheck(None);
-        let mut child = std::process::Command::new("true").spawn().unwrap();
-        let exit = ExitFd::watch(child.id(), WatchMode::Auto).unwrap();
-        let _attached = waiter.attach_fd(&exit).unwrap();
-        let deadline = Instant::now() + Duration::from_secs(30);
-        assert_eq!(waiter.wait(Some(deadline)).unwrap(), Wake::Data);
-        assert!(child.wait().unwrap().success());
     }
 
     #[test]

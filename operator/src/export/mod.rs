@@ -1,0 +1,487 @@
+//! `hnav log export DIR --mcap out.mcap`: a run as an MCAP file that Foxglove Studio opens.
+//!
+//! Every channel's messages are JSON (message encoding `json`) with a JSON schema (schema
+//! encoding `jsonschema`, [`schemas`]). Log time is simulated time: `round x control
+//! period` for what comes from the consensus log (a lockstep round `r` is decided once `r`
+//! periods have been simulated), the samples' own `t_ns` for the recording.
+//!
+//! | topic | schema | from | one message per |
+//! |---|---|---|---|
+//! | `/map` | `foxglove.Grid` | the scenario (`invocation.json`) | the run (field `occupied`, 1 = wall) |
+//! | `/robots/<i>/truth` | `foxglove.PoseInFrame` | `recording/trajectories.bin` | ground-truth sample of robot `i` |
+//! | `/robots/<i>/estimate` | `foxglove.PoseInFrame` | `recording/trajectories.bin` | dead-reckoned sample of robot `i` |
+//! | `/robots/<i>/neural_map` | `foxglove.Grid` | `recording/maps.bin` | snapshot of agent `i` (fields `activation`, `log10_activation`) |
+//! | `/commits` | `hnav.CommittedCells` | `log/` | round: the cells its commit gave |
+//! | `/decisions` | `hnav.Decision` | `log/` | decision of every round |
+//! | `/replans` | `hnav.Replan` | `log/` | replan record |
+//!
+//! Poses and grids are in one frame, `map`: metres, x along columns, y along rows (the sim's
+//! frame; cell `(x, y)` spans `[x c, (x + 1) c) x [y c, (y + 1) c)`), z up. A missing
+//! recording file, or a scenario that cannot be loaded, leaves its channels out and is
+//! reported in [`ExportReport::notes`]; a damaged file is an error naming it and the offset.
+
+pub mod schemas;
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{BufWriter, Seek, Write};
+use std::path::{Path, PathBuf};
+
+use base64::Engine as _;
+use serde_json::{json, Value};
+
+use crate::invocation::Invocation;
+use crate::recording::{
+    self, MapReader, MapSnapshot, PoseSample, PoseSource, RecordingError, TrajectoryReader,
+};
+use hnav_runtime::consensus_log::{read_decided, LogError, LoggedDecision, Record, RunHeader};
+use hnav_runtime::msg::{ConflictKind, Verdict, NO_CELL};
+use hnav_runtime::scenario::Scenario;
+
+/// The frame every pose and grid is in.
+pub const FRAME: &str = "map";
+/// The control period assumed when the run's scenario cannot be loaded (the default
+/// `[sim]`: 100 Hz odometry, 1 ms steps).
+pub const DEFAULT_PERIOD_NS: u64 = 10_000_000;
+/// The cell size assumed without the scenario and the trajectory file (the default
+/// `[robot] cell_size_m`).
+pub const DEFAULT_CELL_SIZE_M: f64 = 0.16;
+/// `log10_activation` of a neuron at exactly 0 (below the smallest `f32`).
+const LOG10_OF_ZERO: f32 = -46.0;
+
+/// Why an export failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    /// The consensus log cannot be read (names the file and offset).
+    #[error(transparent)]
+    Log(#[from] LogError),
+    /// The log has no header.
+    #[error("{}: the log has no run header", dir.display())]
+    NoHeader {
+        /// The log directory.
+        dir: PathBuf,
+    },
+    /// A recording file is damaged (names the file and offset).
+    #[error(transparent)]
+    Recording(#[from] RecordingError),
+    /// The output cannot be written.
+    #[error("{}: cannot write the MCAP file: {problem}", path.display())]
+    Write {
+        /// The output file.
+        path: PathBuf,
+        /// What went wrong.
+        problem: String,
+    },
+}
+
+/// What an export wrote.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ExportReport {
+    /// Per topic: its schema's name and how many messages it got.
+    pub channels: BTreeMap<String, (String, u64)>,
+    /// What was missing or assumed (missing recording files, torn tails, no scenario).
+    pub notes: Vec<String>,
+}
+
+impl ExportReport {
+    /// Messages in all channels.
+    pub fn messages(&self) -> u64 {
+        self.channels.values().map(|c| c.1).sum()
+    }
+}
+
+/// What the export knows of the run beyond its log.
+struct RunInfo {
+    header: RunHeader,
+    period_ns: u64,
+    cell_size_m: f64,
+    scenario: Option<Scenario>,
+}
+
+/// Writes the run in `run_dir` (holding `log/`, maybe `recording/` and `invocation.json`)
+/// to the MCAP file `out`.
+pub fn export_mcap(run_dir: &Path, out: &Path) -> Result<ExportReport, ExportError> {
+    let log_dir = run_dir.join("log");
+    let records = read_decided(&log_dir)?.records;
+    let header = match records.first() {
+        Some(Record::Header(h)) => h.clone(),
+        _ => return Err(ExportError::NoHeader { dir: log_dir }),
+    };
+    let mut report = ExportReport::default();
+    let info = run_info(run_dir, header, &mut report.notes);
+    let write_err = |e: &dyn std::fmt::Display| ExportError::Write {
+        path: out.to_path_buf(),
+        problem: e.to_string(),
+    };
+    let file = File::create(out).map_err(|e| write_err(&e))?;
+    let mut w = Mcap::new(BufWriter::new(file)).map_err(|e| write_err(&e))?;
+    let written = write_all(&mut w, run_dir, &records, &info, &mut report.notes)
+        .and_then(|()| w.finish().map_err(|e| write_err(&e)));
+    match written {
+        Ok(counts) => report.channels = counts,
+        Err(e) => {
+            // No half-written file that looks like an export.
+            let _ = std::fs::remove_file(out);
+            return Err(match e {
+                ExportError::Write { problem, .. } => write_err(&problem),
+                other => other,
+            });
+        }
+    }
+    Ok(report)
+}
+
+/// The period and cell size of the run: from its scenario when `invocation.json` names one
+/// that still hashes as the log's header says, else the defaults (noted).
+fn run_info(run_dir: &Path, header: RunHeader, notes: &mut Vec<String>) -> RunInfo {
+    let scenario = Invocation::read(run_dir)
+        .map_err(|e| e.to_string())
+        .and_then(|inv| {
+            let s = inv
+                .process_args("export", run_dir)
+                .scenario()
+                .map_err(|e| e.to_string())?;
+            if s.scenario_hash() == header.scenario_hash {
+                Ok(s)
+            } else {
+                Err(format!(
+                    "{}: the scenario no longer hashes as the log's header says",
+                    inv.scenario.display()
+                ))
+            }
+        });
+    match scenario {
+        Ok(s) => RunInfo {
+            period_ns: s.sim.steps_per_control_period() * u64::from(s.sim.step_ms) * 1_000_000,
+            cell_size_m: s.robot.cell_size_m,
+            scenario: Some(s),
+            header,
+        },
+        Err(why) => {
+            notes.push(format!(
+                "no scenario ({why}): no /map channel; rounds timed at {} ms, cells of {} m",
+                DEFAULT_PERIOD_NS / 1_000_000,
+                DEFAULT_CELL_SIZE_M
+            ));
+            RunInfo {
+                header,
+                period_ns: DEFAULT_PERIOD_NS,
+                cell_size_m: DEFAULT_CELL_SIZE_M,
+                scenario: None,
+            }
+        }
+    }
+}
+
+fn write_all(
+    w: &mut Mcap<impl Write + Seek>,
+    run_dir: &Path,
+    records: &[Record],
+    info: &RunInfo,
+    notes: &mut Vec<String>,
+) -> Result<(), ExportError> {
+    if let Some(s) = &info.scenario {
+        let g = &s.map.grid;
+        let occupied: Vec<u8> = g
+            .tiles()
+            .iter()
+            .map(|t| u8::from(!t.is_passable()))
+            .collect();
+        let fields = [("occupied", 0, NUMERIC_UINT8)];
+        let msg = grid_message(0, (g.width(), info.cell_size_m), 1, &fields, &occupied);
+        w.message("/map", schemas::GRID, 0, &msg)?;
+    }
+    let rec_dir = run_dir.join(recording::DIR);
+    let trajectories = rec_dir.join(recording::TRAJECTORIES);
+    let mut cell_size = info.cell_size_m;
+    if trajectories.exists() {
+        let mut r = TrajectoryReader::open(&trajectories)?;
+        cell_size = f64::from(r.header().cell_size_m);
+        for i in 0..r.header().robots {
+            w.channel(&format!("/robots/{i}/truth"), schemas::POSE_IN_FRAME)?;
+            w.channel(&format!("/robots/{i}/estimate"), schemas::POSE_IN_FRAME)?;
+        }
+        while let Some(s) = r.next_sample()? {
+            let topic = match s.source {
+                PoseSource::Truth => format!("/robots/{}/truth", s.robot),
+                PoseSource::Estimate => format!("/robots/{}/estimate", s.robot),
+            };
+            w.message(&topic, schemas::POSE_IN_FRAME, s.t_ns, &pose_message(&s))?;
+        }
+        if r.torn_tail() > 0 {
+            notes.push(format!(
+                "{}: a torn tail of {} bytes skipped",
+                trajectories.display(),
+                r.torn_tail()
+            ));
+        }
+    } else {
+        notes.push(format!(
+            "{} missing: no /robots/<i>/truth and /robots/<i>/estimate channels",
+            trajectories.display()
+        ));
+    }
+    let maps = rec_dir.join(recording::MAPS);
+    if maps.exists() {
+        let mut r = MapReader::open(&maps)?;
+        for i in 0..info.header.agents.len() {
+            w.channel(&format!("/robots/{i}/neural_map"), schemas::GRID)?;
+        }
+        while let Some(snap) = r.next_snapshot()? {
+            let topic = format!("/robots/{}/neural_map", snap.header.agent);
+            w.message(
+                &topic,
+                schemas::GRID,
+                snap.t_ns,
+                &neural_map_message(&snap, cell_size),
+            )?;
+        }
+        if r.torn_tail() > 0 {
+            notes.push(format!(
+                "{}: a torn tail of {} bytes skipped",
+                maps.display(),
+                r.torn_tail()
+            ));
+        }
+    } else {
+        notes.push(format!(
+            "{} missing: no /robots/<i>/neural_map channels",
+            maps.display()
+        ));
+    }
+    log_channels(w, records, info)
+}
+
+/// `/commits`, `/decisions` and `/replans`, from the consensus log.
+fn log_channels(
+    w: &mut Mcap<impl Write + Seek>,
+    records: &[Record],
+    info: &RunInfo,
+) -> Result<(), ExportError> {
+    let width = info.header.width;
+    for (topic, schema) in [
+        ("/commits", schemas::COMMITTED_CELLS),
+        ("/decisions", schemas::DECISION),
+        ("/replans", schemas::REPLAN),
+    ] {
+        w.channel(topic, schema)?;
+    }
+    for r in records {
+        let Some(round) = r.round() else { continue };
+        let t = round.saturating_mul(info.period_ns);
+        match r {
+            Record::Round(rec) => {
+                let cells: Vec<Value> = rec
+                    .decisions
+                    .iter()
+                    .filter(|d| d.cell != NO_CELL)
+                    .map(|d| json!({"agent": d.agent, "cell": cell(d.cell, width)}))
+                    .collect();
+                let commit = json!({"timestamp": stamp(t), "round": round, "cells": cells});
+                w.message("/commits", schemas::COMMITTED_CELLS, t, &commit)?;
+                for d in &rec.decisions {
+                    w.message(
+                        "/decisions",
+                        schemas::DECISION,
+                        t,
+                        &decision_message(t, round, d, width),
+                    )?;
+                }
+            }
+            Record::Replan(p) => {
+                let msg = json!({
+                    "timestamp": stamp(t),
+                    "round": round,
+                    "agent": p.agent,
+                    "planner": p.planner,
+                    "found": p.found,
+                    "waypoints": p.waypoints.iter().map(|&c| cell(c, width)).collect::<Vec<_>>(),
+                });
+                w.message("/replans", schemas::REPLAN, t, &msg)?;
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+const NUMERIC_UINT8: u8 = 1;
+const NUMERIC_FLOAT32: u8 = 7;
+const DIRECTIONS: [&str; 8] = ["N", "NE", "E", "SE", "S", "SW", "W", "NW"];
+
+fn stamp(t_ns: u64) -> Value {
+    json!({"sec": t_ns / 1_000_000_000, "nsec": t_ns % 1_000_000_000})
+}
+
+fn cell(index: u32, width: u32) -> Value {
+    if index == NO_CELL || width == 0 {
+        Value::Null
+    } else {
+        json!([index % width, index / width])
+    }
+}
+
+fn decision_message(t: u64, round: u64, d: &LoggedDecision, width: u32) -> Value {
+    let name = |n: Option<&str>, code: u8| n.map_or_else(|| code.to_string(), str::to_string);
+    json!({
+        "timestamp": stamp(t),
+        "round": round,
+        "agent": d.agent,
+        "verdict": name(Verdict::from_u8(d.verdict).map(Verdict::name), d.verdict),
+        "kind": name(ConflictKind::from_u8(d.kind).map(ConflictKind::name), d.kind),
+        "refused": (0..8).filter(|b| d.refused & (1 << b) != 0).map(|b| DIRECTIONS[b]).collect::<Vec<_>>(),
+        "cell": cell(d.cell, width),
+        "waypoint": cell(d.waypoint, width),
+    })
+}
+
+fn pose_message(s: &PoseSample) -> Value {
+    let half = f64::from(s.theta_rad) / 2.0;
+    json!({
+        "timestamp": stamp(s.t_ns),
+        "frame_id": FRAME,
+        "pose": {
+            "position": {"x": f64::from(s.x_m), "y": f64::from(s.y_m), "z": 0.0},
+            "orientation": {"x": 0.0, "y": 0.0, "z": half.sin(), "w": half.cos()}
+        }
+    })
+}
+
+/// A `foxglove.Grid` at the frame's origin: `columns` cells of `cell_m` a row, each
+/// `cell_stride` bytes of `data` holding `fields` (name, offset, numeric type).
+fn grid_message(
+    t_ns: u64,
+    (columns, cell_m): (u32, f64),
+    cell_stride: u32,
+    fields: &[(&str, u32, u8)],
+    data: &[u8],
+) -> Value {
+    json!({
+        "timestamp": stamp(t_ns),
+        "frame_id": FRAME,
+        "pose": {
+            "position": {"x": 0.0, "y": 0.0, "z": 0.0},
+            "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}
+        },
+        "column_count": columns,
+        "cell_size": {"x": cell_m, "y": cell_m},
+        "row_stride": columns * cell_stride,
+        "cell_stride": cell_stride,
+        "fields": fields.iter().map(|(name, offset, ty)| json!({"name": name, "offset": offset, "type": ty})).collect::<Vec<_>>(),
+        "data": base64::engine::general_purpose::STANDARD.encode(data),
+    })
+}
+
+/// A neural map as a grid of its activations and their log10, since the wave front decays
+/// geometrically and a linear colour scale shows only the cells next to the target.
+fn neural_map_message(snap: &MapSnapshot, cell_m: f64) -> Value {
+    let mut data = Vec::with_capacity(snap.values.len() * 8);
+    for &v in &snap.values {
+        let log = if v > 0.0 { v.log10() } else { LOG10_OF_ZERO };
+        data.extend_from_slice(&v.to_le_bytes());
+        data.extend_from_slice(&log.to_le_bytes());
+    }
+    let fields = [
+        ("activation", 0, NUMERIC_FLOAT32),
+        ("log10_activation", 4, NUMERIC_FLOAT32),
+    ];
+    grid_message(snap.t_ns, (snap.header.width, cell_m), 8, &fields, &data)
+}
+
+/// The MCAP writer with one schema per name, one channel per topic and a count per channel.
+struct Mcap<W: Write + Seek> {
+    writer: mcap::Writer<W>,
+    schemas: BTreeMap<&'static str, u16>,
+    channels: BTreeMap<String, u16>,
+    sequences: BTreeMap<u16, u32>,
+    counts: BTreeMap<String, (String, u64)>,
+}
+
+impl<W: Write + Seek> Mcap<W> {
+    fn new(out: W) -> mcap::McapResult<Self> {
+        let writer = mcap::WriteOptions::new()
+            .compression(None)
+            .profile("")
+            .library(concat!("hnav ", env!("CARGO_PKG_VERSION")))
+            .create(out)?;
+        Ok(Mcap {
+            writer,
+            schemas: BTreeMap::new(),
+            channels: BTreeMap::new(),
+            sequences: BTreeMap::new(),
+            counts: BTreeMap::new(),
+        })
+    }
+
+    fn error(e: mcap::McapError) -> ExportError {
+        ExportError::Write {
+            path: PathBuf::new(),
+            problem: e.to_string(),
+        }
+    }
+
+    /// The channel of `topic` (made, with its schema, on first use).
+    fn channel(&mut self, topic: &str, schema: &'static str) -> Result<u16, ExportError> {
+        if let Some(&id) = self.channels.get(topic) {
+            return Ok(id);
+        }
+        let schema_id = match self.schemas.get(schema) {
+            Some(&id) => id,
+            None => {
+                let id = self
+                    .writer
+                    .add_schema(schema, "jsonschema", &schemas::schema(schema))
+                    .map_err(Self::error)?;
+                self.schemas.insert(schema, id);
+                id
+            }
+        };
+        let id = self
+            .writer
+            .add_channel(schema_id, topic, "json", &BTreeMap::new())
+            .map_err(Self::error)?;
+        self.channels.insert(topic.to_string(), id);
+        self.counts
+            .insert(topic.to_string(), (schema.to_string(), 0));
+        Ok(id)
+    }
+
+    fn message(
+        &mut self,
+        topic: &str,
+        schema: &'static str,
+        t_ns: u64,
+        msg: &Value,
+    ) -> Result<(), ExportError> {
+        let channel_id = self.channel(topic, schema)?;
+        let seq = self.sequences.entry(channel_id).or_insert(0);
+        *seq += 1;
+        let header = mcap::records::MessageHeader {
+            channel_id,
+            sequence: *seq,
+            log_time: t_ns,
+            publish_time: t_ns,
+        };
+        let data = serde_json::to_vec(msg).map_err(|e| ExportError::Write {
+            path: PathBuf::new(),
+            problem: e.to_string(),
+        })?;
+        self.writer
+            .write_to_known_channel(&header, &data)
+            .map_err(Self::error)?;
+        if let Some(c) = self.counts.get_mut(topic) {
+            c.1 += 1;
+        }
+        Ok(())
+    }
+
+    /// Writes the summary and footer, flushes the file and returns the counts.
+    fn finish(mut self) -> Result<BTreeMap<String, (String, u64)>, String> {
+        self.writer.finish().map_err(|e| e.to_string())?;
+        self.writer
+            .into_inner()
+            .flush()
+            .map_err(|e| e.to_string())?;
+        Ok(self.counts)
+    }
+}

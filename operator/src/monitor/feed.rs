@@ -1,0 +1,151 @@
+//! Where the view's data comes from: the [`Feed`] trait and what it yields.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use super::health::HealthRow;
+use super::state::RunInfo;
+use crate::supervisor::registry::LiveRunError;
+use hnav_runtime::msg::{Commit, Lifecycle, Progress, Truth};
+use hnav_runtime::scenario::ScenarioError;
+use hnav_runtime::transport::TransportError;
+
+/// How a run's view came to its end.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunEnd {
+    /// The coordinator reported every agent at its goal (or unable to reach it).
+    AllAtGoal,
+    /// The coordinator committed the last round of a lockstep run's time limit.
+    TimeLimit,
+    /// The supervisor published `Stop` (its own end, a signal, a run that cannot go on).
+    Stopped,
+    /// The supervisor is gone: the registry no longer lists the run, or its pid died.
+    SupervisorGone,
+}
+
+impl RunEnd {
+    /// In words, for the status line.
+    pub fn describe(self) -> &'static str {
+        match self {
+            RunEnd::AllAtGoal => "every robot at its goal",
+            RunEnd::TimeLimit => "time limit reached",
+            RunEnd::Stopped => "stopped by the supervisor",
+            RunEnd::SupervisorGone => "the supervisor is gone",
+        }
+    }
+}
+
+/// One thing a feed learned. Borrowed: a live feed hands out the payload in shared memory,
+/// without a copy.
+#[derive(Debug, Clone, Copy)]
+pub enum Update<'a> {
+    /// Ground truth: every robot's pose, the collisions so far.
+    Truth(&'a Truth),
+    /// One round's decisions.
+    Commit(&'a Commit),
+    /// The coordinator's tally.
+    Progress(&'a Progress),
+    /// A process came up, went down, was restarted or lost; `Stop`.
+    Lifecycle(&'a Lifecycle),
+    /// The run's processes now.
+    Health(&'a [HealthRow]),
+    /// The run is over; nothing follows.
+    Ended(RunEnd),
+}
+
+/// What [`Feed::wait`] returned for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Waited {
+    /// New updates may be there, or the deadline passed: pump.
+    Ready,
+    /// SIGINT or SIGTERM: the viewer should end.
+    Stop,
+}
+
+/// A source of what the view shows. See the [module docs](super) for the seam.
+pub trait Feed {
+    /// The run's static picture, known before any update.
+    fn info(&self) -> &RunInfo;
+
+    /// Blocks until updates may be there, `until` passes or the process is asked to stop.
+    /// Never busy: a live feed sleeps in its `Waiter`.
+    fn wait(&mut self, until: Instant) -> Result<Waited, FeedError>;
+
+    /// Hands every update available now to `apply`, in the order the view should fold them,
+    /// without blocking. After it has yielded [`Update::Ended`] it yields nothing more.
+    fn pump(&mut self, apply: &mut dyn FnMut(Update<'_>)) -> Result<(), FeedError>;
+}
+
+/// Why a feed could not be opened or read.
+#[derive(Debug, thiserror::Error)]
+pub enum FeedError {
+    /// The registry holds no live run.
+    #[error("no live run in the run registry {} (`hnav run` starts one)", dir.display())]
+    NoRuns {
+        /// The registry directory.
+        dir: PathBuf,
+    },
+    /// More than one live run, and none named.
+    #[error("{} live runs, name one (`hnav top RUN`): {}", runs.len(), runs.join(", "))]
+    SeveralRuns {
+        /// `id (dir)` of each.
+        runs: Vec<String>,
+    },
+    /// No live run has this id or directory.
+    #[error("no live run `{run}` (neither a run id nor the directory of one) in the run registry {} (`hnav ps` lists the live runs)", dir.display())]
+    NotFound {
+        /// The argument.
+        run: String,
+        /// The registry directory.
+        dir: PathBuf,
+    },
+    /// The run named is unknown or dead.
+    #[error(transparent)]
+    Lookup(#[from] LiveRunError),
+    /// The registry entry does not say which scenario the run's processes run.
+    #[error("run `{run}` does not name its scenario in the run registry (a supervisor older than `hnav top`)")]
+    NoScenario {
+        /// The run id.
+        run: String,
+    },
+    /// The run's scenario cannot be loaded any more.
+    #[error("run `{run}`: {source}")]
+    Scenario {
+        /// The run id.
+        run: String,
+        /// Why.
+        source: ScenarioError,
+    },
+    /// The scenario file was changed after the run started.
+    #[error("run `{run}`: {} is not the scenario the run started with (its hash is {now:016x}, the run's log says {logged:016x})", path.display())]
+    ScenarioChanged {
+        /// The run id.
+        run: String,
+        /// The scenario file.
+        path: PathBuf,
+        /// Its hash now.
+        now: u64,
+        /// The hash in the run's log header.
+        logged: u64,
+    },
+    /// A run directory that cannot be played back (its log, map or summary), or a speed out
+    /// of range.
+    #[error("{}: {problem}", path.display())]
+    Playback {
+        /// The run directory, or the file at fault.
+        path: PathBuf,
+        /// What is wrong.
+        problem: String,
+    },
+    /// The recording's trajectories could not be read.
+    #[error(transparent)]
+    Recording(#[from] crate::recording::RecordingError),
+    /// The run's topics could not be opened or read.
+    #[error("run `{run}`: {source}")]
+    Transport {
+        /// The run id.
+        run: String,
+        /// Why.
+        source: TransportError,
+    },
+}

@@ -1,0 +1,257 @@
+use super::*;
+
+/// A 4 x 2 room, cells 1 m wide, agent 0 from cell 0 to cell 2, agent 1 from 4 to 7.
+fn view() -> ViewState {
+    ViewState::new(RunInfo {
+        run_id: "t".into(),
+        mode: "lockstep".into(),
+        grid: Grid::new(4, 2).unwrap(),
+        starts: vec![0, 4],
+        goals: vec![2, 7],
+        cell_size_m: 1.0,
+    })
+}
+
+fn commit(round: u64, decisions: &[(u32, Verdict, ConflictKind, u32)]) -> Commit {
+    let mut c = Commit {
+        round,
+        count: decisions.len() as u32,
+        ..Commit::default()
+    };
+    for (slot, &(agent, verdict, kind, cell)) in c.decisions.iter_mut().zip(decisions) {
+        *slot = Decision {
+            agent,
+            verdict: verdict as u8,
+            kind: kind as u8,
+            cell,
+            ..Decision::default()
+        };
+    }
+    c
+}
+
+fn truth(period: u64, poses: &[(f64, f64)]) -> Truth {
+    let mut t = Truth {
+        period,
+        robots: poses.len() as u32,
+        ..Truth::default()
+    };
+    for (slot, &(x_m, y_m)) in t.poses.iter_mut().zip(poses) {
+        *slot = Pose {
+            x_m,
+            y_m,
+            theta_rad: 0.0,
+        };
+    }
+    t
+}
+
+fn states(v: &ViewState) -> Vec<AgentState> {
+    v.agents.iter().map(AgentView::state).collect()
+}
+
+use ConflictKind as K;
+use Verdict as V;
+
+#[test]
+fn decisions_and_ground_truth_make_the_states() {
+    let mut v = view();
+    let now = Instant::now();
+    assert_eq!(states(&v), [AgentState::Waiting; 2]);
+    v.apply(Update::Truth(&truth(1, &[(0.5, 0.5), (0.5, 1.5)])), now);
+    v.apply(
+        Update::Commit(&commit(
+            1,
+            &[(0, V::Accept, K::None, 1), (1, V::Block, K::HeadOn, 0)],
+        )),
+        now,
+    );
+    assert_eq!(states(&v), [AgentState::Moving, AgentState::Blocked]);
+    // Driving: "held, nothing asked" keeps a pending move moving, even with the pose still.
+    v.apply(Update::Truth(&truth(2, &[(0.5, 0.5), (0.5, 1.5)])), now);
+    v.apply(
+        Update::Commit(&commit(
+            2,
+            &[(0, V::Hold, K::None, 0), (1, V::Replan, K::None, 0)],
+        )),
+        now,
+    );
+    assert_eq!(states(&v), [AgentState::Moving, AgentState::Replanning]);
+    // Agent 0 arrives in cell 1 and stands there: held by a conflict now.
+    v.apply(Update::Truth(&truth(3, &[(1.5, 0.5), (0.5, 1.5)])), now);
+    v.apply(Update::Truth(&truth(4, &[(1.5, 0.5), (0.5, 1.5)])), now);
+    v.apply(
+        Update::Commit(&commit(
+            3,
+            &[(0, V::Hold, K::Crossing, 0), (1, V::Hold, K::Reserved, 0)],
+        )),
+        now,
+    );
+    assert_eq!(states(&v), [AgentState::Held, AgentState::Held]);
+    // On to the goal: moving until ground truth is in it, then at goal.
+    v.apply(
+        Update::Commit(&commit(
+            4,
+            &[(0, V::Accept, K::None, 2), (1, V::Hold, K::None, 0)],
+        )),
+        now,
+    );
+    v.apply(Update::Truth(&truth(5, &[(1.9, 0.5), (0.5, 1.5)])), now);
+    assert_eq!(v.agents[0].state(), AgentState::Moving);
+    v.apply(Update::Truth(&truth(6, &[(2.1, 0.5), (0.5, 1.5)])), now);
+    v.apply(
+        Update::Commit(&commit(
+            5,
+            &[(0, V::Hold, K::None, 0), (1, V::Hold, K::None, 0)],
+        )),
+        now,
+    );
+    assert_eq!(v.agents[0].state(), AgentState::AtGoal);
+    assert_eq!(v.at_goal(), 1);
+}
+
+#[test]
+fn a_robot_that_moves_is_moving_even_when_its_accept_was_missed() {
+    let mut v = view();
+    let now = Instant::now();
+    v.apply(Update::Commit(&commit(1, &[(0, V::Hold, K::None, 0)])), now);
+    v.apply(Update::Truth(&truth(1, &[(0.5, 0.5), (0.5, 1.5)])), now);
+    assert_eq!(v.agents[0].state(), AgentState::Held);
+    v.apply(Update::Truth(&truth(2, &[(0.8, 0.5), (0.5, 1.5)])), now);
+    assert_eq!(v.agents[0].state(), AgentState::Moving);
+    // An older period (a restarted sim's repeat) changes nothing.
+    v.apply(Update::Truth(&truth(1, &[(3.5, 0.5), (0.5, 1.5)])), now);
+    assert_eq!(v.agents[0].cell, Some(0));
+}
+
+#[test]
+fn down_and_lost_come_from_the_lifecycle_topic() {
+    let mut v = view();
+    let now = Instant::now();
+    v.apply(Update::Lifecycle(&Lifecycle::down(Role::Agent, 1, 0)), now);
+    assert_eq!(v.agents[1].state(), AgentState::Down);
+    v.apply(
+        Update::Lifecycle(&Lifecycle::restarted(Role::Agent, 1, 1)),
+        now,
+    );
+    assert_eq!(v.agents[1].state(), AgentState::Waiting);
+    v.apply(Update::Lifecycle(&Lifecycle::lost(Role::Agent, 0, 3)), now);
+    assert_eq!(v.agents[0].state(), AgentState::Down);
+    assert!(v.agents[0].lost());
+    // The coordinator's death is a line of its own and nobody's state.
+    v.apply(
+        Update::Lifecycle(&Lifecycle::down(Role::Coordinator, 0, 0)),
+        now,
+    );
+    let events: Vec<_> = v
+        .recent
+        .iter()
+        .map(|l| match l {
+            RecentLine::Process { role, event, .. } => (role.name(), event.name()),
+            RecentLine::Decision { .. } => ("decision", ""),
+        })
+        .collect();
+    assert_eq!(
+        events,
+        [
+            ("agent", "down"),
+            ("agent", "restarted"),
+            ("agent", "lost"),
+            ("coordinator", "down")
+        ]
+    );
+    assert_eq!(v.ended, None);
+    v.apply(
+        Update::Lifecycle(&Lifecycle::stop(hnav_runtime::msg::StopReason::Requested)),
+        now,
+    );
+    assert_eq!(v.ended, Some(RunEnd::Stopped));
+}
+
+#[test]
+fn the_latest_records_skip_idle_holds_and_keep_ten() {
+    let mut v = view();
+    let now = Instant::now();
+    for round in 1..=15 {
+        v.apply(
+            Update::Commit(&commit(
+                round,
+                &[(0, V::Accept, K::None, 1), (1, V::Hold, K::None, 0)],
+            )),
+            now,
+        );
+    }
+    assert_eq!(v.recent.len(), RECENT);
+    let rounds: Vec<u64> = v
+        .recent
+        .iter()
+        .map(|l| match l {
+            RecentLine::Decision { round, agent, .. } => {
+                assert_eq!(*agent, 0);
+                *round
+            }
+            RecentLine::Process { .. } => 0,
+        })
+        .collect();
+    assert_eq!(rounds, (6..=15).collect::<Vec<_>>());
+}
+
+#[test]
+fn missed_and_repeated_commits_are_counted_once() {
+    let mut v = view();
+    let now = Instant::now();
+    v.apply(Update::Commit(&commit(10, &[])), now);
+    v.apply(Update::Commit(&commit(14, &[])), now);
+    v.apply(Update::Commit(&commit(14, &[])), now);
+    v.apply(Update::Commit(&commit(15, &[])), now);
+    assert_eq!((v.round, v.missed_commits), (15, 3));
+}
+
+#[test]
+fn progress_ends_the_run_with_its_reason() {
+    let mut v = view();
+    let now = Instant::now();
+    v.apply(
+        Update::Progress(&Progress {
+            round: 7,
+            ..Progress::default()
+        }),
+        now,
+    );
+    assert_eq!((v.round, v.ended), (7, None));
+    let done = Progress {
+        round: 9,
+        done: Progress::ALL_AT_GOAL,
+        ..Progress::default()
+    };
+    v.apply(Update::Progress(&done), now);
+    assert_eq!(v.ended, Some(RunEnd::AllAtGoal));
+    // The first reason stays.
+    v.apply(Update::Ended(RunEnd::SupervisorGone), now);
+    assert_eq!(v.ended, Some(RunEnd::AllAtGoal));
+    assert_eq!(v.rounds_per_s(now), 0.0);
+}
+
+#[test]
+fn the_rate_is_rounds_over_the_last_second() {
+    let mut m = RateMeter::default();
+    let t0 = Instant::now();
+    assert_eq!(m.rate(t0), 0.0);
+    // 100 rounds every 100 ms for 3 s: 1000 rounds/s.
+    for i in 0..=30u64 {
+        m.note(t0 + Duration::from_millis(100 * i), 100 * i);
+    }
+    let end = t0 + Duration::from_secs(3);
+    assert!((m.rate(end) - 1000.0).abs() < 1e-6, "{}", m.rate(end));
+    // Half a second without a round: half the rate.
+    let later = end + Duration::from_millis(500);
+    assert!((m.rate(later) - 500.0).abs() < 1.0, "{}", m.rate(later));
+    // Only the last second is kept.
+    assert!(m.samples.len() <= 12, "{}", m.samples.len());
+    // A young meter measures what it has.
+    let mut young = RateMeter::default();
+    young.note(t0, 0);
+    young.note(t0 + Duration::from_millis(200), 50);
+    let r = young.rate(t0 + Duration::from_millis(200));
+    assert!((r - 250.0).abs() < 1e-6, "{r}");
+}

@@ -1,0 +1,169 @@
+//! `hnav log replay DIR`: start a lockstep run again and check that every round decides
+//! exactly as its consensus log says.
+//!
+//! A lockstep run is a function of its scenario and seed (README, *Lockstep and realtime*),
+//! so the same scenario, seed, agents and fault plan must write the same log. The replay
+//! takes them from `DIR/invocation.json` ([`crate::invocation`]), refuses a scenario whose
+//! hash is no longer the log header's (the file or its map changed since), runs it through
+//! the supervisor library ([`super::run::run`], as `hnav run` does) under a fresh run id
+//! into a temporary run directory, and compares the two logs decoded, record by record
+//! ([`hnav_runtime::consensus_log::compare()`]). The temporary directory is removed afterwards,
+//! whatever happened.
+
+use std::path::{Path, PathBuf};
+
+use super::run::{run, RunError, RunOptions};
+use crate::invocation::{Invocation, InvocationError, FILE as INVOCATION};
+use hnav_runtime::consensus_log::{compare, read_decided, Comparison, LogError, Record, RunHeader};
+use hnav_runtime::scenario::{ClockMode, ScenarioError};
+use hnav_runtime::transport::RunId;
+
+/// What a replay needs.
+#[derive(Clone, Debug)]
+pub struct ReplayOptions {
+    /// The run directory (holding `log/` and `invocation.json`), or its `log/`.
+    pub dir: PathBuf,
+    /// Where `hnav-sim`, `hnav-coordinator` and `hnav-agent` are.
+    pub bin_dir: PathBuf,
+    /// A progress bar on stderr (a terminal), else progress lines.
+    pub progress: bool,
+    /// The replay's run id [default: a fresh unique one].
+    pub run: Option<RunId>,
+}
+
+/// Why a run cannot be replayed (the input is not a replayable run), or the replay could not
+/// be made.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    /// The run's log cannot be read.
+    #[error(transparent)]
+    Log(#[from] LogError),
+    /// The log has no header.
+    #[error("{}: the log has no run header", dir.display())]
+    NoHeader {
+        /// The log directory.
+        dir: PathBuf,
+    },
+    /// The run was not a lockstep run.
+    #[error("{}: a {clock} run cannot be replayed: only a lockstep run is a function of its scenario and seed (a realtime run's rounds close on wall-clock deadlines)", dir.display())]
+    NotLockstep {
+        /// The log directory.
+        dir: PathBuf,
+        /// The header's clock.
+        clock: String,
+    },
+    /// `invocation.json` is missing or bad.
+    #[error("{source}; the run directory must hold the {INVOCATION} that `hnav run` writes")]
+    Invocation {
+        /// The cause.
+        source: InvocationError,
+    },
+    /// The scenario cannot be loaded.
+    #[error("the run's scenario cannot be loaded: {0}")]
+    Scenario(#[from] ScenarioError),
+    /// The scenario is no longer the one the log was written by.
+    #[error("{}: the scenario (with the run's --agents, --seed, --mode and faults) hashes to {now:#018x}, the log's header says {logged:#018x}: the scenario file or its map changed since the run", scenario.display())]
+    HashMismatch {
+        /// The scenario file.
+        scenario: PathBuf,
+        /// Its hash now.
+        now: u64,
+        /// The hash in the log's header.
+        logged: u64,
+    },
+    /// The temporary run directory could not be made.
+    #[error("{}: cannot create the replay's run directory: {source}", dir.display())]
+    TempDir {
+        /// The directory.
+        dir: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The replayed run failed to happen.
+    #[error("the replay could not run: {0}")]
+    Run(#[from] RunError),
+}
+
+/// A replay's result: how its log compares with the run's, and the header both share.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Replayed {
+    /// The comparison.
+    pub comparison: Comparison,
+    /// The logged run's header.
+    pub header: RunHeader,
+}
+
+/// The run directory `dir` names: itself, or the directory holding it when `dir` is a
+/// run's `log/`.
+pub fn run_dir_of(dir: &Path) -> PathBuf {
+    match dir.parent() {
+        Some(parent)
+            if !dir.join(INVOCATION).exists()
+                && dir.file_name().is_some_and(|n| n == "log")
+                && parent.join(INVOCATION).exists() =>
+        {
+            parent.to_path_buf()
+        }
+        _ => dir.to_path_buf(),
+    }
+}
+
+/// Replays the run in `opts.dir` (see the [module docs](self)).
+pub fn replay(opts: &ReplayOptions) -> Result<Replayed, ReplayError> {
+    let dir = run_dir_of(&opts.dir);
+    let log_dir = dir.join("log");
+    let logged = read_decided(&log_dir)?.records;
+    let header = match logged.first() {
+        Some(Record::Header(h)) => h.clone(),
+        _ => return Err(ReplayError::NoHeader { dir: log_dir }),
+    };
+    if header.clock != ClockMode::Lockstep.name() {
+        return Err(ReplayError::NotLockstep {
+            dir: log_dir,
+            clock: header.clock,
+        });
+    }
+    let invocation = Invocation::read(&dir).map_err(|source| ReplayError::Invocation { source })?;
+    let run_id = opts.run.clone().unwrap_or_else(|| RunId::unique("replay"));
+    let tmp = TempRunDir(std::env::temp_dir().join(format!("hnav-{}", run_id.as_str())));
+    let args = invocation.process_args(run_id.as_str(), &tmp.0);
+    let scenario = args.scenario()?;
+    if scenario.scenario_hash() != header.scenario_hash {
+        return Err(ReplayError::HashMismatch {
+            scenario: invocation.scenario,
+            now: scenario.scenario_hash(),
+            logged: header.scenario_hash,
+        });
+    }
+    std::fs::create_dir_all(&tmp.0).map_err(|source| ReplayError::TempDir {
+        dir: tmp.0.clone(),
+        source,
+    })?;
+    run(&RunOptions {
+        args,
+        bin_dir: opts.bin_dir.clone(),
+        progress: opts.progress,
+        force: false,
+        // The comparison reads the log only; a recording would cost the replay time.
+        record: false,
+        host: None,
+    })?;
+    let replayed = read_decided(tmp.0.join("log"))?.records;
+    Ok(Replayed {
+        comparison: compare(&logged, &replayed, header.width),
+        header,
+    })
+}
+
+/// The replay's run directory, removed when dropped (also when the replay failed).
+struct TempRunDir(PathBuf);
+
+impl Drop for TempRunDir {
+    fn drop(&mut self) {
+        if self.0.exists() {
+            if let Err(e) = std::fs::remove_dir_all(&self.0) {
+                tracing::warn!("{}: replay directory not removed: {e}", self.0.display());
+            }
+        }
+    }
+}

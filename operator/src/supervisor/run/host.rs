@@ -1,0 +1,94 @@
+//! This host's part of a run across hosts (`hnav run --host NAME`): which of the run's
+//! processes it starts, its bridge's command line, and which processes of other hosts its
+//! start-up handshake waits for.
+//!
+//! Every host's supervisor waits for the `Up` of every process of the run (those of other
+//! hosts cross the bridges) and then publishes `Start`; a process takes the first `Start` and
+//! ignores the others. Nothing but the bridge is spawned before the bridge is up, and a bridge
+//! is up only once it hears every other host's bridge, so no `Up` is sent before the far
+//! side can hear it.
+
+use std::path::{Path, PathBuf};
+
+use super::slots::processes_of;
+use crate::supervisor::child::ChildSpec;
+use crate::supervisor::startup::Roll;
+use hnav_runtime::msg::Role;
+use hnav_runtime::placement::{Host, Placement, PlacementError};
+use hnav_runtime::scenario::{ClockMode, Scenario};
+
+/// This host's part of a run across hosts.
+#[derive(Debug, Clone)]
+pub struct HostPart {
+    file: PathBuf,
+    placement: Placement,
+    index: usize,
+    /// The processes of the run that other hosts run.
+    remote: Vec<(Role, u32, String)>,
+}
+
+impl HostPart {
+    /// Host `name` of the placement in `file`, checked for a run of `scenario`.
+    pub fn load(file: &Path, name: &str, scenario: &Scenario) -> Result<Self, PlacementError> {
+        let placement = Placement::load(file, scenario.agents.len())?;
+        let index = placement.index_of(name)?;
+        Ok(Self {
+            file: file.to_path_buf(),
+            remote: remote_of(&placement, index, scenario),
+            placement,
+            index,
+        })
+    }
+
+    /// This host.
+    pub fn this(&self) -> &Host {
+        &self.placement.hosts()[self.index]
+    }
+
+    /// This host's place in the placement (its bridge's index).
+    pub fn index(&self) -> usize {
+        self.index
+    }
+
+    /// `spec` (of `hnav-bridge`) with the arguments for run `run` of `scenario`: in
+    /// realtime, samples other than lifecycle events that a link cannot take are dropped
+    /// rather than waited for.
+    pub(super) fn bridge_args(&self, spec: ChildSpec, run: &str, scenario: &Scenario) -> ChildSpec {
+        let spec = spec
+            .arg("--run")
+            .arg(run)
+            .arg("--agents")
+            .arg(scenario.agents.len().to_string())
+            .arg("--hosts")
+            .arg(&self.file)
+            .arg("--host")
+            .arg(&self.this().name);
+        match scenario.sim.clock {
+            ClockMode::Realtime => spec.arg("--best-effort"),
+            ClockMode::Lockstep => spec,
+        }
+    }
+
+    /// Every process of the run that another host runs: role, index and that host.
+    pub(super) fn remote(&self) -> impl Iterator<Item = (Role, u32, &str)> + '_ {
+        self.remote.iter().map(|(r, i, h)| (*r, *i, h.as_str()))
+    }
+
+    /// Adds to `roll` every process of the run that another host runs.
+    pub(super) fn add_remote(&self, roll: &mut Roll) {
+        for (role, index, host) in self.remote() {
+            roll.push(role, index, Some(host));
+        }
+    }
+}
+
+/// Every process of a run of `scenario` that a host other than `me` of `placement` runs.
+fn remote_of(placement: &Placement, me: usize, scenario: &Scenario) -> Vec<(Role, u32, String)> {
+    let me = &placement.hosts()[me].name;
+    processes_of(scenario)
+        .filter_map(|(role, index)| {
+            let host = &placement.host_of(role, index)?.name;
+            (host != me).then(|| (role, index, host.clone()))
+        })
+        .collect()
+}

@@ -1,0 +1,297 @@
+//! The run summary `hnav run` writes to `DIR/summary.json` and prints as a table.
+//!
+//! Per-agent numbers are the [`Tally`] of the consensus log, the durable record of what was
+//! decided: accepted moves (steps and their octile length from the start in the log's
+//! header), refused or held requests (conflicts) and global replans. Whether a robot reached its goal
+//! comes from the sim's ground truth — its true pose lies in its goal cell — not from what the
+//! agents believed.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use hnav_runtime::consensus_log::{read_decided, LogError, Record, Tally};
+use hnav_runtime::msg::{LifecycleEvent, Role, Truth};
+use hnav_runtime::rejected::Rejections;
+
+/// One agent's line of the summary.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AgentSummary {
+    /// Agent index.
+    pub id: u32,
+    /// Whether the robot's true pose ended in its goal cell.
+    pub reached_goal: bool,
+    /// Accepted moves.
+    pub steps: u32,
+    /// Length of the accepted moves in cells (straight 1, diagonal sqrt 2).
+    pub length: f64,
+    /// Refused or held requests.
+    pub conflicts: u32,
+    /// Global replans.
+    pub replans: u32,
+    /// Whether the agent reported its goal unreachable (an unreachable record in the log).
+    pub unreachable: bool,
+    /// Whether the agent's process is gone for good (a `lost` record in the log, or the
+    /// supervisor gave it up): its robot stood for the rest of the run and its goal counts
+    /// as not reached, wherever the robot is.
+    pub lost: bool,
+}
+
+/// A robot lost during the run: its agent's process exited and was not restarted.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LostRobot {
+    /// Agent index.
+    pub id: u32,
+    /// Why, as the supervisor saw it (`hnav-agent 2 ended (killed by SIGKILL) and is not
+    /// restarted (restart limit of 1 reached)`).
+    pub why: String,
+}
+
+/// The whole run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunSummary {
+    /// The run id.
+    pub run_id: String,
+    /// `lockstep` or `realtime`.
+    pub mode: String,
+    /// Per agent.
+    pub agents: Vec<AgentSummary>,
+    /// Collisions the sim recorded on ground truth.
+    pub collisions: u32,
+    /// Decision rounds committed.
+    pub rounds: u64,
+    /// Wall time of the run in seconds.
+    pub wall_time_s: f64,
+    /// How the run ended: `all-at-goal`, `time-limit`, `stopped`, or `incomplete`.
+    pub end: String,
+    /// The consensus log directory.
+    pub log: PathBuf,
+    /// Why the supervisor ended the run early because it could not go on (the sim or the
+    /// coordinator down and not restarted, or no agent left); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cannot_go_on: Option<String>,
+    /// Candidates the coordinator dropped as malformed or hostile, per
+    /// [`Rejected`](hnav_runtime::rejected::Rejected) class (every class, zeros included).
+    pub rejected: BTreeMap<String, u64>,
+    /// The robots lost during the run, by index; empty when none was.
+    pub lost: Vec<LostRobot>,
+    /// What the recorder wrote into `DIR/recording/`; absent with `hnav run --no-record`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub recording: Option<super::recorder::RecordingSummary>,
+    /// Why `DIR/report.svg` could not be drawn, if it could not (the run still counts).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub report_error: Option<String>,
+}
+
+impl RunSummary {
+    /// Marks each of `lost` (index, why) lost: its goal counts as not reached.
+    pub fn mark_lost(&mut self, lost: &[(u32, String)]) {
+        for (id, why) in lost {
+            if let Some(a) = self.agents.get_mut(*id as usize) {
+                a.lost = true;
+            }
+            self.lost.push(LostRobot {
+                id: *id,
+                why: why.clone(),
+            });
+        }
+        for a in self.agents.iter_mut().filter(|a| a.lost) {
+            a.reached_goal = false;
+        }
+    }
+
+    /// Whether every robot reached its goal without a collision.
+    pub fn success(&self) -> bool {
+        self.cannot_go_on.is_none()
+            && self.collisions == 0
+            && self.agents.iter().all(|a| a.reached_goal)
+    }
+
+    /// Builds the summary from the log in `log_dir` and the last ground truth (poses in
+    /// metres, cells `cell_size_m` wide), with the coordinator's counts of dropped candidates
+    /// from the run directory holding `log_dir`.
+    pub fn from_log(
+        run_id: &str,
+        log_dir: &Path,
+        truth: Option<&Truth>,
+        cell_size_m: f64,
+        wall_time_s: f64,
+    ) -> Result<RunSummary, LogError> {
+        let contents = read_decided(log_dir)?;
+        let mut header = None;
+        let mut tally = Tally::default();
+        let mut rounds = 0;
+        let mut end = "incomplete".to_string();
+        let mut unreachable = Vec::new();
+        let mut lost = Vec::new();
+        for r in &contents.records {
+            match r {
+                Record::Header(h) => {
+                    tally = Tally::from_header(h);
+                    header = Some(h);
+                }
+                Record::Round(rec) => {
+                    rounds = rounds.max(rec.round);
+                    tally.fold_round(rec);
+                }
+                Record::End(e) => end = e.reason.name().to_string(),
+                Record::Unreachable(u) => unreachable.push(u.agent),
+                Record::Lifecycle(l)
+                    if l.role == Role::Agent as u8 && l.event == LifecycleEvent::Lost as u8 =>
+                {
+                    lost.push(l.index);
+                }
+                Record::Lifecycle(_)
+                | Record::Replan(_)
+                | Record::Raft(_)
+                | Record::RaftState(_) => {}
+            }
+        }
+        let mut agents: Vec<AgentSummary> = (0u32..)
+            .zip(tally.agents())
+            .map(|(id, t)| AgentSummary {
+                id,
+                reached_goal: false,
+                steps: t.steps,
+                length: t.length,
+                conflicts: t.conflicts,
+                replans: t.replans,
+                unreachable: unreachable.contains(&id),
+                lost: lost.contains(&id),
+            })
+            .collect();
+        if let (Some(t), Some(h)) = (truth, header) {
+            let width = h.width.max(1);
+            for ((a, pose), entry) in agents.iter_mut().zip(t.poses()).zip(&h.agents) {
+                let (gx, gy) = (entry.goal % width, entry.goal / width);
+                let cx = (pose.x_m / cell_size_m).floor();
+                let cy = (pose.y_m / cell_size_m).floor();
+                a.reached_goal = !a.lost && cx == f64::from(gx) && cy == f64::from(gy);
+            }
+        }
+        Ok(RunSummary {
+            run_id: run_id.to_string(),
+            mode: header.map(|h| h.clock.clone()).unwrap_or_default(),
+            agents,
+            collisions: truth.map_or(0, |t| t.collisions),
+            rounds,
+            wall_time_s,
+            end,
+            log: log_dir.to_path_buf(),
+            cannot_go_on: None,
+            rejected: read_rejected(log_dir.parent().unwrap_or(Path::new("."))),
+            lost: Vec::new(),
+            recording: None,
+            report_error: None,
+        })
+    }
+
+    /// The summary of a host of a run across hosts that does not run the coordinator: the
+    /// consensus log is on another host, so only what crossed the bridge is known here (the
+    /// last ground truth and the coordinator's last progress). Steps, conflicts and replans
+    /// are zero: `hnav log show` on the coordinator's host has them.
+    pub fn from_truth(
+        run_id: &str,
+        scenario: &hnav_runtime::scenario::Scenario,
+        truth: Option<&Truth>,
+        progress: Option<&hnav_runtime::msg::Progress>,
+        wall_time_s: f64,
+    ) -> RunSummary {
+        let cell = scenario.robot.cell_size_m;
+        let reached = |i: usize| {
+            let (Some(t), Some(a)) = (truth, scenario.agents.get(i)) else {
+                return false;
+            };
+            t.poses().get(i).is_some_and(|p| {
+                (p.x_m / cell).floor() == f64::from(a.goal.x)
+                    && (p.y_m / cell).floor() == f64::from(a.goal.y)
+            })
+        };
+        let agents = (0..scenario.agents.len())
+            .map(|i| AgentSummary {
+                id: i as u32,
+                reached_goal: reached(i),
+                steps: 0,
+                length: 0.0,
+                conflicts: 0,
+                replans: 0,
+                unreachable: false,
+                lost: false,
+            })
+            .collect();
+        let end = match progress.map(|p| p.done) {
+            Some(hnav_runtime::msg::Progress::ALL_AT_GOAL) => "all-at-goal",
+            Some(hnav_runtime::msg::Progress::TIME_LIMIT) => "time-limit",
+            _ => "incomplete",
+        };
+        RunSummary {
+            run_id: run_id.to_string(),
+            mode: scenario.sim.clock.to_string(),
+            agents,
+            collisions: truth.map_or(0, |t| t.collisions),
+            rounds: progress.map_or(0, |p| p.round),
+            wall_time_s,
+            end: end.to_string(),
+            log: PathBuf::new(),
+            cannot_go_on: None,
+            rejected: BTreeMap::new(),
+            lost: Vec::new(),
+            recording: None,
+            report_error: None,
+        }
+    }
+
+    /// Writes `summary.json` into `dir` atomically; returns its path.
+    ///
+    /// The text goes to a temporary file in `dir`, is synced, and is renamed over
+    /// `summary.json` (then the directory is synced): a reader finds the whole summary or
+    /// none, never a truncated one, even when the disk fills up or the supervisor dies
+    /// half-way. On failure the temporary file is removed.
+    pub fn write_json(&self, dir: &Path) -> std::io::Result<PathBuf> {
+        let path = dir.join("summary.json");
+        let text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)? + "\n";
+        hnav_runtime::durable::replace_file(&path, text.as_bytes())?;
+        Ok(path)
+    }
+
+    /// The table `hnav run` prints.
+    pub fn render(&self) -> String {
+        let mut s = String::from("agent  goal  steps  length  conflicts  replans\n");
+        for a in &self.agents {
+            let goal = match (a.reached_goal, a.unreachable, a.lost) {
+                (true, _, _) => "yes",
+                (false, _, true) => "lost",
+                (false, true, false) => "unreachable",
+                (false, false, false) => "NO",
+            };
+            s += &format!(
+                "{:>5}  {:>4}  {:>5}  {:>6.2}  {:>9}  {:>7}\n",
+                a.id, goal, a.steps, a.length, a.conflicts, a.replans
+            );
+        }
+        let at_goal = self.agents.iter().filter(|a| a.reached_goal).count();
+        s += &format!(
+            "{} of {} at goal, {} collisions, {} rounds, {:.2} s wall ({}, {})\n",
+            at_goal,
+            self.agents.len(),
+            self.collisions,
+            self.rounds,
+            self.wall_time_s,
+            self.mode,
+            self.end
+        );
+        s
+    }
+}
+
+/// The coordinator's counts of dropped candidates in `run_dir` (see [`hnav_runtime::rejected`]);
+/// all zero, with a warning, when its file cannot be read.
+fn read_rejected(run_dir: &Path) -> BTreeMap<String, u64> {
+    Rejections::load(run_dir)
+        .unwrap_or_else(|e| {
+            tracing::warn!("{e}; the summary counts no dropped candidates");
+            Rejections::default()
+        })
+        .to_map()
+}
