@@ -9,13 +9,14 @@ use hnav_runtime::msg::Lifecycle;
 use hnav_runtime::topics as run_topics;
 use hnav_runtime::transport::{Bell, RunId, Sender, Transport, TransportError, Wake};
 use zenoh::liveliness::LivelinessToken;
-use zenoh::pubsub::{Publisher, Subscriber};
+use zenoh::pubsub::Subscriber;
 use zenoh::qos::{CongestionControl, Priority};
 use zenoh::sample::{Locality, Sample, SampleKind};
 use zenoh::{Session, Wait};
 
 use crate::delay::{Delay, DelayLine};
 use crate::hosts::{self, HostsView, Peers};
+use crate::outlet::{AheadLine, Outlet};
 use crate::port::{self, Port};
 use crate::session::{self, Endpoints, SessionError};
 use crate::topics::TopicSpec;
@@ -38,6 +39,9 @@ pub enum BridgeError {
     /// The test-only delay ([`crate::delay::DELAY_ENV`]) is malformed.
     #[error("{0}")]
     Delay(String),
+    /// The thread for puts that may wait did not start.
+    #[error("cannot start the bridge's ahead thread: {0}")]
+    Thread(std::io::Error),
     /// A Zenoh publisher or subscriber was not declared.
     #[error("zenoh: declare {what} on {key}: {why}")]
     Declare {
@@ -136,7 +140,7 @@ struct HostWatch {
 pub struct Bridge {
     transport: Transport,
     ports: Vec<Box<dyn Port>>,
-    publishers: Vec<Publisher<'static>>,
+    publishers: Vec<Outlet>,
     _subscribers: Vec<Subscriber<()>>,
     hosts: Option<HostWatch>,
     // After the subscribers, whose callbacks feed it: it ends once they are gone.
@@ -146,6 +150,8 @@ pub struct Bridge {
     overflow: Arc<AtomicU64>,
     stopper: Stopper,
     counts: Counts,
+    // After the outlets that feed it: its thread makes its last puts, then ends.
+    ahead: Option<AheadLine>,
     // Declared last: dropped after the publishers and subscribers that live in it.
     _session: Session,
 }
@@ -178,6 +184,14 @@ impl Bridge {
         let overflow = Arc::new(AtomicU64::new(0));
         let mut ports = Vec::with_capacity(topics.len());
         let mut publishers = Vec::with_capacity(topics.len());
+        // With droppable topics (a realtime run) the others' puts may wait for a congested
+        // link: they go through a thread of their own ([`crate::outlet`]).
+        let best_effort = topics.iter().any(|t| t.droppable);
+        let ahead = if best_effort {
+            Some(AheadLine::start().map_err(BridgeError::Thread)?)
+        } else {
+            None
+        };
         let mut subscribers = Vec::with_capacity(topics.len());
         for (i, spec) in topics.iter().enumerate() {
             ports.push(port::open(&transport, spec)?);
@@ -190,22 +204,23 @@ impl Bridge {
             // A droppable sample waits at most 100 µs for room in a full queue and goes in the
             // data queue; everything else waits (a lost decision could hold a lockstep round
             // for ever), in a queue ahead of the droppable ones when there are any.
-            let (congestion, priority) = match (spec.droppable, topics.iter().any(|t| t.droppable))
-            {
+            let (congestion, priority) = match (spec.droppable, best_effort) {
                 (true, _) => (CongestionControl::Drop, Priority::Data),
                 (false, true) => (CongestionControl::Block, Priority::InteractiveHigh),
                 (false, false) => (CongestionControl::Block, Priority::Data),
             };
-            publishers.push(
-                session
-                    .declare_publisher(key.clone())
-                    .congestion_control(congestion)
-                    .priority(priority)
-                    .express(true)
-                    .allowed_destination(Locality::Remote)
-                    .wait()
-                    .map_err(|e| declare("publisher", e))?,
-            );
+            let publisher = session
+                .declare_publisher(key.clone())
+                .congestion_control(congestion)
+                .priority(priority)
+                .express(true)
+                .allowed_destination(Locality::Remote)
+                .wait()
+                .map_err(|e| declare("publisher", e))?;
+            publishers.push(match &ahead {
+                Some(line) if !spec.droppable => Outlet::ahead(publisher, line),
+                _ => Outlet::direct(publisher),
+            });
             let (tx, ring, overflow) = (tx.clone(), bell.try_clone()?, Arc::clone(&overflow));
             subscribers.push(
                 session
@@ -246,6 +261,7 @@ impl Bridge {
             overflow,
             stopper,
             counts: Counts::default(),
+            ahead,
             _session: session,
         })
     }
@@ -260,7 +276,7 @@ impl Bridge {
     /// before that reaches nobody.
     pub fn wait_connected(&self, timeout: Duration) -> bool {
         let deadline = Instant::now() + timeout;
-        self.publishers.iter().all(|p| {
+        self.publishers.iter().map(Outlet::publisher).all(|p| {
             // Listen first, then look: a match announced in between is not missed.
             let Ok(listener) = p.matching_listener().wait() else {
                 return false;
@@ -284,6 +300,7 @@ impl Bridge {
     pub fn counts(&self) -> Counts {
         Counts {
             overflow: self.overflow.load(Ordering::Relaxed),
+            failed: self.counts.failed + self.ahead.as_ref().map_or(0, AheadLine::failed),
             ..self.counts
         }
     }

@@ -13,6 +13,9 @@
 //!   and back.
 //! - [`delay`]: a test-only delay on every sample from another host.
 //! - [`Bridge`]: one host's end: the ports, the loop, the counters.
+//! - `outlet` (private): a port's way out to Zenoh; in a realtime run the samples that must
+//!   not be dropped (lifecycle, `ready`) go through a thread of their own, so that a link
+//!   that cannot take them never holds the loop.
 //!
 //! Out of iceoryx2 a sample is read in place and its bytes go straight into Zenoh's buffer;
 //! into iceoryx2 the bytes are written into a loaned sample, checked there ([`Wire`]) and
@@ -24,6 +27,7 @@
 mod bridge;
 pub mod delay;
 pub mod hosts;
+mod outlet;
 mod port;
 pub mod session;
 pub mod topics;

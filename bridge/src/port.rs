@@ -13,10 +13,9 @@ use hnav_runtime::transport::{
     TransportError, Waiter,
 };
 use zenoh::bytes::ZBytes;
-use zenoh::pubsub::Publisher;
-use zenoh::Wait;
 
 use crate::bridge::Counts;
+use crate::outlet::Outlet;
 use crate::topics::{Payload, TopicSpec};
 
 /// A topic's two directions, whatever its payload type.
@@ -28,8 +27,7 @@ pub(crate) trait Port {
     /// Never forwards what publisher `id` sends (one of the bridge's own, on this topic).
     fn skip(&mut self, id: PublisherId);
     /// Forwards what the host's processes published since the last call to `out`.
-    fn send_out(&self, out: &Publisher<'static>, counts: &mut Counts)
-        -> Result<(), TransportError>;
+    fn send_out(&self, out: &Outlet, counts: &mut Counts) -> Result<(), TransportError>;
     /// Publishes `payload` from another host into iceoryx2 on `transport`, checked; `Err` is
     /// why it was dropped.
     fn bring_in(
@@ -75,15 +73,10 @@ impl<T: Wire + Default> Port for Typed<T> {
         self.own.push(id);
     }
 
-    fn send_out(
-        &self,
-        out: &Publisher<'static>,
-        counts: &mut Counts,
-    ) -> Result<(), TransportError> {
+    fn send_out(&self, out: &Outlet, counts: &mut Counts) -> Result<(), TransportError> {
         self.rx.drain_pending_except(&self.own, |v| {
             // The sample is read in place; its bytes are copied once, into Zenoh's buffer.
-            let put = out.put(v.bytes()).attachment(T::wire_name()).wait();
-            counts.put(&self.topic, put.map_err(|e| e.to_string()));
+            counts.put(&self.topic, out.put(v.bytes(), T::wire_name()));
         })?;
         Ok(())
     }
@@ -130,11 +123,7 @@ impl Port for Map {
         self.own.get_mut().push(id);
     }
 
-    fn send_out(
-        &self,
-        out: &Publisher<'static>,
-        counts: &mut Counts,
-    ) -> Result<(), TransportError> {
+    fn send_out(&self, out: &Outlet, counts: &mut Counts) -> Result<(), TransportError> {
         let own = self.own.borrow();
         self.rx.drain_pending_except(&own, |h, values| {
             let mut w = ZBytes::writer();
@@ -142,12 +131,9 @@ impl Port for Map {
             let written = w
                 .write_all(h.bytes())
                 .and_then(|()| w.write_all(bytemuck::cast_slice(values)));
-            let put = written.map_err(|e| e.to_string()).and_then(|()| {
-                out.put(w.finish())
-                    .attachment(MapHeader::wire_name())
-                    .wait()
-                    .map_err(|e| e.to_string())
-            });
+            let put = written
+                .map_err(|e| e.to_string())
+                .and_then(|()| out.put(w.finish(), MapHeader::wire_name()));
             counts.put(&self.topic, put);
         })?;
         Ok(())

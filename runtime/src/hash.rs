@@ -14,6 +14,20 @@
 //! assert_eq!(SplitMix64::new(1_234_567).next_u64(), 6_457_827_717_110_365_317);
 //! ```
 
+/// The seed a property test draws its cases from: `fixed` in the test command, so that it
+/// repeats run after run, or the number in `PROPTEST_RNG_SEED` when that is set, so that a
+/// sweep of fresh seeds is one loop (docs/reference/tests.md). A value that is not a number is
+/// refused loudly rather than silently replaced by `fixed`.
+pub fn test_seed(fixed: u64) -> u64 {
+    match std::env::var("PROPTEST_RNG_SEED") {
+        Err(_) => fixed,
+        Ok(v) => v
+            .trim()
+            .parse()
+            .unwrap_or_else(|_| panic!("PROPTEST_RNG_SEED={v:?} is not a u64")),
+    }
+}
+
 /// FNV-1a 64-bit hasher.
 #[derive(Clone, Copy, Debug)]
 pub struct Fnv1a64(u64);

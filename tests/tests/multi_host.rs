@@ -27,6 +27,8 @@ use hnav_tests::{Peer, TestRun};
 
 /// Generous: debug builds of up to 20 processes and three bridges on a 2-core machine.
 const RUN_TIMEOUT: Duration = Duration::from_secs(600);
+/// Rounds the coordinator must decide while a robot host is cut off (see the cut test).
+const MIN_ROUNDS_WHILE_CUT: u64 = 5;
 /// The hosts' names: the base station, then two robot computers.
 const HOSTS: [&str; 3] = ["base", "robots-a", "robots-b"];
 
@@ -376,7 +378,8 @@ fn a_robot_host_cut_off_for_two_seconds_stands_and_rejoins() {
     net.cut(2, true).unwrap();
     across.finish();
 
-    // Host 2 runs agents 3, 4 and 5: each logged down, then back, in that order.
+    // Host 2 runs agents 3, 4 and 5: each logged down once the cut came (after round
+    // 1000), then back.
     let events = lifecycle_records(&log);
     for agent in 3..6u32 {
         let of: Vec<_> = events
@@ -384,15 +387,43 @@ fn a_robot_host_cut_off_for_two_seconds_stands_and_rejoins() {
             .filter(|e| e.1 == Some(Role::Agent) && e.2 == agent)
             .map(|e| (e.0, e.3))
             .collect();
-        let down = of.iter().position(|e| e.1 == Some(LifecycleEvent::Down));
-        let back = of
-            .iter()
-            .position(|e| e.1 == Some(LifecycleEvent::Restarted));
-        assert!(
-            matches!((down, back), (Some(d), Some(b)) if d < b),
-            "agent {agent}: {of:?}"
-        );
         println!("agent {agent}: lifecycle records (round, event) {of:?}");
+        let down = of
+            .iter()
+            .rposition(|e| e.0 >= 1000 && e.1 == Some(LifecycleEvent::Down))
+            .unwrap_or_else(|| panic!("agent {agent} never down after round 1000: {of:?}"));
+        let back = of[down..]
+            .iter()
+            .find(|e| e.1 == Some(LifecycleEvent::Restarted))
+            .unwrap_or_else(|| panic!("agent {agent} never back after the cut: {of:?}"));
+        // The cut host must not stop the others: while it is away the coordinator goes on
+        // deciding rounds for the robots of the other hosts. Counted in rounds, not seconds,
+        // so that a busy machine does not change the verdict: a base station held by the
+        // dead link decided 1 round in the 1.2 s it stood (seen once in 11 runs of the
+        // binary under load, before puts that may wait left the bridge's loop); a working
+        // one decides 55 to 125 in that time.
+        let decided = back.0 - of[down].0;
+        assert!(
+            decided >= MIN_ROUNDS_WHILE_CUT,
+            "only {decided} rounds decided while agent {agent}'s host was cut off: {of:?}"
+        );
+    }
+    // No put to Zenoh held a bridge's loop (every topic of its host waits behind it); a put
+    // that must wait for the dead link waits on the ahead thread.
+    for (host, dir) in HOSTS.iter().zip(&across.dirs) {
+        let bridge_log = std::fs::read_to_string(dir.join("logs/bridge.log")).unwrap_or_default();
+        for l in bridge_log.lines().filter(|l| l.contains("held the bridge")) {
+            println!("{host} bridge: {l}");
+            let held_ms = l
+                .split("held_ms=")
+                .nth(1)
+                .and_then(|r| r.split_whitespace().next()?.parse::<f64>().ok())
+                .unwrap_or(0.0);
+            assert!(
+                !(l.contains("loop thread") && held_ms >= 200.0),
+                "a put held {host}'s bridge loop: {l}"
+            );
+        }
     }
     // The sim's watchdog braked each robot of the cut host.
     let sim_log = std::fs::read_to_string(across.dirs[0].join("logs/sim.log")).unwrap();
@@ -405,12 +436,14 @@ fn a_robot_host_cut_off_for_two_seconds_stands_and_rejoins() {
     for l in sim_log.lines().filter(|l| l.contains("watchdog")) {
         println!("sim: {l}");
     }
-    // The robots of the other robot host drive on: a cut host must not hold the base
-    // station's bridge (it did, about a second, while every sample waited for room on the
-    // dead link). A brake of theirs under half a second is the machine's load, not the cut.
+    // How long the robots of the other robot host stood at most, for the record: on a busy
+    // machine an agent process may miss its 100 ms watchdog by itself, so the verdict on
+    // them is the rounds decided above, not this.
     for robot in 0..3 {
-        let longest = longest_brake_s(&sim_log, robot);
-        assert!(longest < 0.5, "robot {robot} stood {longest} s:\n{sim_log}");
+        println!(
+            "robot {robot} stood at most {:.3} s",
+            longest_brake_s(&sim_log, robot)
+        );
     }
     let s = summary(&across.dirs[0]);
     println!(

@@ -130,7 +130,7 @@ fn the_instances_online_pibt_leaves_unfinished_are_finished() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 32, rng_seed: proptest::test_runner::RngSeed::Fixed(hnav_runtime::hash::test_seed(0x1aca)), ..ProptestConfig::default() })]
 
     /// On random maps (the PIBT property test's, reduced to moves on cycles) with random
     /// instances of up to 40 % of the free cells: no two robots on one cell in any round, and

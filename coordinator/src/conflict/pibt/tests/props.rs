@@ -146,7 +146,7 @@ fn bound(free: usize, agents: usize) -> u64 {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 20, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 20, rng_seed: proptest::test_runner::RngSeed::Fixed(hnav_runtime::hash::test_seed(0x9b17)), ..ProptestConfig::default() })]
 
     /// On every round of every instance (up to 40 % of the free cells) the checker of
     /// [`World::step`] holds: no cell held by two rows, hence no swap, no wall entered. Up to
