@@ -155,7 +155,7 @@ fn render(info: &RunInfo, quick: bool, took: Duration, ran: &[(&str, Ran)]) -> S
     for (name, r) in ran {
         let _ = writeln!(
             s,
-            "\n## {name}\n\n`{}` ({:.0} s)\n\n```\n{}```",
+            "\n## {name}\n\n`{}` ({:.0} s)\n\n```text\n{}```",
             r.command,
             r.took.as_secs_f64(),
             r.stdout
