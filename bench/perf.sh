@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The performance suite with its peers, in one run (README, *Performance*):
+# The performance suite with its peers, in one run (docs/explanation/performance.md):
 #
 #   bench/perf.sh OUT [--quick] [--no-peers]
 #

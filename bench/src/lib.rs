@@ -12,7 +12,7 @@
 //! | [`mapf`] | `hnav-bench mapf --map FILE --scen FILE [--agents 50,100] [--rules dissertation,pibt,lacam] [--json] [--out DIR] [--quick]` | the first-N-entries MAPF instances of a MovingAI `.scen` run by whole swarms: robots at goal, collisions, makespan, sum of lengths against the lower bound, conflicts, replans, wall time, the processes' memory |
 //! | [`neural_map`] | `hnav-bench neural-map [--quick]` | neuron updates per second and time per map for 20x20 to 1024x1024, tanh against linear, and plan queries |
 //! | [`sim`] | `hnav-bench sim [--robots 1,64,1024] [--seconds S] [--json]` | robot-steps per second of the physics stepper |
-//! | [`perf`] | `hnav-bench perf [--quick] --out DIR` | the performance suite in one run: `latency`, `round` at 1 to 256 agents, `neural-map`; `DIR/perf.md` for the README |
+//! | [`perf`] | `hnav-bench perf [--quick] --out DIR` | the performance suite in one run: `latency`, `round` at 1 to 256 agents, `neural-map`; `DIR/perf.md` for `docs/explanation/performance.md` |
 //! | [`plan`] | `hnav-bench plan --planner P --map FILE (--start X,Y --goal X,Y \| --scen FILE [--first N]) [--json]` | one planning query, or every entry of a MovingAI scenario against its optimal length |
 //! | [`round`] | `hnav-bench round [--agents 1,8,32,128,256] [--rounds N] [--fsync every-record,none] [--json] [--out DIR]`, `hnav-bench round --faults [--trials N]` | a decision round's latency against a real `hnav-coordinator` (all candidates in -> commit at every agent); SIGKILL -> `Down` detection and restarted agent -> first decision |
 //! | [`seed002`] | `hnav-bench seed002 [--trials N] [--seed S]` | seed 002's obstacle-density experiment (A*, Basic Theta*, Lazy Theta* on random circular obstacles) beside the thesis's Table 3.1 |

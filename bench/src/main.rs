@@ -47,7 +47,7 @@ enum Command {
     /// and one futex wake (the notifier's cost and the last waiter's wake-up).
     Fanout(hnav_bench::fanout::FanoutArgs),
     /// The performance suite in one run (latency, round at 1..256 agents, neural map), each
-    /// part's output in DIR and DIR/perf.md for the README.
+    /// part's output in DIR and DIR/perf.md (for docs/explanation/performance.md).
     Perf {
         /// The smoke-check variant (under 2 minutes).
         #[arg(long)]

@@ -1,13 +1,13 @@
 //! `hnav-bench perf`: the performance suite in one command — the latency suite, the decision
 //! round at 1 to 256 agents under both fsync policies, the commit fan-out, and the neural map
-//! — run one after the other on a quiet machine, so that every ratio in the README comes from
-//! one run.
+//! — run one after the other on a quiet machine, so that every ratio in `docs/explanation/performance.md`
+//! comes from one run.
 //!
 //! Each part is this binary's own subcommand run as a child process (`latency`, `round`,
 //! `fanout`, `neural-map`): the parts stay usable alone, and a part that fails or hangs is reported
 //! with its output instead of taking the suite down with it. Their output is echoed and kept
 //! in `DIR/<part>.txt`; `DIR/perf.md` gathers the machine, each part's command and duration,
-//! and the outputs, ready to paste into the README's *Performance* section.
+//! and the outputs, ready to paste into `docs/explanation/performance.md`.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -155,7 +155,7 @@ fn render(info: &RunInfo, quick: bool, took: Duration, ran: &[(&str, Ran)]) -> S
     for (name, r) in ran {
         let _ = writeln!(
             s,
-            "\n## {name}\n\n`{}` ({:.0} s)\n\n```\n{}```",
+            "\n## {name}\n\n`{}` ({:.0} s)\n\n```text\n{}```",
             r.command,
             r.took.as_secs_f64(),
             r.stdout

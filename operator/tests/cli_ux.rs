@@ -51,7 +51,7 @@ fn check_exit_codes_are_the_documented_ones() {
         &tmp.path().join("missing.toml").display().to_string(),
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    // What the README says, `hnav check --help` says too.
+    // What docs/reference/cli.md says, `hnav check --help` says too.
     let help = text(&hnav(&["check", "--help"]));
     assert!(
         help.contains(

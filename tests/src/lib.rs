@@ -15,11 +15,13 @@
 //!   resolver) for the papers' conflict experiments;
 //! - [`tmux`]: a terminal of a test's own for full-screen programs (`hnav top`, playback);
 //! - [`netns`]: hosts on one machine (network namespaces, a switch, loss, partitions) for the
-//!   multi-host tests (`tests/multi_host.rs`).
+//!   multi-host tests (`tests/multi_host.rs`);
+//! - [`docs`]: what `tests/docs.rs` checks in the markdown (commands, links, paths).
 //!
 //! Tests that SIGKILL processes live in their own test binaries (`tests/*_kill.rs`).
 //! Tests that send other signals do too (`tests/waiter_signals.rs`).
 
+pub mod docs;
 pub mod lost_wakeup;
 pub mod netns;
 pub mod pattern;

@@ -3,7 +3,7 @@
 //! its id and prints commits, ground truth and an agent's neural map.
 //!
 //! The Python is the virtual environment's with the pinned `iceoryx2` package: `$HNAV_PYTHON`,
-//! else `target/py-venv/bin/python` (made by the README's command). Without either the tests
+//! else `target/py-venv/bin/python` (made by the command in docs/how-to/python-client.md). Without either the tests
 //! skip, saying so, unless `HNAV_REQUIRE_PYTHON` is set (CI sets it): then they fail.
 
 use std::path::PathBuf;

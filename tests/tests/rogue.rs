@@ -22,7 +22,7 @@ const ROGUE_TIMEOUT: Duration = Duration::from_secs(30);
 /// the dissertation's rules equal priorities refuse both parties, and two equal robots
 /// crossing can then refuse each other for as long as the realtime timing keeps them in step
 /// (seen: agents 2 and 3, both at speed 2, stuck for 35 s of a flooded realtime run on a
-/// loaded machine). That is the rules' weakness (README, *Dense swarms: PIBT*), not what
+/// loaded machine). That is the rules' weakness (`docs/explanation/conflict-rules.md`), not what
 /// this file tests.
 const ROOM: &str = r#"
 name = "rogue-room"

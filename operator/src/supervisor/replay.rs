@@ -1,7 +1,7 @@
 //! `hnav log replay DIR`: start a lockstep run again and check that every round decides
 //! exactly as its consensus log says.
 //!
-//! A lockstep run is a function of its scenario and seed (README, *Lockstep and realtime*),
+//! A lockstep run is a function of its scenario and seed (`docs/explanation/design.md`),
 //! so the same scenario, seed, agents and fault plan must write the same log. The replay
 //! takes them from `DIR/invocation.json` ([`crate::invocation`]), refuses a scenario whose
 //! hash is no longer the log header's (the file or its map changed since), runs it through

@@ -1,5 +1,5 @@
 //! `[health]`: how often every process beats and how long each role may stay silent before
-//! the supervisor declares it hung (see the README's *Hangs*).
+//! the supervisor declares it hung (see `docs/explanation/hangs.md`).
 //!
 //! ```toml
 //! [health]

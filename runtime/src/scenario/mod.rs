@@ -42,7 +42,7 @@
 //! fsync = "every-record"               # or "batched", "none"
 //! replan_after_rounds = 3
 //! time_limit_s = 120.0                 # lockstep: simulated time, in rounds; realtime: wall clock
-//! rules = "lacam"                      # or "dissertation" (the seeds' reproductions), "pibt": README, *Dense swarms*
+//! rules = "lacam"                      # or "dissertation" (the seeds' reproductions), "pibt": docs/explanation/conflict-rules.md
 //!
 //! [restart]                            # per role; default for each role as shown
 //! agent = { policy = "on-failure", max_restarts = 3, backoff_ms = 100 }
@@ -56,14 +56,14 @@
 //!                                      # 60 s plus the agents' neural-map builds, scaled
 //!                                      # with the map (params::default_startup_timeout_s)
 //!
-//! [health]                             # hang detection (README, *Hangs*); not in the hash
+//! [health]                             # hang detection (docs/explanation/hangs.md); not in the hash
 //! heartbeat_ms = 50                    # every process beats this often, in [1, 60000]
 //! agent_hang_ms = 1000                 # silence before a process is declared hung, in
 //! coordinator_hang_ms = 2000           # [2 * heartbeat_ms, 3600000]; the agents' default
 //! sim_hang_ms = 1000                   # grows with the map (health::default_agent_hang_ms)
 //!
-//! [record]                             # the run's recording (README, *Recording and
-//! trajectory_hz = 20                   # report*); not in the hash. Pose samples per
+//! [record]                             # the run's recording (docs/reference/logs-and-
+//! trajectory_hz = 20                   # recordings.md); not in the hash. Pose samples per
 //! max_mb = 64                          # simulated second (0: every truth message), the
 //! maps = true                          # cap of each file in MiB, neural-map snapshots
 //!
@@ -74,8 +74,8 @@
 //! priority = 2.0                       # optional, > 0; default 1 / speed
 //! start_heading_deg = 90.0             # optional, in [-360, 360]; default 0 = facing +x (towards
 //!                                      # larger columns); 90 faces +y (towards larger rows)
-//! planner = "hnav"                     # or "pso" (seed 003) or "ga-fuzzy" (seed 004): README,
-//!                                      # *Mixed swarms*
+//! planner = "hnav"                     # or "pso" (seed 003) or "ga-fuzzy" (seed 004):
+//!                                      # docs/explanation/conflict-rules.md
 //!
 //! [[faults]]                           # optional fault plan (more on the command line:
 //!                                      # `hnav run --kill/--term/--freeze`, [`fault_arg`])

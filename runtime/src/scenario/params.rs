@@ -191,7 +191,7 @@ pub enum FsyncPolicy {
 /// The rules of the decision round (`[coordinator] rules`).
 ///
 /// The default is [`Rules::Lacam`], the only rules measured to bring every robot home on the
-/// MAPF benchmark at every size (README, *MAPF benchmark*); the seeds' reproductions name
+/// MAPF benchmark at every size (`docs/explanation/mapf-benchmark.md`); the seeds' reproductions name
 /// [`Rules::Dissertation`].
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]

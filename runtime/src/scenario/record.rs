@@ -1,5 +1,5 @@
-//! `[record]`: what the supervisor's recorder keeps of a run (see the README's *Recording
-//! and report*).
+//! `[record]`: what the supervisor's recorder keeps of a run (see
+//! `docs/reference/logs-and-recordings.md`).
 //!
 //! ```toml
 //! [record]

@@ -5,7 +5,7 @@
 //!
 //! Online PIBT ([`Pibt`]) decides one round at a time and is incomplete on these robots: its
 //! reachability theorem needs the pusher to enter the vacated cell in the same step, and maps
-//! with dead ends and corridors are outside it anyway (the README's *Dense swarms* gives the
+//! with dead ends and corridors are outside it anyway (`docs/explanation/conflict-rules.md` gives the
 //! robots it left away from home). LaCAM searches configurations until it has a plan to the
 //! goals, and a plan found is a plan executed to the end.
 //!
@@ -22,7 +22,7 @@
 //! # What it costs
 //!
 //! The search allocates and may take a while (milliseconds for the benchmark's instances, see
-//! the README); it runs in the round that plans, once per plan. Every other round follows the
+//! `docs/explanation/conflict-rules.md`); it runs in the round that plans, once per plan. Every other round follows the
 //! schedule without allocating.
 
 mod generator;

@@ -121,7 +121,7 @@ fn a_robot_that_stops_breaks_the_plan_and_the_others_are_replanned_around_it() {
 #[test]
 fn the_instances_online_pibt_leaves_unfinished_are_finished() {
     // random-32-32-20, the first 50 entries: online PIBT leaves 2 robots away for ever (the
-    // README's table), LaCAM brings every robot home.
+    // table in docs/explanation/conflict-rules.md), LaCAM brings every robot home.
     let (map, scen) = ("random-32-32-20.map", "random-32-32-20-random-1.scen");
     let pibt = run(map, scen, 50, 20_000, Rounds::Pibt);
     assert!(pibt.is_err(), "online PIBT finished: {pibt:?}");

@@ -4,7 +4,7 @@
 //! Exit codes: 0 all good, 1 checks ran and found problems (or the report could not be
 //! written), 2 the input could not be loaded or is invalid (and for usage errors, via clap).
 //! For `hnav check`: 0 the scenario is valid and its report written, 1 it is valid but the
-//! report could not be written, 2 it is invalid or cannot be read (README, *Command line*).
+//! report could not be written, 2 it is invalid or cannot be read (`docs/reference/cli.md`).
 
 mod clean_cmd;
 mod kill_cmd;
