@@ -32,6 +32,16 @@ const MIN_ROUNDS_WHILE_CUT: u64 = 5;
 /// The hosts' names: the base station, then two robot computers.
 const HOSTS: [&str; 3] = ["base", "robots-a", "robots-b"];
 
+/// The tests of this binary run one at a time: each starts about 20 processes and three
+/// bridges, and side by side on 2 cores they starved each other (a verdict about a cut
+/// host must not depend on what the binary's other tests are doing).
+fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
+    static ONE: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    // A test that failed holding it poisons it; the next one still runs.
+    ONE.lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
 /// Whether CI requires these tests to run (`HNAV_REQUIRE_NETNS=1`, set by `.ci/run` where its
 /// probe made a namespace and nftables is installed): a skip is then a failure.
 fn required() -> bool {
@@ -214,6 +224,7 @@ fn one_host(tag: &str, scenario: &Path, dir: &Path, extra: &[&str]) -> f64 {
 
 /// In lockstep, `scenario` across the three hosts logs what it logs on one host.
 fn same_log_as_one_host(tag: &str, scenario: &Path, extra: &[&str]) {
+    let _one = one_at_a_time();
     let Some(net) = net_or_skip(tag) else { return };
     let tmp = tempfile::tempdir().unwrap();
     let mut args = vec!["--mode", "lockstep"];
@@ -257,6 +268,7 @@ fn sixteen_agents_across_three_hosts_log_what_one_host_logs() {
 
 #[test]
 fn delay_and_loss_on_every_link_still_bring_every_robot_home() {
+    let _one = one_at_a_time();
     // The loss is nftables': without `nft` the test skips and says so (unless CI, which
     // installs it, requires the namespace tests).
     if let Err(e) = Net::loss_tool() {
@@ -343,6 +355,7 @@ fn every_host_shows_the_whole_run(tmp: &Path) {
 
 #[test]
 fn a_robot_host_cut_off_for_two_seconds_stands_and_rejoins() {
+    let _one = one_at_a_time();
     let Some(net) = net_or_skip("cut") else {
         return;
     };
