@@ -4,11 +4,10 @@
 //!
 //! A put that must not be dropped waits for room on every link it goes out on, up to the
 //! session's `wait_before_close` (one lease, see [`crate::session`]). Made on the loop, that
-//! wait holds every topic of the host: a robot host cut off from the others once stood the
-//! robots of the hosts that were *not* cut for about a second (all three at once, released
-//! when the cut host came back), because the base station's bridge waited on the dead link.
-//! Made on the ahead thread, it holds only the events queued behind it, which keep their
-//! order. Lockstep runs (nothing droppable) keep every put on the loop: there a lost or late
+//! wait would hold every topic of the host while one link is dead: a lifecycle event
+//! published while a robot host is cut off (a restart on the base station, say) would stand
+//! the robots of every other host for up to a lease. Made on the ahead thread, it holds only
+//! the events queued behind it, which keep their order. Lockstep runs (nothing droppable) keep every put on the loop: there a lost or late
 //! sample holds the round anyway, and the order of all topics is the order of the loop.
 
 use std::sync::atomic::{AtomicU64, Ordering};
