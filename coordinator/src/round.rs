@@ -177,7 +177,9 @@ impl Arbiter {
     }
 
     /// [`Arbiter::decide`], calling `tick` often while a long computation runs (LaCAM's
-    /// search), so that the caller can keep its heartbeat going.
+    /// search), so that the caller can keep its heartbeat going. A round is three steps: the
+    /// candidates are read into the rows, the rows resolved by the run's rules, and each
+    /// outcome answered (with a waypoint, when the rules replan and the agent is stuck).
     pub fn decide_with(
         &mut self,
         round: u64,
@@ -186,6 +188,22 @@ impl Arbiter {
     ) -> (&[Decision], &[ReplanRecord]) {
         self.decisions.clear();
         self.replans.clear();
+        self.read(candidates);
+        let replanning = self.resolve(tick);
+        for i in 0..self.rows.len() {
+            if let Some(d) = self.answer(round, i, replanning) {
+                // The tally counts what is published (and logged), so that a replay of the
+                // log after a restart and the run summary arrive at the same numbers.
+                self.tally.fold(&LoggedDecision::from(&d));
+                self.decisions.push(d);
+            }
+        }
+        (&self.decisions, &self.replans)
+    }
+
+    /// Takes the round's candidates into the rows: an agent missing from the round keeps its
+    /// cells and stands.
+    fn read(&mut self, candidates: &[Option<Candidate>]) {
         for (i, row) in self.rows.iter_mut().enumerate() {
             match candidates.get(i).copied().flatten() {
                 Some(c) => {
@@ -210,7 +228,12 @@ impl Arbiter {
             }
             row.priority = self.priorities[i];
         }
-        let replanning = match &mut self.round {
+    }
+
+    /// Resolves the rows by the run's rules into `outcomes`; returns whether the rules
+    /// replan (only the dissertation's do).
+    fn resolve(&mut self, tick: &mut dyn FnMut()) -> bool {
+        match &mut self.round {
             Round::Dissertation(r) => {
                 r.resolve(&self.rows, &mut self.outcomes);
                 true
@@ -223,48 +246,48 @@ impl Arbiter {
                 l.resolve_with(&self.rows, &mut self.outcomes, tick);
                 false
             }
-        };
-        for i in 0..self.rows.len() {
-            let row = self.rows[i];
-            let o = self.outcomes[i];
-            let stuck = replanning
-                && self.flags[i] & CandidateFlags::LOCAL_EXTREMUM != 0
-                && row.mode == AgentMode::Active
-                && row.is_at_rest();
-            if row.probable.is_none() && !stuck && !o.accepted() {
-                continue;
-            }
-            let mut d = o.decision(i as u32, &self.grid);
-            if row.probable.is_some() {
-                if o.accepted() {
-                    self.waiting[i] = 0;
-                } else {
-                    self.waiting[i] += 1;
-                    // The contested cell travels with a refusal: an agent blocked by a
-                    // standing one learns it as an obstacle.
-                    d.cell = o
-                        .cell
-                        .and_then(|c| self.grid.checked_index(c))
-                        .map_or(NO_CELL, |c| c as u32);
-                }
-            }
-            if replanning && (stuck || self.waiting[i] >= self.replan_after) {
-                if let Some(r) = self.replan(round, i) {
-                    d = Decision {
-                        agent: i as u32,
-                        verdict: Verdict::Replan as u8,
-                        waypoint: r,
-                        ..Decision::default()
-                    };
-                    self.waiting[i] = 0;
-                }
-            }
-            // The tally counts what is published (and logged), so that a replay of the log
-            // after a restart and the run summary arrive at the same numbers.
-            self.tally.fold(&LoggedDecision::from(&d));
-            self.decisions.push(d);
         }
-        (&self.decisions, &self.replans)
+    }
+
+    /// Agent `i`'s answer: its outcome as a decision, or a waypoint when it is stuck or has
+    /// waited too long (`replanning` rules only); `None` when it asked for nothing, is not
+    /// stuck and was not moved.
+    fn answer(&mut self, round: u64, i: usize, replanning: bool) -> Option<Decision> {
+        let row = self.rows[i];
+        let o = self.outcomes[i];
+        let stuck = replanning
+            && self.flags[i] & CandidateFlags::LOCAL_EXTREMUM != 0
+            && row.mode == AgentMode::Active
+            && row.is_at_rest();
+        if row.probable.is_none() && !stuck && !o.accepted() {
+            return None;
+        }
+        let mut d = o.decision(i as u32, &self.grid);
+        if row.probable.is_some() {
+            if o.accepted() {
+                self.waiting[i] = 0;
+            } else {
+                self.waiting[i] += 1;
+                // The contested cell travels with a refusal: an agent blocked by a standing
+                // one learns it as an obstacle.
+                d.cell = o
+                    .cell
+                    .and_then(|c| self.grid.checked_index(c))
+                    .map_or(NO_CELL, |c| c as u32);
+            }
+        }
+        if replanning && (stuck || self.waiting[i] >= self.replan_after) {
+            if let Some(waypoint) = self.replan(round, i) {
+                self.waiting[i] = 0;
+                return Some(Decision {
+                    agent: i as u32,
+                    verdict: Verdict::Replan as u8,
+                    waypoint,
+                    ..Decision::default()
+                });
+            }
+        }
+        Some(d)
     }
 
     /// Plans agent `i` around the others; records the replan and returns the waypoint.
