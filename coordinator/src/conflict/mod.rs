@@ -37,17 +37,17 @@
 //!
 //! | # | situation | verdict | kind |
 //! |---|---|---|---|
-//! | 1 | `p` not an 8-neighbour of `current`, off the grid or blocked | Block (bit `d` when `d` exists) | [`Invalid`](ConflictKind::Invalid) |
-//! | 2 | diagonal past blocked map corners (Fig. 3-7, per [`CornerCutting`]), or whose side cell another agent holds | Block | [`CornerCut`](ConflictKind::CornerCut) |
-//! | 3 | `p` held by a [`Standing`](AgentMode::Standing) or [`Finished`](AgentMode::Finished) agent: type (d), whatever the priorities | Block | [`StableCell`](ConflictKind::StableCell) |
-//! | 4 | head-on, type (b): an active agent B at rest asks for A's cell while A asks for B's | lower priority Block, higher Hold, equal both Block | [`HeadOn`](ConflictKind::HeadOn) |
-//! | 5 | `p` held by another active agent (moving out, or waiting) | Hold | [`Reserved`](ConflictKind::Reserved) |
-//! | 6 | crossing, type (a): the footprints (`p` plus a diagonal's side cells) of two remaining requests meet | lower priority Block, equal both Block | [`Crossing`](ConflictKind::Crossing) |
-//! | 7 | no request (moving, nothing asked, standing, finished) | Hold | [`None`](ConflictKind::None) |
+//! | 1 | `p` not an 8-neighbour of `current`, off the grid or blocked | Block (bit `d` when `d` exists) | [`Invalid`](hnav_runtime::msg::ConflictKind::Invalid) |
+//! | 2 | diagonal past blocked map corners (Fig. 3-7, per [`CornerCutting`]), or whose side cell another agent holds | Block | [`CornerCut`](hnav_runtime::msg::ConflictKind::CornerCut) |
+//! | 3 | `p` held by a [`Standing`](AgentMode::Standing) or [`Finished`](AgentMode::Finished) agent: type (d), whatever the priorities | Block | [`StableCell`](hnav_runtime::msg::ConflictKind::StableCell) |
+//! | 4 | head-on, type (b): an active agent B at rest asks for A's cell while A asks for B's | lower priority Block, higher Hold, equal both Block | [`HeadOn`](hnav_runtime::msg::ConflictKind::HeadOn) |
+//! | 5 | `p` held by another active agent (moving out, or waiting) | Hold | [`Reserved`](hnav_runtime::msg::ConflictKind::Reserved) |
+//! | 6 | crossing, type (a): the footprints (`p` plus a diagonal's side cells) of two remaining requests meet | lower priority Block, equal both Block | [`Crossing`](hnav_runtime::msg::ConflictKind::Crossing) |
+//! | 7 | no request (moving, nothing asked, standing, finished) | Hold | [`None`](hnav_runtime::msg::ConflictKind::None) |
 //!
 //! Anything else is accepted ([`Verdict::Accept`], `cell = p`). A head-on agent whose
 //! footprint also meets a third agent's request is reported as
-//! [`Combined`](ConflictKind::Combined), type (c); its verdict is the head-on one.
+//! [`Combined`](hnav_runtime::msg::ConflictKind::Combined), type (c); its verdict is the head-on one.
 //!
 //! Why these choices:
 //!
@@ -73,6 +73,9 @@
 //! `O(n log n)` for `n` agents (one in-place sort; the type (c) check adds `O(n)` per head-on
 //! agent) with generation stamps instead of clearing per-cell tables, and allocates nothing
 //! (the caller's `out` keeps its capacity).
+//!
+//! [`CornerCutting`]: hnav_runtime::grid::CornerCutting
+//! [`Verdict::Accept`]: hnav_runtime::msg::Verdict::Accept
 
 pub mod lacam;
 pub mod pibt;

@@ -81,7 +81,7 @@ pub fn side_cells(from: Cell, to: Cell) -> Option<[Cell; 2]> {
         .then_some([Cell::new(to.x, from.y), Cell::new(from.x, to.y)])
 }
 
-/// Options of a [`Resolver`].
+/// Options of a round of any rule set (`Resolver`, `Pibt`, `Lacam`).
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
 pub struct Options {
     /// Diagonals past blocked **map** cells (Fig. 3-7): [`CornerCutting::Forbidden`] refuses a

@@ -26,6 +26,10 @@
 //!   goal is `Ok(None)`; `start == goal` is a one-cell path of length 0.
 //! * A planner keeps its buffers between queries: a query allocates only its answer (and
 //!   grows the buffers when the grid is larger than any before).
+//!
+//! [`CornerCutting`]: hnav_runtime::grid::CornerCutting
+//! [`HazardMap`]: crate::terrain::HazardMap
+//! [`PlanError`]: crate::error::PlanError
 
 pub mod astar;
 mod interface;
