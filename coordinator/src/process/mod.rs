@@ -32,6 +32,14 @@
 //! exits (`Deposed`): its state may hold a round the cluster never committed, and its
 //! restart (the supervisor's) rebuilds it from its journal as a follower.
 //!
+//! | module | concept |
+//! |---|---|
+//! | `state` | what the coordinator knows between wake-ups: the open round, the roster, the end watch, the supervisor's events, a replica's committed records applied |
+//! | `decision_log` | where its decisions become final: its own consensus log or its replica's Raft log |
+//! | `ports` | the topics of the rounds: candidates in, commits and progress out |
+//! | `outcome` | [`CoordinatorOutcome`], what a finished run reports |
+//! | `error` | [`CoordinatorError`] |
+//!
 //! [`SimParams::rounds_in`]: hnav_runtime::scenario::params::SimParams::rounds_in
 //! [`Progress::done`]: hnav_runtime::msg::Progress::done
 
