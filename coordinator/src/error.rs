@@ -58,7 +58,7 @@ pub enum PlanError {
         /// What is wrong, in words.
         problem: String,
     },
-    /// A planner name that [`crate::planner::PlannerKind`] does not know.
+    /// A planner name that `planner::PlannerKind` does not know.
     #[error("unknown planner {name:?} (expected astar, theta or lazy-theta)")]
     UnknownPlanner {
         /// The name as given.

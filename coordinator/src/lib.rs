@@ -8,15 +8,24 @@
 //! planners, and the terrain-hazard model they can plan with, after seed 002 (a thesis on
 //! Lazy Theta* for s-bots on rough terrain).
 //!
+//! Modules, highest first: a module may import only modules listed below it (no two files of
+//! the crate import each other, directly or through a ring).
+//!
 //! | module | concept |
 //! |---|---|
-//! | [`planner`] | the [`Planner`](planner::Planner) trait; A*, Basic Theta*, Lazy Theta*; line of sight; single queries for the bench |
-//! | [`terrain`] | slope, roughness and relief from a height map; the hazard index `R`; route hazard `c = sum alpha R` |
+//! | [`process`] | the `hnav-coordinator` process: `new`/`run`, its ports, its state (the open round, the roster, the end watch), the [`Waiter`](hnav_runtime::transport::Waiter) loop, round deadline, log-then-commit through its decision log (a [`LogWriter`](hnav_runtime::consensus_log::LogWriter), or a replica's [`RaftLog`](replication::RaftLog)), restart from the log |
+//! | [`replication`] | the replicated consensus log: one replica's Raft peer ([`Replica`](replication::Replica), the `raft` crate), its journal, its link, and [`RaftLog`](replication::RaftLog), which proposes round records and hands out the committed ones |
+//! | [`round`] | the decision round: [`Arbiter`](round::Arbiter) reads the candidates into rows, resolves them, answers each agent (replanning in hybrid mode) and tallies the decisions |
 //! | [`conflict`] | one decision round of `shared_paths`: the conflict types (a)–(d), corners, reservations; the [`Resolver`](conflict::Resolver); [`Pibt`](conflict::Pibt), priority inheritance (`rules = "pibt"`); [`Lacam`](conflict::Lacam), PIBT made complete (`rules = "lacam"`) |
-//! | [`round`] | the decision round: [`Arbiter`](round::Arbiter) keeps the rows, runs the resolver, tallies the decisions, replans (hybrid mode) |
-//! | [`process`] | the `hnav-coordinator` process: `new`/`run`, its ports and state, the [`Waiter`](hnav_runtime::transport::Waiter) loop, round deadline, log-then-commit (through [`LogWriter`](hnav_runtime::consensus_log::LogWriter)), restart from the log |
-//! | [`replication`] | one replica's Raft peer ([`Replica`](replication::Replica), the `raft` crate): propose round records, take the committed ones; the building block of the replicated consensus log |
+//! | [`planner`] | the [`Planner`](planner::Planner) trait; A*, Basic Theta*, Lazy Theta*; single queries for the bench |
+//! | [`terrain`] | slope, roughness and relief from a height map; the hazard index `R`; route hazard `c = sum alpha R` |
+//! | [`mod@line_of_sight`] | line of sight between cell centres and the exact cell walk behind it, which the planners and the route hazard share |
 //! | [`error`] | [`PlanError`], every way a caller's input can be unusable |
+//!
+//! The crate depends on `hnav-runtime` only among the workspace's crates: never on
+//! `hnav-operator` (which starts this process) nor on another process crate (agent, sim,
+//! bridge); what they share with it (messages, topics, the consensus log's format) is the
+//! runtime's.
 //!
 //! ```
 //! use hnav_coordinator::planner::{LazyTheta, Planner, PlannerConfig};
@@ -34,6 +43,7 @@
 
 pub mod conflict;
 pub mod error;
+pub mod line_of_sight;
 pub mod planner;
 pub mod process;
 pub mod replication;

@@ -5,7 +5,7 @@ use std::cmp::Ordering;
 use hnav_runtime::grid::{Cell, CornerCutting, Direction, Grid};
 use hnav_runtime::msg::{ConflictKind, Verdict};
 
-use super::{AgentMode, AgentRow, Options, Outcome};
+use super::shared_paths::{AgentMode, AgentRow, Options, Outcome};
 
 /// "No agent" in the per-cell tables.
 const NOBODY: u32 = u32::MAX;

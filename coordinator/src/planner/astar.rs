@@ -15,9 +15,10 @@
 
 use hnav_runtime::grid::{octile, Cell, Grid};
 
+use super::interface::{PlanStats, Planner, PlannerConfig};
+use super::path::Path;
 use super::search::{planner_options, Search};
 use super::space::Space;
-use super::{Path, PlanStats, Planner, PlannerConfig};
 use crate::error::PlanError;
 
 /// The coordinator's A* planner. Reuse one value for many queries: its buffers are kept.

@@ -25,11 +25,12 @@
 
 use hnav_runtime::grid::{Cell, Grid};
 
-use super::line_of_sight::euclid;
+use super::interface::{PlanStats, Planner, PlannerConfig};
+use super::path::Path;
 use super::search::{planner_options, Search};
 use super::space::Space;
-use super::{Path, PlanStats, Planner, PlannerConfig};
 use crate::error::PlanError;
+use crate::line_of_sight::euclid;
 
 /// The Lazy Theta* planner. Reuse one value for many queries: its buffers are kept.
 #[derive(Clone, Debug, Default)]
@@ -127,7 +128,8 @@ impl Planner for LazyTheta {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::planner::{check_path, BasicTheta};
+    use crate::planner::path::check_path;
+    use crate::planner::theta::BasicTheta;
     use hnav_runtime::grid::CornerCutting;
 
     fn grid(rows: &[&str]) -> Grid {

@@ -3,7 +3,7 @@
 use hnav_runtime::grid::{Cell, CornerCutting, Grid};
 use serde::{Deserialize, Serialize};
 
-use super::line_of_sight::walk;
+use crate::line_of_sight::walk;
 use crate::terrain::HazardMap;
 
 /// A planned path: the cells from start to goal and the polyline length through their
@@ -51,7 +51,7 @@ pub enum PathDefect {
 
 /// Checks that `cells` runs from `start` to `goal`, that no waypoint is outside, blocked or
 /// (with a hazard map) impassable, and that each pair of consecutive waypoints has line of
-/// sight under `rule` over the same obstacles (see [`mod@crate::planner::line_of_sight`]).
+/// sight under `rule` over the same obstacles (see [`mod@crate::line_of_sight`]).
 /// A*'s paths pass too: every legal move has line of sight, except a diagonal squeeze
 /// between two blocked cells, which only A* with corners allowed can produce.
 pub fn check_path(

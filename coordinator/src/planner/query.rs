@@ -13,7 +13,10 @@ use std::time::Instant;
 use hnav_runtime::grid::{Cell, CornerCutting, Grid};
 use hnav_runtime::plan::PlanResult;
 
-use super::{AStar, BasicTheta, LazyTheta, Planner, PlannerConfig};
+use super::astar::AStar;
+use super::interface::{Planner, PlannerConfig};
+use super::lazy_theta::LazyTheta;
+use super::theta::BasicTheta;
 use crate::error::PlanError;
 
 /// The grid planners of this crate, by the names the bench and the scenario files use.

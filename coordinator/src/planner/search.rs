@@ -8,10 +8,10 @@
 
 use hnav_runtime::grid::Cell;
 
-use super::line_of_sight::euclid;
+use super::interface::PlanStats;
 use super::open_list::OpenList;
 use super::space::Space;
-use super::PlanStats;
+use crate::line_of_sight::euclid;
 
 /// One node's state, valid only while `stamp` equals the current generation.
 #[derive(Clone, Copy, Debug, Default)]

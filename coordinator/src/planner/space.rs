@@ -7,8 +7,8 @@
 use hnav_runtime::grid::geometry::{cell_index, index_cell};
 use hnav_runtime::grid::{Cell, CornerCutting, Endpoint, Grid};
 
-use super::line_of_sight::{euclid, walk};
 use crate::error::PlanError;
+use crate::line_of_sight::{euclid, walk};
 use crate::terrain::{hazard::walk_hazard, HazardMap};
 
 /// A validated view of one query's grid.

@@ -32,71 +32,37 @@
 //! exits (`Deposed`): its state may hold a round the cluster never committed, and its
 //! restart (the supervisor's) rebuilds it from its journal as a follower.
 //!
+//! | module | concept |
+//! |---|---|
+//! | `state` | what the coordinator knows between wake-ups: the open round, the roster, the end watch, the supervisor's events, a replica's committed records applied |
+//! | `decision_log` | where its decisions become final: its own consensus log or its replica's Raft log |
+//! | `ports` | the topics of the rounds: candidates in, commits and progress out |
+//! | `outcome` | [`CoordinatorOutcome`], what a finished run reports |
+//! | `error` | [`CoordinatorError`] |
+//!
 //! [`SimParams::rounds_in`]: hnav_runtime::scenario::params::SimParams::rounds_in
 //! [`Progress::done`]: hnav_runtime::msg::Progress::done
 
 use std::path::Path;
 use std::time::Duration;
 
-use hnav_runtime::consensus_log::{EndReason, LogError};
+use hnav_runtime::consensus_log::EndReason;
 use hnav_runtime::health::Heartbeat;
 use hnav_runtime::launch::{LifecyclePorts, StartOutcome};
 use hnav_runtime::msg::{Role, MAX_AGENTS};
 use hnav_runtime::scenario::Scenario;
-use hnav_runtime::transport::{Transport, TransportError, Waiter, Wake};
+use hnav_runtime::transport::{Transport, Waiter, Wake};
 
-mod decisions;
+mod decision_log;
+mod error;
+mod outcome;
 mod ports;
 mod state;
 
+pub use error::CoordinatorError;
+pub use outcome::CoordinatorOutcome;
 use ports::Ports;
 use state::State;
-
-/// What stopped or broke the coordinator.
-#[derive(Debug, thiserror::Error)]
-pub enum CoordinatorError {
-    /// The transport failed.
-    #[error(transparent)]
-    Transport(#[from] TransportError),
-    /// The consensus log failed: no commit may be published without it.
-    #[error(transparent)]
-    Log(#[from] LogError),
-    /// The log belongs to another scenario or seed.
-    #[error("the log in {dir} was written for another run: {what}")]
-    ForeignLog {
-        /// The log directory.
-        dir: String,
-        /// What differs.
-        what: String,
-    },
-    /// The swarm is larger than a commit can carry.
-    #[error("{0} agents; a commit carries at most {MAX_AGENTS}")]
-    TooManyAgents(usize),
-    /// The replica's Raft peer, journal or link failed.
-    #[error(transparent)]
-    Replica(#[from] crate::replication::ReplicaError),
-    /// This replica decided as leader of a term it lost: it exits, to be restarted from its
-    /// journal as a follower.
-    #[error("deposed: led in term {term}, the cluster is in term {now}; restarting from the log")]
-    Deposed {
-        /// The term it led.
-        term: u64,
-        /// The term it is in now.
-        now: u64,
-    },
-}
-
-/// How the coordinator's run ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct CoordinatorOutcome {
-    /// Last committed round.
-    pub round: u64,
-    /// Whether every agent reached its goal.
-    pub all_at_goal: bool,
-    /// Candidates dropped as malformed or hostile (every class of
-    /// [`Rejected`](hnav_runtime::rejected::Rejected) together).
-    pub dropped: u64,
-}
 
 /// The coordinator process.
 pub struct CoordinatorProcess<'t> {
@@ -176,7 +142,7 @@ impl<'t> CoordinatorProcess<'t> {
         let waiter = self.transport.waiter()?;
         let _candidates = waiter.attach(&p.candidates)?;
         let _lifecycle = waiter.attach(self.life.events())?;
-        let link = st.raft_link();
+        let link = st.log().link();
         let _raft = link
             .as_ref()
             .map(|l| waiter.attach(l.inbox()))
@@ -200,12 +166,12 @@ fn follow(
 ) -> Result<Option<EndReason>, CoordinatorError> {
     let waiter = transport.waiter()?;
     let _lifecycle = waiter.attach(life.events())?;
-    let link = st.raft_link();
+    let link = st.log().link();
     let _raft = link
         .as_ref()
         .map(|l| waiter.attach(l.inbox()))
         .transpose()?;
-    if let Some((role, term)) = st.raft_role() {
+    if let Some((role, term)) = st.log().role() {
         tracing::info!(role, term, "replica up, following");
     }
     loop {
@@ -215,12 +181,12 @@ fn follow(
             return Ok(Some(reason));
         }
         if st.take_lead()? {
-            if let Some((_, term)) = st.raft_role() {
+            if let Some((_, term)) = st.log().role() {
                 tracing::info!(term, "replica leads");
             }
             return Ok(None);
         }
-        let until = st.raft_deadline();
+        let until = st.log().deadline();
         if waiter.wait(heart.until(until)?)? == Wake::Stop {
             return Ok(Some(EndReason::Stopped));
         }
@@ -264,7 +230,7 @@ fn rounds(
             st.close_round(p, waiter, &mut tick)?;
             continue;
         }
-        let until = match (deadline, st.raft_deadline()) {
+        let until = match (deadline, st.log().deadline()) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         };

@@ -13,7 +13,7 @@ pub(super) struct Ports {
     pub(super) candidates: Receiver<Candidate>,
     /// The decided rounds, to every agent.
     pub(super) commit: Sender<Commit>,
-    /// The run's progress, for the supervisor and the sim.
+    /// The run's progress, for the supervisor (`hnav run`), `hnav top` and the bridge.
     pub(super) progress: Sender<Progress>,
 }
 

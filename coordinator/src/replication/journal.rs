@@ -3,7 +3,7 @@
 //!
 //! Raft reads its log from the library's `MemStorage`; the [`Journal`] is what makes it
 //! survive the process. Every entry and hard state Raft hands out in a `Ready` is written
-//! here, and the [`Replica`](super::Replica) flushes the journal (one `fdatasync` under the
+//! here, and the [`Replica`](super::peer::Replica) flushes the journal (one `fdatasync` under the
 //! fsync policy `every-record`) before it releases the messages that acknowledge them: a vote
 //! or an append is acknowledged only once it is durable. A hard state that only moves the
 //! commit index is written with the next flush, not synced on its own: Raft recovers a
@@ -23,7 +23,7 @@ use hnav_runtime::scenario::FsyncPolicy;
 use raft::eraftpb::{ConfState, Entry, HardState};
 use raft::storage::MemStorage;
 
-use super::ReplicaError;
+use super::error::ReplicaError;
 
 /// A replica's durable Raft log.
 pub struct Journal {

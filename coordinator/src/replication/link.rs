@@ -18,7 +18,8 @@ use hnav_runtime::transport::{
     Delivery, Qos, SliceReceiver, SliceSender, Transport, TransportError,
 };
 
-use super::{decode, ReplicaError};
+use super::error::ReplicaError;
+use super::wire::decode;
 
 /// The largest encoded message a topic carries. [`MAX_ENTRIES_BYTES`] keeps Raft's appends
 /// well below it; a round record is a few KiB at 256 agents.

@@ -1,4 +1,6 @@
-//! One coordinator replica's Raft peer: the building block of a replicated consensus log.
+//! The coordinator's replication (`coordinator.replicas` 3 or 5): one replica's Raft peer, its
+//! journal on disk, its link to the other replicas, and its end of the cluster as the
+//! coordinator process uses it.
 //!
 //! The dissertation's consensus log is a replicated state machine: a cluster of coordinators
 //! agrees on every decision, and a cluster of `2f + 1` keeps deciding while `f` are lost. The
@@ -20,392 +22,45 @@
 //! and flushes it before the messages that acknowledge them leave ([`Replica::durable`]).
 //! A replica restarted over its journal comes back with its term, vote and entries, and Raft
 //! hands its committed entries out again. [`RaftLink`] carries the messages between processes
-//! on the HNAV transport (`raft/<i>` topics).
+//! on the HNAV transport (`raft/<i>` topics). [`RaftLog`] is what the coordinator process
+//! holds: the peer over its journal and link, ticked on the replica's clock; it proposes the
+//! rounds a leader decides and hands out the records other leaders committed. [`Overheard`]
+//! keeps what a following replica hears of the supervisor until it comes to lead.
+//!
+//! The *format* of a replica's log (its records, how the decided sequence is resolved from
+//! them, the role file) stays in [`hnav_runtime::consensus_log::replicated`]: the run summary,
+//! `hnav log show`, `replay`, the exports and the operator's `hnav ps` and `hnav kill` read it
+//! there, and the operator must not depend on this crate. What lives here is the writing side,
+//! which only a coordinator process runs.
+//!
+//! | module | concept |
+//! |---|---|
+//! | `raft_log` | [`RaftLog`]: the peer, journal and link together, as the coordinator uses them |
+//! | `overheard` | [`Overheard`]: the supervisor's liveness events a following replica keeps |
+//! | `peer` | [`Replica`], [`ReplicaConfig`], [`Role`], [`Committed`]: one voter and its `Ready` cycle |
+//! | `journal` | [`Journal`]: the Raft log on disk, in the consensus-log segments |
+//! | `link` | [`RaftLink`]: the `raft/<i>` topics between replicas |
+//! | `wire` | [`encode`], [`decode`]: a Raft message as bytes |
+//! | `log_bridge` | Raft's `slog` lines into `tracing` |
+//! | `error` | [`ReplicaError`] |
 //!
 //! [`Waiter`]: hnav_runtime::transport::Waiter
 
-use std::collections::VecDeque;
-
-use protobuf::Message as _;
-use raft::eraftpb::{ConfState, Entry, EntryType, Message};
-use raft::storage::MemStorage;
-use raft::{Config, RawNode, StateRole};
-
+mod error;
 mod journal;
 mod link;
 mod log_bridge;
+mod overheard;
+mod peer;
+mod raft_log;
 #[cfg(test)]
 mod tests;
+mod wire;
 
+pub use error::ReplicaError;
 pub use journal::Journal;
 pub use link::{topic, Inbox, RaftLink, MAX_ENTRIES_BYTES, MAX_MESSAGE_BYTES};
-
-/// Why a replica could not be made, or could not take a message or a proposal.
-#[derive(Debug, thiserror::Error)]
-pub enum ReplicaError {
-    /// The replica's id is 0 (Raft's "nobody") or not among the voters.
-    #[error("replica id {id} is not one of the voters {voters:?} (ids start at 1)")]
-    NotAVoter {
-        /// The id asked for.
-        id: u64,
-        /// The cluster's voters.
-        voters: Vec<u64>,
-    },
-    /// A proposal reached a replica that is not the leader: only the leader decides rounds.
-    #[error("replica {id} is not the leader (the leader is {leader})")]
-    NotLeader {
-        /// This replica.
-        id: u64,
-        /// The leader it knows of, 0 for none.
-        leader: u64,
-    },
-    /// A message from the wire that is no Raft message.
-    #[error("a Raft message that does not decode ({0})")]
-    Decode(String),
-    /// A message that does not encode (protobuf refused it, it is too large for its topic,
-    /// or it is addressed to no other voter).
-    #[error("a Raft message that does not go out ({0})")]
-    Encode(String),
-    /// The HNAV transport failed under a `raft/<i>` topic.
-    #[error("raft transport: {0}")]
-    Transport(#[from] hnav_runtime::transport::TransportError),
-    /// The Raft library refused (a bad configuration, a message for another cluster, a
-    /// storage error).
-    #[error("raft: {0}")]
-    Raft(#[from] raft::Error),
-    /// The replica's journal (its consensus log) failed: nothing may be acknowledged.
-    #[error(transparent)]
-    Log(#[from] hnav_runtime::consensus_log::LogError),
-    /// The journal in the replica's log directory belongs to another run.
-    #[error("the replica log in {dir} was written for another run: {what}")]
-    ForeignLog {
-        /// The log directory.
-        dir: String,
-        /// What differs.
-        what: String,
-    },
-    /// Raft asked to install a snapshot; replicas catch up by log replay only (entries are
-    /// never compacted away).
-    #[error("raft sent a snapshot; replicas catch up from the log and never compact it")]
-    Snapshot,
-}
-
-/// A replica's timing and identity.
-#[derive(Debug, Clone)]
-pub struct ReplicaConfig {
-    /// This replica's id, 1-based.
-    pub id: u64,
-    /// Every voter of the cluster, this one included.
-    pub voters: Vec<u64>,
-    /// Ticks without a leader's heartbeat before a follower stands for election; Raft
-    /// randomises each timeout in `[election_ticks, 2 * election_ticks)`.
-    pub election_ticks: usize,
-    /// Ticks between the leader's heartbeats; well below `election_ticks`.
-    pub heartbeat_ticks: usize,
-}
-
-impl ReplicaConfig {
-    /// A replica of a cluster of `n` voters (ids 1..=n) with etcd's default timing, 10 ticks
-    /// to an election and 1 between heartbeats.
-    pub fn cluster(id: u64, n: u64) -> Self {
-        ReplicaConfig {
-            id,
-            voters: (1..=n).collect(),
-            election_ticks: 10,
-            heartbeat_ticks: 1,
-        }
-    }
-}
-
-/// A replica's part in the cluster, as Raft names it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Role {
-    /// Decides the rounds and replicates them.
-    Leader,
-    /// Follows the leader of its term.
-    Follower,
-    /// Stands for election.
-    Candidate,
-    /// Asks whether it could win before raising the term (pre-vote).
-    PreCandidate,
-}
-
-impl Role {
-    /// Lower-case name, as `hnav ps` would show it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Role::Leader => "leader",
-            Role::Follower => "follower",
-            Role::Candidate => "candidate",
-            Role::PreCandidate => "pre-candidate",
-        }
-    }
-}
-
-/// An entry the cluster has committed: a majority holds it durably, it is final.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Committed {
-    /// Raft's log index (1-based, gapless over every entry, empty ones included).
-    pub index: u64,
-    /// The term of the leader that proposed it.
-    pub term: u64,
-    /// What was proposed.
-    pub data: Vec<u8>,
-}
-
-/// One voter of a Raft cluster, driven by its owner's loop.
-pub struct Replica {
-    node: RawNode<MemStorage>,
-    /// Where entries and hard states are made durable; `None` keeps them in memory only (the
-    /// in-process tests).
-    journal: Option<Journal>,
-    /// Where the messages that may leave before the storage go at once ([`Replica::send_early`]);
-    /// without it they wait in the outbox with the rest.
-    early: Option<std::rc::Rc<RaftLink>>,
-    outbox: Vec<Message>,
-    committed: VecDeque<Committed>,
-}
-
-impl Replica {
-    /// A replica of a new cluster: empty storage that knows the voters.
-    pub fn new(config: &ReplicaConfig) -> Result<Self, ReplicaError> {
-        let storage =
-            MemStorage::new_with_conf_state(ConfState::from((config.voters.clone(), Vec::new())));
-        Self::restart(config, storage)
-    }
-
-    /// A replica whose Raft log is the journal in `dir` (created with `header` if new,
-    /// replayed if not): a restarted process comes back with its term, vote and entries, and
-    /// its committed entries come out of [`take_committed`](Self::take_committed) again.
-    pub fn durable(
-        config: &ReplicaConfig,
-        dir: &std::path::Path,
-        header: hnav_runtime::consensus_log::RunHeader,
-        fsync: hnav_runtime::scenario::FsyncPolicy,
-    ) -> Result<Self, ReplicaError> {
-        let (journal, storage) = Journal::open(dir, header, fsync, &config.voters)?;
-        let mut replica = Self::restart(config, storage)?;
-        replica.journal = Some(journal);
-        // The committed entries of the journal are ready at once.
-        replica.process()?;
-        Ok(replica)
-    }
-
-    /// Makes everything the journal holds durable (the end of a run); nothing for a replica
-    /// in memory.
-    pub fn sync(&mut self) -> Result<(), ReplicaError> {
-        match &mut self.journal {
-            Some(j) => j.sync(),
-            None => Ok(()),
-        }
-    }
-
-    /// A replica over storage that survived it: its term, vote and entries come back; what it
-    /// had applied is applied again from the start (its owner's state machine starts empty).
-    pub fn restart(config: &ReplicaConfig, storage: MemStorage) -> Result<Self, ReplicaError> {
-        if config.id == 0 || !config.voters.contains(&config.id) {
-            return Err(ReplicaError::NotAVoter {
-                id: config.id,
-                voters: config.voters.clone(),
-            });
-        }
-        let raft_config = Config {
-            id: config.id,
-            election_tick: config.election_ticks,
-            heartbeat_tick: config.heartbeat_ticks,
-            // A replica that was cut off and comes back must not depose a working leader by
-            // its higher term alone (pre-vote), and a leader cut off from the majority steps
-            // down instead of believing it still leads (check-quorum): its stale decisions
-            // can then never be taken for the cluster's.
-            pre_vote: true,
-            check_quorum: true,
-            // Appends fit the `raft/<i>` topics (`link`).
-            max_size_per_msg: MAX_ENTRIES_BYTES,
-            ..Config::default()
-        };
-        raft_config.validate()?;
-        let node = RawNode::new(&raft_config, storage, &log_bridge::logger(config.id))?;
-        Ok(Replica {
-            node,
-            journal: None,
-            early: None,
-            outbox: Vec::new(),
-            committed: VecDeque::new(),
-        })
-    }
-
-    /// This replica's id.
-    pub fn id(&self) -> u64 {
-        self.node.raft.id
-    }
-
-    /// Its role now.
-    pub fn role(&self) -> Role {
-        match self.node.raft.state {
-            StateRole::Leader => Role::Leader,
-            StateRole::Follower => Role::Follower,
-            StateRole::Candidate => Role::Candidate,
-            StateRole::PreCandidate => Role::PreCandidate,
-        }
-    }
-
-    /// The term it is in.
-    pub fn term(&self) -> u64 {
-        self.node.raft.term
-    }
-
-    /// The leader it knows of, if any.
-    pub fn leader(&self) -> Option<u64> {
-        Some(self.node.raft.leader_id).filter(|&l| l != 0)
-    }
-
-    /// The index of the last entry in its log, committed or not: after a
-    /// [`propose`](Self::propose), the proposal's.
-    pub fn last_index(&self) -> u64 {
-        self.node.raft.raft_log.last_index()
-    }
-
-    /// The highest index it knows committed.
-    pub fn committed_index(&self) -> u64 {
-        self.node.raft.raft_log.committed
-    }
-
-    /// Whether it leads and has committed an entry of its own term: only then is every entry
-    /// of earlier leaders that will ever commit committed (and handed out), so the state it
-    /// applied is the cluster's and it may decide.
-    pub fn can_decide(&self) -> bool {
-        self.role() == Role::Leader && self.node.raft.commit_to_current_term()
-    }
-
-    /// The storage, to keep for a restart ([`Replica::restart`]).
-    pub fn storage(&self) -> &MemStorage {
-        self.node.store()
-    }
-
-    /// Advances its logical clock by one tick (elections, heartbeats).
-    pub fn tick(&mut self) -> Result<(), ReplicaError> {
-        self.node.tick();
-        self.process()
-    }
-
-    /// Sends a heartbeat to every follower now (a leader only; nothing otherwise): it carries
-    /// the commit index, so the followers know the last entries committed without waiting
-    /// for the next heartbeat (the end of a run).
-    pub fn ping(&mut self) -> Result<(), ReplicaError> {
-        self.node.ping();
-        self.process()
-    }
-
-    /// Takes a message another replica sent.
-    pub fn step(&mut self, message: Message) -> Result<(), ReplicaError> {
-        self.node.step(message)?;
-        self.process()
-    }
-
-    /// Proposes `data` (a round record) for the cluster to commit; only the leader may.
-    pub fn propose(&mut self, data: &[u8]) -> Result<(), ReplicaError> {
-        if self.role() != Role::Leader {
-            return Err(ReplicaError::NotLeader {
-                id: self.id(),
-                leader: self.node.raft.leader_id,
-            });
-        }
-        self.node.propose(Vec::new(), data.to_vec())?;
-        self.process()
-    }
-
-    /// Sends the messages Raft lets leave before the storage (a leader's appends and
-    /// heartbeats) on `link` the moment they exist, instead of queueing them for
-    /// [`take_messages`](Self::take_messages): a leader's own `fdatasync` then runs while its
-    /// followers write theirs, and a round costs one sync on its path instead of two. A
-    /// message that does not go out is Raft's to resend.
-    pub fn send_early(&mut self, link: std::rc::Rc<RaftLink>) {
-        self.early = Some(link);
-    }
-
-    /// The messages to send to the other replicas, each addressed (`Message::to`). Every one
-    /// may be sent at once: what they acknowledge is already in the storage.
-    pub fn take_messages(&mut self) -> std::vec::Drain<'_, Message> {
-        self.outbox.drain(..)
-    }
-
-    /// The entries committed since the last call, in log order. Entries without data (the
-    /// empty entry each new leader appends) are left out; their indices are skipped.
-    pub fn take_committed(&mut self) -> std::collections::vec_deque::Drain<'_, Committed> {
-        self.committed.drain(..)
-    }
-
-    /// The `Ready` cycle: persist, release messages, apply, until Raft has nothing left.
-    fn process(&mut self) -> Result<(), ReplicaError> {
-        while self.node.has_ready() {
-            let mut ready = self.node.ready();
-            // Messages of a leader may leave before its own append (Raft's leader writes in
-            // parallel with its followers); the rest wait for the storage below.
-            let early = ready.take_messages();
-            match &self.early {
-                Some(link) => {
-                    for m in &early {
-                        if let Err(e) = link.send(m) {
-                            tracing::debug!(to = m.to, "raft message not sent: {e}");
-                        }
-                    }
-                }
-                None => self.outbox.extend(early),
-            }
-            let store = self.node.store().clone();
-            if !ready.snapshot().is_empty() {
-                return Err(ReplicaError::Snapshot);
-            }
-            self.collect(ready.take_committed_entries());
-            store.wl().append(ready.entries())?;
-            if let Some(hs) = ready.hs() {
-                store.wl().set_hardstate(hs.clone());
-            }
-            if let Some(j) = &mut self.journal {
-                j.entries(ready.entries());
-                if let Some(hs) = ready.hs() {
-                    j.hard_state(hs);
-                }
-                // Durable before the messages that acknowledge it.
-                j.flush()?;
-            }
-            self.outbox.extend(ready.take_persisted_messages());
-            let mut light = self.node.advance(ready);
-            if let Some(commit) = light.commit_index() {
-                store.wl().mut_hard_state().set_commit(commit);
-                if let Some(j) = &mut self.journal {
-                    j.commit(commit);
-                }
-            }
-            self.outbox.extend(light.take_messages());
-            self.collect(light.take_committed_entries());
-            self.node.advance_apply();
-        }
-        Ok(())
-    }
-
-    fn collect(&mut self, entries: Vec<Entry>) {
-        for e in entries {
-            if e.get_entry_type() == EntryType::EntryNormal && !e.data.is_empty() {
-                self.committed.push_back(Committed {
-                    index: e.index,
-                    term: e.term,
-                    // The entry is consumed: its buffer becomes the record, no copy.
-                    data: e.data.into(),
-                });
-            }
-        }
-    }
-}
-
-/// A message as bytes for the wire (protobuf, Raft's own encoding).
-pub fn encode(message: &Message) -> Result<Vec<u8>, ReplicaError> {
-    message
-        .write_to_bytes()
-        .map_err(|e| ReplicaError::Encode(e.to_string()))
-}
-
-/// A message from the wire.
-pub fn decode(bytes: &[u8]) -> Result<Message, ReplicaError> {
-    Message::parse_from_bytes(bytes).map_err(|e| ReplicaError::Decode(e.to_string()))
-}
+pub use overheard::Overheard;
+pub use peer::{Committed, Replica, ReplicaConfig, Role};
+pub use raft_log::RaftLog;
+pub use wire::{decode, encode};

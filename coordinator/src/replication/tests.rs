@@ -5,6 +5,7 @@
 use super::*;
 use hnav_runtime::consensus_log::{encode_record, read_decided, Record, RoundRecord, RunHeader};
 use hnav_runtime::scenario::FsyncPolicy;
+use raft::storage::MemStorage;
 
 /// Replicas 1..=n, each `None` while lost, with the storages kept for restarts and every
 /// entry each has committed so far.

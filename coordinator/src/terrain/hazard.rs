@@ -18,10 +18,10 @@
 
 use hnav_runtime::grid::{Cell, CornerCutting, Grid, TerrainKind};
 
+use super::params::TerrainParams;
 use super::relief::TerrainFactors;
-use super::TerrainParams;
 use crate::error::PlanError;
-use crate::planner::line_of_sight::{euclid, walk};
+use crate::line_of_sight::{euclid, walk};
 
 /// The chord length (in cells) below which a crossed cell counts half: half a cell diagonal,
 /// `sqrt 2 / 2`, i.e. `(sqrt 2 / 2) e` in metres. \[thesis, threshold read dimensionally\]

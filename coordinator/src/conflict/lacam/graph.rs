@@ -5,7 +5,7 @@
 use hnav_runtime::grid::{Direction, Grid};
 
 use crate::conflict::pibt::distance::can_step;
-use crate::conflict::{side_cells, Options};
+use crate::conflict::shared_paths::{side_cells, Options};
 
 /// "No cell" / "no agent" in the search's tables.
 pub(super) const NONE: u32 = u32::MAX;

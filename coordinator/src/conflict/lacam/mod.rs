@@ -35,7 +35,8 @@ mod tests;
 use hnav_runtime::grid::{Cell, Grid};
 
 use super::pibt::distance::UNREACHABLE;
-use super::{AgentMode, AgentRow, Options, Outcome, Pibt};
+use super::pibt::Pibt;
+use super::shared_paths::{AgentMode, AgentRow, Options, Outcome};
 use generator::Problem;
 use graph::Graph;
 use schedule::Schedule;

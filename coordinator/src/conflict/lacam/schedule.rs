@@ -17,7 +17,7 @@ use hnav_runtime::grid::Cell;
 use hnav_runtime::msg::{ConflictKind, Verdict};
 
 use super::graph::{Graph, NONE};
-use crate::conflict::{AgentMode, AgentRow, Outcome};
+use crate::conflict::shared_paths::{AgentMode, AgentRow, Outcome};
 
 /// One move of one robot, with the visits it waits for.
 #[derive(Clone, Copy, Debug)]

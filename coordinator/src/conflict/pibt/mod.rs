@@ -73,7 +73,7 @@ use hnav_runtime::grid::{Cell, Direction, Grid};
 use hnav_runtime::msg::{ConflictKind, Verdict};
 
 use super::resolve::cmp_priority;
-use super::{side_cells, AgentMode, AgentRow, Options, Outcome};
+use super::shared_paths::{side_cells, AgentMode, AgentRow, Options, Outcome};
 use distance::{can_step, Distances};
 
 /// A distance as the leading part of a preference key: above the 36 bits of the tie breaks

@@ -1,66 +1,62 @@
-//! The coordinator's state between wake-ups: the open round's candidates, who is live, the
-//! last decided round and where its decisions become final ([`Decisions`]: its consensus log,
-//! or the Raft cluster of its replicas, `replica`).
+//! The coordinator's state between wake-ups, restored from the log on a restart: the last
+//! decided round, the [`OpenRound`] being collected, the [`Roster`] of who is live, the
+//! [`EndWatch`] of when the run is over, and the [`DecisionLog`] its decisions become final
+//! in. A replica's Raft-specific parts live in [`crate::replication`]; here they are only
+//! applied: the records other leaders committed are replayed like a restarted coordinator's
+//! log, and what it heard while following is reconciled when it comes to lead.
+//!
+//! | module | concept |
+//! |---|---|
+//! | `supervisor` | the supervisor's events: liveness logged, a roster entry reconciled with the log, a following replica's memory of them |
+//! | `end_watch` | [`EndWatch`]: why and when the run ends; unreachable goals confirmed by the walls |
+//! | `open_round` | [`OpenRound`]: the open round's candidates, its deadline, its record |
+//! | `roster` | [`Roster`]: per agent live, down or lost, and its restarts |
+//! | `dropped` | [`Dropped`]: the counts of dropped candidates, kept across restarts |
 
-mod replica;
+mod dropped;
+mod end_watch;
+mod open_round;
+mod roster;
+mod supervisor;
 
-use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::path::Path;
 
 use hnav_runtime::consensus_log::{
-    candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LogWriter,
-    LoggedDecision, Record, RoundRecord, RunHeader, UnreachableRecord, FORMAT_VERSION,
+    AgentEntry, EndReason, EndRecord, LogWriter, Record, RoundRecord, RunHeader, UnreachableRecord,
+    FORMAT_VERSION,
 };
-use hnav_runtime::grid::{reachable_from, Cell, CornerCutting, Grid};
-use hnav_runtime::launch::LifecyclePorts;
-use hnav_runtime::msg::{
-    Candidate, CandidateFlags, Lifecycle, LifecycleEvent, Progress, Role, RosterState, StopReason,
-};
-use hnav_runtime::rejected::{Rejected, Rejections};
+use hnav_runtime::msg::{CandidateFlags, Lifecycle, LifecycleEvent, Progress, Role};
+use hnav_runtime::rejected::Rejected;
 use hnav_runtime::scenario::{ClockMode, Scenario};
-use hnav_runtime::transport::Waiter;
+use hnav_runtime::transport::{Transport, Waiter, Wake};
 
-use super::decisions::Decisions;
+use super::decision_log::DecisionLog;
+use super::error::CoordinatorError;
+use super::outcome::CoordinatorOutcome;
 use super::ports::Ports;
-use super::{CoordinatorError, CoordinatorOutcome};
+use crate::replication::{Overheard, RaftLog};
 use crate::round::Arbiter;
+use dropped::Dropped;
+use end_watch::EndWatch;
+use open_round::OpenRound;
+use roster::Roster;
 
-/// Everything the coordinator knows of the run, restored from the log on a restart.
+/// Everything the coordinator knows of the run.
 pub(super) struct State {
     arbiter: Arbiter,
-    log: Decisions,
-    clock: ClockMode,
-    deadline: Duration,
+    log: DecisionLog,
+    /// The last decided round, 0 before the first.
     round: u64,
+    /// Its record, for the agents that missed its commit.
     last_record: Option<RoundRecord>,
-    pending: Vec<Option<Candidate>>,
-    present: Vec<Candidate>,
-    live: Vec<bool>,
-    opened: Option<Instant>,
-    /// In lockstep, the round after which the time limit ends the run.
-    round_limit: Option<u64>,
-    /// Why the run ended, once the log holds its end.
-    end: Option<EndReason>,
-    /// Candidates dropped, per class; kept in `DIR/rejected.json` across restarts.
-    rejected: Rejections,
-    run_dir: PathBuf,
-    /// Per agent: its restarts so far, as the supervisor counts them.
-    restarts: Vec<u32>,
-    /// Per agent: gone for good (`Lost`); its robot stands for the rest of the run and its
-    /// goal counts as not reached.
-    lost: Vec<bool>,
+    open: OpenRound,
+    roster: Roster,
+    watch: EndWatch,
+    dropped: Dropped,
     /// The supervisor's events of one drain, kept so that draining allocates nothing once warm.
     events: Vec<Lifecycle>,
-    /// The map's walls, for confirming an agent's report of an unreachable goal.
-    walls: Grid,
-    corners: CornerCutting,
-    goals: Vec<Cell>,
-    /// Per agent: `None` until it first reports its goal unreachable, then whether the walls
-    /// confirm it. An agent stays in its connected part of the map, so one check is enough.
-    unreachable: Vec<Option<bool>>,
-    /// A following replica: per agent, the last liveness the supervisor told (roster state
-    /// and restarts), reconciled with the log when the replica comes to lead.
-    heard: Vec<Option<(RosterState, u32)>>,
+    /// A following replica's memory of the supervisor.
+    heard: Overheard,
 }
 
 /// The header a log of `s` must start with.
@@ -101,7 +97,7 @@ impl State {
                 "cut a torn tail off the consensus log"
             );
         }
-        let mut state = State::new(scenario, run_dir, Decisions::Log(log));
+        let mut state = State::new(scenario, run_dir, DecisionLog::Single(log));
         let expected = header(scenario);
         match recovered.records.first() {
             None => {
@@ -122,63 +118,71 @@ impl State {
         Ok(state)
     }
 
+    /// Replica `id`'s state: its journal in `run_dir/log/<id>` opened (or created), and the
+    /// records it holds committed applied.
+    pub(super) fn open_replica(
+        transport: &Transport,
+        scenario: &Scenario,
+        run_dir: &Path,
+        id: u64,
+    ) -> Result<Self, CoordinatorError> {
+        let raft = RaftLog::open(transport, scenario, run_dir, id, header(scenario))?;
+        let log = DecisionLog::Replicated(Box::new(raft));
+        let mut state = State::new(scenario, run_dir, log);
+        state.apply_committed();
+        state.say_resumed();
+        Ok(state)
+    }
+
     /// A state with nothing decided yet, whose decisions go to `log`.
-    fn new(scenario: &Scenario, run_dir: &Path, log: Decisions) -> Self {
+    fn new(scenario: &Scenario, run_dir: &Path, log: DecisionLog) -> Self {
         let n = scenario.agents.len();
         State {
             arbiter: Arbiter::new(scenario),
-            clock: scenario.sim.clock,
-            deadline: Duration::from_millis(u64::from(scenario.coordinator.round_deadline_ms)),
+            log,
             round: 0,
             last_record: None,
-            pending: vec![None; n],
-            present: Vec::with_capacity(n),
-            live: vec![true; n],
-            opened: None,
-            round_limit: (scenario.sim.clock == ClockMode::Lockstep)
-                .then(|| scenario.sim.rounds_in(scenario.coordinator.time_limit_s)),
-            end: None,
-            rejected: load_rejections(run_dir),
-            run_dir: run_dir.to_path_buf(),
-            restarts: vec![0; n],
-            lost: vec![false; n],
+            open: OpenRound::new(scenario),
+            roster: Roster::new(n),
+            watch: EndWatch::new(scenario),
+            dropped: Dropped::load(run_dir),
             events: Vec::new(),
-            walls: scenario.map.grid.clone(),
-            corners: scenario.map.corner_cutting,
-            goals: scenario.agents.iter().map(|a| a.goal).collect(),
-            unreachable: vec![None; n],
-            heard: vec![None; n],
-            log,
+            heard: Overheard::new(n),
         }
     }
 
     /// Says where a restarted coordinator resumes.
     fn say_resumed(&self) {
         if self.round > 0 {
-            let down = self.live.iter().filter(|l| !**l).count();
             tracing::info!(
                 round = self.round,
-                agents_down = down,
+                agents_down = self.roster.down(),
                 "resumed from the consensus log"
             );
         }
+    }
+
+    /// Where its decisions become final.
+    pub(super) fn log(&self) -> &DecisionLog {
+        &self.log
     }
 
     /// What the run came to so far.
     pub(super) fn outcome(&self) -> CoordinatorOutcome {
         CoordinatorOutcome {
             round: self.round,
-            all_at_goal: self.ended() && self.at_goal() as usize == self.arbiter.agents(),
-            dropped: self.rejected.total(),
+            all_at_goal: self.ended()
+                && self.roster.at_goal(&self.arbiter) as usize == self.arbiter.agents(),
+            dropped: self.dropped.total(),
         }
     }
 
     /// Whether the log already holds the end of the run.
     pub(super) fn ended(&self) -> bool {
-        self.end.is_some()
+        self.watch.reason().is_some()
     }
 
-    /// Folds one record of an existing log into the state.
+    /// Folds one record of an existing log (or one another leader committed) into the state.
     fn replay(&mut self, r: &Record) {
         match r {
             Record::Round(rec) => {
@@ -186,73 +190,27 @@ impl State {
                 self.arbiter.replay(rec);
                 self.last_record = Some(rec.clone());
             }
-            Record::End(e) => self.end = Some(e.reason),
+            Record::End(e) => self.watch.ended(e.reason),
             Record::Lifecycle(l) => {
                 if let (Some(Role::Agent), Some(ev)) =
                     (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
                 {
-                    self.agent_event(l.index, ev, l.restarts);
+                    self.roster.event(l.index, ev, l.restarts);
                 }
             }
-            Record::Unreachable(u) => {
-                if let Some(r) = self.unreachable.get_mut(u.agent as usize) {
-                    *r = Some(true);
-                }
-            }
+            Record::Unreachable(u) => self.watch.logged_unreachable(u.agent),
             Record::Header(_) | Record::Replan(_) | Record::Raft(_) | Record::RaftState(_) => {}
         }
     }
 
-    /// What an agent's lifecycle event (heard or replayed) says of who is live: a `Down`
-    /// agent is not waited for until it is back, a `Lost` one never again.
-    fn agent_event(&mut self, index: u32, ev: LifecycleEvent, restarts: u32) {
-        let i = index as usize;
-        let (Some(live), Some(lost), Some(r)) = (
-            self.live.get_mut(i),
-            self.lost.get_mut(i),
-            self.restarts.get_mut(i),
-        ) else {
-            return;
-        };
-        *r = (*r).max(restarts);
-        match ev {
-            LifecycleEvent::Down => *live = false,
-            LifecycleEvent::Restarted => *live = !*lost,
-            LifecycleEvent::Lost => (*live, *lost) = (false, true),
-            _ => {}
-        }
-    }
-
-    /// Agents at their goal, lost ones not counted (what the end record says).
-    fn at_goal(&self) -> u32 {
-        (0..self.arbiter.agents())
-            .filter(|&i| self.arbiter.agent_at_goal(i) && !self.lost[i])
-            .count() as u32
-    }
-
-    /// Whether every agent is at its goal, confirmed unable to reach it, or lost.
-    fn settled(&self) -> bool {
-        (0..self.arbiter.agents()).all(|i| {
-            self.arbiter.agent_at_goal(i) || self.unreachable[i] == Some(true) || self.lost[i]
-        })
-    }
-
     /// Logs, once per agent and before the round's record, a goal its agent reports
-    /// unreachable (`NO_PATH`) when the walls confirm it. A report the walls do not confirm
-    /// (the agent's map counts robots it was blocked by as obstacles, and robots move on) is
-    /// not logged: the agent stands still as it asked and is asked again later.
+    /// unreachable (`NO_PATH`) when the walls confirm it ([`EndWatch::confirm_unreachable`]).
     fn confirm_unreachable(&mut self, round: u64) -> Result<(), CoordinatorError> {
-        for (i, c) in self.pending.iter().enumerate() {
+        for (i, c) in self.open.candidates().iter().enumerate() {
             let Some(c) = c.filter(|c| c.flags & CandidateFlags::NO_PATH != 0) else {
                 continue;
             };
-            if self.unreachable[i].is_some() || self.walls.cell_at(c.current as usize).is_none() {
-                continue;
-            }
-            let reach = reachable_from(&self.walls, self.goals[i], self.corners);
-            let unreachable = !reach[c.current as usize];
-            self.unreachable[i] = Some(unreachable);
-            if unreachable {
+            if self.watch.confirm_unreachable(i, c.current) {
                 tracing::warn!(agent = i, "goal unreachable; the agent stands still");
                 self.log.append(&Record::Unreachable(UnreachableRecord {
                     round,
@@ -261,116 +219,6 @@ impl State {
                 }))?;
             }
         }
-        Ok(())
-    }
-
-    /// Takes in every pending supervisor event; returns how the run ends if one was `Stop`.
-    pub(super) fn hear_supervisor(
-        &mut self,
-        p: &Ports,
-        life: &LifecyclePorts,
-    ) -> Result<Option<EndReason>, CoordinatorError> {
-        // Taken out so that applying the events may borrow the state; an error ends the
-        // process, so losing the buffer then costs nothing.
-        let mut events = std::mem::take(&mut self.events);
-        events.clear();
-        let stop = life.drain_samples(|_, _, l| events.push(*l))?;
-        let ended = self.ended();
-        for l in &events {
-            self.on_lifecycle(l)?;
-        }
-        self.events = events;
-        // A robot lost while every other one is settled ends the run here, between rounds.
-        self.end_if_over()?;
-        if self.ended() && !ended {
-            self.publish_progress(p)?;
-        }
-        Ok(stop.map(|reason| match reason {
-            StopReason::TimeLimit => EndReason::TimeLimit,
-            StopReason::Requested => EndReason::Stopped,
-        }))
-    }
-
-    /// A supervisor event: liveness of agents, logged for the record with the restart count
-    /// the supervisor gives; a roster entry is reconciled with what the log holds.
-    fn on_lifecycle(&mut self, l: &Lifecycle) -> Result<(), CoordinatorError> {
-        let (Some(role), Some(ev)) = (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
-        else {
-            return Ok(());
-        };
-        match ev {
-            LifecycleEvent::Down | LifecycleEvent::Restarted | LifecycleEvent::Lost => {
-                if role == Role::Agent {
-                    self.agent_event(l.index, ev, l.restarts);
-                }
-                self.log_event(role, l.index, ev, l.restarts)
-            }
-            LifecycleEvent::Roster if role == Role::Agent => match RosterState::from_u8(l.reason) {
-                Some(state) => self.reconcile(l.index, state, l.restarts),
-                None => Ok(()),
-            },
-            _ => Ok(()),
-        }
-    }
-
-    /// A roster entry (sent after this coordinator came up): the records the log misses
-    /// because the agent died, came back or was given up while no coordinator listened are
-    /// logged now, at the current round, and the agent is waited for or not accordingly.
-    fn reconcile(
-        &mut self,
-        index: u32,
-        state: RosterState,
-        restarts: u32,
-    ) -> Result<(), CoordinatorError> {
-        let i = index as usize;
-        let (Some(&live), Some(&lost), Some(&logged)) =
-            (self.live.get(i), self.lost.get(i), self.restarts.get(i))
-        else {
-            return Ok(());
-        };
-        let mut missed: [Option<(LifecycleEvent, u32)>; 2] = [None, None];
-        match state {
-            // Up with restarts the log has not seen: it died and came back meanwhile.
-            RosterState::Up if !lost && (!live || logged < restarts) => {
-                if live {
-                    missed[0] = Some((LifecycleEvent::Down, restarts.saturating_sub(1)));
-                }
-                missed[1] = Some((LifecycleEvent::Restarted, restarts));
-            }
-            RosterState::Down if live => missed[0] = Some((LifecycleEvent::Down, restarts)),
-            RosterState::Lost if !lost => {
-                if live {
-                    missed[0] = Some((LifecycleEvent::Down, restarts));
-                }
-                missed[1] = Some((LifecycleEvent::Lost, restarts));
-            }
-            _ => {}
-        }
-        for (ev, count) in missed.into_iter().flatten() {
-            self.agent_event(index, ev, count);
-            self.log_event(Role::Agent, index, ev, count)?;
-        }
-        Ok(())
-    }
-
-    /// Logs a lifecycle event at the current round, unless the run has ended.
-    fn log_event(
-        &mut self,
-        role: Role,
-        index: u32,
-        ev: LifecycleEvent,
-        restarts: u32,
-    ) -> Result<(), CoordinatorError> {
-        if self.ended() {
-            return Ok(());
-        }
-        let event = match ev {
-            LifecycleEvent::Restarted => Lifecycle::restarted(role, index, restarts),
-            LifecycleEvent::Lost => Lifecycle::lost(role, index, restarts),
-            _ => Lifecycle::down(role, index, restarts),
-        };
-        self.log
-            .append(&Record::Lifecycle(LifecycleRecord::new(self.round, &event)))?;
         Ok(())
     }
 
@@ -383,18 +231,12 @@ impl State {
                 // An agent behind (a restarted one, or one the dead coordinator never
                 // answered): the last commit brings it up to date.
                 resend |= class == Rejected::PastRound && self.round > 0;
-                self.reject(class, &c);
+                self.dropped.note(class, &c);
                 return;
             }
             if !self.ended() {
-                let i = c.agent as usize;
-                if self.pending.iter().all(Option::is_none) {
-                    self.opened = Some(Instant::now());
-                }
-                self.pending[i] = Some(c);
-                // A candidate shows an agent live, unless the supervisor gave it up (a
-                // sample it sent before it died).
-                self.live[i] = !self.lost[i];
+                self.open.take(c);
+                self.roster.heard_from(c.agent as usize);
             }
         })?;
         if resend {
@@ -403,63 +245,28 @@ impl State {
         Ok(())
     }
 
-    /// Counts a dropped candidate; only the first of its class is logged, so that a flood
-    /// costs no log line and no allocation per message.
-    fn reject(&mut self, class: Rejected, c: &Candidate) {
-        if self.rejected.note(class) {
-            tracing::warn!(
-                class = class.name(),
-                agent = c.agent,
-                round = c.round,
-                "candidate dropped; further ones of this class are only counted"
-            );
-        }
-    }
-
-    /// Logs the totals of dropped candidates (if any) and keeps them in `DIR/rejected.json`
-    /// for the run summary and for a coordinator restarted after this one.
+    /// Logs the totals of dropped candidates (if any) and keeps them for the run summary and
+    /// for a coordinator restarted after this one.
     pub(super) fn report_rejections(&self) {
-        if self.rejected.total() > 0 {
-            tracing::warn!(counts = %self.rejected, "candidates dropped in this run");
-        }
-        if let Err(e) = self.rejected.store(&self.run_dir) {
-            tracing::warn!(
-                "cannot write {}: {e}",
-                self.run_dir.join(hnav_runtime::rejected::FILE).display()
-            );
-        }
+        self.dropped.report();
     }
 
     /// Publishes the last logged round's commit again, if there is one.
     pub(super) fn resend_last_commit(&self, p: &Ports) -> Result<(), CoordinatorError> {
         if let Some(rec) = &self.last_record {
-            let term = self.term();
-            p.commit.send_in_place(|slot| {
-                rec.write_commit(slot);
-                slot.term = term;
-            })?;
+            publish_commit(p, rec, self.log.term())?;
         }
         Ok(())
     }
 
     /// Whether the open round has every live agent's candidate.
     pub(super) fn ready(&self) -> bool {
-        !self.ended()
-            && self.pending.iter().any(Option::is_some)
-            && self
-                .live
-                .iter()
-                .zip(&self.pending)
-                .all(|(&l, c)| !l || c.is_some())
+        !self.ended() && self.open.complete(&self.roster)
     }
 
-    /// When the open round closes without the missing candidates: in realtime
-    /// `round_deadline_ms` after its first candidate; never in lockstep, or with no round open.
-    pub(super) fn round_deadline(&self) -> Option<Instant> {
-        match (self.clock, self.opened) {
-            (ClockMode::Realtime, Some(opened)) => Some(opened + self.deadline),
-            _ => None,
-        }
+    /// When the open round closes without the missing candidates ([`OpenRound::deadline`]).
+    pub(super) fn round_deadline(&self) -> Option<std::time::Instant> {
+        self.open.deadline()
     }
 
     /// Decides the open round, makes it durable, then commits it. `tick` is called often
@@ -472,41 +279,25 @@ impl State {
     ) -> Result<(), CoordinatorError> {
         let round = self.round + 1;
         self.confirm_unreachable(round)?;
-        let (decisions, replans) = self.arbiter.decide_with(round, &self.pending, tick);
+        let (decisions, replans) = self
+            .arbiter
+            .decide_with(round, self.open.candidates(), tick);
         for r in replans {
             self.log.append(&Record::Replan(r.clone()))?;
         }
-        // The record's buffers are reused round after round: no allocation once warm.
-        self.present.clear();
-        self.present.extend(self.pending.iter().flatten());
-        let mut rec = self
-            .last_record
-            .take()
-            .unwrap_or_else(|| RoundRecord::new(0, &[], &[]));
-        rec.round = round;
-        rec.candidates = self.present.len() as u32;
-        rec.candidates_digest = candidates_digest(&self.present);
-        rec.decisions.clear();
-        rec.decisions
-            .extend(decisions.iter().map(LoggedDecision::from));
+        let rec = self.open.record(round, decisions, self.last_record.take());
         let record = Record::Round(rec);
         self.log.append(&record)?;
         let Record::Round(rec) = record else {
             unreachable!("built as a round record above")
         };
         // A replica's round is final once a majority holds it; only then may it leave.
-        let settled = self.settle(waiter, tick)?;
-        let term = self.term();
-        if settled {
-            p.commit.send_in_place(|slot| {
-                rec.write_commit(slot);
-                slot.term = term;
-            })?;
+        if self.settle(waiter, tick)? {
+            publish_commit(p, &rec, self.log.term())?;
         }
         self.last_record = Some(rec);
         self.round = round;
-        self.pending.iter_mut().for_each(|c| *c = None);
-        self.opened = None;
+        self.open.clear();
         self.end_if_over()?;
         // The end of the run, if this round ended it, is final before the progress says so.
         if self.settle(waiter, tick)? {
@@ -515,74 +306,134 @@ impl State {
         Ok(())
     }
 
-    /// Ends the run once every agent is at its goal or, in lockstep, once the round of its
-    /// time limit is committed: the limit is counted here, in rounds of simulated time, so
-    /// that a lockstep run ends at the same record whatever the wall clock says.
+    /// Ends the run once it is over ([`EndWatch::due`]).
     pub(super) fn end_if_over(&mut self) -> Result<(), CoordinatorError> {
-        if self.ended() || self.round == 0 {
-            return Ok(());
+        match self.watch.due(self.round, &self.arbiter, &self.roster) {
+            Some(reason) => self.end(reason),
+            None => Ok(()),
         }
-        if self.at_goal() as usize == self.arbiter.agents() {
-            self.end(EndReason::AllAtGoal)?;
-        } else if self.settled() && self.lost.iter().any(|l| *l) {
-            self.end(EndReason::AllAtGoalOrLost)?;
-        } else if self.settled() {
-            self.end(EndReason::AllAtGoalOrUnreachable)?;
-        } else if self.round_limit.is_some_and(|limit| self.round >= limit) {
-            self.end(EndReason::TimeLimit)?;
-        }
-        Ok(())
     }
 
     /// Logs the end of the run (durably) and decides nothing more.
     pub(super) fn end(&mut self, reason: EndReason) -> Result<(), CoordinatorError> {
         self.log.append(&Record::End(EndRecord {
             round: self.round,
-            at_goal: self.at_goal(),
+            at_goal: self.roster.at_goal(&self.arbiter),
             reason,
         }))?;
         self.log.sync()?;
-        self.end = Some(reason);
+        self.watch.ended(reason);
         Ok(())
     }
 
     /// Flushes the log to disk.
     pub(super) fn sync(&mut self) -> Result<(), CoordinatorError> {
-        self.log.sync()?;
-        Ok(())
+        self.log.sync()
     }
 
-    /// Tells the supervisor and the sim how far the run is.
+    /// Tells the run's observers how far the run is: the supervisor (`hnav run` ends the run
+    /// on `done` and learns the leader of replicas from it), `hnav top`, and the bridge, which
+    /// carries it to the other hosts.
     pub(super) fn publish_progress(&self, p: &Ports) -> Result<(), CoordinatorError> {
         let t = self.arbiter.tally();
         p.progress.send(Progress {
             round: self.round,
             agents: self.arbiter.agents() as u32,
-            at_goal: self.at_goal(),
+            at_goal: self.roster.at_goal(&self.arbiter),
             conflicts: t.conflicts(),
             replans: t.replans(),
-            leader: self.replica_id() as u8,
-            done: match self.end {
-                // Nothing is left to decide for the unreachable ones either.
-                Some(
-                    EndReason::AllAtGoal
-                    | EndReason::AllAtGoalOrUnreachable
-                    | EndReason::AllAtGoalOrLost,
-                ) => Progress::ALL_AT_GOAL,
-                Some(EndReason::TimeLimit) => Progress::TIME_LIMIT,
-                Some(EndReason::Stopped) | None => 0,
-            },
+            leader: self.log.replica_id() as u8,
+            done: self.watch.done(),
             reserved: [0; 6],
         })?;
         Ok(())
     }
+
+    /// One pass of a replica (messages, tick) and the other leaders' committed records
+    /// applied. A leader that was deposed after it decided stops here: its state may hold
+    /// decisions the cluster never took, and its restart rebuilds it from the journal.
+    pub(super) fn pump(&mut self) -> Result<(), CoordinatorError> {
+        let Some(raft) = self.log.raft() else {
+            return Ok(());
+        };
+        raft.pump()?;
+        if let Some(term) = raft.deposed() {
+            return Err(CoordinatorError::Deposed {
+                term,
+                now: raft.term(),
+            });
+        }
+        self.apply_committed();
+        Ok(())
+    }
+
+    /// Applies the records other leaders committed, as a restarted coordinator replays its
+    /// log.
+    fn apply_committed(&mut self) {
+        let Some(raft) = self.log.raft() else { return };
+        let records = raft.take_applied();
+        for r in &records {
+            self.replay(r);
+        }
+        if let Some(raft) = self.log.raft() {
+            raft.recycle(records);
+        }
+    }
+
+    /// Whether this replica may decide now (a single coordinator always may): it leads, and
+    /// every record of earlier leaders is applied. The first time, the supervisor's events
+    /// it heard while following are reconciled with the log (what no leader logged is
+    /// logged now).
+    pub(super) fn take_lead(&mut self) -> Result<bool, CoordinatorError> {
+        let Some(raft) = self.log.raft() else {
+            return Ok(true);
+        };
+        let first = !raft.leading();
+        if !raft.take_lead() {
+            return Ok(false);
+        }
+        if first {
+            for (i, state, restarts) in self.heard.take() {
+                self.reconcile(i, state, restarts)?;
+            }
+        }
+        Ok(true)
+    }
+
+    /// Waits until the records proposed so far are committed (at once for a single
+    /// coordinator, whose appends are final). `false` when the process is told to stop first.
+    fn settle(
+        &mut self,
+        waiter: &Waiter,
+        tick: &mut dyn FnMut(),
+    ) -> Result<bool, CoordinatorError> {
+        loop {
+            self.pump()?;
+            let ended = self.ended();
+            let Some(raft) = self.log.raft() else {
+                return Ok(true);
+            };
+            if raft.settled() {
+                if ended {
+                    // The followers are stopped soon after the end: they learn now that it
+                    // is committed, not at the next heartbeat.
+                    raft.ping()?;
+                }
+                return Ok(true);
+            }
+            tick();
+            if waiter.wait(Some(raft.deadline()))? == Wake::Stop {
+                return Ok(false);
+            }
+        }
+    }
 }
 
-/// The counts an earlier coordinator of the run left, or none; a file that cannot be read is
-/// reported and counting starts again from zero, since the counts never decide anything.
-fn load_rejections(run_dir: &Path) -> Rejections {
-    Rejections::load(run_dir).unwrap_or_else(|e| {
-        tracing::warn!("{e}; counting dropped candidates from zero");
-        Rejections::default()
-    })
+/// Publishes `rec`'s commit in term `term`.
+fn publish_commit(p: &Ports, rec: &RoundRecord, term: u32) -> Result<(), CoordinatorError> {
+    p.commit.send_in_place(|slot| {
+        rec.write_commit(slot);
+        slot.term = term;
+    })?;
+    Ok(())
 }

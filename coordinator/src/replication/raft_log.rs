@@ -1,58 +1,29 @@
-//! Where the coordinator's decisions become final: its own consensus log (a single
-//! coordinator), or the Raft cluster of its replicas (`coordinator.replicas` 3 or 5).
+//! A replica's end of the cluster as the coordinator uses it ([`RaftLog`]): it proposes the
+//! records of the rounds it decides while it leads, and takes the records other leaders
+//! committed while it follows.
 //!
-//! A single coordinator appends a record and it is final once the append returns (durable by
-//! the fsync policy). A replica that leads proposes the record instead; it is final once a
-//! majority of the replicas holds it durably ([`RaftLog::settled`]), and only then may its
-//! Commit leave. A replica that follows takes the leader's committed records
-//! ([`RaftLog::pump`]) and applies them to its own state, so that it is ready to lead.
+//! A record a leading replica proposes is final once a majority of the replicas holds it
+//! durably ([`RaftLog::settled`]), and only then may its Commit leave. A following replica
+//! takes the leader's committed records ([`RaftLog::pump`]) for the coordinator to apply to
+//! its own state, so that it is ready to lead.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 use hnav_runtime::consensus_log::{
-    decode_record, encode_record, LogWriter, Record, ReplicaRole, RunHeader, ROLE_FILE,
+    decode_record, encode_record, Record, ReplicaRole, RunHeader, ROLE_FILE,
 };
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::transport::Transport;
 
-use super::CoordinatorError;
-use crate::replication::{RaftLink, Replica, ReplicaConfig, ReplicaError, Role};
-
-/// The coordinator's decisions' destination.
-pub(super) enum Decisions {
-    /// A single coordinator's log.
-    Log(LogWriter),
-    /// A replica's Raft log.
-    Raft(Box<RaftLog>),
-}
-
-impl Decisions {
-    /// Makes `record` final (single) or proposes it (the leading replica).
-    pub(super) fn append(&mut self, record: &Record) -> Result<(), CoordinatorError> {
-        match self {
-            Decisions::Log(log) => {
-                log.append(record)?;
-            }
-            Decisions::Raft(raft) => raft.propose(record)?,
-        }
-        Ok(())
-    }
-
-    /// Makes everything appended durable now.
-    pub(super) fn sync(&mut self) -> Result<(), CoordinatorError> {
-        match self {
-            Decisions::Log(log) => log.sync()?,
-            Decisions::Raft(raft) => raft.replica.sync()?,
-        }
-        Ok(())
-    }
-}
+use super::error::ReplicaError;
+use super::link::RaftLink;
+use super::peer::{Replica, ReplicaConfig, Role};
 
 /// A replica's end of the cluster: its Raft peer over its journal, the `raft/<i>` topics, and
 /// the replica's logical clock.
-pub(super) struct RaftLog {
+pub struct RaftLog {
     replica: Replica,
     /// Shared with the process loop, which waits on its inbox while the state pumps it.
     link: Rc<RaftLink>,
@@ -64,8 +35,8 @@ pub(super) struct RaftLog {
     proposed: u64,
     tick: Duration,
     next_tick: Instant,
-    /// Records committed by other leaders, in log order, for the state to apply.
-    pub(super) applied: Vec<Record>,
+    /// Records committed by other leaders, in log order, for the coordinator to apply.
+    applied: Vec<Record>,
     /// The replica's log directory, where its role file is kept for `hnav ps`.
     dir: PathBuf,
     /// The role and term the role file says.
@@ -75,13 +46,13 @@ pub(super) struct RaftLog {
 impl RaftLog {
     /// Replica `id` of `scenario`'s cluster, its journal in `run_dir/log/<id>` (created with
     /// `header`, or replayed).
-    pub(super) fn open(
+    pub fn open(
         transport: &Transport,
         scenario: &Scenario,
-        run_dir: &std::path::Path,
+        run_dir: &Path,
         id: u64,
         header: RunHeader,
-    ) -> Result<Self, CoordinatorError> {
+    ) -> Result<Self, ReplicaError> {
         let c = &scenario.coordinator;
         let config = ReplicaConfig {
             election_ticks: c.election_ticks(),
@@ -113,33 +84,33 @@ impl RaftLog {
     }
 
     /// The link, whose inbox wakes the process loop.
-    pub(super) fn link(&self) -> Rc<RaftLink> {
+    pub fn link(&self) -> Rc<RaftLink> {
         Rc::clone(&self.link)
     }
 
     /// This replica's Raft id.
-    pub(super) fn id(&self) -> u64 {
+    pub fn id(&self) -> u64 {
         self.replica.id()
     }
 
     /// The term it is in.
-    pub(super) fn term(&self) -> u64 {
+    pub fn term(&self) -> u64 {
         self.replica.term()
     }
 
     /// Its role now.
-    pub(super) fn role(&self) -> Role {
+    pub fn role(&self) -> Role {
         self.replica.role()
     }
 
     /// When the next tick is due: the latest a wait may last.
-    pub(super) fn deadline(&self) -> Instant {
+    pub fn deadline(&self) -> Instant {
         self.next_tick
     }
 
     /// Whether it may start to decide: it leads and every earlier leader's committed entry is
     /// applied ([`Replica::can_decide`]). From then on it decides in this term only.
-    pub(super) fn take_lead(&mut self) -> bool {
+    pub fn take_lead(&mut self) -> bool {
         if self.led.is_none() && self.replica.can_decide() {
             self.led = Some(self.replica.term());
         }
@@ -147,26 +118,26 @@ impl RaftLog {
     }
 
     /// Whether it has started to decide.
-    pub(super) fn leading(&self) -> bool {
+    pub fn leading(&self) -> bool {
         self.led.is_some()
     }
 
     /// Whether it decided in a term it no longer leads: its state may hold decisions the
     /// cluster never committed, and only a restart from the journal sets that right.
-    pub(super) fn deposed(&self) -> Option<u64> {
+    pub fn deposed(&self) -> Option<u64> {
         let led = self.led?;
         (self.replica.role() != Role::Leader || self.replica.term() != led).then_some(led)
     }
 
     /// Whether every proposal is committed: a majority holds it durably.
-    pub(super) fn settled(&self) -> bool {
+    pub fn settled(&self) -> bool {
         self.replica.committed_index() >= self.proposed
     }
 
     /// One pass of the replica: the messages that came in, a tick if one is due, the
     /// messages that go out, and the committed records of other leaders into
-    /// [`applied`](Self::applied).
-    pub(super) fn pump(&mut self) -> Result<(), CoordinatorError> {
+    /// [`take_applied`](Self::take_applied).
+    pub fn pump(&mut self) -> Result<(), ReplicaError> {
         let replica = &mut self.replica;
         let mut failed = None;
         self.link.receive(|m| {
@@ -180,7 +151,7 @@ impl RaftLog {
             }
         })?;
         if let Some(e) = failed {
-            return Err(e.into());
+            return Err(e);
         }
         let now = Instant::now();
         if now >= self.next_tick {
@@ -210,14 +181,32 @@ impl RaftLog {
         }
     }
 
+    /// Makes everything its journal holds durable now.
+    pub fn sync(&mut self) -> Result<(), ReplicaError> {
+        self.replica.sync()
+    }
+
+    /// The records other leaders committed that the coordinator has not applied yet, in log
+    /// order. The coordinator applies them and hands the emptied buffer back
+    /// ([`RaftLog::recycle`]), so that following allocates nothing once warm.
+    pub fn take_applied(&mut self) -> Vec<Record> {
+        std::mem::take(&mut self.applied)
+    }
+
+    /// Takes back the buffer [`RaftLog::take_applied`] lent, emptied.
+    pub fn recycle(&mut self, mut records: Vec<Record>) {
+        records.clear();
+        self.applied = records;
+    }
+
     /// Tells the followers the commit index now (the run's end: they stop soon after).
-    pub(super) fn ping(&mut self) -> Result<(), CoordinatorError> {
+    pub fn ping(&mut self) -> Result<(), ReplicaError> {
         self.replica.ping()?;
         self.send()
     }
 
     /// Proposes `record`; the leader only.
-    fn propose(&mut self, record: &Record) -> Result<(), CoordinatorError> {
+    pub fn propose(&mut self, record: &Record) -> Result<(), ReplicaError> {
         self.buf.clear();
         encode_record(record, &mut self.buf)?;
         self.replica.propose(&self.buf)?;
@@ -226,7 +215,7 @@ impl RaftLog {
     }
 
     /// Sends what Raft has to say. A message that does not go out is Raft's to resend.
-    fn send(&mut self) -> Result<(), CoordinatorError> {
+    fn send(&mut self) -> Result<(), ReplicaError> {
         for m in self.replica.take_messages() {
             if let Err(e) = self.link.send(&m) {
                 tracing::debug!(to = m.to, "raft message not sent: {e}");
@@ -236,17 +225,13 @@ impl RaftLog {
     }
 
     /// Moves the committed records this replica did not decide itself into `applied`.
-    fn take_committed(&mut self) -> Result<(), CoordinatorError> {
+    fn take_committed(&mut self) -> Result<(), ReplicaError> {
         for c in self.replica.take_committed() {
             if Some(c.term) == self.led {
                 continue;
             }
-            let record = decode_record(&c.data).map_err(|p| {
-                CoordinatorError::Replica(ReplicaError::Decode(format!(
-                    "committed entry {}: {p}",
-                    c.index
-                )))
-            })?;
+            let record = decode_record(&c.data)
+                .map_err(|p| ReplicaError::Decode(format!("committed entry {}: {p}", c.index)))?;
             self.applied.push(record);
         }
         Ok(())

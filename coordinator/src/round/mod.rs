@@ -177,7 +177,9 @@ impl Arbiter {
     }
 
     /// [`Arbiter::decide`], calling `tick` often while a long computation runs (LaCAM's
-    /// search), so that the caller can keep its heartbeat going.
+    /// search), so that the caller can keep its heartbeat going. A round is three steps: the
+    /// candidates are read into the rows, the rows resolved by the run's rules, and each
+    /// outcome answered (with a waypoint, when the rules replan and the agent is stuck).
     pub fn decide_with(
         &mut self,
         round: u64,
@@ -186,6 +188,22 @@ impl Arbiter {
     ) -> (&[Decision], &[ReplanRecord]) {
         self.decisions.clear();
         self.replans.clear();
+        self.read(candidates);
+        let replanning = self.resolve(tick);
+        for i in 0..self.rows.len() {
+            if let Some(d) = self.answer(round, i, replanning) {
+                // The tally counts what is published (and logged), so that a replay of the
+                // log after a restart and the run summary arrive at the same numbers.
+                self.tally.fold(&LoggedDecision::from(&d));
+                self.decisions.push(d);
+            }
+        }
+        (&self.decisions, &self.replans)
+    }
+
+    /// Takes the round's candidates into the rows: an agent missing from the round keeps its
+    /// cells and stands.
+    fn read(&mut self, candidates: &[Option<Candidate>]) {
         for (i, row) in self.rows.iter_mut().enumerate() {
             match candidates.get(i).copied().flatten() {
                 Some(c) => {
@@ -210,7 +228,12 @@ impl Arbiter {
             }
             row.priority = self.priorities[i];
         }
-        let replanning = match &mut self.round {
+    }
+
+    /// Resolves the rows by the run's rules into `outcomes`; returns whether the rules
+    /// replan (only the dissertation's do).
+    fn resolve(&mut self, tick: &mut dyn FnMut()) -> bool {
+        match &mut self.round {
             Round::Dissertation(r) => {
                 r.resolve(&self.rows, &mut self.outcomes);
                 true
@@ -223,48 +246,48 @@ impl Arbiter {
                 l.resolve_with(&self.rows, &mut self.outcomes, tick);
                 false
             }
-        };
-        for i in 0..self.rows.len() {
-            let row = self.rows[i];
-            let o = self.outcomes[i];
-            let stuck = replanning
-                && self.flags[i] & CandidateFlags::LOCAL_EXTREMUM != 0
-                && row.mode == AgentMode::Active
-                && row.is_at_rest();
-            if row.probable.is_none() && !stuck && !o.accepted() {
-                continue;
-            }
-            let mut d = o.decision(i as u32, &self.grid);
-            if row.probable.is_some() {
-                if o.accepted() {
-                    self.waiting[i] = 0;
-                } else {
-                    self.waiting[i] += 1;
-                    // The contested cell travels with a refusal: an agent blocked by a
-                    // standing one learns it as an obstacle.
-                    d.cell = o
-                        .cell
-                        .and_then(|c| self.grid.checked_index(c))
-                        .map_or(NO_CELL, |c| c as u32);
-                }
-            }
-            if replanning && (stuck || self.waiting[i] >= self.replan_after) {
-                if let Some(r) = self.replan(round, i) {
-                    d = Decision {
-                        agent: i as u32,
-                        verdict: Verdict::Replan as u8,
-                        waypoint: r,
-                        ..Decision::default()
-                    };
-                    self.waiting[i] = 0;
-                }
-            }
-            // The tally counts what is published (and logged), so that a replay of the log
-            // after a restart and the run summary arrive at the same numbers.
-            self.tally.fold(&LoggedDecision::from(&d));
-            self.decisions.push(d);
         }
-        (&self.decisions, &self.replans)
+    }
+
+    /// Agent `i`'s answer: its outcome as a decision, or a waypoint when it is stuck or has
+    /// waited too long (`replanning` rules only); `None` when it asked for nothing, is not
+    /// stuck and was not moved.
+    fn answer(&mut self, round: u64, i: usize, replanning: bool) -> Option<Decision> {
+        let row = self.rows[i];
+        let o = self.outcomes[i];
+        let stuck = replanning
+            && self.flags[i] & CandidateFlags::LOCAL_EXTREMUM != 0
+            && row.mode == AgentMode::Active
+            && row.is_at_rest();
+        if row.probable.is_none() && !stuck && !o.accepted() {
+            return None;
+        }
+        let mut d = o.decision(i as u32, &self.grid);
+        if row.probable.is_some() {
+            if o.accepted() {
+                self.waiting[i] = 0;
+            } else {
+                self.waiting[i] += 1;
+                // The contested cell travels with a refusal: an agent blocked by a standing
+                // one learns it as an obstacle.
+                d.cell = o
+                    .cell
+                    .and_then(|c| self.grid.checked_index(c))
+                    .map_or(NO_CELL, |c| c as u32);
+            }
+        }
+        if replanning && (stuck || self.waiting[i] >= self.replan_after) {
+            if let Some(waypoint) = self.replan(round, i) {
+                self.waiting[i] = 0;
+                return Some(Decision {
+                    agent: i as u32,
+                    verdict: Verdict::Replan as u8,
+                    waypoint,
+                    ..Decision::default()
+                });
+            }
+        }
+        Some(d)
     }
 
     /// Plans agent `i` around the others; records the replan and returns the waypoint.
@@ -341,248 +364,4 @@ impl Arbiter {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use hnav_runtime::msg::ConflictKind;
-
-    fn scenario(text: &str) -> Scenario {
-        Scenario::from_str(text, "test.toml", std::path::Path::new(".")).unwrap()
-    }
-
-    fn cand(s: &Scenario, agent: u32, cur: (u32, u32), prob: Option<(u32, u32)>) -> Candidate {
-        let g = &s.map.grid;
-        let cur = g.index(Cell::new(cur.0, cur.1)) as u32;
-        Candidate {
-            round: 1,
-            agent,
-            current: cur,
-            next: cur,
-            probable: prob.map_or(NO_CELL, |p| g.index(Cell::new(p.0, p.1)) as u32),
-            ..Candidate::default()
-        }
-    }
-
-    const TWO: &str = r#"
-        name = "t"
-        [map]
-        rows = ["........", "........", "........"]
-        [coordinator]
-        rules = "dissertation"
-        replan_after_rounds = 2
-        [[agents]]
-        start = [0, 1]
-        goal = [7, 1]
-        [[agents]]
-        start = [2, 1]
-        goal = [2, 0]
-        speed = 0.5
-    "#;
-
-    #[test]
-    fn a_missing_agent_is_a_standing_obstacle() {
-        let s = scenario(TWO);
-        let mut a = Arbiter::new(&s);
-        let c0 = cand(&s, 0, (1, 1), Some((2, 1)));
-        let (d, _) = a.decide(1, &[Some(c0), None]);
-        assert_eq!(d.len(), 1);
-        assert_eq!(d[0].verdict, Verdict::Block as u8);
-        assert_eq!(d[0].kind, ConflictKind::StableCell as u8);
-        assert_eq!(d[0].cell, s.map.grid.index(Cell::new(2, 1)) as u32);
-    }
-
-    #[test]
-    fn waiting_too_long_gives_a_waypoint_around_the_blocker() {
-        let s = scenario(TWO);
-        let mut a = Arbiter::new(&s);
-        let c0 = cand(&s, 0, (1, 1), Some((2, 1)));
-        let c1 = cand(&s, 1, (2, 1), None);
-        let (d, r) = a.decide(1, &[Some(c0), Some(c1)]);
-        assert_eq!(d[0].verdict, Verdict::Hold as u8, "{d:?}");
-        assert!(r.is_empty());
-        let (d, r) = a.decide(2, &[Some(c0), Some(c1)]);
-        assert_eq!(d[0].verdict, Verdict::Replan as u8);
-        assert_eq!(r.len(), 1);
-        let wp = s.map.grid.cell_at(d[0].waypoint as usize).unwrap();
-        assert_ne!(wp, Cell::new(2, 1));
-        // Round 1 held, round 2 replanned (as published, not also counted as held).
-        assert_eq!(a.tally().agents()[0].replans, 1);
-        assert_eq!(a.tally().agents()[0].conflicts, 1);
-    }
-
-    #[test]
-    fn the_tally_of_the_published_decisions_is_the_tally_of_their_replay() {
-        let s = scenario(TWO);
-        let mut live = Arbiter::new(&s);
-        let mut replayed = Arbiter::new(&s);
-        let c0 = cand(&s, 0, (1, 1), Some((2, 1)));
-        let c1 = cand(&s, 1, (2, 1), Some((2, 0)));
-        let c1_standing = cand(&s, 1, (2, 1), None);
-        for (round, c1) in (1..).zip([c1_standing, c1_standing, c1, c1_standing]) {
-            let (d, _) = live.decide(round, &[Some(c0), Some(c1)]);
-            replayed.replay(&RoundRecord::new(round, &[], d));
-        }
-        let t = live.tally();
-        assert_eq!(t, replayed.tally());
-        // Agent 0: held, replanned, held (agent 1 leaving its cell), replanned.
-        assert_eq!((t.conflicts(), t.replans()), (2, 2), "{t:?}");
-        assert_eq!(t.agents()[1].steps, 1, "{t:?}");
-    }
-
-    #[test]
-    fn each_hostile_candidate_is_put_in_its_class() {
-        let s = scenario(TWO);
-        let a = Arbiter::new(&s);
-        let g = &s.map.grid;
-        let at = |x, y| g.index(Cell::new(x, y)) as u32;
-        let good = Candidate {
-            priority: 1.0,
-            speed: 1.0,
-            ..cand(&s, 0, (1, 1), Some((2, 1)))
-        };
-        assert_eq!(a.check(&good), Ok(()));
-        let moving = Candidate {
-            next: at(2, 2),
-            probable: NO_CELL,
-            ..good
-        };
-        assert_eq!(a.check(&moving), Ok(()));
-        let bad: [(Candidate, Rejected); 12] = [
-            (Candidate { agent: 2, ..good }, Rejected::Agent),
-            (
-                Candidate {
-                    agent: u32::MAX,
-                    ..good
-                },
-                Rejected::Agent,
-            ),
-            (
-                Candidate {
-                    flags: 1 << 5,
-                    ..good
-                },
-                Rejected::Flags,
-            ),
-            (
-                Candidate {
-                    reserved: 7,
-                    ..good
-                },
-                Rejected::Flags,
-            ),
-            (
-                Candidate {
-                    priority: f32::NAN,
-                    ..good
-                },
-                Rejected::PrioritySpeed,
-            ),
-            (
-                Candidate {
-                    speed: f32::INFINITY,
-                    ..good
-                },
-                Rejected::PrioritySpeed,
-            ),
-            (
-                Candidate {
-                    priority: -1.0,
-                    ..good
-                },
-                Rejected::PrioritySpeed,
-            ),
-            (
-                Candidate {
-                    priority: 2.0,
-                    ..good
-                },
-                Rejected::PrioritySpeed,
-            ),
-            (
-                Candidate {
-                    current: 24,
-                    ..good
-                },
-                Rejected::Cell,
-            ),
-            (
-                Candidate {
-                    next: at(3, 1),
-                    ..good
-                },
-                Rejected::Cell,
-            ),
-            (
-                Candidate {
-                    probable: at(5, 1),
-                    ..good
-                },
-                Rejected::Cell,
-            ),
-            (
-                Candidate {
-                    probable: 24,
-                    ..good
-                },
-                Rejected::Cell,
-            ),
-        ];
-        for (c, class) in bad {
-            assert_eq!(a.check(&c), Err(class), "{c:?}");
-        }
-    }
-
-    #[test]
-    fn pibt_moves_an_agent_that_asked_nothing_and_replans_nobody() {
-        let s = scenario(
-            r#"
-            name = "t"
-            [map]
-            rows = ["........", "........", "........"]
-            [coordinator]
-            rules = "pibt"
-            replan_after_rounds = 2
-            [[agents]]
-            start = [0, 1]
-            goal = [7, 1]
-            [[agents]]
-            start = [1, 1]
-            goal = [1, 1]
-        "#,
-        );
-        let mut a = Arbiter::new(&s);
-        let g = &s.map.grid;
-        let c0 = cand(&s, 0, (0, 1), Some((1, 1)));
-        let c1 = Candidate {
-            flags: CandidateFlags::AT_GOAL | CandidateFlags::STANDING,
-            ..cand(&s, 1, (1, 1), None)
-        };
-        let (d, r) = a.decide(1, &[Some(c0), Some(c1)]);
-        assert!(r.is_empty(), "no replans in pibt mode");
-        // Agent 0 pushes agent 1 off its goal and waits for the cell.
-        assert_eq!(d.len(), 2, "{d:?}");
-        assert_eq!(d[0].verdict, Verdict::Hold as u8);
-        assert_eq!(d[0].kind, ConflictKind::Reserved as u8);
-        assert_eq!(d[1].verdict, Verdict::Accept as u8);
-        assert_eq!(d[1].kind, ConflictKind::Pushed as u8);
-        let to = g.cell_at(d[1].cell as usize).unwrap();
-        assert!(Direction::between(Cell::new(1, 1), to).is_some());
-        assert_ne!(to, Cell::new(0, 1));
-        let cell = d[1].cell;
-        // Agent 0 keeps waiting while agent 1 drives out, past replan_after_rounds = 2, and
-        // is never replanned; agent 1, driving, gets no decision.
-        for round in 2..=4 {
-            let moving = Candidate {
-                next: cell,
-                flags: 0,
-                ..c1
-            };
-            let (d, r) = a.decide(round, &[Some(c0), Some(moving)]);
-            assert!(r.is_empty(), "no replans in pibt mode");
-            assert_eq!(d.len(), 1, "{d:?}");
-            assert_eq!(d[0].verdict, Verdict::Hold as u8);
-        }
-        // A push is a step, a hold a conflict.
-        assert_eq!(a.tally().agents()[1].steps, 1, "{:?}", a.tally());
-        assert_eq!(a.tally().agents()[0].conflicts, 4);
-    }
-}
+mod tests;
