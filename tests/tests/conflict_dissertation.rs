@@ -26,10 +26,10 @@ use std::f64::consts::SQRT_2;
 
 use hnav_agent::neural_map::{Activation, Denominator, DiagonalRule, NeuralMapOptions};
 use hnav_agent::path_constructor::{PathOptions, VisitedRule};
+use hnav_bench::tick::{run, summary, AgentSpec, CellIds, Policy, TickConfig, TickRun, Timing};
 use hnav_coordinator::conflict::Options;
 use hnav_runtime::grid::Grid;
 use hnav_runtime::msg::ConflictKind;
-use hnav_tests::tick::{run, summary, AgentSpec, CellIds, Policy, TickConfig, TickRun, Timing};
 
 const IDS: CellIds = CellIds::RowMajor;
 

@@ -17,10 +17,10 @@
 
 use hnav_agent::neural_map::NeuralMapOptions;
 use hnav_agent::path_constructor::{PathOptions, VisitedRule};
+use hnav_bench::tick::{run, summary, AgentSpec, CellIds, Policy, TickConfig, TickRun, Timing};
 use hnav_coordinator::conflict::Options;
 use hnav_runtime::grid::Grid;
 use hnav_runtime::msg::ConflictKind;
-use hnav_tests::tick::{run, summary, AgentSpec, CellIds, Policy, TickConfig, TickRun, Timing};
 
 const IDS: CellIds = CellIds::ColumnMajor;
 const PRIORITIES: [f64; 3] = [3.0, 2.0, 1.0];

@@ -170,7 +170,6 @@ impl Measured {
 
 /// Runs every setting of the experiment (the tables' and the ablation's) and analyses them.
 pub fn measure(options: Options) -> anyhow::Result<Measured> {
-
     let n = if options.quick { 20 } else { 100 };
     let tasks = tasks(n, options.seed);
     let mut settings: Vec<(&'static str, u32, f64, f64, PsoOptions)> = Vec::new();
@@ -239,7 +238,8 @@ pub fn measure(options: Options) -> anyhow::Result<Measured> {
     let original = pool(&by("original"), options.seed ^ 0x0a);
     let corners = pool(&by(MODIFIED_CORNERS), options.seed ^ 0x0b);
     let modified = pool(&by(MODIFIED), options.seed ^ 0x0c);
-    let z = |p: &Pooled| two_proportion_z((original.successes, original.runs), (p.successes, p.runs));
+    let z =
+        |p: &Pooled| two_proportion_z((original.successes, original.runs), (p.successes, p.runs));
     let pooled = PooledAll {
         z_success: z(&modified),
         z_success_corners: z(&corners),

@@ -25,8 +25,8 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
-use super::pso_tasks::{Row, TaskRun, MODIFIED, MODIFIED_CORNERS, PAPER_TABLE_1, PAPER_TABLE_2};
 use super::pso_paired::{per_task_mean, pooled_per_task, pooled_stream};
+use super::pso_tasks::{Row, TaskRun, MODIFIED, MODIFIED_CORNERS, PAPER_TABLE_1, PAPER_TABLE_2};
 use super::stats::{mean, paired, wilson, Interval, Paired, Z95};
 
 const RESAMPLES: usize = 2000;
@@ -38,17 +38,29 @@ const K_MAX: f64 = 1200.0;
 /// first as the reference.
 const VARIANTS: [(&str, &str, Option<&str>); 8] = [
     ("original", "(original, r_max 1/2/4)", None),
-    (MODIFIED_CORNERS, "(d) nothing: full modified", Some("sides")),
+    (
+        MODIFIED_CORNERS,
+        "(d) nothing: full modified",
+        Some("sides"),
+    ),
     (MODIFIED, "(d) nothing: full modified", Some("always")),
     ("no-virtual-obstacles", "(a) virtual obstacles", None),
-    ("fixed-weights-corners", "(b) adaptive weights", Some("sides")),
+    (
+        "fixed-weights-corners",
+        "(b) adaptive weights",
+        Some("sides"),
+    ),
     ("fixed-weights", "(b) adaptive weights", Some("always")),
     (
         "original-blocked-move-corners",
         "(c) modified blocked move",
         Some("sides"),
     ),
-    ("original-blocked-move", "(c) modified blocked move", Some("always")),
+    (
+        "original-blocked-move",
+        "(c) modified blocked move",
+        Some("always"),
+    ),
 ];
 
 /// The paper's share of runs that never reached the goal (local minima), per setting, in the

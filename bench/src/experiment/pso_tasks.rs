@@ -186,7 +186,12 @@ pub struct TaskRun {
 
 /// One setting (`options`) run on every task, each run on its own stream (from `seed`, `salt`
 /// and the task's index). The row's labels and paper figures are left for the caller.
-pub fn run_setting(tasks: &[Task], options: &PsoOptions, salt: u64, seed: u64) -> anyhow::Result<Row> {
+pub fn run_setting(
+    tasks: &[Task],
+    options: &PsoOptions,
+    salt: u64,
+    seed: u64,
+) -> anyhow::Result<Row> {
     let mut swarm = Swarm::default();
     let (mut successes, mut not_reached, mut unsolvable, mut gaps) = (0, 0, 0, 0);
     let mut per_task = Vec::with_capacity(tasks.len());
