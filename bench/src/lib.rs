@@ -15,6 +15,7 @@
 //! | [`perf`] | `hnav-bench perf [--quick] --out DIR` | the performance suite in one run: `latency`, `round` at 1 to 256 agents, `neural-map`; `DIR/perf.md` for `docs/explanation/performance.md` |
 //! | [`plan`] | `hnav-bench plan --planner P --map FILE (--start X,Y --goal X,Y \| --scen FILE [--first N]) [--json]` | one planning query, or every entry of a MovingAI scenario against its optimal length |
 //! | [`round`] | `hnav-bench round [--agents 1,8,32,128,256] [--rounds N] [--fsync every-record,none] [--json] [--out DIR]`, `hnav-bench round --faults [--trials N]` | a decision round's latency against a real `hnav-coordinator` (all candidates in -> commit at every agent); SIGKILL -> `Down` detection and restarted agent -> first decision |
+//! | [`tick`] | — | a discrete-time multi-agent run (neural maps, path constructor, conflict resolver): the papers' conflict experiments, for `experiment fidelity` and the conflict tests of `hnav-tests` (`tests/conflict_*.rs`) |
 //! | [`seed002`] | `hnav-bench seed002 [--trials N] [--seed S]` | seed 002's obstacle-density experiment (A*, Basic Theta*, Lazy Theta* on random circular obstacles) beside the thesis's Table 3.1 |
 //!
 //! Results go to stdout as a table and to CSV files in dora-benchmark's schema
@@ -34,3 +35,4 @@ pub mod round;
 pub mod seed002;
 pub mod sim;
 pub mod swarm_run;
+pub mod tick;

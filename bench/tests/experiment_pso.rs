@@ -1,5 +1,6 @@
 //! `hnav-bench experiment pso --quick` through the binary: the report's shape (the nine
-//! settings of both tables and of Table 2 without the corner analysis, beside the paper's figures, intervals that bracket their estimates) and the
+//! settings of both tables and of Table 2 with the corner analysis, beside the paper's
+//! figures, both step counts, intervals that bracket their estimates) and the
 //! same JSON twice for one seed, another for another seed; the ablation's tables and their
 //! invariants (not the paper's direction). Nothing here is a timing.
 
@@ -44,12 +45,12 @@ fn quick_json_has_both_tables_and_is_deterministic() {
         ("original", 1, 183.0),
         ("original", 2, 210.0),
         ("original", 4, 155.0),
+        ("modified-corners", 5, 159.0),
+        ("modified-corners", 7, 100.0),
+        ("modified-corners", 10, 93.0),
         ("modified", 5, 159.0),
         ("modified", 7, 100.0),
         ("modified", 10, 93.0),
-        ("modified-always", 5, 159.0),
-        ("modified-always", 7, 100.0),
-        ("modified-always", 10, 93.0),
     ];
     assert_eq!(settings.len(), expected.len(), "{settings:?}");
     for ((alg, p, steps), (ea, ep, es)) in settings.iter().zip(expected) {
@@ -67,6 +68,14 @@ fn quick_json_has_both_tables_and_is_deterministic() {
         ) {
             assert!(slo <= m && m <= shi, "{r}");
         }
+        // The other count: every run, a never-reached one at 1200, so never below the mean
+        // over successes.
+        let all = r["all_runs_steps"].as_f64().unwrap();
+        let (alo, ahi) = (
+            r["all_runs_ci"]["lo"].as_f64().unwrap(),
+            r["all_runs_ci"]["hi"].as_f64().unwrap(),
+        );
+        assert!(alo <= all && all <= ahi && ahi <= 1200.0, "{r}");
     }
     // The paired steps: nine setting pairs and the pooled row per corner rule, each on at
     // most the tasks there are, its mean difference the difference of its means.
@@ -76,10 +85,11 @@ fn quick_json_has_both_tables_and_is_deterministic() {
         let rule = if i < 10 {
             "modified"
         } else {
-            "modified-always"
+            "modified-corners"
         };
         assert_eq!(p["modified"], rule, "{p}");
         assert_eq!(p["r_max"].is_null(), i % 10 == 9, "{p}");
+        assert_eq!(p["all_runs"]["n"].as_u64(), Some(runs), "every task: {p}");
         let s = &p["steps"];
         assert!(s["n"].as_u64().unwrap() <= runs, "{p}");
         if let (Some(a), Some(b), Some(d)) = (
@@ -119,13 +129,13 @@ fn ablation_has_its_shape(ab: &Value, runs: u64) {
         names,
         [
             "original",
+            "modified-corners",
             "modified",
-            "modified-always",
             "no-virtual-obstacles",
+            "fixed-weights-corners",
             "fixed-weights",
-            "fixed-weights-always",
-            "original-blocked-move",
-            "original-blocked-move-always"
+            "original-blocked-move-corners",
+            "original-blocked-move"
         ]
     );
     for r in rows {
@@ -173,7 +183,7 @@ fn ablation_has_its_shape(ab: &Value, runs: u64) {
     }
     let splits = ab["splits"].as_array().unwrap();
     assert_eq!(splits.len(), 8);
-    for rule in ["modified", "modified-always"] {
+    for rule in ["modified", "modified-corners"] {
         let mine: Vec<&Value> = splits.iter().filter(|x| x["modified"] == rule).collect();
         let total: u64 = mine.iter().map(|x| x["tasks"].as_u64().unwrap()).sum();
         assert_eq!(total, runs, "{rule}: every task in one group");

@@ -11,8 +11,6 @@
 //!   it forges (`tests/rogue.rs`);
 //! - [`pattern`]: the deterministic payloads both sides of a test agree on;
 //! - [`lost_wakeup`]: both halves of the lost-wake-up reproducer (`tests/lost_wakeup.rs`);
-//! - [`tick`]: a discrete-time multi-agent run (neural maps, path constructor, conflict
-//!   resolver) for the papers' conflict experiments;
 //! - [`tmux`]: a terminal of a test's own for full-screen programs (`hnav top`, playback);
 //! - [`netns`]: hosts on one machine (network namespaces, a switch, loss, partitions) for the
 //!   multi-host tests (`tests/multi_host.rs`);
@@ -27,7 +25,6 @@ pub mod netns;
 pub mod pattern;
 pub mod rogue;
 pub mod swarm;
-pub mod tick;
 pub mod tmux;
 
 use std::io::{BufRead, BufReader};

@@ -24,43 +24,18 @@
 
 use std::f64::consts::SQRT_2;
 
-use hnav_agent::neural_map::{Activation, Denominator, DiagonalRule, NeuralMapOptions};
-use hnav_agent::path_constructor::{PathOptions, VisitedRule};
-use hnav_coordinator::conflict::Options;
+use hnav_bench::tick::{run, summary, AgentSpec, CellIds, TickConfig, TickRun};
 use hnav_runtime::grid::Grid;
 use hnav_runtime::msg::ConflictKind;
-use hnav_tests::tick::{run, summary, AgentSpec, CellIds, Policy, TickConfig, TickRun, Timing};
 
 const IDS: CellIds = CellIds::RowMajor;
 
 /// One published row: the conflict move (from, to), the path length, the time (s).
 type Published = (Option<(u32, u32)>, f64, f64);
 
+/// The set-up the fidelity table runs these tables with, so both check the same thing.
 fn config(speeds: &[f64], sweep: bool) -> TickConfig {
-    TickConfig {
-        map: NeuralMapOptions {
-            activation: Activation::Linear,
-            denominator: Denominator::OffGridAsZero,
-            ..NeuralMapOptions::dissertation()
-        },
-        path: PathOptions {
-            heading_bonus: true,
-            visited: VisitedRule::Zero,
-            corner_rule: Some(DiagonalRule::Always),
-            ..PathOptions::default()
-        },
-        resolver: Options {
-            sweep,
-            ..Options::default()
-        },
-        policy: Policy::Sidestep,
-        timing: Timing::Speeds {
-            speeds: speeds.to_vec(),
-            dt: 0.05,
-        },
-        max_ticks: 4000,
-        ids: IDS,
-    }
+    hnav_bench::experiment::fidelity::chapter3::dissertation_config(speeds, sweep)
 }
 
 struct Table {

@@ -15,12 +15,10 @@
 //! In both, a robot never enters a cell another robot has not left (no co-location), which is
 //! where Fig. 5's published log cannot be reproduced (see [`fig_5_head_on_without_co_location`]).
 
-use hnav_agent::neural_map::NeuralMapOptions;
-use hnav_agent::path_constructor::{PathOptions, VisitedRule};
+use hnav_bench::tick::{run, summary, AgentSpec, CellIds, Policy, TickConfig, TickRun};
 use hnav_coordinator::conflict::Options;
 use hnav_runtime::grid::Grid;
 use hnav_runtime::msg::ConflictKind;
-use hnav_tests::tick::{run, summary, AgentSpec, CellIds, Policy, TickConfig, TickRun, Timing};
 
 const IDS: CellIds = CellIds::ColumnMajor;
 const PRIORITIES: [f64; 3] = [3.0, 2.0, 1.0];
@@ -47,23 +45,17 @@ fn agents(g: &Grid, (starts, goals): ([u32; 3], [u32; 3])) -> Vec<AgentSpec> {
         .collect()
 }
 
+/// The fidelity table's set-up (which holds with `HOLD` on point robots), with `policy` and
+/// `sweep` varied.
 fn config(policy: Policy, sweep: bool) -> TickConfig {
+    let base = hnav_bench::experiment::fidelity::seeds::seed_001_config();
     TickConfig {
-        map: NeuralMapOptions::seed_001(),
-        path: PathOptions {
-            // The papers' 0.7071, to the last bit.
-            diagonal_weight: std::f64::consts::FRAC_1_SQRT_2,
-            visited: VisitedRule::Negate,
-            ..PathOptions::default()
-        },
+        policy,
         resolver: Options {
             sweep,
-            ..Options::default()
+            ..base.resolver
         },
-        policy,
-        timing: Timing::Ticks,
-        max_ticks: 100,
-        ids: IDS,
+        ..base
     }
 }
 

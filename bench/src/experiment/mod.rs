@@ -7,20 +7,24 @@
 //!
 //! | module | experiment | what |
 //! |---|---|---|
+//! | [`fidelity`] | `fidelity` | every number the seeds publish that HNAV computes, beside ours, with a status; writes `docs/experiments/fidelity.md` |
 //! | [`ga_fuzzy`] | `ga-fuzzy` | seed 004: the GA + fuzzy planner against A* and HNAV on the MovingAI maps and on the seed's setting with moving robots |
 //! | [`hnav_vs_astar`] | `hnav-vs-astar` | dissertation Tables 3-8/3-9: HNAV against A* on four 20x20 tasks, tanh against linear, partial against full activation; then MovingAI scenario samples |
 //! | [`pso`] | `pso` | seed 003's Tables 1 and 2: the original swarm against the modified one |
-//! | [`pso_paired`] | — | the `pso` experiment's paired step comparison: original against modified on the tasks both solve |
 //! | [`pso_ablation`] | — | the `pso` experiment's ablation: the modified algorithm with one modification switched off, and how steps are counted |
+//! | [`pso_paired`] | — | the `pso` experiment's paired step comparison: original against modified on the tasks both solve |
+//! | [`pso_tasks`] | — | the `pso` experiment's paper rows, maps, endpoints and one setting's runs, which the three above read |
 //! | [`stats`] | — | the intervals the tables print: Wilson for rates, bootstrap for means |
 
 use serde::Serialize;
 
+pub mod fidelity;
 pub mod ga_fuzzy;
 pub mod hnav_vs_astar;
 pub mod pso;
 pub mod pso_ablation;
 pub mod pso_paired;
+pub mod pso_tasks;
 pub mod stats;
 
 /// One experiment: its command-line name, a line for `--help`, and the function that runs it.
@@ -45,6 +49,11 @@ pub const EXPERIMENTS: &[Experiment] = &[
         name: "pso",
         about: "seed 003, Tables 1-2: original PSO (r_max 1/2/4) vs modified (n_lm 5/7/10)",
         run: pso::run,
+    },
+    Experiment {
+        name: fidelity::NAME,
+        about: "every number the seeds publish beside ours, with a status; the full run writes docs/experiments/fidelity.md",
+        run: fidelity::run,
     },
     Experiment {
         name: ga_fuzzy::NAME,

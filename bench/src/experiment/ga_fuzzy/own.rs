@@ -51,7 +51,7 @@ pub struct World {
 }
 
 fn random_map(rng: &mut ChaCha8Rng) -> Grid {
-    super::super::pso::random_rectangles(rng, SIDE, RECTANGLES, MAX_RECT)
+    super::super::pso_tasks::random_rectangles(rng, SIDE, RECTANGLES, MAX_RECT)
 }
 
 fn free_cell(grid: &Grid, taken: &[Cell], rng: &mut ChaCha8Rng) -> Option<Cell> {
