@@ -13,7 +13,7 @@ use hnav_runtime::grid::Grid;
 
 use super::{matched, Row, Status};
 
-const DOC_LINK: &str = "../../README.md";
+const DOC_LINK: &str = "../explanation/planning.md#the-neural-map-agent";
 
 /// Table 2-1 as published: the activation matrix of an empty 10 x 10 network with I_56 = 1.
 #[rustfmt::skip]

@@ -117,7 +117,7 @@ fn seed_002(options: Options) -> anyhow::Result<Vec<Row>> {
                     close,
                     Status::reading(reading),
                     "more than 2 % apart: the thesis's obstacle fields are not published",
-                    "../../docs/experiments/README.md",
+                    "../explanation/planning.md#seed-002s-experiment",
                 ),
             ));
         }
