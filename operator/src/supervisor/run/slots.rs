@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::error::RunError;
-use super::host::HostPart;
+use super::host::{processes_of, HostPart};
 use crate::supervisor::child::{Child, ChildError, ChildSpec, ExitInfo};
 use crate::supervisor::events::{RunEvent, RunEvents};
 use crate::supervisor::registry::RunRecord;
@@ -377,19 +377,6 @@ impl Slots {
         }
         Ok(holds)
     }
-}
-
-/// Every process of a run of `scenario` but the bridges, in the order they start: the sim,
-/// the coordinator (index 0) or its replicas (1 to n, their Raft ids), the agents. Each runs
-/// the binary `hnav-<role>`.
-pub(super) fn processes_of(scenario: &Scenario) -> impl Iterator<Item = (Role, u32)> {
-    let coordinators = match scenario.coordinator.replicas {
-        1 => 0..=0,
-        n => 1..=n,
-    };
-    std::iter::once((Role::Sim, 0))
-        .chain(coordinators.map(|id| (Role::Coordinator, id)))
-        .chain((0..scenario.agents.len() as u32).map(|i| (Role::Agent, i)))
 }
 
 /// That `role`/`index` ended with `exit` and is not restarted for `why`, in words.
