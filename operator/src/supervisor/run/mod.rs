@@ -9,14 +9,16 @@
 //!    process group with its output in `DIR/logs/<node>.log`, and wait until every one has
 //!    announced itself on `ready`; then publish `Start` (see [`hnav_runtime::launch`] and
 //!    [`super::startup`]).
-//! 3. Watch: block in a `Waiter` on the children's exit descriptors (a child's death wakes it
-//!    at once) with a short tick for the progress bar and the fault schedule. A dead child is
-//!    reaped, its stale iceoryx2 resources removed (which wakes its peers with a "peer dead"
-//!    event), the others told on the lifecycle topic, and it is restarted under its role's
-//!    policy with `--resume` (module `slots`). The progress bar (`progress`) follows the
-//!    coordinator's progress topic; the scenario's planned faults (`faults`) too in realtime,
-//!    and the sim's `Hold` at each fault's round in lockstep. Every process that is up has a
-//!    hang deadline (`hang`): one silent past it is SIGKILLed and takes the same path.
+//! 3. Watch (module `watch`): block in a `Waiter` on the children's exit descriptors (a
+//!    child's death wakes it at once) with a short tick for the progress bar and the fault
+//!    schedule. A dead child is reaped, its stale iceoryx2 resources removed (which wakes its
+//!    peers with a "peer dead" event), the others told on the lifecycle topic, and it is
+//!    restarted under its role's policy with `--resume` (module `slots`). The progress bar
+//!    (`progress`) follows the coordinator's progress topic; the scenario's planned faults
+//!    (`faults`) too in realtime, and the sim's `Hold` at each fault's round in lockstep.
+//!    Every process that is up has a hang deadline (`hang`): one silent past it is SIGKILLed
+//!    and takes the same path. The fault schedule, the hang watch and the slots only decide,
+//!    and return actions (`action`); the watch alone carries them out.
 //! 4. End when the coordinator reports every agent at its goal, or (lockstep) the last round
 //!    of the time limit committed; when the time limit passes on the wall clock (realtime);
 //!    when the run cannot go on (the sim or the coordinator down and not restarted, or no
@@ -31,6 +33,18 @@
 //!    step 1 wrote (`DIR/map.map`). A report that cannot be drawn is a warning on stderr and
 //!    the summary's `report_error`, never a failed run.
 
+// Modules, highest first (a module uses only those below it):
+//
+// | module | what it holds |
+// |---|---|
+// | `watch` | the watch from `Start` to the end: its loop, and the one place its actions are carried out |
+// | `faults` | the planned faults: when each is due, its signal, the lockstep hold, the end of a freeze |
+// | `hang` | the hang deadlines of the processes that are up, and the kill of a silent one |
+// | `progress` | the progress bar (or line) |
+// | `slots` | the run's processes: spawn, reap, restart under their policy, `Up`s announced |
+// | `host` | this host's part of a run across hosts; the list of a run's processes |
+// | `action` | what the watch's parts want done: signals, journal lines, lifecycle messages, respawns |
+// | `error` | [`RunError`] |
 mod watch;
 
 mod faults;
@@ -53,19 +67,18 @@ use super::events::RunEvents;
 use super::recorder::{Recorder, RecordingSummary};
 use super::registry::{RunRecord, RunRegistry};
 use super::run_dir::RunDir;
-use super::startup::{Roll, Startup, SupervisorPorts};
+use super::startup::{Roll, Startup};
 use super::stop::stop_all;
 use super::summary::RunSummary;
 use crate::invocation::Invocation;
 use error::io;
 use hang::HangWatch;
 use hnav_runtime::launch::ProcessArgs;
-use hnav_runtime::msg::{Lifecycle, Progress, Role, StopReason, Truth};
+use hnav_runtime::msg::{Lifecycle, Role, StopReason};
 use hnav_runtime::scenario::Scenario;
-use hnav_runtime::topics;
-use hnav_runtime::transport::{purge_run, Bell, Receiver, RunId, Transport};
+use hnav_runtime::transport::{purge_run, Bell, RunId};
 use slots::Slots;
-use watch::{End, Watch};
+use watch::{End, Ports, Seen, Watch};
 
 pub use error::RunError;
 pub use host::HostPart;
@@ -90,32 +103,6 @@ pub struct RunOptions {
     /// In a run across hosts, this host's part (`--host NAME`): only its processes and its
     /// bridge are started here.
     pub host: Option<HostPart>,
-}
-
-/// The supervisor's node on the run's transport and its ports (dropped in this order: the
-/// ports, then the node).
-struct Ports {
-    life: SupervisorPorts,
-    progress: Receiver<Progress>,
-    truth: Receiver<Truth>,
-    transport: Transport,
-}
-
-impl Ports {
-    /// The supervisor's node in `run` (it handles SIGINT and SIGTERM) and its ports, for a
-    /// run of `agents` agents.
-    fn open(run: &RunId, agents: usize) -> Result<Self, RunError> {
-        let transport = Transport::builder(run)
-            .node_name("supervisor")
-            .handle_signals(true)
-            .create()?;
-        Ok(Self {
-            life: SupervisorPorts::open(&transport, agents)?,
-            progress: transport.receiver(topics::PROGRESS, topics::progress_qos())?,
-            truth: transport.receiver(topics::TRUTH, topics::truth_qos())?,
-            transport,
-        })
-    }
 }
 
 /// Runs the scenario to its end and returns the summary (also written to `DIR/summary.json`).
@@ -311,13 +298,6 @@ fn prepare_dir(dir: &Path, scenario: &Scenario) -> Result<(), RunError> {
     let map = dir.join(crate::report::MAP_FILE);
     std::fs::write(&map, hnav_runtime::grid::write_map(&scenario.map.grid)).map_err(io(&map))?;
     Ok(())
-}
-
-/// The latest of what the run's processes published that the summary needs.
-#[derive(Default)]
-struct Seen {
-    truth: Option<Truth>,
-    progress: Option<Progress>,
 }
 
 /// Spawns the processes, runs the start-up handshake, then watches until the run ends,

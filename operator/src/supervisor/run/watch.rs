@@ -16,12 +16,13 @@ use super::faults::FaultSchedule;
 use super::hang::HangWatch;
 use super::progress::ProgressView;
 use super::slots::Slots;
-use super::{Ports, Seen};
 use crate::supervisor::events::{RunEvent, RunEvents};
 use crate::supervisor::registry::RunRecord;
-use hnav_runtime::msg::{LifecycleEvent, Progress};
+use crate::supervisor::startup::SupervisorPorts;
+use hnav_runtime::msg::{LifecycleEvent, Progress, Truth};
 use hnav_runtime::scenario::{ClockMode, Scenario};
-use hnav_runtime::transport::Wake;
+use hnav_runtime::topics;
+use hnav_runtime::transport::{Receiver, RunId, Transport, Wake};
 
 /// Refresh period of the progress bar and the fault schedule.
 const TICK: Duration = Duration::from_millis(50);
@@ -34,6 +35,39 @@ pub(super) enum End {
     Signalled,
     /// The sim or the coordinator is gone for good, or no agent is left: why.
     CannotGoOn(String),
+}
+
+/// The supervisor's node on the run's transport and its ports (dropped in this order: the
+/// ports, then the node).
+pub(super) struct Ports {
+    pub(super) life: SupervisorPorts,
+    pub(super) progress: Receiver<Progress>,
+    pub(super) truth: Receiver<Truth>,
+    pub(super) transport: Transport,
+}
+
+impl Ports {
+    /// The supervisor's node in `run` (it handles SIGINT and SIGTERM) and its ports, for a
+    /// run of `agents` agents.
+    pub(super) fn open(run: &RunId, agents: usize) -> Result<Self, RunError> {
+        let transport = Transport::builder(run)
+            .node_name("supervisor")
+            .handle_signals(true)
+            .create()?;
+        Ok(Self {
+            life: SupervisorPorts::open(&transport, agents)?,
+            progress: transport.receiver(topics::PROGRESS, topics::progress_qos())?,
+            truth: transport.receiver(topics::TRUTH, topics::truth_qos())?,
+            transport,
+        })
+    }
+}
+
+/// The latest of what the run's processes published that the summary needs.
+#[derive(Default)]
+pub(super) struct Seen {
+    pub(super) truth: Option<Truth>,
+    pub(super) progress: Option<Progress>,
 }
 
 /// What one look at the run found.
