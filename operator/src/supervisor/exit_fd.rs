@@ -22,7 +22,7 @@
 //! waiter attachment must be dropped once its child is handled or every wait returns at once.
 
 use std::io;
-use std::os::fd::{FromRawFd, IntoRawFd, OwnedFd, RawFd};
+use std::os::fd::{BorrowedFd, FromRawFd, IntoRawFd, OwnedFd, RawFd};
 use std::time::{Duration, Instant};
 
 use iceoryx2_bb_posix::file_descriptor::{FileDescriptor, FileDescriptorBased};
@@ -80,6 +80,20 @@ impl ExitFd {
         // SAFETY: the value is only read, not stored beyond the caller's use; the descriptor
         // stays owned (and closed) by `self.fd`.
         unsafe { self.fd.native_handle() }
+    }
+
+    /// A second descriptor for the same exit (`dup`), so that a waiter can watch it while
+    /// the [`Child`](super::child::Child) it came from is moved or replaced.
+    pub fn try_clone(&self) -> io::Result<Self> {
+        // SAFETY: `as_raw_fd` is open for as long as `self` lives, and the borrow ends here.
+        let fd = unsafe { BorrowedFd::borrow_raw(self.as_raw_fd()) }.try_clone_to_owned()?;
+        // SAFETY: `into_raw_fd` released ownership of the fresh descriptor, which this value
+        // now takes.
+        let fd = unsafe { FileDescriptor::new_unchecked(fd.into_raw_fd()) };
+        Ok(Self {
+            fd,
+            mode: self.mode,
+        })
     }
 
     /// Whether the child has exited, without blocking.

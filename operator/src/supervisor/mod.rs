@@ -3,28 +3,31 @@
 //! watches them, restarts what dies under the scenario's restart policy, and stops everything
 //! cleanly.
 //!
-//! It builds on the rest of the crate (launch, msg, topics, transport, scenario,
-//! consensus_log) and nothing outside `supervisor` uses it: the processes of a run never
-//! link the supervisor's code, and `hnav-bench round` borrows its pieces to stand in for it.
+//! It builds on `hnav-runtime` (launch, msg, topics, transport, scenario, consensus_log) and,
+//! in this crate, on `report`, `recording` and `invocation`. The processes of a run never
+//! link it; the `hnav` binary drives it, [`crate::monitor`] reads its registry, and
+//! `hnav-bench round` borrows its pieces to stand in for it.
+//!
+//! Modules, highest first (a module uses only those below it in this table):
 //!
 //! | module | what it holds |
 //! |---|---|
-//! | [`child`] | one child process: spawn in its own process group with an appended log, reap, describe its exit, signal it or its group |
-//! | [`exit_fd`] | the pidfd (or waiter-thread pipe) that makes a child's exit wake the supervisor's `Waiter` |
-//! | [`events`] | the run's event journal `DIR/events.jsonl`: signals, exits, hangs, respawns, each stamped with the host's monotonic clock |
-//! | [`restart`] | per-child restart decisions: policy, cap, doubling backoff |
-//! | [`stop`] | the escalating stop of a run's children: wait, SIGTERM, SIGKILL, reap |
-//! | [`run_dir`] | a run's hold on its output directory: the directory lock, and `--force` for a finished run's outputs |
-//! | [`clean`] | removing what a dead run left: leftover processes, shared memory, iceoryx2 files, registry entry |
-//! | [`registry`] | the on-disk list of live runs and their processes that `hnav ps` reads |
-//! | [`startup`] | the supervisor's half of the lifecycle protocol: the start-up handshake and the events it publishes |
+//! | [`replay`] | `hnav log replay`: a lockstep run started again from its invocation, its log compared with the original's |
 //! | [`run`] | `hnav run`: spawn, start-up handshake, watch and restart, faults, stop, summary |
-//! | [`recorder`] | the recorder thread: ground truth, estimates and neural maps into `DIR/recording/` by simulated time |
-//! | [`summary`] | the run summary (`summary.json`): per-agent steps, length, conflicts, replans from the consensus log; goals and collisions from ground truth |
 //! | [`kill`] | `hnav kill`: a signal to one process of a live run found in the registry, recorded in its journal |
 //! | [`ps`] | what `hnav ps` shows: each registered process as running, exited or dead, as JSON or a table |
 //! | [`services`] | what `hnav services RUN` shows: a live run's topics with their publishers and subscribers |
-//! | [`replay`] | `hnav log replay`: a lockstep run started again from its invocation, its log compared with the original's |
+//! | [`clean`] | removing what a dead run left: leftover processes, shared memory, iceoryx2 files, registry entry |
+//! | [`registry`] | the on-disk list of live runs and their processes that `hnav ps` reads |
+//! | [`summary`] | the run summary (`summary.json`): per-agent steps, length, conflicts, replans from the consensus log; goals and collisions from ground truth |
+//! | [`recorder`] | the recorder thread: ground truth, estimates and neural maps into `DIR/recording/` by simulated time |
+//! | [`startup`] | the supervisor's half of the lifecycle protocol: the start-up handshake and the events it publishes |
+//! | [`stop`] | the escalating stop of a run's children: wait, SIGTERM, SIGKILL, reap |
+//! | [`restart`] | per-child restart decisions: policy, cap, doubling backoff |
+//! | [`child`] | one child process: spawn in its own process group with an appended log, reap, describe its exit, signal it or its group |
+//! | [`exit_fd`] | the pidfd (or waiter-thread pipe) that makes a child's exit wake the supervisor's `Waiter` |
+//! | [`events`] | the run's event journal `DIR/events.jsonl`: signals, exits, hangs, respawns, each stamped with the host's monotonic clock |
+//! | [`run_dir`] | a run's hold on its output directory: the directory lock, and `--force` for a finished run's outputs |
 
 pub mod child;
 pub mod clean;

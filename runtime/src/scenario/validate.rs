@@ -133,18 +133,29 @@ pub(super) fn check_agent(
     robot: &RobotParams,
     seen: &mut Seen,
 ) -> Result<(), ScenarioError> {
-    for (which, cell, loc) in [
+    check_endpoints(i, a, at, grid)?;
+    check_motion(i, a, at, robot)?;
+    seen.claim(i, a, at)
+}
+
+/// Start and goal inside the map, then both passable (an endpoint outside is reported before
+/// any on an obstacle).
+fn check_endpoints(
+    i: usize,
+    a: &AgentSpec,
+    at: &AgentLocs,
+    grid: &Grid,
+) -> Result<(), ScenarioError> {
+    let endpoints = [
         (Endpoint::Start, a.start, &at.start),
         (Endpoint::Goal, a.goal, &at.goal),
-    ] {
+    ];
+    for (which, cell, loc) in endpoints {
         if !grid.contains(cell) {
             return Err(outside(i, which, cell.x.into(), cell.y.into(), grid, loc));
         }
     }
-    for (which, cell, loc) in [
-        (Endpoint::Start, a.start, &at.start),
-        (Endpoint::Goal, a.goal, &at.goal),
-    ] {
+    for (which, cell, loc) in endpoints {
         if let Some(tile) = grid.tile(cell).filter(|t| !t.is_passable()) {
             let (at, ch) = (loc.clone(), tile.to_char());
             return Err(match which {
@@ -163,6 +174,16 @@ pub(super) fn check_agent(
             });
         }
     }
+    Ok(())
+}
+
+/// Speed (positive, within the robot's), priority (positive) and start heading (in range).
+fn check_motion(
+    i: usize,
+    a: &AgentSpec,
+    at: &AgentLocs,
+    robot: &RobotParams,
+) -> Result<(), ScenarioError> {
     if !(a.speed.is_finite() && a.speed > 0.0) {
         return Err(ScenarioError::NonPositiveSpeed {
             at: at.speed.clone(),
@@ -198,140 +219,169 @@ pub(super) fn check_agent(
             ),
         });
     }
-    if let Some(&other) = seen.starts.get(&a.start) {
-        return Err(ScenarioError::DuplicateStart {
-            at: at.start.clone(),
-            agent: i,
-            other,
-            cell: a.start,
-        });
-    }
-    if let Some(&other) = seen.goals.get(&a.goal) {
-        return Err(ScenarioError::DuplicateGoal {
-            at: at.goal.clone(),
-            agent: i,
-            other,
-            cell: a.goal,
-        });
-    }
-    seen.starts.insert(a.start, i);
-    seen.goals.insert(a.goal, i);
     Ok(())
 }
 
+impl Seen {
+    /// Takes agent `i`'s start and goal, refused if an earlier agent has either.
+    fn claim(&mut self, i: usize, a: &AgentSpec, at: &AgentLocs) -> Result<(), ScenarioError> {
+        if let Some(&other) = self.starts.get(&a.start) {
+            return Err(ScenarioError::DuplicateStart {
+                at: at.start.clone(),
+                agent: i,
+                other,
+                cell: a.start,
+            });
+        }
+        if let Some(&other) = self.goals.get(&a.goal) {
+            return Err(ScenarioError::DuplicateGoal {
+                at: at.goal.clone(),
+                agent: i,
+                other,
+                cell: a.goal,
+            });
+        }
+        self.starts.insert(a.start, i);
+        self.goals.insert(a.goal, i);
+        Ok(())
+    }
+}
+
+/// Fault `i` of the TOML's `[[faults]]`, checked against a run of `agents` agents.
 pub(super) fn build_fault(
     i: usize,
     raw: &Spanned<RawFault>,
     agents: usize,
     lines: &Lines<'_>,
 ) -> Result<FaultSpec, ScenarioError> {
-    let at = lines.at(raw);
+    let entry = lines.at(raw);
     let f = raw.get_ref();
-    let target = match (f.role, &f.index) {
-        (RawRole::Agent, None) => {
-            return Err(ScenarioError::BadFault {
-                at,
-                fault: i,
-                problem: "role = \"agent\" needs an `index`".into(),
-            })
-        }
-        (RawRole::Agent, Some(ix)) => {
-            let index = *ix.get_ref();
-            match usize::try_from(index) {
-                Ok(a) if a < agents => FaultTarget::Agent(a),
-                _ => {
-                    return Err(ScenarioError::FaultAgentOutOfRange {
-                        at: lines.at(ix),
-                        fault: i,
-                        index,
-                        agents,
-                    })
-                }
-            }
-        }
-        (RawRole::Coordinator, Some(ix)) => match u32::try_from(*ix.get_ref()) {
-            Ok(id) if (1..=crate::msg::MAX_REPLICAS).contains(&id) => FaultTarget::Replica(id),
-            _ => {
-                return Err(ScenarioError::BadFault {
-                    at: lines.at(ix),
-                    fault: i,
-                    problem: format!(
-                        "a coordinator's `index` names a replica, 1 to {}",
-                        crate::msg::MAX_REPLICAS
-                    ),
-                })
-            }
-        },
-        (_, Some(ix)) => {
-            return Err(ScenarioError::BadFault {
-                at: lines.at(ix),
-                fault: i,
-                problem: "`index` is only meaningful with role = \"agent\" or \"coordinator\""
-                    .into(),
-            })
-        }
-        (RawRole::Coordinator, None) => FaultTarget::Coordinator,
-        (RawRole::Sim, None) => FaultTarget::Sim,
-    };
-    let bad = |at: Loc, problem: String| ScenarioError::BadFault {
+    Ok(FaultSpec {
+        target: fault_target(i, f, agents, lines, &entry)?,
+        at: fault_time(i, f, lines, entry)?,
+        action: fault_action(i, f, lines)?,
+    })
+}
+
+/// A [`ScenarioError::BadFault`] of fault `i`.
+fn bad_fault(i: usize, at: Loc, problem: impl Into<String>) -> ScenarioError {
+    ScenarioError::BadFault {
         at,
         fault: i,
-        problem,
+        problem: problem.into(),
+    }
+}
+
+/// Whom fault `i` hits: its `role` and `index`; `entry` is where the fault is written.
+fn fault_target(
+    i: usize,
+    f: &RawFault,
+    agents: usize,
+    lines: &Lines<'_>,
+    entry: &Loc,
+) -> Result<FaultTarget, ScenarioError> {
+    let Some(ix) = &f.index else {
+        return match f.role {
+            RawRole::Agent => Err(bad_fault(
+                i,
+                entry.clone(),
+                "role = \"agent\" needs an `index`",
+            )),
+            RawRole::Coordinator => Ok(FaultTarget::Coordinator),
+            RawRole::Sim => Ok(FaultTarget::Sim),
+        };
     };
-    let when = match (&f.at_round, &f.at_s) {
-        (Some(r), None) => FaultTime::Round(*r.get_ref()),
+    let index = *ix.get_ref();
+    match f.role {
+        RawRole::Agent => match usize::try_from(index) {
+            Ok(a) if a < agents => Ok(FaultTarget::Agent(a)),
+            _ => Err(ScenarioError::FaultAgentOutOfRange {
+                at: lines.at(ix),
+                fault: i,
+                index,
+                agents,
+            }),
+        },
+        RawRole::Coordinator => match u32::try_from(index) {
+            Ok(id) if (1..=crate::msg::MAX_REPLICAS).contains(&id) => Ok(FaultTarget::Replica(id)),
+            _ => Err(bad_fault(
+                i,
+                lines.at(ix),
+                format!(
+                    "a coordinator's `index` names a replica, 1 to {}",
+                    crate::msg::MAX_REPLICAS
+                ),
+            )),
+        },
+        RawRole::Sim => Err(bad_fault(
+            i,
+            lines.at(ix),
+            "`index` is only meaningful with role = \"agent\" or \"coordinator\"",
+        )),
+    }
+}
+
+/// When fault `i` fires: exactly one of `at_round` and `at_s`; `entry` is where the fault is
+/// written.
+fn fault_time(
+    i: usize,
+    f: &RawFault,
+    lines: &Lines<'_>,
+    entry: Loc,
+) -> Result<FaultTime, ScenarioError> {
+    match (&f.at_round, &f.at_s) {
+        (Some(r), None) => Ok(FaultTime::Round(*r.get_ref())),
         (None, Some(s)) => {
             let secs = *s.get_ref();
-            check_at_s(secs).map_err(|p| bad(lines.at(s), format!("`at_s` {p}")))?;
-            FaultTime::Seconds(secs)
+            check_at_s(secs).map_err(|p| bad_fault(i, lines.at(s), format!("`at_s` {p}")))?;
+            Ok(FaultTime::Seconds(secs))
         }
-        (Some(_), Some(s)) => {
-            return Err(bad(
-                lines.at(s),
-                "give one of `at_round` and `at_s`, not both".into(),
-            ))
-        }
-        (None, None) => return Err(bad(at, "needs `at_round` or `at_s`".into())),
-    };
-    let action = match f.action {
+        (Some(_), Some(s)) => Err(bad_fault(
+            i,
+            lines.at(s),
+            "give one of `at_round` and `at_s`, not both",
+        )),
+        (None, None) => Err(bad_fault(i, entry, "needs `at_round` or `at_s`")),
+    }
+}
+
+/// What fault `i` does: a kill (with its `signal`) or a freeze (for `for_s`), each refusing
+/// the other's key.
+fn fault_action(i: usize, f: &RawFault, lines: &Lines<'_>) -> Result<FaultAction, ScenarioError> {
+    match f.action {
         RawFaultAction::Kill => {
             if let Some(d) = &f.for_s {
-                return Err(bad(
+                return Err(bad_fault(
+                    i,
                     lines.at(d),
-                    "`for_s` is only meaningful with action = \"freeze\"".into(),
+                    "`for_s` is only meaningful with action = \"freeze\"",
                 ));
             }
-            FaultAction::Kill(
-                f.signal
-                    .as_ref()
-                    .map_or(FaultSignal::Kill, |s| *s.get_ref()),
-            )
+            let signal = f
+                .signal
+                .as_ref()
+                .map_or(FaultSignal::Kill, |s| *s.get_ref());
+            Ok(FaultAction::Kill(signal))
         }
         RawFaultAction::Freeze => {
             if let Some(s) = &f.signal {
-                return Err(bad(
+                return Err(bad_fault(
+                    i,
                     lines.at(s),
                     "`signal` is only meaningful with action = \"kill\" (a freeze sends \
-                     SIGSTOP, then SIGCONT after `for_s`)"
-                        .into(),
+                     SIGSTOP, then SIGCONT after `for_s`)",
                 ));
             }
-            let for_s = match &f.for_s {
-                None => None,
-                Some(d) => {
-                    let secs = *d.get_ref();
-                    check_for_s(secs).map_err(|p| bad(lines.at(d), format!("`for_s` {p}")))?;
-                    Some(secs)
-                }
-            };
-            FaultAction::Freeze { for_s }
+            let for_s = f.for_s.as_ref().map(|d| {
+                let secs = *d.get_ref();
+                check_for_s(secs).map_err(|p| bad_fault(i, lines.at(d), format!("`for_s` {p}")))?;
+                Ok(secs)
+            });
+            Ok(FaultAction::Freeze {
+                for_s: for_s.transpose()?,
+            })
         }
-    };
-    Ok(FaultSpec {
-        at: when,
-        action,
-        target,
-    })
+    }
 }
 
 /// Refuses the first agent whose goal is not in its start's connected part of the map (walls

@@ -1,5 +1,8 @@
-//! `hnav`: the HNAV command line. Argument parsing only; the work is done by
-//! `hnav_runtime::scenario` and `hnav_runtime::grid`.
+//! `hnav`: the HNAV command line, the binary of `hnav-operator`. Argument parsing and
+//! printing only, one module per verb (`run_cmd`, `ps_cmd`, `top`, ...): a run and what
+//! reads it back are this crate's library (`hnav_operator::supervisor`, `monitor`, `report`,
+//! `export`); `hnav check`, `hnav map` and `hnav layout`, here, are thin calls into
+//! `hnav_runtime::scenario`, `hnav_runtime::grid` and `hnav_runtime::msg`.
 //!
 //! Exit codes: 0 all good, 1 checks ran and found problems (or the report could not be
 //! written), 2 the input could not be loaded or is invalid (and for usage errors, via clap).

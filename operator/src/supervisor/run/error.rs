@@ -51,6 +51,10 @@ pub enum RunError {
         /// What it writes there.
         writes: String,
     },
+    /// A child's exit descriptor could not be duplicated for the watch (out of descriptors,
+    /// say).
+    #[error("cannot watch the run's processes for their exits: {0}")]
+    ExitFd(#[source] std::io::Error),
     /// The consensus log could not be read for the summary.
     #[error(transparent)]
     Log(#[from] LogError),

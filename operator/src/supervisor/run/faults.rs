@@ -16,13 +16,17 @@
 //! change the log). The SIGCONT is a deadline of the supervisor's wait, and goes only to the
 //! incarnation that was stopped: one that died meanwhile (hang detection kills a process
 //! frozen for too long) or was replaced gets nothing.
+//!
+//! The schedule only decides: it reads the slots and returns the signals to send
+//! ([`Action::Signal`]); the watch sends them and tells it where each fault's landed
+//! ([`FaultSchedule::landed`]), which is what a hold waits for and what a freeze ends.
 
 use std::time::{Duration, Instant};
 
+use super::action::{Action, Incarnation, Landed, Shot, Why};
 use super::slots::Slots;
 use crate::supervisor::child::Signal;
-use crate::supervisor::events::RunEvent;
-use hnav_runtime::msg::Role;
+use hnav_runtime::msg::{Lifecycle, Role};
 use hnav_runtime::scenario::{
     FaultAction, FaultSignal, FaultSpec, FaultTarget, FaultTime, SimParams,
 };
@@ -55,16 +59,14 @@ enum Due {
 /// Lockstep: the period the sim holds at and the process incarnations its faults hit.
 struct Held {
     period: u64,
-    /// Role, index and pid of each process that has to settle before the run resumes.
-    hit: Vec<(Role, u32, u32)>,
+    /// Each process that has to settle before the run resumes.
+    hit: Vec<Incarnation>,
 }
 
 /// A frozen process to continue.
 struct Thaw {
     at: Instant,
-    role: Role,
-    index: u32,
-    pid: u32,
+    target: Incarnation,
     fault: usize,
 }
 
@@ -106,21 +108,23 @@ impl<'s> FaultSchedule<'s> {
         self.leader = u32::from(leader);
     }
 
-    /// Realtime: sends the signals of the faults that are due, `since_start` after `Start`,
-    /// each once.
-    pub(super) fn fire_due(&mut self, slots: &Slots, since_start: Duration) {
+    /// Realtime: the signals of the faults that are due, `since_start` after `Start`, each
+    /// once.
+    pub(super) fn fire_due(&mut self, slots: &Slots, since_start: Duration) -> Vec<Action> {
         if self.lockstep {
-            return;
+            return Vec::new();
         }
+        let mut todo = Vec::new();
         for i in 0..self.faults.len() {
             let due = match self.due[i] {
                 Due::Round(r) => r <= self.round,
                 Due::After(d) => d <= since_start,
             };
             if !self.done[i] && due {
-                self.fire(i, slots, self.round, false);
+                todo.extend(self.fire(i, slots, self.round, false));
             }
         }
+        todo
     }
 
     /// The next time something is due: a realtime fault in seconds (`start` = when `Start`
@@ -137,86 +141,65 @@ impl<'s> FaultSchedule<'s> {
         timed.chain(self.thaws.iter().map(|t| t.at)).min()
     }
 
-    /// Sends SIGCONT to every frozen process whose freeze is over by `now`.
-    pub(super) fn thaw_due(&mut self, slots: &Slots, now: Instant) {
+    /// The SIGCONT of every frozen process whose freeze is over by `now`.
+    pub(super) fn thaw_due(&mut self, now: Instant) -> Vec<Action> {
         let (due, later): (Vec<Thaw>, Vec<Thaw>) = self.thaws.drain(..).partition(|t| t.at <= now);
         self.thaws = later;
-        for t in due {
-            self.thaw(&t, slots);
-        }
+        due.iter().map(|t| self.thaw(t)).collect()
     }
 
-    /// Continues every process still frozen by the plan, so that the end of the run finds
-    /// them able to stop politely.
-    pub(super) fn thaw_all(&mut self, slots: &Slots) {
-        for t in std::mem::take(&mut self.thaws) {
-            self.thaw(&t, slots);
-        }
+    /// The SIGCONT of every process still frozen by the plan, so that the end of the run
+    /// finds them able to stop politely.
+    pub(super) fn thaw_all(&mut self) -> Vec<Action> {
+        let all = std::mem::take(&mut self.thaws);
+        all.iter().map(|t| self.thaw(t)).collect()
     }
 
-    fn thaw(&self, t: &Thaw, slots: &Slots) {
-        let Some(c) = slots
-            .child(t.role, t.index)
-            .filter(|c| c.pid() == t.pid && c.exit().is_none())
-        else {
-            tracing::info!(
-                node = t.role.node_name(t.index),
-                pid = t.pid,
-                "frozen process is gone; no SIGCONT"
-            );
-            return;
-        };
-        if let Err(e) = c.signal(Signal::SIGCONT) {
-            tracing::warn!("freeze not ended: {e}");
-            return;
-        }
-        tracing::warn!(node = t.role.node_name(t.index), "fault: continued");
-        slots.events().record(RunEvent::Signalled {
-            node: t.role.node_name(t.index),
-            pid: t.pid,
-            signal: Signal::SIGCONT.to_string(),
-            fault: Some(t.fault),
+    fn thaw(&self, t: &Thaw) -> Action {
+        Action::Signal(Shot {
+            target: t.target,
+            signal: Signal::SIGCONT,
+            why: Why::Thaw(t.fault),
             round: self.round,
-        });
+            wait_stop: false,
+        })
     }
 
-    /// Lockstep: the sim holds before `period`; fires the faults of that round (each once: a
-    /// restarted sim holding again at a round already done is resumed at once).
-    pub(super) fn on_hold(&mut self, slots: &Slots, period: u64) {
+    /// Lockstep: the sim holds before `period`; the signals of the faults of that round
+    /// (each once: a restarted sim holding again at a round already done is resumed at once).
+    pub(super) fn on_hold(&mut self, slots: &Slots, period: u64) -> Vec<Action> {
         self.round = period;
-        let mut hit = Vec::new();
+        self.held = Some(Held {
+            period,
+            hit: Vec::new(),
+        });
+        let mut todo = Vec::new();
         for i in 0..self.faults.len() {
             if !self.done[i] && matches!(self.due[i], Due::Round(r) if r == period) {
-                hit.extend(self.fire(i, slots, period, true));
+                todo.extend(self.fire(i, slots, period, true));
             }
         }
-        self.held = Some(Held { period, hit });
+        todo
     }
 
-    /// Lockstep: the period to resume, once every process hit at the hold is done with.
-    pub(super) fn resume_due(&mut self, slots: &Slots) -> Option<u64> {
+    /// Lockstep: the `Resume` of the hold, once every process hit at it is done with.
+    pub(super) fn resume_due(&mut self, slots: &Slots) -> Option<Action> {
         let held = self.held.as_ref()?;
         if !held
             .hit
             .iter()
-            .all(|&(role, index, pid)| slots.settled(role, index, pid))
+            .all(|t| slots.settled(t.role, t.index, t.pid))
         {
             return None;
         }
-        self.held.take().map(|h| h.period)
+        let period = self.held.take()?.period;
+        Some(Action::Publish(Lifecycle::resume(period)))
     }
 
-    /// Sends fault `i`'s signal and marks it fired; returns whom a hold has to wait for (a
-    /// killed process, or a frozen one that died instead of stopping). With `wait_stop`, a
-    /// freeze returns once its target is stopped. A target that is not running (down,
-    /// waiting for its restart) misses its fault.
-    fn fire(
-        &mut self,
-        i: usize,
-        slots: &Slots,
-        round: u64,
-        wait_stop: bool,
-    ) -> Option<(Role, u32, u32)> {
+    /// Marks fault `i` fired and returns its signal to the process it targets now (none if
+    /// that is not running: down, waiting for its restart, it misses its fault). With
+    /// `wait_stop`, a freeze is waited for until its target is stopped.
+    fn fire(&mut self, i: usize, slots: &Slots, round: u64, wait_stop: bool) -> Option<Action> {
         self.done[i] = true;
         let f = &self.faults[i];
         let (role, index) = match f.target {
@@ -230,31 +213,38 @@ impl<'s> FaultSchedule<'s> {
             FaultAction::Kill(FaultSignal::Term) => Signal::SIGTERM,
             FaultAction::Freeze { .. } => Signal::SIGSTOP,
         };
-        let c = slots.child(role, index)?;
+        let pid = slots.child(role, index)?.pid();
         tracing::warn!(
             node = role.node_name(index),
             %signal,
             round,
             "fault injected"
         );
-        if let Err(e) = c.signal(signal) {
-            tracing::warn!("fault not injected: {e}");
-            return None;
-        }
-        slots.events().record(RunEvent::Signalled {
-            node: role.node_name(index),
-            pid: c.pid(),
-            signal: signal.to_string(),
-            fault: Some(i),
+        Some(Action::Signal(Shot {
+            target: Incarnation { role, index, pid },
+            signal,
+            why: Why::Fault(i),
             round,
-        });
-        let hit = Some((role, index, c.pid()));
-        let FaultAction::Freeze { for_s } = f.action else {
-            return hit;
-        };
-        if wait_stop && !c.wait_stopped() {
-            return hit;
+            wait_stop: wait_stop && matches!(f.action, FaultAction::Freeze { .. }),
+        }))
+    }
+
+    /// Fault `i`'s signal to `target` `landed`: a hold waits for a killed process (or a frozen
+    /// one that died instead of stopping) to settle; a stopped one is continued `for_s` later.
+    pub(super) fn landed(&mut self, i: usize, target: Incarnation, landed: Landed) {
+        match (self.faults[i].action, landed) {
+            (_, Landed::Missed) => {}
+            (FaultAction::Freeze { for_s }, Landed::Sent) => self.thaw_later(i, target, for_s),
+            _ => {
+                if let Some(held) = &mut self.held {
+                    held.hit.push(target);
+                }
+            }
         }
+    }
+
+    /// Fault `i` froze `target`: it is continued `for_s` from now (never without `for_s`).
+    fn thaw_later(&mut self, i: usize, target: Incarnation, for_s: Option<f64>) {
         // A freeze too long for the clock is one that is never ended.
         let end = for_s
             .and_then(|secs| Duration::try_from_secs_f64(secs).ok())
@@ -262,12 +252,9 @@ impl<'s> FaultSchedule<'s> {
         if let Some(at) = end {
             self.thaws.push(Thaw {
                 at,
-                role,
-                index,
-                pid: c.pid(),
+                target,
                 fault: i,
             });
         }
-        None
     }
 }

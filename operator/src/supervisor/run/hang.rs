@@ -5,8 +5,8 @@
 //! ([`Scenario::hang_deadline`]). The earliest of them bounds the watch's wait, so nothing is
 //! polled: the supervisor wakes at that deadline, reads each process's latest beat (one depth-1
 //! buffer per publisher on the `heartbeat` topic) and, if the process is still silent, declares
-//! it hung: a `hung` event in `events.jsonl`, a warning, SIGKILL. Its exit then takes the
-//! ordinary path (reaped, `Down`, restarted under its role's policy, or the run cannot go on).
+//! it hung: a `hung` event in `events.jsonl`, a warning, SIGKILL (actions the watch carries
+//! out, see [`super::action`]). Its exit then takes the ordinary path (reaped, `Down`, restarted under its role's policy, or the run cannot go on).
 //!
 //! A process is watched from the moment it is up: a first start from `Start` (before it, the
 //! start-up timeout bounds it), a restart from its `Up`. Beats carry their own
@@ -21,6 +21,7 @@
 
 use std::time::{Duration, Instant};
 
+use super::action::{Action, Incarnation, Shot, Why};
 use super::slots::Slots;
 use crate::supervisor::child::Signal;
 use crate::supervisor::events::RunEvent;
@@ -140,14 +141,13 @@ impl HangWatch {
         }
     }
 
-    /// Reads the latest beats, declares every process silent past its deadline hung
-    /// (SIGKILL; `round` is the last committed round, for the journal) and returns the next
-    /// deadline, if any process is watched.
+    /// Reads the latest beats and declares every process silent past its deadline hung:
+    /// returns the journal line and SIGKILL of each (`round` is the last committed round, for
+    /// the journal) and the next deadline, if any process is still watched.
     pub(super) fn check(
         &mut self,
-        slots: &Slots,
         round: u64,
-    ) -> Result<Option<Instant>, TransportError> {
+    ) -> Result<(Vec<Action>, Option<Instant>), TransportError> {
         self.take_beats()?;
         let now = Instant::now();
         if let Some(late) = self.pause.check_at(now) {
@@ -155,6 +155,7 @@ impl HangWatch {
         }
         let now_ns = monotonic_ns();
         let mut next: Option<Instant> = None;
+        let mut todo = Vec::new();
         for k in 0..self.nodes.len() {
             let Some(w) = self.nodes[k].filter(|w| !w.declared) else {
                 continue;
@@ -167,12 +168,17 @@ impl HangWatch {
                 next = Some(next.map_or(due, |n| n.min(due)));
                 continue;
             }
-            self.declare(slots, role, index, w.pid, silent, hang, round);
+            let target = Incarnation {
+                role,
+                index,
+                pid: w.pid,
+            };
+            todo.extend(declare(target, silent, hang, round));
             if let Some(w) = &mut self.nodes[k] {
                 w.declared = true;
             }
         }
-        Ok(next)
+        Ok((todo, next))
     }
 
     /// Notes the instant the coming wait is asked to end by: the supervisor is expected back
@@ -211,48 +217,6 @@ impl HangWatch {
         Ok(())
     }
 
-    /// Declares `role`/`index` (process `pid`) hung after `silent` of silence and kills it.
-    #[allow(clippy::too_many_arguments)]
-    fn declare(
-        &self,
-        slots: &Slots,
-        role: Role,
-        index: u32,
-        pid: u32,
-        silent: Duration,
-        hang: Duration,
-        round: u64,
-    ) {
-        let node = role.node_name(index);
-        let silent_ms = silent.as_millis() as u64;
-        tracing::warn!(
-            node,
-            pid,
-            silent_ms,
-            deadline_ms = hang.as_millis() as u64,
-            "process hung: no heartbeat within its deadline; killing it"
-        );
-        slots.events().record(RunEvent::Hung {
-            node: node.clone(),
-            pid,
-            silent_ms,
-        });
-        let Some(child) = slots.child(role, index).filter(|c| c.pid() == pid) else {
-            return;
-        };
-        if let Err(e) = child.signal(Signal::SIGKILL) {
-            tracing::warn!(node, "hung process not killed: {e}");
-            return;
-        }
-        slots.events().record(RunEvent::Signalled {
-            node,
-            pid,
-            signal: Signal::SIGKILL.to_string(),
-            fault: None,
-            round,
-        });
-    }
-
     fn slot_of(&self, role: Role, index: u32) -> Option<usize> {
         Self::slot_index(self.nodes.len(), role, index)
     }
@@ -287,6 +251,33 @@ impl HangWatch {
             Role::Agent | Role::Bridge => 2,
         }
     }
+}
+
+/// Declares `target` hung after `silent` of silence (its deadline: `hang`): a journal line,
+/// then SIGKILL.
+fn declare(target: Incarnation, silent: Duration, hang: Duration, round: u64) -> [Action; 2] {
+    let node = target.role.node_name(target.index);
+    let silent_ms = silent.as_millis() as u64;
+    tracing::warn!(
+        node,
+        pid = target.pid,
+        silent_ms,
+        deadline_ms = hang.as_millis() as u64,
+        "process hung: no heartbeat within its deadline; killing it"
+    );
+    let hung = RunEvent::Hung {
+        node,
+        pid: target.pid,
+        silent_ms,
+    };
+    let kill = Shot {
+        target,
+        signal: Signal::SIGKILL,
+        why: Why::Hung,
+        round,
+        wait_stop: false,
+    };
+    [Action::Journal(hung), Action::Signal(kill)]
 }
 
 #[cfg(test)]

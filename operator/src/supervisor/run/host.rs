@@ -1,6 +1,7 @@
 //! This host's part of a run across hosts (`hnav run --host NAME`): which of the run's
 //! processes it starts, its bridge's command line, and which processes of other hosts its
-//! start-up handshake waits for.
+//! start-up handshake waits for. Also the list of a run's processes ([`processes_of`]) that
+//! both this host's slots and the other hosts' part are cut from.
 //!
 //! Every host's supervisor waits for the `Up` of every process of the run (those of other
 //! hosts cross the bridges) and then publishes `Start`; a process takes the first `Start` and
@@ -10,7 +11,6 @@
 
 use std::path::{Path, PathBuf};
 
-use super::slots::processes_of;
 use crate::supervisor::child::ChildSpec;
 use crate::supervisor::startup::Roll;
 use hnav_runtime::msg::Role;
@@ -91,4 +91,17 @@ fn remote_of(placement: &Placement, me: usize, scenario: &Scenario) -> Vec<(Role
             (host != me).then(|| (role, index, host.clone()))
         })
         .collect()
+}
+
+/// Every process of a run of `scenario` but the bridges, in the order they start: the sim,
+/// the coordinator (index 0) or its replicas (1 to n, their Raft ids), the agents. Each runs
+/// the binary `hnav-<role>`.
+pub(super) fn processes_of(scenario: &Scenario) -> impl Iterator<Item = (Role, u32)> {
+    let coordinators = match scenario.coordinator.replicas {
+        1 => 0..=0,
+        n => 1..=n,
+    };
+    std::iter::once((Role::Sim, 0))
+        .chain(coordinators.map(|id| (Role::Coordinator, id)))
+        .chain((0..scenario.agents.len() as u32).map(|i| (Role::Agent, i)))
 }

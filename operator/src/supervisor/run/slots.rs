@@ -1,21 +1,24 @@
 //! The run's processes, one slot per role and index: how each is started, its entry in the
 //! run registry, and its restarts under its role's policy.
+//!
+//! The slots hold the state; what is to be done about an exit or an `Up` (journal lines,
+//! lifecycle messages, respawns) they return as [`Action`]s for the watch to carry out.
 
-use std::cell::Cell;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use super::action::Action;
 use super::error::RunError;
-use super::host::HostPart;
+use super::host::{processes_of, HostPart};
 use crate::supervisor::child::{Child, ChildError, ChildSpec, ExitInfo};
-use crate::supervisor::events::{RunEvent, RunEvents};
+use crate::supervisor::events::RunEvent;
+use crate::supervisor::exit_fd::ExitFd;
 use crate::supervisor::registry::RunRecord;
 use crate::supervisor::restart::{GiveUpReason, RestartDecision, RestartTracker};
-use crate::supervisor::startup::SupervisorPorts;
 use hnav_runtime::launch::ProcessArgs;
-use hnav_runtime::msg::{Lifecycle, LifecycleEvent, Role, RosterState};
+use hnav_runtime::msg::{Lifecycle, Role, RosterState};
 use hnav_runtime::scenario::{GiveUpAction, RestartPolicy, RestartRule, Scenario};
-use hnav_runtime::transport::{Bell, Transport, BELL_ENV};
+use hnav_runtime::transport::{Bell, BELL_ENV};
 
 /// One process of the run and what the supervisor knows of it.
 struct Slot {
@@ -24,10 +27,8 @@ struct Slot {
     tracker: RestartTracker,
     restart_at: Option<Instant>,
     /// Restarted, `Restarted` not yet announced: that waits until the new process is up, so
-    /// that peers reacting to it (the sim resends odometry) find its ports. A `Cell`, because
-    /// the slots stay borrowed by the waiter's attachments on the children's exit descriptors
-    /// while `Up`s are taken.
-    announce: Cell<bool>,
+    /// that peers reacting to it (the sim resends odometry) find its ports.
+    announce: bool,
     /// Gone for good (not restarted): why, in words.
     lost: Option<String>,
 }
@@ -38,8 +39,6 @@ pub(super) struct Slots {
     slots: Vec<Slot>,
     /// The run directory, named when a process stops on a full disk.
     dir: PathBuf,
-    /// `DIR/events.jsonl`: exits, respawns, `Up`s and the faults' signals.
-    events: RunEvents,
     /// What an agent gone for good does to the run.
     on_give_up: GiveUpAction,
     /// In a run across hosts, this host's part.
@@ -96,7 +95,7 @@ impl Slots {
                 child: None,
                 tracker: RestartTracker::new(rule),
                 restart_at: None,
-                announce: Cell::new(false),
+                announce: false,
                 lost: None,
             });
         };
@@ -108,7 +107,6 @@ impl Slots {
         Self {
             slots,
             dir: dir.to_path_buf(),
-            events: RunEvents::create(dir),
             on_give_up: scenario.restart.on_give_up,
             host: host.cloned(),
         }
@@ -117,11 +115,6 @@ impl Slots {
     /// In a run across hosts, this host's part.
     pub(super) fn host(&self) -> Option<&HostPart> {
         self.host.as_ref()
-    }
-
-    /// The run's event journal.
-    pub(super) fn events(&self) -> &RunEvents {
-        &self.events
     }
 
     /// Starts every process of `role` (every process: `None`) not started yet.
@@ -139,12 +132,18 @@ impl Slots {
         self.slots.iter().filter_map(|s| s.child.as_ref())
     }
 
+    /// A descriptor of each child's exit of its own, for a waiter that stays attached while
+    /// the slots change.
+    pub(super) fn exit_fds(&self) -> std::io::Result<Vec<ExitFd>> {
+        self.children().map(|c| c.exit_fd().try_clone()).collect()
+    }
+
     /// Role, index and pid of every process that is up: running, and announced up again if
     /// it was restarted (what the hang watch holds deadlines for).
     pub(super) fn up(&self) -> impl Iterator<Item = (Role, u32, u32)> + '_ {
         self.slots
             .iter()
-            .filter(|s| !s.announce.get())
+            .filter(|s| !s.announce)
             .filter_map(|s| Some((s.spec.role, s.spec.index, s.child.as_ref()?.pid())))
     }
 
@@ -163,7 +162,7 @@ impl Slots {
             .iter()
             .find(|s| s.spec.role == role && s.spec.index == index)
             .is_none_or(|s| match &s.child {
-                Some(c) => c.pid() != pid && !s.announce.get(),
+                Some(c) => c.pid() != pid && !s.announce,
                 None => s.restart_at.is_none(),
             })
     }
@@ -184,21 +183,21 @@ impl Slots {
             .collect()
     }
 
-    /// Tells every process what state each agent is in now (`Roster`), for a sim or a
-    /// coordinator that was down and missed their events.
-    fn publish_roster(&self, life: &SupervisorPorts) -> Result<(), RunError> {
-        for s in self.slots.iter().filter(|s| s.spec.role == Role::Agent) {
+    /// What state each agent is in now (`Roster`), for a sim or a coordinator that was down
+    /// and missed their events.
+    fn roster(&self) -> impl Iterator<Item = Action> + '_ {
+        let agents = self.slots.iter().filter(|s| s.spec.role == Role::Agent);
+        agents.map(|s| {
             let restarts = s.tracker.restarts();
             let (state, restarts) = match (&s.child, s.lost.is_some()) {
                 (_, true) => (RosterState::Lost, restarts),
-                (Some(_), false) if !s.announce.get() => (RosterState::Up, restarts),
+                (Some(_), false) if !s.announce => (RosterState::Up, restarts),
                 // Dead, waiting for its restart, or restarted and not up yet: the restart
                 // already counted is still to be announced.
                 _ => (RosterState::Down, restarts.saturating_sub(1)),
             };
-            life.publish(Lifecycle::roster(s.spec.index, state, restarts))?;
-        }
-        Ok(())
+            Action::Publish(Lifecycle::roster(s.spec.index, state, restarts))
+        })
     }
 
     /// The earliest pending restart.
@@ -225,108 +224,144 @@ impl Slots {
         }
     }
 
-    /// Reaps exited children, tells the others (`Down`), and restarts what is due. Returns
-    /// why the run cannot go on, if it cannot: the sim or the coordinator is down and not
-    /// restarted, coordinator replicas are lost until no majority is left, or no agent is
-    /// left. A child that stopped on a full disk ends the run instead: [`RunError::NoSpace`].
-    pub(super) fn reap_and_restart(
-        &mut self,
-        transport: &Transport,
-        life: &SupervisorPorts,
-    ) -> Result<Option<String>, RunError> {
+    /// Reaps exited children and restarts what is due. Returns what is to be done about it,
+    /// in this order: each exit journalled and told (`Down`; `Lost` if not restarted), the
+    /// dead processes' resources removed, the respawns; and whether the run goes on.
+    pub(super) fn reap_and_restart(&mut self) -> Reaped {
+        let mut todo = Vec::new();
+        let mut gone = Gone::default();
         let mut died = false;
-        // The sim or the coordinator gone for good ends the run; a replica only once no
-        // majority is left (Raft's cluster goes on without a minority); an agent only if it
-        // was the last one.
-        let (mut core_gone, mut replica_gone, mut agent_gone) = (None, None, None);
-        for s in &mut self.slots {
-            let Some(exit) = s.child.as_ref().and_then(|c| c.try_reap()) else {
+        for k in 0..self.slots.len() {
+            let Some(exit) = self.slots[k].child.as_ref().and_then(|c| c.try_reap()) else {
                 continue;
             };
             died = true;
-            let pid = s.child.take().map_or(0, |c| c.pid());
-            let (role, index) = (s.spec.role, s.spec.index);
-            tracing::warn!(node = role.node_name(index), %exit, "process exited");
-            self.events.record(RunEvent::Exited {
-                node: role.node_name(index),
-                pid,
-                how: exit.to_string(),
-            });
-            life.publish(Lifecycle::down(role, index, s.tracker.restarts()))?;
-            match s.tracker.on_exit(&exit) {
-                RestartDecision::Restart { after } => s.restart_at = Some(Instant::now() + after),
-                RestartDecision::GiveUp(GiveUpReason::NoSpace) => {
-                    return Err(RunError::NoSpace {
-                        node: role.node_name(index),
-                        writes: role_writes(role, index, &self.dir),
-                    })
-                }
-                RestartDecision::GiveUp(why) => {
-                    tracing::warn!(node = role.node_name(index), %why, "not restarted");
-                    life.publish(Lifecycle::lost(role, index, s.tracker.restarts()))?;
-                    let ended = not_restarted(role, index, &exit, why);
-                    let replica = role == Role::Coordinator && index > 0;
-                    let gone = if replica {
-                        format!("{ended}: the cluster goes on while a majority of it is left")
-                    } else {
-                        format!("{ended}: the run cannot go on")
-                    };
-                    self.events.record(RunEvent::GaveUp {
-                        node: role.node_name(index),
-                        why: gone.clone(),
-                    });
-                    match role {
-                        Role::Agent if self.on_give_up == GiveUpAction::Stop => {
-                            core_gone = Some(format!(
-                                "{ended}, and [restart] on_give_up = \"stop\" ends the run"
-                            ));
-                        }
-                        Role::Agent => agent_gone = Some(gone),
-                        Role::Coordinator if replica => replica_gone = Some(ended.clone()),
-                        Role::Sim | Role::Coordinator | Role::Bridge => core_gone = Some(gone),
-                    }
-                    s.lost = Some(ended);
-                }
+            if let Err(full) = self.on_exit(k, exit, &mut gone, &mut todo) {
+                return Reaped {
+                    todo,
+                    verdict: Err(full),
+                };
             }
         }
         if died {
-            // Removing the dead nodes' resources wakes their peers with "peer dead".
-            if let Err(e) = transport.cleanup_dead_nodes() {
-                tracing::warn!("dead-node clean-up failed: {e}");
+            todo.push(Action::CleanUpDead);
+        }
+        let verdict = self.cannot_go_on(gone);
+        if verdict.is_none() {
+            todo.extend(self.due_restarts());
+        }
+        Reaped {
+            todo,
+            verdict: Ok(verdict),
+        }
+    }
+
+    /// Slot `k`'s child exited with `exit`: journalled, told `Down`, then restarted later or
+    /// given up on (told `Lost`, noted in `gone`). One that stopped on a full disk is
+    /// [`RunError::NoSpace`]: a restart would meet the same full disk.
+    fn on_exit(
+        &mut self,
+        k: usize,
+        exit: ExitInfo,
+        gone: &mut Gone,
+        todo: &mut Vec<Action>,
+    ) -> Result<(), RunError> {
+        let s = &mut self.slots[k];
+        let pid = s.child.take().map_or(0, |c| c.pid());
+        let (role, index) = (s.spec.role, s.spec.index);
+        let node = role.node_name(index);
+        tracing::warn!(node, %exit, "process exited");
+        todo.push(Action::Journal(RunEvent::Exited {
+            node: node.clone(),
+            pid,
+            how: exit.to_string(),
+        }));
+        todo.push(Action::Publish(Lifecycle::down(
+            role,
+            index,
+            s.tracker.restarts(),
+        )));
+        let why = match s.tracker.on_exit(&exit) {
+            RestartDecision::Restart { after } => {
+                s.restart_at = Some(Instant::now() + after);
+                return Ok(());
             }
+            RestartDecision::GiveUp(GiveUpReason::NoSpace) => {
+                let writes = role_writes(role, index, &self.dir);
+                return Err(RunError::NoSpace { node, writes });
+            }
+            RestartDecision::GiveUp(why) => why,
+        };
+        tracing::warn!(node, %why, "not restarted");
+        todo.push(Action::Publish(Lifecycle::lost(
+            role,
+            index,
+            s.tracker.restarts(),
+        )));
+        let ended = not_restarted(role, index, &exit, why);
+        let why = gone.note(role, index, &ended, self.on_give_up);
+        todo.push(Action::Journal(RunEvent::GaveUp { node, why }));
+        s.lost = Some(ended);
+        Ok(())
+    }
+
+    /// Why the run cannot go on after the losses of one reaping (`gone`), if it cannot: the
+    /// sim or the coordinator is gone for good; a replica only once no majority is left
+    /// (Raft's cluster goes on without a minority); an agent only if it was the last one.
+    fn cannot_go_on(&self, gone: Gone) -> Option<String> {
+        if gone.core.is_some() {
+            return gone.core;
         }
-        if core_gone.is_some() {
-            return Ok(core_gone);
+        if let Some(last) = gone.replica.filter(|_| !self.replica_majority_left()) {
+            return Some(format!(
+                "no majority of the coordinator replicas is left; the last lost: {last}"
+            ));
         }
-        if let Some(gone) = replica_gone.filter(|_| !self.replica_majority_left()) {
-            return Ok(Some(format!(
-                "no majority of the coordinator replicas is left; the last lost: {gone}"
-            )));
-        }
-        if let Some(gone) = agent_gone.filter(|_| !self.any_agent_left()) {
-            return Ok(Some(format!("no agent is left; the last: {gone}")));
-        }
+        let last = gone.agent.filter(|_| !self.any_agent_left())?;
+        Some(format!("no agent is left; the last: {last}"))
+    }
+
+    /// The respawns that are due, each taken off the schedule.
+    fn due_restarts(&mut self) -> Vec<Action> {
         let now = Instant::now();
-        for s in &mut self.slots {
-            if s.restart_at.is_some_and(|t| t <= now) {
-                s.restart_at = None;
-                let spec = s.spec.clone().arg("--resume");
-                let child = Child::spawn(&spec)?;
-                tracing::info!(
-                    node = spec.role.node_name(spec.index),
-                    pid = child.pid(),
-                    "restarted"
-                );
-                self.events.record(RunEvent::Spawned {
-                    node: spec.role.node_name(spec.index),
-                    pid: child.pid(),
-                    restarts: s.tracker.restarts(),
-                });
-                s.child = Some(child);
-                s.announce.set(true);
+        let due = self
+            .slots
+            .iter_mut()
+            .filter(|s| s.restart_at.is_some_and(|t| t <= now));
+        due.map(|s| {
+            s.restart_at = None;
+            Action::Respawn {
+                role: s.spec.role,
+                index: s.spec.index,
             }
-        }
-        Ok(None)
+        })
+        .collect()
+    }
+
+    /// Starts `role`/`index` again with `--resume`; its `Restarted` waits for its `Up`.
+    /// Returns the journal's line for it (none: the run has no such process).
+    pub(super) fn respawn(
+        &mut self,
+        role: Role,
+        index: u32,
+    ) -> Result<Option<RunEvent>, ChildError> {
+        let slot = self
+            .slots
+            .iter_mut()
+            .find(|s| s.spec.role == role && s.spec.index == index);
+        let Some(s) = slot else {
+            return Ok(None);
+        };
+        let child = Child::spawn(&s.spec.clone().arg("--resume"))?;
+        let (node, pid) = (role.node_name(index), child.pid());
+        tracing::info!(node, pid, "restarted");
+        s.child = Some(child);
+        s.announce = true;
+        Ok(Some(RunEvent::Spawned {
+            node,
+            pid,
+            restarts: s.tracker.restarts(),
+        }))
     }
 
     /// Whether more than half of the coordinator replicas are not lost for good (running, or
@@ -342,54 +377,77 @@ impl Slots {
         total == 0 || 2 * left > total
     }
 
-    /// Publishes `Restarted` for every restarted process that has announced itself up;
-    /// returns the periods of the sim's `Hold`s among what came in on `ready`.
-    pub(super) fn announce_restarts(&self, life: &SupervisorPorts) -> Result<Vec<u64>, RunError> {
-        let ready = life.ready();
-        let mut up = Vec::new();
-        let mut holds = Vec::new();
-        ready.drain_pending(|l| match LifecycleEvent::from_u8(l.event) {
-            Some(LifecycleEvent::Up) => up.push((l.role, l.index)),
-            Some(LifecycleEvent::Hold) => holds.push(l.period()),
-            // A start-up phase report is not yet the process being up.
-            _ => {}
-        })?;
-        for (role, index) in up {
-            let slot = self
+    /// Restarted processes that announced themselves up (`ups`: role and index as they came
+    /// in on `ready`): each journalled `Up` and announced `Restarted`, and after a sim's or a
+    /// coordinator's, the agents' roster that it missed.
+    pub(super) fn on_up(&mut self, ups: &[(u8, u32)]) -> Vec<Action> {
+        let mut todo = Vec::new();
+        for &(role, index) in ups {
+            let announced = self
                 .slots
-                .iter()
-                .find(|s| s.announce.get() && s.spec.role as u8 == role && s.spec.index == index);
-            if let Some(s) = slot {
-                s.announce.set(false);
-                self.events.record(RunEvent::Up {
-                    node: s.spec.role.node_name(s.spec.index),
-                    pid: s.child.as_ref().map_or(0, |c| c.pid()),
-                });
-                life.publish(Lifecycle::restarted(
-                    s.spec.role,
-                    s.spec.index,
-                    s.tracker.restarts(),
-                ))?;
-                if s.spec.role != Role::Agent {
-                    self.publish_roster(life)?;
-                }
+                .iter_mut()
+                .find(|s| s.announce && s.spec.role as u8 == role && s.spec.index == index);
+            let Some(s) = announced else {
+                continue;
+            };
+            s.announce = false;
+            let (role, index) = (s.spec.role, s.spec.index);
+            todo.push(Action::Journal(RunEvent::Up {
+                node: role.node_name(index),
+                pid: s.child.as_ref().map_or(0, |c| c.pid()),
+            }));
+            let restarts = s.tracker.restarts();
+            todo.push(Action::Publish(Lifecycle::restarted(role, index, restarts)));
+            if role != Role::Agent {
+                todo.extend(self.roster());
             }
         }
-        Ok(holds)
+        todo
     }
 }
 
-/// Every process of a run of `scenario` but the bridges, in the order they start: the sim,
-/// the coordinator (index 0) or its replicas (1 to n, their Raft ids), the agents. Each runs
-/// the binary `hnav-<role>`.
-pub(super) fn processes_of(scenario: &Scenario) -> impl Iterator<Item = (Role, u32)> {
-    let coordinators = match scenario.coordinator.replicas {
-        1 => 0..=0,
-        n => 1..=n,
-    };
-    std::iter::once((Role::Sim, 0))
-        .chain(coordinators.map(|id| (Role::Coordinator, id)))
-        .chain((0..scenario.agents.len() as u32).map(|i| (Role::Agent, i)))
+/// What one reaping found.
+pub(super) struct Reaped {
+    /// What to do about it, in this order.
+    pub(super) todo: Vec<Action>,
+    /// `Ok(Some(why))`: the run cannot go on; `Err`: a process stopped on a full disk.
+    pub(super) verdict: Result<Option<String>, RunError>,
+}
+
+/// The processes given up on in one reaping, for the verdict on the run.
+#[derive(Default)]
+struct Gone {
+    /// The sim, the coordinator or a bridge (or an agent under `on_give_up = "stop"`): the
+    /// run ends.
+    core: Option<String>,
+    /// A coordinator replica: the run ends once no majority is left.
+    replica: Option<String>,
+    /// An agent: the run ends if it was the last one.
+    agent: Option<String>,
+}
+
+impl Gone {
+    /// Notes that `role`/`index` `ended` and is not restarted (`on_give_up`: what an agent
+    /// gone for good does to the run); returns what that means to the run, for the journal.
+    fn note(&mut self, role: Role, index: u32, ended: &str, on_give_up: GiveUpAction) -> String {
+        let replica = role == Role::Coordinator && index > 0;
+        let gone = if replica {
+            format!("{ended}: the cluster goes on while a majority of it is left")
+        } else {
+            format!("{ended}: the run cannot go on")
+        };
+        match role {
+            Role::Agent if on_give_up == GiveUpAction::Stop => {
+                self.core = Some(format!(
+                    "{ended}, and [restart] on_give_up = \"stop\" ends the run"
+                ));
+            }
+            Role::Agent => self.agent = Some(gone.clone()),
+            Role::Coordinator if replica => self.replica = Some(ended.to_string()),
+            Role::Sim | Role::Coordinator | Role::Bridge => self.core = Some(gone.clone()),
+        }
+        gone
+    }
 }
 
 /// That `role`/`index` ended with `exit` and is not restarted for `why`, in words.
