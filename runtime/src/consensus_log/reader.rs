@@ -240,6 +240,15 @@ enum Step {
     Torn(TornTail),
 }
 
+/// Whether a file of `len` bytes, of which `read` came first and the rest is in `file`, holds
+/// only zero bytes (a read error counts as no).
+fn zeros(file: &mut BufReader<File>, read: &[u8], len: u64) -> bool {
+    let mut rest = Vec::new();
+    read.iter().all(|&b| b == 0)
+        && file.take(len).read_to_end(&mut rest).is_ok()
+        && rest.iter().all(|&b| b == 0)
+}
+
 /// Position in one open segment file.
 #[derive(Debug)]
 struct Cursor {
@@ -259,6 +268,16 @@ impl Cursor {
         let mut magic = [0u8; 8];
         file.read_exact(&mut magic[..have])
             .map_err(|e| LogError::io(&path, e))?;
+        if last && magic[..have] != MAGIC[..have] && zeros(&mut file, &magic[..have], len) {
+            // The segment was created and extended, but its magic never reached the disk.
+            return Ok(Err(TornTail {
+                path,
+                segment: index,
+                offset: 0,
+                bytes: len,
+                problem: FrameProblem::ZeroFill { bytes: len },
+            }));
+        }
         if magic[..have] != MAGIC[..have] || (have < MAGIC.len() && !last) {
             return Err(LogError::BadMagic { path });
         }

@@ -80,8 +80,9 @@ pub fn seal_checksummed(buf: &mut [u8], start: usize) {
 }
 
 /// Records of `len` bytes each, without header or checksum: every complete record is a
-/// frame (the owner judges its content), and only a record cut short by the end of the
-/// file is a torn tail.
+/// frame (the owner judges its content) except one of only zero bytes, which is what a file
+/// system leaves when it extended the file before the data reached the disk. A record cut
+/// short by the end of the file, or zeros up to it, is a torn tail.
 #[derive(Clone, Copy, Debug)]
 pub struct Fixed {
     /// Bytes of a record.
@@ -105,7 +106,12 @@ impl FrameFormat for Fixed {
         u64::from(self.len)
     }
 
-    fn decode(&self, _: &[u8], _: &[u8]) -> Result<(), FrameProblem> {
+    fn decode(&self, _: &[u8], record: &[u8]) -> Result<(), FrameProblem> {
+        if record.iter().all(|&b| b == 0) {
+            return Err(FrameProblem::ZeroFill {
+                bytes: record.len() as u64,
+            });
+        }
         Ok(())
     }
 }
