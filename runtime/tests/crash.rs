@@ -188,6 +188,14 @@ fn tears(len: usize) -> Vec<Option<Tear>> {
     out
 }
 
+/// A fresh directory, in memory where the machine has `/dev/shm`: the test makes thousands
+/// of files, and the disk's speed is not what it measures.
+fn scratch() -> tempfile::TempDir {
+    tempfile::tempdir_in("/dev/shm")
+        .or_else(|_| tempfile::tempdir())
+        .unwrap()
+}
+
 /// Cut points tried and records lost, per file kind.
 #[derive(Default)]
 struct Tally {
@@ -223,14 +231,14 @@ fn every_cut(
     write_len: usize,
     mut attempt: impl FnMut(&Path, FaultDisk) -> (u64, bool),
 ) {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch();
     let plan = Rc::new(Plan::default());
     let (lost, _) = attempt(dir.path(), FaultDisk(plan.clone()));
     assert_eq!(lost, 0, "a run without a crash lost records");
     let ops = plan.ops.get();
     for at in 0..ops {
         for tear in tears(write_len) {
-            let dir = tempfile::tempdir().unwrap();
+            let dir = scratch();
             let plan = Plan::cut(at, tear);
             let (lost, torn) = attempt(dir.path(), FaultDisk(plan.clone()));
             let (Some(Tear::Prefix(k) | Tear::Zeros(k)), written) = (tear, plan.cut_write.get())
@@ -428,7 +436,7 @@ fn a_consensus_log_loses_no_acknowledged_record_at_any_cut() {
 /// append until the log is reopened; the reopened log holds every record acknowledged before.
 #[test]
 fn a_failed_fsync_poisons_the_log_writer() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = scratch();
     let log = dir.path().join("log");
     let plan = Rc::new(Plan::default());
     let options = WriterOptions::new(FsyncPolicy::EveryRecord);
