@@ -3,7 +3,7 @@
 //!
 //! The frames are read by the durable toolkit's [`FrameReader`], whose rules say what counts
 //! as torn; only the last segment may end torn, and in it also a segment magic cut short (a
-//! prefix of it). Any other bad spot, and any bad spot in an earlier segment, is
+//! prefix of it) or never written (a segment of only zero bytes). Any other bad spot, and any bad spot in an earlier segment, is
 //! [`LogError::Corrupt`]. Reading never modifies a file.
 
 use std::fmt;
@@ -268,27 +268,23 @@ impl Cursor {
         let mut magic = [0u8; 8];
         file.read_exact(&mut magic[..have])
             .map_err(|e| LogError::io(&path, e))?;
-        if last && magic[..have] != MAGIC[..have] && zeros(&mut file, &magic[..have], len) {
-            // The segment was created and extended, but its magic never reached the disk.
-            return Ok(Err(TornTail {
-                path,
-                segment: index,
+        let whole = |problem| {
+            let torn = Torn {
                 offset: 0,
                 bytes: len,
-                problem: FrameProblem::ZeroFill { bytes: len },
-            }));
+                problem,
+            };
+            Ok(Err(TornTail::new(&path, index, torn)))
+        };
+        if last && magic[..have] != MAGIC[..have] && zeros(&mut file, &magic[..have], len) {
+            // The segment was created and extended, but its magic never reached the disk.
+            return whole(FrameProblem::ZeroFill { bytes: len });
         }
         if magic[..have] != MAGIC[..have] || (have < MAGIC.len() && !last) {
             return Err(LogError::BadMagic { path });
         }
         if have < MAGIC.len() {
-            return Ok(Err(TornTail {
-                path,
-                segment: index,
-                offset: 0,
-                bytes: len,
-                problem: FrameProblem::ShortMagic { have: len },
-            }));
+            return whole(FrameProblem::ShortMagic { have: len });
         }
         let frames = FrameReader::new(format(), file, MAGIC.len() as u64, len, last);
         Ok(Ok(Self {

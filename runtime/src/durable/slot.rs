@@ -327,7 +327,7 @@ mod tests {
         b[0] ^= 1;
         assert_eq!(reason(&b), "not a test slot of this version");
         let mut b = good.clone();
-        b[20] ^= 1;
+        b[26] ^= 1;
         assert_eq!(reason(&b), "checksum mismatch (torn or damaged)");
         let mut b = good.clone();
         b[16..24].copy_from_slice(&u64::MAX.to_le_bytes());
@@ -345,15 +345,15 @@ mod tests {
         pair.store(5, fill(5, b"five")).unwrap();
         let newest = pair.load(seq).unwrap().unwrap();
         assert_eq!((newest.seq, newest.path), (5, pair.path(5)));
+        let e = pair
+            .load(|_| Err("foreign".into()))
+            .unwrap_err()
+            .to_string();
+        assert!(e.ends_with("b: foreign"), "{e}");
         // A torn newest slot: the other one.
         let mut torn = std::fs::read(pair.path(5)).unwrap();
         torn[30] ^= 1;
         std::fs::write(pair.path(5), &torn).unwrap();
         assert_eq!(pair.load(seq).unwrap().unwrap().seq, 4);
-        let e = pair
-            .load(|_| Err("foreign".into()))
-            .unwrap_err()
-            .to_string();
-        assert!(e.ends_with("foreign"), "{e}");
     }
 }
