@@ -77,14 +77,13 @@ impl Invocation {
         }
     }
 
-    /// Writes `dir/invocation.json` (whole or not at all: a temporary file renamed).
+    /// Writes `dir/invocation.json` whole or not at all
+    /// ([`replace_file`](hnav_runtime::durable::replace_file)).
     pub fn write(&self, dir: &Path) -> std::io::Result<PathBuf> {
         let path = dir.join(FILE);
-        let tmp = dir.join(format!("{FILE}.tmp"));
         let mut text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
         text.push('\n');
-        std::fs::write(&tmp, text)?;
-        std::fs::rename(&tmp, &path)?;
+        hnav_runtime::durable::replace_file(&path, text.as_bytes())?;
         Ok(path)
     }
 

@@ -145,17 +145,12 @@ impl Rejections {
         Ok(out)
     }
 
-    /// Writes the counts to `dir/rejected.json`, replacing it by rename so that a reader never
-    /// sees half a file. Not synced: the counts are a report, not a record the run depends on.
+    /// Writes the counts to `dir/rejected.json` whole or not at all
+    /// ([`replace_file`](crate::durable::replace_file)): a reader never sees half a file, and
+    /// a coordinator restarted after a crash finds the counts of before.
     pub fn store(&self, dir: &Path) -> std::io::Result<()> {
-        let path = dir.join(FILE);
-        let tmp = dir.join(format!(".{FILE}.tmp-{}", std::process::id()));
         let text = serde_json::to_string_pretty(&self.to_map()).map_err(std::io::Error::other)?;
-        std::fs::write(&tmp, text + "\n")
-            .and_then(|()| std::fs::rename(&tmp, &path))
-            .inspect_err(|_| {
-                let _ = std::fs::remove_file(&tmp);
-            })
+        crate::durable::replace_file(&dir.join(FILE), (text + "\n").as_bytes())
     }
 }
 

@@ -2,21 +2,25 @@
 //! (ARCHITECTURE, Faults) — its row, its target and where its dead reckoning stood.
 //!
 //! A robot's controller would keep this in battery-backed RAM; here it is a small fixed-size
-//! file rewritten in place (`pwrite` at offset 0, no fsync) after every control period. The
-//! page cache survives the agent's SIGKILL, which is the failure this is for; a machine crash
-//! ends the run anyway. A checksum over the record rejects a torn or foreign file, and a
-//! restarted agent without a usable checkpoint starts from its scenario start.
+//! [slot](hnav_runtime::durable::slot) rewritten in place (`pwrite` at offset 0, no fsync)
+//! after every control period. The page cache survives the agent's SIGKILL, which is the
+//! failure this is for; a machine crash ends the run anyway. The slot's checksum rejects a
+//! torn or foreign file, and a restarted agent without a usable checkpoint starts from its
+//! scenario start.
 
-use std::fs::File;
-use std::os::unix::fs::FileExt;
+use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 
-use hnav_runtime::hash::Fnv1a64;
+use hnav_runtime::durable::{SlotFile, SlotLayout, SlotLen, SlotRead};
 use hnav_runtime::msg::Pose;
 
-const MAGIC: u64 = 0x4b43_5641_4e48_0001; // "HNAVCK" v1
-const FIELDS: usize = 11;
-const SIZE: usize = 8 * (FIELDS + 1);
+/// The slot: magic `"HNAVCK" v1`, the ten words of a [`Checkpoint`], FNV-1a 64.
+const LAYOUT: SlotLayout = SlotLayout {
+    magic: 0x4b43_5641_4e48_0001,
+    what: "agent checkpoint",
+    len: SlotLen::Fixed(8 * FIELDS),
+};
+const FIELDS: usize = 10;
 
 /// One agent's resumable state.
 #[derive(Clone, Copy, PartialEq, Debug)]
@@ -40,9 +44,8 @@ pub struct Checkpoint {
 }
 
 impl Checkpoint {
-    fn encode(&self) -> [u8; SIZE] {
-        let words: [u64; FIELDS] = [
-            MAGIC,
+    fn words(&self) -> [u64; FIELDS] {
+        [
             self.period,
             self.ticks_left as u64,
             self.ticks_right as u64,
@@ -53,49 +56,41 @@ impl Checkpoint {
             u64::from(self.next),
             u64::from(self.target),
             self.last_commit,
-        ];
-        let mut out = [0u8; SIZE];
-        let mut h = Fnv1a64::new();
-        for (i, w) in words.iter().enumerate() {
-            out[8 * i..8 * i + 8].copy_from_slice(&w.to_le_bytes());
-            h.u64(*w);
-        }
-        out[8 * FIELDS..].copy_from_slice(&h.finish().to_le_bytes());
-        out
+        ]
     }
 
-    fn decode(b: &[u8]) -> Option<Checkpoint> {
-        if b.len() != SIZE {
+    /// The checkpoint in a slot's payload; `None` for a cell index beyond `u32`.
+    fn decode(payload: &[u8]) -> Option<Checkpoint> {
+        if payload.len() != 8 * FIELDS {
             return None;
         }
-        let word = |i: usize| u64::from_le_bytes(b[8 * i..8 * i + 8].try_into().unwrap_or([0; 8]));
-        let mut h = Fnv1a64::new();
-        h.bytes(&b[..8 * FIELDS]);
-        if word(0) != MAGIC || word(FIELDS) != h.finish() {
-            return None;
-        }
+        let word = |i: usize| {
+            let mut w = [0u8; 8];
+            w.copy_from_slice(&payload[8 * i..8 * i + 8]);
+            u64::from_le_bytes(w)
+        };
         let cell = |i: usize| u32::try_from(word(i)).ok();
         Some(Checkpoint {
-            period: word(1),
-            ticks_left: word(2) as i64,
-            ticks_right: word(3) as i64,
+            period: word(0),
+            ticks_left: word(1) as i64,
+            ticks_right: word(2) as i64,
             pose: Pose {
-                x_m: f64::from_bits(word(4)),
-                y_m: f64::from_bits(word(5)),
-                theta_rad: f64::from_bits(word(6)),
+                x_m: f64::from_bits(word(3)),
+                y_m: f64::from_bits(word(4)),
+                theta_rad: f64::from_bits(word(5)),
             },
-            current: cell(7)?,
-            next: cell(8)?,
-            target: cell(9)?,
-            last_commit: word(10),
+            current: cell(6)?,
+            next: cell(7)?,
+            target: cell(8)?,
+            last_commit: word(9),
         })
     }
 }
 
 /// The checkpoint file of one agent.
 pub struct CheckpointFile {
+    slot: RefCell<SlotFile>,
     path: PathBuf,
-    file: File,
 }
 
 impl CheckpointFile {
@@ -109,28 +104,29 @@ impl CheckpointFile {
         if let Some(dir) = path.parent() {
             std::fs::create_dir_all(dir)?;
         }
-        let file = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(path)?;
+        let mut slot = SlotFile::new(path, LAYOUT);
+        slot.open()?;
         Ok(CheckpointFile {
+            slot: RefCell::new(slot),
             path: path.to_path_buf(),
-            file,
         })
     }
 
     /// The stored checkpoint, if the file holds a valid one.
     pub fn load(&self) -> Option<Checkpoint> {
-        let mut buf = [0u8; SIZE];
-        self.file.read_exact_at(&mut buf, 0).ok()?;
-        Checkpoint::decode(&buf)
+        match self.slot.borrow().load().ok()? {
+            SlotRead::Usable(payload) => Checkpoint::decode(&payload),
+            SlotRead::Missing | SlotRead::Unusable(_) => None,
+        }
     }
 
     /// Overwrites the stored checkpoint (one write, no allocation).
     pub fn store(&self, c: &Checkpoint) -> std::io::Result<()> {
-        self.file.write_all_at(&c.encode(), 0)
+        self.slot.borrow_mut().store(|buf| {
+            for w in c.words() {
+                buf.extend_from_slice(&w.to_le_bytes());
+            }
+        })
     }
 
     /// The file's path.
@@ -171,13 +167,47 @@ mod tests {
 
     #[test]
     fn a_damaged_record_is_refused() {
-        let mut b = sample().encode();
-        for i in [0, 9, 40, SIZE - 1] {
+        let dir = tempfile::tempdir().unwrap();
+        let path = CheckpointFile::path_in(dir.path(), 0);
+        let f = CheckpointFile::open(&path).unwrap();
+        f.store(&sample()).unwrap();
+        let good = std::fs::read(&path).unwrap();
+        assert_eq!(
+            good.len(),
+            96,
+            "magic, ten words, checksum: the format of before"
+        );
+        for i in [0, 9, 40, 95] {
+            let mut b = good.clone();
             b[i] ^= 0x10;
-            assert_eq!(Checkpoint::decode(&b), None, "byte {i}");
-            b[i] ^= 0x10;
+            std::fs::write(&path, &b).unwrap();
+            assert_eq!(f.load(), None, "byte {i}");
         }
-        assert_eq!(Checkpoint::decode(&b[..SIZE - 1]), None);
-        assert_eq!(Checkpoint::decode(&b), Some(sample()));
+        std::fs::write(&path, &good[..95]).unwrap();
+        assert_eq!(f.load(), None);
+        std::fs::write(&path, &good).unwrap();
+        assert_eq!(f.load(), Some(sample()));
+    }
+
+    /// The bytes of a checkpoint as the agent wrote them before the slot was shared with the
+    /// sim: old files stay readable.
+    #[test]
+    fn the_slot_bytes_are_those_of_before() {
+        let c = sample();
+        let mut words = vec![0x4b43_5641_4e48_0001u64];
+        words.extend(c.words());
+        let mut h = hnav_runtime::hash::Fnv1a64::new();
+        for w in &words {
+            h.u64(*w);
+        }
+        words.push(h.finish());
+        let old: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.ckpt");
+        std::fs::write(&path, &old).unwrap();
+        let f = CheckpointFile::open(&path).unwrap();
+        assert_eq!(f.load(), Some(c));
+        f.store(&c).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), old);
     }
 }

@@ -18,12 +18,14 @@
 //! ```
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Read, Write};
+use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
+use hnav_runtime::durable::framed::seal_checksummed;
+use hnav_runtime::durable::{Appender, Checksummed, FrameProblem, FrameReader, Torn};
 use hnav_runtime::msg::MapHeader;
 
-use super::{io, read_up_to, RecordingError, Written};
+use super::{frame_step, io, Pending, RecordingError, Written};
 
 const MAGIC: &[u8; 7] = b"HNAVMAP";
 const VERSION: u8 = 1;
@@ -45,10 +47,21 @@ pub struct MapSnapshot {
     pub values: Vec<f32>,
 }
 
+/// The frames of `maps.bin`: a body of 40 bytes and up to [`MAX_CELLS`] values.
+type MapFormat = Checksummed<fn(&[u8]) -> Result<MapSnapshot, FrameProblem>>;
+
+fn format() -> MapFormat {
+    Checksummed {
+        min_len: BODY_HEADER_LEN as u32,
+        max_len: (BODY_HEADER_LEN + 4 * MAX_CELLS) as u32,
+        decode: decode_body,
+    }
+}
+
 /// Appends snapshots to a new `maps.bin`, up to a size cap.
 pub struct MapWriter {
     path: PathBuf,
-    out: BufWriter<File>,
+    out: Pending,
     max_bytes: u64,
     written: Written,
 }
@@ -58,9 +71,9 @@ impl MapWriter {
     /// past `max_bytes`.
     pub fn create(path: &Path, max_bytes: u64) -> Result<Self, RecordingError> {
         let file = File::create(path).map_err(io(path))?;
-        let mut out = BufWriter::new(file);
-        out.write_all(MAGIC).map_err(io(path))?;
-        out.write_all(&[VERSION]).map_err(io(path))?;
+        let mut out = Pending::new(Appender::new(file, 0));
+        out.buf.extend_from_slice(MAGIC);
+        out.buf.push(VERSION);
         Ok(MapWriter {
             path: path.to_path_buf(),
             out,
@@ -99,20 +112,15 @@ impl MapWriter {
             self.written.dropped += 1;
             return Ok(false);
         }
-        let head = encode_body_header(t_ns, header);
-        let mut crc = crc32c::crc32c(&head);
+        let buf = &mut self.out.buf;
+        let start = buf.len();
+        buf.extend_from_slice(&[0; 8]);
+        buf.extend_from_slice(&encode_body_header(t_ns, header));
         for v in values {
-            crc = crc32c::crc32c_append(crc, &v.to_le_bytes());
+            buf.extend_from_slice(&v.to_le_bytes());
         }
-        let w = &mut self.out;
-        let path = &self.path;
-        w.write_all(&(body_len as u32).to_le_bytes())
-            .map_err(io(path))?;
-        w.write_all(&crc.to_le_bytes()).map_err(io(path))?;
-        w.write_all(&head).map_err(io(path))?;
-        for v in values {
-            w.write_all(&v.to_le_bytes()).map_err(io(path))?;
-        }
+        seal_checksummed(buf, start);
+        self.out.write_full().map_err(io(&self.path))?;
         self.written.records += 1;
         self.written.bytes += 8 + body_len as u64;
         Ok(true)
@@ -123,9 +131,9 @@ impl MapWriter {
         self.written
     }
 
-    /// Flushes what was written.
+    /// Writes what is buffered and syncs the file: the recording is durable when it returns.
     pub fn finish(mut self) -> Result<Written, RecordingError> {
-        self.out.flush().map_err(io(&self.path))?;
+        self.out.finish().map_err(io(&self.path))?;
         Ok(self.written)
     }
 }
@@ -143,6 +151,34 @@ fn encode_body_header(t_ns: u64, h: &MapHeader) -> [u8; BODY_HEADER_LEN] {
     b[36] = h.activation;
     b[37..40].copy_from_slice(&h.reserved);
     b
+}
+
+/// A frame's body as a snapshot, if its map's size is the frame's.
+fn decode_body(body: &[u8]) -> Result<MapSnapshot, FrameProblem> {
+    let values = body.len() - BODY_HEADER_LEN;
+    let undecodable = |detail| Err(FrameProblem::Undecodable { detail });
+    if !values.is_multiple_of(4) {
+        return undecodable(format!("a body of {} bytes", body.len()));
+    }
+    let (t_ns, header) = decode_body_header(body);
+    let cells = header.width as usize * header.height as usize;
+    if cells != values / 4 {
+        return undecodable(format!(
+            "a {} x {} map in a frame of {} values",
+            header.width,
+            header.height,
+            values / 4
+        ));
+    }
+    let values = body[BODY_HEADER_LEN..]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    Ok(MapSnapshot {
+        t_ns,
+        header,
+        values,
+    })
 }
 
 fn decode_body_header(b: &[u8]) -> (u64, MapHeader) {
@@ -168,16 +204,15 @@ fn decode_body_header(b: &[u8]) -> (u64, MapHeader) {
 /// Reads a `maps.bin` frame by frame.
 pub struct MapReader {
     path: PathBuf,
-    input: BufReader<File>,
-    offset: u64,
-    torn: u64,
-    body: Vec<u8>,
+    frames: Option<FrameReader<MapFormat>>,
+    torn: Option<Torn>,
 }
 
 impl MapReader {
     /// Opens the file and checks its magic.
     pub fn open(path: &Path) -> Result<Self, RecordingError> {
         let file = File::open(path).map_err(io(path))?;
+        let len = file.metadata().map_err(io(path))?.len();
         let mut input = BufReader::new(file);
         let mut magic = [0u8; 8];
         let bad = || RecordingError::BadMagic {
@@ -202,72 +237,16 @@ impl MapReader {
         }
         Ok(MapReader {
             path: path.to_path_buf(),
-            input,
-            offset: 8,
-            torn: 0,
-            body: Vec::new(),
+            frames: Some(FrameReader::new(format(), input, 8, len, true)),
+            torn: None,
         })
     }
 
-    fn corrupt(&self, problem: String) -> RecordingError {
-        RecordingError::Corrupt {
-            path: self.path.clone(),
-            offset: self.offset,
-            problem,
-        }
-    }
-
-    /// The next snapshot; `Ok(None)` at the end. A frame cut short by the end of the file is
-    /// a torn tail: it reads as the end, and [`MapReader::torn_tail`] tells its length.
+    /// The next snapshot; `Ok(None)` at the end. A torn tail (a frame cut by a crash, see
+    /// [`hnav_runtime::durable::read`]) reads as the end, and [`MapReader::torn`] tells
+    /// where it is.
     pub fn next_snapshot(&mut self) -> Result<Option<MapSnapshot>, RecordingError> {
-        let mut frame = [0u8; 8];
-        let have = read_up_to(&mut self.input, &mut frame, &self.path)?;
-        if have < 8 {
-            self.torn = have as u64;
-            return Ok(None);
-        }
-        let len = u32::from_le_bytes([frame[0], frame[1], frame[2], frame[3]]) as usize;
-        let stored = u32::from_le_bytes([frame[4], frame[5], frame[6], frame[7]]);
-        if len < BODY_HEADER_LEN
-            || !(len - BODY_HEADER_LEN).is_multiple_of(4)
-            || (len - BODY_HEADER_LEN) / 4 > MAX_CELLS
-        {
-            return Err(self.corrupt(format!("impossible frame length {len}")));
-        }
-        let mut body = std::mem::take(&mut self.body);
-        body.resize(len, 0);
-        let have = read_up_to(&mut self.input, &mut body, &self.path)?;
-        if have < len {
-            self.torn = 8 + have as u64;
-            return Ok(None);
-        }
-        let computed = crc32c::crc32c(&body);
-        if computed != stored {
-            return Err(self.corrupt(format!(
-                "checksum mismatch (stored {stored:#010x}, computed {computed:#010x})"
-            )));
-        }
-        let (t_ns, header) = decode_body_header(&body);
-        let cells = header.width as usize * header.height as usize;
-        if cells != (len - BODY_HEADER_LEN) / 4 {
-            return Err(self.corrupt(format!(
-                "a {} x {} map in a frame of {} values",
-                header.width,
-                header.height,
-                (len - BODY_HEADER_LEN) / 4
-            )));
-        }
-        let values = body[BODY_HEADER_LEN..]
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect();
-        self.body = body;
-        self.offset += 8 + len as u64;
-        Ok(Some(MapSnapshot {
-            t_ns,
-            header,
-            values,
-        }))
+        Ok(frame_step(&mut self.frames, &mut self.torn, &self.path)?.map(|(_, s)| s))
     }
 
     /// Every remaining snapshot, and the bytes of a torn tail (0 if none).
@@ -276,12 +255,17 @@ impl MapReader {
         while let Some(s) = self.next_snapshot()? {
             out.push(s);
         }
-        Ok((out, self.torn))
+        Ok((out, self.torn_tail()))
     }
 
-    /// Bytes of a partial frame found at the end (0 until the end is reached, or if none).
+    /// Bytes of a torn tail found at the end (0 until the end is reached, or if none).
     pub fn torn_tail(&self) -> u64 {
-        self.torn
+        self.torn.as_ref().map_or(0, |t| t.bytes)
+    }
+
+    /// The torn tail found at the end, if any: `torn tail cut at offset N (...)`.
+    pub fn torn(&self) -> Option<&Torn> {
+        self.torn.as_ref()
     }
 }
 
@@ -336,23 +320,33 @@ mod tests {
         std::fs::write(&path, &full[..full.len() - 5]).unwrap();
         let (maps, torn) = MapReader::open(&path).unwrap().read_all().unwrap();
         assert_eq!((maps.len(), torn), (1, 8 + BODY_HEADER_LEN as u64 + 24 - 5));
+        // The final frame damaged is what a cut write can leave: a torn tail, located.
         let mut damaged = full.clone();
         let last = damaged.len() - 1;
         damaged[last] ^= 0x40;
         std::fs::write(&path, &damaged).unwrap();
+        let mut r = MapReader::open(&path).unwrap();
+        while r.next_snapshot().unwrap().is_some() {}
+        let torn = r.torn().unwrap().to_string();
+        assert!(torn.starts_with("torn tail cut at offset 80 (72 bytes: checksum mismatch"));
+        // A damaged frame with another after it is corruption.
+        let mut damaged = full.clone();
+        damaged[20] ^= 0x40;
+        std::fs::write(&path, &damaged).unwrap();
         let e = MapReader::open(&path).unwrap().read_all().err().unwrap();
         assert!(
-            e.to_string().contains("at byte 80: checksum mismatch"),
+            e.to_string().contains("at byte 8: checksum mismatch"),
             "{e}"
         );
         let mut huge = full[..8].to_vec();
         huge.extend_from_slice(&u32::MAX.to_le_bytes());
         huge.extend_from_slice(&[0; 4]);
+        huge.extend_from_slice(&full[8..]);
         std::fs::write(&path, &huge).unwrap();
         let e = MapReader::open(&path).unwrap().read_all().err().unwrap();
         assert!(
             e.to_string()
-                .ends_with("at byte 8: impossible frame length 4294967295"),
+                .ends_with("at byte 8: record length 4294967295 runs past the end of the file (144 bytes left)"),
             "{e}"
         );
     }

@@ -14,13 +14,17 @@
 //! Both are little-endian, start with an 8-byte magic whose last byte is the format version,
 //! and are written append-only through a size cap: a sample beyond the cap is dropped and
 //! counted, and [`trajectory::TrajectoryWriter::finish`] marks the file truncated, so a long
-//! run cannot fill the disk. A writer killed mid-write leaves a torn tail, which the readers
-//! report and skip rather than treat as corruption.
+//! run cannot fill the disk. Both are frames of the durable toolkit
+//! ([`hnav_runtime::durable`]), appended a chunk at a time and synced once, when the recording
+//! finishes. A writer killed mid-write leaves a torn tail, which the readers report ("torn
+//! tail cut at offset N") and skip rather than treat as corruption.
 
 pub mod maps;
 pub mod trajectory;
 
 use std::path::PathBuf;
+
+use hnav_runtime::durable::{Appender, FrameError, FrameFormat, FrameReader, Step, Torn};
 
 pub use maps::{MapReader, MapSnapshot, MapWriter};
 pub use trajectory::{
@@ -89,23 +93,73 @@ pub struct Written {
     pub bytes: u64,
 }
 
-/// Reads up to `buf.len()` bytes, fewer only at the end of the file: both readers tell a torn
-/// tail from the end by how many bytes came.
-fn read_up_to(
-    input: &mut impl std::io::Read,
-    buf: &mut [u8],
-    path: &std::path::Path,
-) -> Result<usize, RecordingError> {
-    let mut have = 0;
-    while have < buf.len() {
-        match input.read(&mut buf[have..]) {
-            Ok(0) => break,
-            Ok(n) => have += n,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            Err(e) => return Err(io(path)(e)),
+/// A recording file's frames waiting to be written, and the file: frames go out a chunk at
+/// a time (one write call each), so that a sample costs no system call.
+struct Pending {
+    out: Appender<std::fs::File>,
+    buf: Vec<u8>,
+}
+
+impl Pending {
+    /// Bytes buffered before they are written.
+    const CHUNK: usize = 64 << 10;
+
+    fn new(out: Appender<std::fs::File>) -> Self {
+        Self {
+            out,
+            buf: Vec::with_capacity(Self::CHUNK),
         }
     }
-    Ok(have)
+
+    /// Writes the buffer once it holds a chunk.
+    fn write_full(&mut self) -> std::io::Result<()> {
+        if self.buf.len() >= Self::CHUNK {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        if !self.buf.is_empty() {
+            self.out.append(&self.buf)?;
+            self.buf.clear();
+        }
+        Ok(())
+    }
+
+    /// Writes the buffer and syncs the file (a failed sync is reported, not retried).
+    fn finish(&mut self) -> std::io::Result<()> {
+        self.flush()?;
+        self.out.sync()
+    }
+}
+
+/// The next frame of a recording file (its offset and what it decoded to); `Ok(None)` at the
+/// end or at a torn tail, which goes to `torn`, and ever after.
+fn frame_step<F: FrameFormat>(
+    frames: &mut Option<FrameReader<F>>,
+    torn: &mut Option<Torn>,
+    path: &std::path::Path,
+) -> Result<Option<(u64, F::Item)>, RecordingError> {
+    let Some(reader) = frames else {
+        return Ok(None);
+    };
+    let stop = match reader.step() {
+        Ok(Step::Frame { offset, item, .. }) => return Ok(Some((offset, item))),
+        Ok(Step::End) => None,
+        Ok(Step::Torn(t)) => Some(t),
+        Err(FrameError::Io(e)) => return Err(io(path)(e)),
+        Err(FrameError::Corrupt { offset, problem }) => {
+            return Err(RecordingError::Corrupt {
+                path: path.to_path_buf(),
+                offset,
+                problem: problem.to_string(),
+            })
+        }
+    };
+    *frames = None;
+    *torn = stop;
+    Ok(None)
 }
 
 fn io(path: &std::path::Path) -> impl FnOnce(std::io::Error) -> RecordingError + '_ {

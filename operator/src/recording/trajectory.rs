@@ -22,7 +22,7 @@
 //! ```
 //!
 //! ```
-//! use hnav_runtime::recording::{PoseSample, PoseSource, TrajectoryHeader, TrajectoryReader, TrajectoryWriter};
+//! use hnav_operator::recording::{PoseSample, PoseSource, TrajectoryHeader, TrajectoryReader, TrajectoryWriter};
 //! let dir = tempfile::tempdir().unwrap();
 //! let path = dir.path().join("trajectories.bin");
 //! let header = TrajectoryHeader { robots: 2, rate_hz: 20, cell_size_m: 0.16, width: 12, height: 12, truncated: false, control_period_us: 10_000 };
@@ -37,10 +37,12 @@
 //! ```
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Read, Seek, SeekFrom, Write};
+use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
-use super::{io, read_up_to, RecordingError, Written};
+use hnav_runtime::durable::{Appender, DiskFile, Fixed, FrameReader, Torn};
+
+use super::{frame_step, io, Pending, RecordingError, Written};
 
 const MAGIC: &[u8; 7] = b"HNAVTRJ";
 const VERSION: u8 = 1;
@@ -199,7 +201,7 @@ impl PoseSample {
 /// Appends samples to a new `trajectories.bin`, up to a size cap.
 pub struct TrajectoryWriter {
     path: PathBuf,
-    out: BufWriter<File>,
+    out: Pending,
     header: TrajectoryHeader,
     max_bytes: u64,
     written: Written,
@@ -214,8 +216,8 @@ impl TrajectoryWriter {
         max_bytes: u64,
     ) -> Result<Self, RecordingError> {
         let file = File::create(path).map_err(io(path))?;
-        let mut out = BufWriter::new(file);
-        out.write_all(&header.encode()).map_err(io(path))?;
+        let mut out = Pending::new(Appender::new(file, 0));
+        out.buf.extend_from_slice(&header.encode());
         Ok(TrajectoryWriter {
             path: path.to_path_buf(),
             out,
@@ -234,7 +236,8 @@ impl TrajectoryWriter {
             self.written.dropped += 1;
             return Ok(false);
         }
-        self.out.write_all(&s.encode()).map_err(io(&self.path))?;
+        self.out.buf.extend_from_slice(&s.encode());
+        self.out.write_full().map_err(io(&self.path))?;
         self.written.records += 1;
         self.written.bytes += SAMPLE_LEN as u64;
         Ok(true)
@@ -245,16 +248,19 @@ impl TrajectoryWriter {
         self.written
     }
 
-    /// Flushes the samples and, if any were dropped, marks the header truncated.
+    /// Writes the samples, marks the header truncated if any were dropped, and syncs the
+    /// file: the recording is durable when it returns.
     pub fn finish(mut self) -> Result<Written, RecordingError> {
         self.out.flush().map_err(io(&self.path))?;
         if self.written.dropped > 0 {
             self.header.truncated = true;
-            let file = self.out.get_mut();
-            file.seek(SeekFrom::Start(0)).map_err(io(&self.path))?;
-            file.write_all(&self.header.encode())
+            self.out
+                .out
+                .file()
+                .write_at(0, &self.header.encode())
                 .map_err(io(&self.path))?;
         }
+        self.out.finish().map_err(io(&self.path))?;
         Ok(self.written)
     }
 }
@@ -262,16 +268,16 @@ impl TrajectoryWriter {
 /// Reads a `trajectories.bin`.
 pub struct TrajectoryReader {
     path: PathBuf,
-    input: BufReader<File>,
+    frames: Option<FrameReader<Fixed>>,
     header: TrajectoryHeader,
-    offset: u64,
-    torn: u64,
+    torn: Option<Torn>,
 }
 
 impl TrajectoryReader {
     /// Opens the file and checks its header.
     pub fn open(path: &Path) -> Result<Self, RecordingError> {
         let file = File::open(path).map_err(io(path))?;
+        let len = file.metadata().map_err(io(path))?.len();
         let mut input = BufReader::new(file);
         let mut b = [0u8; HEADER_LEN];
         match input.read_exact(&mut b) {
@@ -285,12 +291,20 @@ impl TrajectoryReader {
             Err(e) => return Err(io(path)(e)),
         }
         let header = TrajectoryHeader::decode(&b, path)?;
+        let samples = Fixed {
+            len: SAMPLE_LEN as u32,
+        };
         Ok(TrajectoryReader {
             path: path.to_path_buf(),
-            input,
+            frames: Some(FrameReader::new(
+                samples,
+                input,
+                HEADER_LEN as u64,
+                len,
+                true,
+            )),
             header,
-            offset: HEADER_LEN as u64,
-            torn: 0,
+            torn: None,
         })
     }
 
@@ -301,22 +315,22 @@ impl TrajectoryReader {
 
     /// The next sample; `Ok(None)` at the end. A partial sample at the end of the file is a
     /// torn tail (the writer was killed): it reads as the end, and
-    /// [`TrajectoryReader::torn_tail`] tells its length.
+    /// [`TrajectoryReader::torn`] tells where it is.
     pub fn next_sample(&mut self) -> Result<Option<PoseSample>, RecordingError> {
-        let mut b = [0u8; SAMPLE_LEN];
-        let have = read_up_to(&mut self.input, &mut b, &self.path)?;
-        if have < SAMPLE_LEN {
-            self.torn = have as u64;
+        let Some((offset, ())) = frame_step(&mut self.frames, &mut self.torn, &self.path)? else {
             return Ok(None);
+        };
+        let mut b = [0u8; SAMPLE_LEN];
+        if let Some(frames) = &self.frames {
+            b.copy_from_slice(frames.payload());
         }
         let s = PoseSample::decode(&b, self.header.robots).map_err(|problem| {
             RecordingError::Corrupt {
                 path: self.path.clone(),
-                offset: self.offset,
+                offset,
                 problem,
             }
         })?;
-        self.offset += SAMPLE_LEN as u64;
         Ok(Some(s))
     }
 
@@ -326,12 +340,17 @@ impl TrajectoryReader {
         while let Some(s) = self.next_sample()? {
             out.push(s);
         }
-        Ok((out, self.torn))
+        Ok((out, self.torn_tail()))
     }
 
     /// Bytes of a partial sample found at the end (0 until the end is reached, or if none).
     pub fn torn_tail(&self) -> u64 {
-        self.torn
+        self.torn.as_ref().map_or(0, |t| t.bytes)
+    }
+
+    /// The torn tail found at the end, if any: `torn tail cut at offset N (...)`.
+    pub fn torn(&self) -> Option<&Torn> {
+        self.torn.as_ref()
     }
 }
 
@@ -403,8 +422,17 @@ mod tests {
             .open(&path)
             .unwrap();
         f.set_len((HEADER_LEN + 3 * SAMPLE_LEN + 7) as u64).unwrap();
-        let (samples, torn) = TrajectoryReader::open(&path).unwrap().read_all().unwrap();
-        assert_eq!((samples.len(), torn), (3, 7));
+        let mut r = TrajectoryReader::open(&path).unwrap();
+        let mut samples = 0;
+        while r.next_sample().unwrap().is_some() {
+            samples += 1;
+        }
+        assert_eq!((samples, r.torn_tail()), (3, 7));
+        let torn = r.torn().unwrap().to_string();
+        assert_eq!(
+            torn,
+            "torn tail cut at offset 104 (7 bytes: record length 24 runs past the end of the file (7 bytes left))"
+        );
     }
 
     #[test]

@@ -3,9 +3,9 @@
 //!
 //! Each supervisor owns one JSON file, `<runs dir>/<run_id>.json`, holding a [`RunRecord`].
 //! It rewrites the file after every spawn and restart, and removes it when the run ends.
-//! Writes go to a temporary file that is then renamed over the old one: a reader sees
-//! either the old record or the new one, never a torn one. There is no fsync: the records
-//! describe live processes, which a crash of the machine ends anyway.
+//! Writes go through [`replace_file`] (a synced temporary file renamed over the old one): a
+//! reader sees either the old record or the new one, never a torn one, and after a crash of
+//! the machine `hnav ps` and `hnav clean` find whole records of the runs it ended.
 //!
 //! A supervisor that died without cleaning up leaves its file behind. Readers notice that its
 //! supervisor is gone and report the run as *stale* (dead); `hnav clean` removes what it
@@ -21,12 +21,11 @@
 //! Tests use [`RunRegistry::at`] rather than the environment, which all the tests of one
 //! binary share.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use serde::{Deserialize, Serialize};
 
+use hnav_runtime::durable::replace_file;
 use hnav_runtime::file_lock::{try_lock, FileLock, TryLock};
 use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::msg::Role;
@@ -387,36 +386,22 @@ impl RunRecord {
             .map(|l| l.args)
     }
 
-    /// Writes the record atomically (temporary file, then rename), creating the directory.
+    /// Writes the record whole or not at all ([`replace_file`]: synced temporary file, then
+    /// rename), creating the directory.
     pub fn write(&self) -> Result<(), RegistryError> {
-        static SEQ: AtomicU64 = AtomicU64::new(0);
-        let io = |path: &Path| {
-            let path = path.to_path_buf();
-            move |source| RegistryError::Io { path, source }
-        };
         let dir = self.file.parent().unwrap_or(Path::new("."));
-        std::fs::create_dir_all(dir).map_err(io(dir))?;
+        std::fs::create_dir_all(dir).map_err(|source| RegistryError::Io {
+            path: dir.to_path_buf(),
+            source,
+        })?;
         let json = serde_json::to_vec_pretty(self).map_err(|source| RegistryError::Parse {
             path: self.file.clone(),
             source,
         })?;
-        let tmp = dir.join(format!(
-            ".{}.{}.{}.tmp",
-            self.run_id,
-            std::process::id(),
-            SEQ.fetch_add(1, Ordering::Relaxed)
-        ));
-        let written = std::fs::File::create(&tmp)
-            .and_then(|mut f| f.write_all(&json))
-            .and_then(|()| std::fs::rename(&tmp, &self.file));
-        if let Err(source) = written {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(RegistryError::Io {
-                path: self.file.clone(),
-                source,
-            });
-        }
-        Ok(())
+        replace_file(&self.file, &json).map_err(|source| RegistryError::Io {
+            path: self.file.clone(),
+            source,
+        })
     }
 
     /// Removes the record file; a file already gone is not an error.

@@ -1,76 +1,14 @@
 //! [`LogError`], every way reading or writing a consensus log can fail, and [`FrameProblem`],
 //! what is wrong with the bytes at one place of a segment.
 
-use std::fmt;
 use std::path::PathBuf;
 
-/// What is wrong with the bytes at one offset of a segment file.
+/// What is wrong with the bytes at one offset of a segment file: the durable toolkit's, since
+/// segments are [`Checksummed`](crate::durable::Checksummed) frames.
 ///
 /// In the last segment's final bytes such a problem is a [torn tail](super::TornTail) (a write
 /// the crash interrupted); anywhere else it is [corruption](LogError::Corrupt).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum FrameProblem {
-    /// Fewer than 8 bytes of segment magic.
-    ShortMagic {
-        /// Bytes present.
-        have: u64,
-    },
-    /// Fewer than the 8 bytes of a record header (length and checksum).
-    ShortHeader {
-        /// Bytes present.
-        have: u64,
-    },
-    /// The record's length runs past the end of the file.
-    LengthPastEnd {
-        /// The stored payload length.
-        len: u32,
-        /// Bytes present after the record header.
-        have: u64,
-    },
-    /// A payload length of 0 or above [`MAX_RECORD_LEN`](super::MAX_RECORD_LEN).
-    BadLength {
-        /// The stored payload length.
-        len: u32,
-    },
-    /// The payload's CRC-32C differs from the stored one.
-    BadChecksum {
-        /// The stored checksum.
-        stored: u32,
-        /// The checksum of the payload as read.
-        computed: u32,
-    },
-    /// The checksum matches but the payload is not a [`Record`](super::Record).
-    Undecodable {
-        /// The decoder's message.
-        detail: String,
-    },
-    /// Only zero bytes from here to the end of the file (a file system extended the file
-    /// before the data of the last write reached the disk).
-    ZeroFill {
-        /// The zero bytes.
-        bytes: u64,
-    },
-}
-
-impl fmt::Display for FrameProblem {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::ShortMagic { have } => write!(f, "only {have} of 8 segment magic bytes"),
-            Self::ShortHeader { have } => write!(f, "only {have} of 8 record header bytes"),
-            Self::LengthPastEnd { len, have } => write!(
-                f,
-                "record length {len} runs past the end of the file ({have} bytes left)"
-            ),
-            Self::BadLength { len } => write!(f, "impossible record length {len}"),
-            Self::BadChecksum { stored, computed } => write!(
-                f,
-                "checksum mismatch (stored {stored:#010x}, computed {computed:#010x})"
-            ),
-            Self::Undecodable { detail } => write!(f, "undecodable record: {detail}"),
-            Self::ZeroFill { bytes } => write!(f, "{bytes} zero bytes up to the end of the file"),
-        }
-    }
-}
+pub use crate::durable::FrameProblem;
 
 /// An error reading, verifying or writing a consensus log. Every variant names the file (or
 /// directory) and, where one applies, the byte offset.

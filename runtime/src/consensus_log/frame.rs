@@ -3,6 +3,8 @@
 
 use super::error::{FrameProblem, LogError};
 use super::record::Record;
+use crate::durable::framed::seal_checksummed;
+use crate::durable::{Checksummed, FrameFormat};
 
 /// The first 8 bytes of every segment file.
 pub const MAGIC: [u8; 8] = *b"HNAVLOG1";
@@ -41,8 +43,7 @@ pub fn encode_frame(record: &Record, buf: &mut Vec<u8>) -> Result<(), LogError> 
         buf.truncate(start);
         return Err(LogError::Encode(e));
     }
-    let payload = &buf[start + FRAME_HEADER_LEN..];
-    let len = payload.len();
+    let len = buf.len() - start - FRAME_HEADER_LEN;
     if len > MAX_RECORD_LEN as usize {
         buf.truncate(start);
         return Err(LogError::TooLarge {
@@ -50,10 +51,20 @@ pub fn encode_frame(record: &Record, buf: &mut Vec<u8>) -> Result<(), LogError> 
             max: MAX_RECORD_LEN,
         });
     }
-    let crc = crc32c::crc32c(payload);
-    buf[start..start + 4].copy_from_slice(&(len as u32).to_le_bytes());
-    buf[start + 4..start + 8].copy_from_slice(&crc.to_le_bytes());
+    seal_checksummed(buf, start);
     Ok(())
+}
+
+/// The segments' frame format, as the durable toolkit reads it.
+pub type LogFormat = Checksummed<fn(&[u8]) -> Result<Record, FrameProblem>>;
+
+/// The segments' frames: a payload of 1 to [`MAX_RECORD_LEN`] bytes, one [`Record`].
+pub fn format() -> LogFormat {
+    Checksummed {
+        min_len: 1,
+        max_len: MAX_RECORD_LEN,
+        decode: decode_record,
+    }
 }
 
 /// Splits a record header into (payload length, stored checksum).
@@ -63,22 +74,12 @@ pub fn parse_frame_header(header: &[u8; FRAME_HEADER_LEN]) -> (u32, u32) {
     (len, crc)
 }
 
-/// Whether a stored payload length can be a record's.
-pub fn plausible_len(len: u32) -> bool {
-    (1..=MAX_RECORD_LEN).contains(&len)
-}
-
 /// Checks `payload` against its stored checksum and decodes it; the whole payload must be
 /// one record.
 pub fn decode_payload(payload: &[u8], stored_crc: u32) -> Result<Record, FrameProblem> {
-    let computed = crc32c::crc32c(payload);
-    if computed != stored_crc {
-        return Err(FrameProblem::BadChecksum {
-            stored: stored_crc,
-            computed,
-        });
-    }
-    decode_record(payload)
+    let mut header = [0u8; FRAME_HEADER_LEN];
+    header[4..].copy_from_slice(&stored_crc.to_le_bytes());
+    format().decode(&header, payload)
 }
 
 /// A record's payload encoding (a frame's payload without the frame): what a replicated log

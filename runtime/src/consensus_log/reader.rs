@@ -1,32 +1,22 @@
 //! Reading a log: [`LogReader`] streams the records of every segment in order and tells a
 //! torn tail (the end of the last segment, cut by a crash) from corruption (anything else).
 //!
-//! In the last segment, a bad spot at offset `p` is a torn tail when either
-//! - every byte from `p` to the end of the file is zero (a file system that extended the file
-//!   before the last write's data reached the disk), or
-//! - the bad bytes reach the end of the file as one cut write would leave them: fewer than 8
-//!   bytes of segment magic (a prefix of it) or of a record header, a record length running
-//!   past the end of the file, or a record with a bad length, checksum or payload ending
-//!   exactly at the end of the file (the final record); and no more bytes than one record can
-//!   have; and no complete, valid record starts anywhere after `p` (so a damaged length
-//!   field in a middle record is corruption, not a torn tail).
-//!
-//! Any other bad spot, and any bad spot in an earlier segment, is [`LogError::Corrupt`].
-//! Reading never modifies a file.
+//! The frames are read by the durable toolkit's [`FrameReader`], whose rules say what counts
+//! as torn; only the last segment may end torn, and in it also a segment magic cut short (a
+//! prefix of it) or never written (a segment of only zero bytes). Any other bad spot, and any bad spot in an earlier segment, is
+//! [`LogError::Corrupt`]. Reading never modifies a file.
 
+use std::fmt;
 use std::fs::File;
-use std::io::{BufReader, Read, Seek, SeekFrom};
+use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
 use super::error::{FrameProblem, LogError};
-use super::frame::{decode_payload, parse_frame_header, plausible_len, FRAME_HEADER_LEN, MAGIC};
+use super::frame::{format, LogFormat, MAGIC};
 use super::record::Record;
 use super::segment::list_segments;
-use super::{FORMAT_VERSION, MAX_RECORD_LEN, REPLICATED_VERSION};
-
-/// Bytes the torn-tail check checksums at most while looking for a complete frame after a
-/// bad one.
-const SCAN_BUDGET: u64 = 256 << 20;
+use super::{FORMAT_VERSION, REPLICATED_VERSION};
+use crate::durable::{FrameError, FrameReader, Step as FrameStep, Torn};
 
 /// Where a record is: its segment, the offset of its header in the segment file, and its
 /// length including the 8-byte header.
@@ -61,6 +51,30 @@ pub struct TornTail {
     pub bytes: u64,
     /// What is wrong at `offset`.
     pub problem: FrameProblem,
+}
+
+impl TornTail {
+    fn new(path: &Path, segment: u32, torn: Torn) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            segment,
+            offset: torn.offset,
+            bytes: torn.bytes,
+            problem: torn.problem,
+        }
+    }
+}
+
+impl fmt::Display for TornTail {
+    /// `DIR/seg-00000002.hlog: torn tail cut at offset N (B bytes: what)`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let torn = Torn {
+            offset: self.offset,
+            bytes: self.bytes,
+            problem: self.problem.clone(),
+        };
+        write!(f, "{}: {torn}", self.path.display())
+    }
 }
 
 /// Everything [`read_log`] found.
@@ -104,7 +118,6 @@ pub struct LogReader {
     segments: Vec<PathBuf>,
     next_segment: usize,
     cursor: Option<Cursor>,
-    payload: Vec<u8>,
     count: u64,
     torn: Option<TornTail>,
     finished: bool,
@@ -124,7 +137,6 @@ impl LogReader {
             segments,
             next_segment: 0,
             cursor: None,
-            payload: Vec::new(),
             count: 0,
             torn: None,
             finished: false,
@@ -174,7 +186,7 @@ impl LogReader {
                     }
                 }
             };
-            match cursor.step(&mut self.payload)? {
+            match cursor.step()? {
                 Step::Record(pos, record) => {
                     if self.count == 0 {
                         check_header(&cursor.path, pos.offset, &record)?;
@@ -228,15 +240,21 @@ enum Step {
     Torn(TornTail),
 }
 
+/// Whether a file of `len` bytes, of which `read` came first and the rest is in `file`, holds
+/// only zero bytes (a read error counts as no).
+fn zeros(file: &mut BufReader<File>, read: &[u8], len: u64) -> bool {
+    let mut rest = Vec::new();
+    read.iter().all(|&b| b == 0)
+        && file.take(len).read_to_end(&mut rest).is_ok()
+        && rest.iter().all(|&b| b == 0)
+}
+
 /// Position in one open segment file.
 #[derive(Debug)]
 struct Cursor {
     path: PathBuf,
     index: u32,
-    file: BufReader<File>,
-    pos: u64,
-    len: u64,
-    last: bool,
+    frames: FrameReader<LogFormat>,
 }
 
 impl Cursor {
@@ -250,144 +268,52 @@ impl Cursor {
         let mut magic = [0u8; 8];
         file.read_exact(&mut magic[..have])
             .map_err(|e| LogError::io(&path, e))?;
+        let whole = |problem| {
+            let torn = Torn {
+                offset: 0,
+                bytes: len,
+                problem,
+            };
+            Ok(Err(TornTail::new(&path, index, torn)))
+        };
+        if last && magic[..have] != MAGIC[..have] && zeros(&mut file, &magic[..have], len) {
+            // The segment was created and extended, but its magic never reached the disk.
+            return whole(FrameProblem::ZeroFill { bytes: len });
+        }
         if magic[..have] != MAGIC[..have] || (have < MAGIC.len() && !last) {
             return Err(LogError::BadMagic { path });
         }
         if have < MAGIC.len() {
-            return Ok(Err(TornTail {
-                path,
-                segment: index,
-                offset: 0,
-                bytes: len,
-                problem: FrameProblem::ShortMagic { have: len },
-            }));
+            return whole(FrameProblem::ShortMagic { have: len });
         }
+        let frames = FrameReader::new(format(), file, MAGIC.len() as u64, len, last);
         Ok(Ok(Self {
             path,
             index,
-            file,
-            pos: MAGIC.len() as u64,
-            len,
-            last,
+            frames,
         }))
     }
 
-    fn io(&self, e: std::io::Error) -> LogError {
-        LogError::io(&self.path, e)
-    }
-
-    fn step(&mut self, payload: &mut Vec<u8>) -> Result<Step, LogError> {
-        let at = self.pos;
-        let left = self.len - at;
-        if left == 0 {
-            return Ok(Step::End);
-        }
-        if left < FRAME_HEADER_LEN as u64 {
-            return self.bad(at, FrameProblem::ShortHeader { have: left }, None);
-        }
-        let mut header = [0u8; FRAME_HEADER_LEN];
-        self.file.read_exact(&mut header).map_err(|e| self.io(e))?;
-        let (len, crc) = parse_frame_header(&header);
-        let have = left - FRAME_HEADER_LEN as u64;
-        if u64::from(len) > have {
-            return self.bad(at, FrameProblem::LengthPastEnd { len, have }, None);
-        }
-        let end = at + FRAME_HEADER_LEN as u64 + u64::from(len);
-        if !plausible_len(len) {
-            return self.bad(at, FrameProblem::BadLength { len }, Some(end));
-        }
-        payload.resize(len as usize, 0);
-        self.file.read_exact(payload).map_err(|e| self.io(e))?;
-        match decode_payload(payload, crc) {
-            Ok(record) => {
-                self.pos = end;
+    fn step(&mut self) -> Result<Step, LogError> {
+        match self.frames.step() {
+            Ok(FrameStep::Frame { offset, len, item }) => {
                 let pos = RecordPos {
                     segment: self.index,
-                    offset: at,
-                    len: end - at,
+                    offset,
+                    len,
                 };
-                Ok(Step::Record(pos, record))
+                Ok(Step::Record(pos, item))
             }
-            Err(problem) => self.bad(at, problem, Some(end)),
+            Ok(FrameStep::End) => Ok(Step::End),
+            Ok(FrameStep::Torn(torn)) => {
+                Ok(Step::Torn(TornTail::new(&self.path, self.index, torn)))
+            }
+            Err(FrameError::Io(e)) => Err(LogError::io(&self.path, e)),
+            Err(FrameError::Corrupt { offset, problem }) => Err(LogError::Corrupt {
+                path: self.path.clone(),
+                offset,
+                problem,
+            }),
         }
-    }
-
-    /// A bad frame at `at` (ending at `end` if its length is plausible): torn or corrupt.
-    fn bad(&mut self, at: u64, problem: FrameProblem, end: Option<u64>) -> Result<Step, LogError> {
-        if self.last {
-            let left = self.len - at;
-            let torn = if end.is_none_or(|e| e == self.len) {
-                // A cut write leaves at most one frame, and no complete frame after it.
-                let one_frame = left <= FRAME_HEADER_LEN as u64 + u64::from(MAX_RECORD_LEN);
-                (one_frame && !self.frame_after(at)?).then(|| problem.clone())
-            } else if self.zeros_from(at)? {
-                Some(FrameProblem::ZeroFill { bytes: left })
-            } else {
-                None
-            };
-            if let Some(problem) = torn {
-                return Ok(Step::Torn(TornTail {
-                    path: self.path.clone(),
-                    segment: self.index,
-                    offset: at,
-                    bytes: self.len - at,
-                    problem,
-                }));
-            }
-        }
-        Err(LogError::Corrupt {
-            path: self.path.clone(),
-            offset: at,
-            problem,
-        })
-    }
-
-    /// Whether a complete, valid frame starts anywhere after `at` (so that the bad frame at
-    /// `at` is not the final one, e.g. its length field is damaged). Gives up and answers yes
-    /// (corruption, nothing truncated) after checksumming [`SCAN_BUDGET`] bytes.
-    fn frame_after(&mut self, at: u64) -> Result<bool, LogError> {
-        self.file
-            .seek(SeekFrom::Start(at + 1))
-            .map_err(|e| self.io(e))?;
-        let mut rest = Vec::new();
-        self.file.read_to_end(&mut rest).map_err(|e| self.io(e))?;
-        let mut budget = SCAN_BUDGET;
-        for q in 0..rest.len().saturating_sub(FRAME_HEADER_LEN) {
-            let mut header = [0u8; FRAME_HEADER_LEN];
-            header.copy_from_slice(&rest[q..q + FRAME_HEADER_LEN]);
-            let (len, crc) = parse_frame_header(&header);
-            let start = q + FRAME_HEADER_LEN;
-            if !plausible_len(len) || len as usize > rest.len() - start {
-                continue;
-            }
-            if budget < u64::from(len) {
-                return Ok(true);
-            }
-            budget -= u64::from(len);
-            if decode_payload(&rest[start..start + len as usize], crc).is_ok() {
-                return Ok(true);
-            }
-        }
-        Ok(false)
-    }
-
-    /// Whether every byte from `at` to the end of the file is zero.
-    fn zeros_from(&mut self, at: u64) -> Result<bool, LogError> {
-        self.file
-            .seek(SeekFrom::Start(at))
-            .map_err(|e| self.io(e))?;
-        let mut left = self.len - at;
-        let mut chunk = [0u8; 4096];
-        while left > 0 {
-            let n = left.min(chunk.len() as u64) as usize;
-            self.file
-                .read_exact(&mut chunk[..n])
-                .map_err(|e| self.io(e))?;
-            if chunk[..n].iter().any(|&b| b != 0) {
-                return Ok(false);
-            }
-            left -= n as u64;
-        }
-        Ok(true)
     }
 }

@@ -40,8 +40,6 @@
 //! # }
 //! ```
 
-use std::fs::{File, OpenOptions};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -50,6 +48,7 @@ use super::frame::{encode_frame, MAGIC};
 use super::reader::{check_header, read_log, LogContents, RecordPos, TornTail};
 use super::record::Record;
 use super::segment::{list_segments, segment_path, DEFAULT_SEGMENT_BYTES};
+use crate::durable::{Appender, Disk, DiskFile, RealDisk};
 use crate::file_lock::{try_lock, FileLock, TryLock};
 use crate::scenario::FsyncPolicy;
 
@@ -98,15 +97,16 @@ pub struct Recovered {
     pub torn: Option<TornTail>,
 }
 
-/// Appends records to a consensus log; see the [module docs](self).
+/// Appends records to a consensus log; see the [module docs](self). Its files are written
+/// on a [`Disk`]: the machine's, or a crash test's.
 #[derive(Debug)]
-pub struct LogWriter {
+pub struct LogWriter<D: Disk = RealDisk> {
+    disk: D,
     dir: PathBuf,
     options: WriterOptions,
-    file: File,
+    file: Appender<D::File>,
     path: PathBuf,
     segment: u32,
-    len: u64,
     records: u64,
     buf: Vec<u8>,
     unsynced: u32,
@@ -116,7 +116,7 @@ pub struct LogWriter {
     _lock: FileLock,
 }
 
-impl LogWriter {
+impl LogWriter<RealDisk> {
     /// Opens (or creates) the log in `dir` with the default segment size.
     pub fn open(dir: impl AsRef<Path>, policy: FsyncPolicy) -> Result<(Self, Recovered), LogError> {
         Self::open_with(dir, WriterOptions::new(policy))
@@ -131,21 +131,33 @@ impl LogWriter {
         dir: impl AsRef<Path>,
         options: WriterOptions,
     ) -> Result<(Self, Recovered), LogError> {
+        Self::open_on(RealDisk, dir, options)
+    }
+}
+
+impl<D: Disk> LogWriter<D> {
+    /// [`LogWriter::open_with`] writing on `disk`.
+    pub fn open_on(
+        disk: D,
+        dir: impl AsRef<Path>,
+        options: WriterOptions,
+    ) -> Result<(Self, Recovered), LogError> {
         let dir = dir.as_ref().to_path_buf();
         let syncing = options.fsync != FsyncPolicy::None;
         if !dir.is_dir() {
             std::fs::create_dir_all(&dir).map_err(|e| write_error(&dir, &dir, e))?;
             if syncing {
                 let parent = dir.parent().filter(|p| !p.as_os_str().is_empty());
-                sync_dir(parent.unwrap_or(Path::new(".")))?;
+                sync_dir(&disk, parent.unwrap_or(Path::new(".")))?;
             }
         }
         let lock = lock_log(&dir)?;
         let segments = list_segments(&dir)?;
         if segments.is_empty() {
             let path = segment_path(&dir, 0);
-            let file = create_segment(&path, &dir, syncing)?;
-            let writer = Self::new(dir, options, (file, lock), path, 0, MAGIC_LEN, 0);
+            let file = create_segment(&disk, &path, &dir, syncing)?;
+            let file = Appender::new(file, MAGIC_LEN);
+            let writer = Self::new((disk, dir), options, (file, lock), path, 0, 0);
             let recovered = Recovered {
                 records: Vec::new(),
                 positions: Vec::new(),
@@ -155,11 +167,10 @@ impl LogWriter {
             return Ok((writer, recovered));
         }
         let contents = read_log(&dir)?;
-        let last = drop_empty_last_segment(&dir, &segments, &contents, syncing)?;
+        let last = drop_empty_last_segment(&disk, &dir, &segments, &contents, syncing)?;
         let path = segments[last].clone();
-        let mut file = OpenOptions::new()
-            .append(true)
-            .open(&path)
+        let file = disk
+            .open_or_create(&path)
             .map_err(|e| LogError::io(&path, e))?;
         // A torn tail of a dropped segment went with its file.
         let truncated_bytes = contents.torn.as_ref().map_or(0, |t| t.bytes);
@@ -171,13 +182,21 @@ impl LogWriter {
             let io = |e| write_error(&dir, &path, e);
             file.set_len(torn.offset).map_err(io)?;
             if torn.offset < MAGIC_LEN {
-                file.write_all(&MAGIC).map_err(io)?;
+                file.write_at(0, &MAGIC).map_err(io)?;
             }
-            file.sync_all().map_err(io)?;
+            file.sync_data().map_err(io)?;
         }
-        let len = file.metadata().map_err(|e| LogError::io(&path, e))?.len();
+        let len = file.len().map_err(|e| LogError::io(&path, e))?;
         let records = contents.records.len() as u64;
-        let writer = Self::new(dir, options, (file, lock), path, last as u32, len, records);
+        let file = Appender::new(file, len);
+        let writer = Self::new(
+            (disk, dir),
+            options,
+            (file, lock),
+            path,
+            last as u32,
+            records,
+        );
         let recovered = Recovered {
             records: contents.records,
             positions: contents.positions,
@@ -188,22 +207,21 @@ impl LogWriter {
     }
 
     fn new(
-        dir: PathBuf,
+        (disk, dir): (D, PathBuf),
         options: WriterOptions,
-        (file, lock): (File, FileLock),
+        (file, lock): (Appender<D::File>, FileLock),
         path: PathBuf,
         segment: u32,
-        len: u64,
         records: u64,
     ) -> Self {
         Self {
             _lock: lock,
+            disk,
             dir,
             options,
             file,
             path,
             segment,
-            len,
             records,
             buf: Vec::with_capacity(4096),
             unsynced: 0,
@@ -243,23 +261,20 @@ impl LogWriter {
     /// Writes one record's frame (rolling to a new segment first if it would not fit).
     fn write(&mut self, record: &Record) -> Result<u64, LogError> {
         if self.records == 0 {
-            check_header(&self.path, self.len, record)?;
+            check_header(&self.path, self.file.len(), record)?;
         }
         self.buf.clear();
         encode_frame(record, &mut self.buf)?;
         let frame = self.buf.len() as u64;
-        if self.len > MAGIC_LEN && self.len + frame > self.options.segment_bytes {
+        let len = self.file.len();
+        if len > MAGIC_LEN && len + frame > self.options.segment_bytes {
             self.roll()?;
         }
-        let offset = self.len;
-        if let Err(e) = self.file.write_all(&self.buf) {
-            // Cut a partial write so that later records do not follow garbage.
-            if self.file.set_len(offset).is_err() {
-                self.poisoned = true;
-            }
-            return Err(write_error(&self.dir, &self.path, e));
-        }
-        self.len += frame;
+        // A failed write is cut off again (or the appender is poisoned).
+        let offset = self.file.append(&self.buf).map_err(|e| {
+            self.poisoned |= self.file.is_poisoned();
+            write_error(&self.dir, &self.path, e)
+        })?;
         self.records += 1;
         self.unsynced += 1;
         Ok(offset)
@@ -298,7 +313,7 @@ impl LogWriter {
 
     /// Bytes in the segment being written.
     pub fn segment_len(&self) -> u64 {
-        self.len
+        self.file.len()
     }
 
     /// Records in the log (recovered and appended).
@@ -327,9 +342,9 @@ impl LogWriter {
 
     fn sync_file(&mut self) -> Result<(), LogError> {
         if self.unsynced > 0 {
-            if let Err(e) = self.file.sync_data() {
+            if let Err(e) = self.file.sync() {
                 // After a failed fsync the kernel may have dropped the dirty pages: the
-                // durable state of the file is unknown.
+                // durable state of the file is unknown (the appender is poisoned too).
                 self.poisoned = true;
                 return Err(write_error(&self.dir, &self.path, e));
             }
@@ -347,18 +362,17 @@ impl LogWriter {
         }
         let next = self.segment + 1;
         let path = segment_path(&self.dir, next);
-        let file = create_segment(&path, &self.dir, syncing).inspect_err(|_| {
+        let file = create_segment(&self.disk, &path, &self.dir, syncing).inspect_err(|_| {
             self.poisoned = true;
         })?;
-        self.file = file;
+        self.file = Appender::new(file, MAGIC_LEN);
         self.path = path;
         self.segment = next;
-        self.len = MAGIC_LEN;
         Ok(())
     }
 }
 
-impl Drop for LogWriter {
+impl<D: Disk> Drop for LogWriter<D> {
     /// Syncs the unsynced records (unless the policy is `None` or the writer is poisoned).
     fn drop(&mut self) {
         if self.options.fsync != FsyncPolicy::None && !self.poisoned {
@@ -377,6 +391,7 @@ impl Drop for LogWriter {
 /// find records missing at the end of a segment: after a restart the first record appended
 /// is often not the one the segment was created for.
 fn drop_empty_last_segment(
+    disk: &impl Disk,
     dir: &Path,
     segments: &[PathBuf],
     contents: &LogContents,
@@ -390,9 +405,10 @@ fn drop_empty_last_segment(
     if last == 0 || holds_records {
         return Ok(last);
     }
-    std::fs::remove_file(&segments[last]).map_err(|e| LogError::io(&segments[last], e))?;
+    disk.remove_file(&segments[last])
+        .map_err(|e| LogError::io(&segments[last], e))?;
     if syncing {
-        sync_dir(dir)?;
+        sync_dir(disk, dir)?;
     }
     Ok(last - 1)
 }
@@ -411,23 +427,26 @@ fn lock_log(dir: &Path) -> Result<FileLock, LogError> {
 }
 
 /// Creates a segment holding only the magic; with `syncing`, syncs it and the directory.
-fn create_segment(path: &Path, dir: &Path, syncing: bool) -> Result<File, LogError> {
-    let mut file = OpenOptions::new()
-        .append(true)
-        .create_new(true)
-        .open(path)
+fn create_segment<D: Disk>(
+    disk: &D,
+    path: &Path,
+    dir: &Path,
+    syncing: bool,
+) -> Result<D::File, LogError> {
+    let file = disk
+        .create_new(path)
         .map_err(|e| write_error(dir, path, e))?;
-    let written = file
-        .write_all(&MAGIC)
-        .and_then(|()| if syncing { file.sync_data() } else { Ok(()) });
+    let written =
+        file.write_at(0, &MAGIC)
+            .and_then(|()| if syncing { file.sync_data() } else { Ok(()) });
     if let Err(e) = written {
         // A segment without its whole magic would read as damage; remove it (a full disk
         // still allows that), so the log ends on the previous, complete segment.
-        let _ = std::fs::remove_file(path);
+        let _ = disk.remove_file(path);
         return Err(write_error(dir, path, e));
     }
     if syncing {
-        sync_dir(dir)?;
+        sync_dir(disk, dir)?;
     }
     Ok(file)
 }
@@ -445,8 +464,6 @@ fn write_error(dir: &Path, path: &Path, e: std::io::Error) -> LogError {
     }
 }
 
-fn sync_dir(dir: &Path) -> Result<(), LogError> {
-    File::open(dir)
-        .and_then(|d| d.sync_all())
-        .map_err(|e| LogError::io(dir, e))
+fn sync_dir(disk: &impl Disk, dir: &Path) -> Result<(), LogError> {
+    disk.sync_dir(dir).map_err(|e| LogError::io(dir, e))
 }

@@ -1,80 +1,56 @@
 //! Files that must survive a crash: one toolkit, so that every durable write in HNAV fails
 //! the same way.
 //!
-//! | item | what it is for |
+//! | module | what it holds |
 //! |---|---|
-//! | [`replace_file`] | a whole file replaced, old or new after a crash, never half of either |
+//! | [`replace`] | [`replace_file`]: a whole file replaced, old or new after a crash, never half of either |
+//! | [`slot`] | [`SlotFile`], [`SlotPair`]: a checkpoint rewritten in place every control period, checksummed |
+//! | [`read`] | [`FrameReader`]: the frames of an append-only file back, a [`Torn`] tail ("torn tail cut at offset N") told from corruption |
+//! | [`append`] | [`Appender`]: frames appended with one write each, synced on demand, poisoned by a failed fsync |
+//! | [`framed`] | [`FrameFormat`]: the consensus log's and `maps.bin`'s [`Checksummed`] frames, `trajectories.bin`'s [`Fixed`] records; [`FrameProblem`] |
+//! | [`disk`] | [`Disk`], [`DiskFile`]: the file operations the writers make, [`RealDisk`] or a crash test's |
 //!
 //! An fsync that fails is data loss the kernel has already forgotten (the page may be clean
-//! and wrong): it is reported as an error, never retried.
+//! and wrong): it is reported as an error (the caller names the file), never retried; an
+//! [`Appender`] refuses every later write until the file is reopened.
+//!
+//! # Which files use it
+//!
+//! | file | how |
+//! |---|---|
+//! | the consensus log's segments | [`Appender`] and [`FrameReader`] in [`Checksummed`] frames, synced by the run's fsync policy |
+//! | `summary.json`, `invocation.json`, `rejected.json`, a replica's role file, the run registry's records | [`replace_file`] |
+//! | `agents/N.ckpt` (agent checkpoint) | one [`SlotFile`] |
+//! | `sim.ckpt.0`, `sim.ckpt.1` (sim checkpoint) | a [`SlotPair`] |
+//! | `recording/maps.bin`, `recording/trajectories.bin` | [`Appender`] and [`FrameReader`] ([`Checksummed`], [`Fixed`]); synced once, when the recording finishes |
+//!
+//! Left as plain writes, because a crash loses nothing a later run needs and the file is
+//! written again whole by whoever wants it: the report (`report.svg`, `report.html`), the MCAP
+//! export, `scenario-report.json`, the run's map copy `map.map` (written before any process
+//! starts; a crash there fails the run's start), and the events journal `events.jsonl`
+//! (append-only lines for people, each one `write`; a torn last line is a torn last line).
+//! `hnav` commands that write a map or a scenario file (`movingai`) write what the user asked
+//! for, once.
 
-use std::io::Write;
-use std::path::Path;
-use std::sync::atomic::{AtomicU64, Ordering};
+pub mod append;
+pub mod disk;
+pub mod framed;
+pub mod read;
+pub mod replace;
+pub mod slot;
 
-/// Replaces `path` by a file holding `bytes`, whole or not at all.
-///
-/// The bytes go to a temporary file beside `path` whose name no other writer uses (process id
-/// and a counter), which is fsynced, renamed over `path`, and the directory fsynced so that the
-/// rename itself survives a crash. On any failure the temporary file is removed and the old
-/// `path` is left as it was; a failed directory fsync is an error too (the new file may not
-/// survive a crash).
-pub fn replace_file(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    static NEXT: AtomicU64 = AtomicU64::new(0);
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path.file_name().unwrap_or_default().to_string_lossy();
-    let tmp = dir.join(format!(
-        ".{name}.tmp-{}-{}",
-        std::process::id(),
-        NEXT.fetch_add(1, Ordering::Relaxed)
-    ));
-    let written = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = written {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e);
-    }
-    std::fs::File::open(dir)?.sync_all()
-}
+pub use append::Appender;
+pub use disk::{Disk, DiskFile, RealDisk};
+pub use framed::{Checksummed, Fixed, FrameFormat, FrameProblem};
+pub use read::{FrameError, FrameReader, Step, Torn};
+pub use replace::{replace_file, replace_file_on};
+pub use slot::{Newest, PairError, SlotFile, SlotLayout, SlotLen, SlotPair, SlotRead};
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_replaced_file_holds_the_new_bytes_and_no_temporary_is_left() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("summary.json");
-        replace_file(&path, b"old").unwrap();
-        replace_file(&path, b"new").unwrap();
-        assert_eq!(std::fs::read(&path).unwrap(), b"new");
-        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
-        assert_eq!(names.len(), 1, "{names:?}");
-    }
-
-    #[test]
-    fn a_failed_replace_leaves_the_old_file_and_no_temporary() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("f");
-        replace_file(&path, b"old").unwrap();
-        // A directory where the temporary would be renamed to: the rename fails.
-        let blocked = dir.path().join("sub");
-        std::fs::create_dir(&blocked).unwrap();
-        std::fs::write(blocked.join("x"), b"").unwrap();
-        assert!(replace_file(&blocked, b"new").is_err());
-        assert_eq!(std::fs::read(&path).unwrap(), b"old");
-        let left: Vec<_> = std::fs::read_dir(dir.path())
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .filter(|n| n.contains(".tmp-"))
-            .collect();
-        assert!(left.is_empty(), "{left:?}");
-    }
+/// The error of a failed fsync: its kind kept (a full disk stays a full disk), its message
+/// saying that the data written since the last sync may be lost.
+fn sync_failed(e: std::io::Error) -> std::io::Error {
+    std::io::Error::new(
+        e.kind(),
+        format!("fsync failed, so data written since the last sync may be lost: {e}"),
+    )
 }

@@ -17,8 +17,8 @@
 //!
 //! A SIGKILL can cut a write short (the kernel checks for a fatal signal between pages), so
 //! a slot can be torn; then it is the slot being written, and the other one holds the
-//! period before, complete. Each slot carries its length and a checksum; [`SimCheckpoint::load`]
-//! takes the newest usable one. No fsync: the page cache survives the process's death, which
+//! period before, complete. Each slot carries its length and a checksum (a
+//! [`SlotPair`] of the durable toolkit); [`SimCheckpoint::load`] takes the newest usable one. No fsync: the page cache survives the process's death, which
 //! is the failure this is for. The scenario hash ties a slot to its run's scenario.
 //!
 //! Written after a period is stepped and before its odometry and truth are published, so that
@@ -28,17 +28,21 @@
 //! torn slot of period `p` means the sim died before publishing `p`, so resuming from `p - 1`
 //! is exact.
 
-use std::fs::{File, OpenOptions};
-use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
 
-use hnav_runtime::hash::Fnv1a64;
+use hnav_runtime::durable::{PairError, SlotLayout, SlotLen, SlotPair};
 
 use crate::world::World;
 
-const MAGIC: u64 = 0x4b43_5341_4e48_0002; // "HNASCK" v2: slots with a length
-/// Header words: magic, scenario hash, period, body length in bytes.
-const HEADER: usize = 4 * 8;
+/// The slot: magic `"HNASCK"` v2 (slots with a length), then the scenario hash, the period,
+/// the world state's length and the world state; FNV-1a 64.
+const LAYOUT: SlotLayout = SlotLayout {
+    magic: 0x4b43_5341_4e48_0002,
+    what: "sim checkpoint",
+    len: SlotLen::Stored { at: 16, base: 24 },
+};
+/// Payload bytes before the world state: scenario hash, period, world state length.
+const BASE: usize = 3 * 8;
 /// The slot files, by period parity.
 pub const SLOT_FILES: [&str; 2] = ["sim.ckpt.0", "sim.ckpt.1"];
 
@@ -70,135 +74,82 @@ pub enum CheckpointError {
     },
 }
 
-/// The sim's checkpoint slots in a run directory, with the buffer a checkpoint is encoded in
-/// (reused, so that a checkpoint allocates nothing once the buffer has grown).
+impl From<PairError> for CheckpointError {
+    fn from(e: PairError) -> Self {
+        match e {
+            PairError::Io { path, source } => Self::Io { path, source },
+            PairError::Unusable { path, what } => Self::Unusable { path, what },
+        }
+    }
+}
+
+/// The sim's checkpoint slots in a run directory (whose buffer is reused, so that a
+/// checkpoint allocates nothing once it has grown).
 pub struct SimCheckpoint {
-    paths: [PathBuf; 2],
-    files: [Option<File>; 2],
+    slots: SlotPair,
     scenario_hash: u64,
-    buf: Vec<u8>,
 }
 
 impl SimCheckpoint {
     /// The checkpoint of a run of the scenario with hash `scenario_hash` in `run_dir`.
     pub fn in_dir(run_dir: &Path, scenario_hash: u64) -> Self {
         Self {
-            paths: SLOT_FILES.map(|f| run_dir.join(f)),
-            files: [None, None],
+            slots: SlotPair::new(SLOT_FILES.map(|f| run_dir.join(f)), LAYOUT),
             scenario_hash,
-            buf: Vec::new(),
         }
     }
 
     /// The slot file period `period` is written to.
     pub fn path(&self, period: u64) -> &Path {
-        &self.paths[(period % 2) as usize]
+        self.slots.path(period)
     }
 
     /// Writes the checkpoint of `world` with `period` periods stepped, into slot `period % 2`.
     pub fn store(&mut self, world: &World, period: u64) -> Result<(), CheckpointError> {
-        self.buf.clear();
-        for w in [MAGIC, self.scenario_hash, period, 0] {
-            self.buf.extend_from_slice(&w.to_le_bytes());
-        }
-        world.write_snapshot(&mut self.buf);
-        let body = (self.buf.len() - HEADER) as u64;
-        self.buf[24..32].copy_from_slice(&body.to_le_bytes());
-        let sum = Fnv1a64::new().bytes(&self.buf).finish();
-        self.buf.extend_from_slice(&sum.to_le_bytes());
-        let slot = (period % 2) as usize;
-        let io = |source| CheckpointError::Io {
-            path: self.paths[slot].clone(),
-            source,
-        };
-        if self.files[slot].is_none() {
-            let f = OpenOptions::new()
-                .write(true)
-                .create(true)
-                .truncate(false)
-                .open(&self.paths[slot])
-                .map_err(io)?;
-            self.files[slot] = Some(f);
-        }
-        let f = self.files[slot].as_ref().expect("opened above");
-        f.write_all_at(&self.buf, 0).map_err(io)
+        let hash = self.scenario_hash;
+        self.slots
+            .store(period, |buf| {
+                // The world state's length (0 here) is filled in by the slot.
+                for w in [hash, period, 0] {
+                    buf.extend_from_slice(&w.to_le_bytes());
+                }
+                world.write_snapshot(buf);
+            })
+            .map_err(|source| CheckpointError::Io {
+                path: self.slots.path(period).to_path_buf(),
+                source,
+            })
     }
 
     /// Restores `world` from the newest usable slot, if there is one: `Ok(None)` when no slot
     /// exists (the sim died before it stepped a period), an error when a slot exists but none
     /// can be used (a restarted sim must not silently start its robots over).
     pub fn load(&self, world: &mut World) -> Result<Option<Restored>, CheckpointError> {
-        let mut best: Option<(u64, &Path, Vec<u8>)> = None;
-        let mut refused = None;
-        for path in &self.paths {
-            let bytes = match std::fs::read(path) {
-                Ok(b) => b,
-                Err(e) if e.kind() == std::io::ErrorKind::NotFound => continue,
-                Err(source) => {
-                    return Err(CheckpointError::Io {
-                        path: path.clone(),
-                        source,
-                    })
-                }
-            };
-            match self.check(&bytes) {
-                Ok(period) if best.as_ref().is_none_or(|b| period > b.0) => {
-                    best = Some((period, path, bytes));
-                }
-                Ok(_) => {}
-                Err(what) => {
-                    refused = Some(CheckpointError::Unusable {
-                        path: path.clone(),
-                        what,
-                    })
-                }
+        let hash = self.scenario_hash;
+        let accept = |payload: &[u8]| {
+            if word(payload, 0) != hash {
+                return Err("written for another scenario".to_string());
             }
-        }
-        let Some((period, path, bytes)) = best else {
-            return refused.map_or(Ok(None), Err);
+            Ok(word(payload, 1))
         };
-        let body = &bytes[HEADER..HEADER + word(&bytes, 3) as usize];
+        let Some(newest) = self.slots.load(accept)? else {
+            return Ok(None);
+        };
         world
-            .restore_snapshot(body)
+            .restore_snapshot(&newest.payload[BASE..])
             .map_err(|e| CheckpointError::Unusable {
-                path: path.to_path_buf(),
+                path: newest.path.to_path_buf(),
                 what: format!("world state {e}"),
             })?;
-        Ok(Some(Restored { period }))
-    }
-
-    /// The period of a complete slot of this scenario, or what is wrong with it.
-    fn check(&self, bytes: &[u8]) -> Result<u64, String> {
-        if bytes.len() < HEADER + 8 {
-            return Err("too short for a sim checkpoint".into());
-        }
-        if word(bytes, 0) != MAGIC {
-            return Err("not a sim checkpoint of this version".into());
-        }
-        let end = usize::try_from(word(bytes, 3))
-            .ok()
-            .and_then(|body| body.checked_add(HEADER))
-            .filter(|&end| end.checked_add(8).is_some_and(|e| e <= bytes.len()))
-            .ok_or("length beyond the file (torn or damaged)")?;
-        if Fnv1a64::new().bytes(&bytes[..end]).finish() != u64_at(bytes, end) {
-            return Err("checksum mismatch (torn or damaged)".into());
-        }
-        if word(bytes, 1) != self.scenario_hash {
-            return Err("written for another scenario".into());
-        }
-        Ok(word(bytes, 2))
+        Ok(Some(Restored { period: newest.seq }))
     }
 }
 
-/// The little-endian header word `i` of `bytes` (`bytes` holds it).
-fn word(bytes: &[u8], i: usize) -> u64 {
-    u64_at(bytes, 8 * i)
-}
-
-/// The little-endian `u64` at byte `offset` of `bytes` (`bytes` holds it).
-fn u64_at(bytes: &[u8], offset: usize) -> u64 {
+/// The little-endian word `i` of a slot's payload (which holds it: the slot checked its
+/// length).
+fn word(payload: &[u8], i: usize) -> u64 {
     let mut w = [0u8; 8];
-    w.copy_from_slice(&bytes[offset..offset + 8]);
+    w.copy_from_slice(&payload[8 * i..8 * i + 8]);
     u64::from_le_bytes(w)
 }
 
@@ -208,6 +159,7 @@ mod tests {
     use hnav_runtime::grid::geometry::cell_centre_pose;
     use hnav_runtime::grid::{Cell, Grid};
     use hnav_runtime::scenario::params::{RobotParams, SimParams};
+    use std::os::unix::fs::FileExt;
 
     fn world() -> World {
         let robot = RobotParams::default();
