@@ -20,6 +20,7 @@
 //! Tests that SIGKILL processes live in their own test binaries (`tests/*_kill.rs`).
 //! Tests that send other signals do too (`tests/waiter_signals.rs`).
 
+pub mod house;
 pub mod lost_wakeup;
 pub mod netns;
 pub mod pattern;
