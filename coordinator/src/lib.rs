@@ -8,14 +8,19 @@
 //! planners, and the terrain-hazard model they can plan with, after seed 002 (a thesis on
 //! Lazy Theta* for s-bots on rough terrain).
 //!
+//! **Must not depend on**: any HNAV crate but `hnav-runtime` (the agents and the sim are reached only through its messages), nor on the operator's libraries (plotters, ratatui, mcap, indicatif).
+//!
+//! Modules, highest first (a module uses only those below it in this table; imports never run
+//! back up):
+//!
 //! | module | concept |
 //! |---|---|
-//! | [`planner`] | the [`Planner`](planner::Planner) trait; A*, Basic Theta*, Lazy Theta*; line of sight; single queries for the bench |
-//! | [`terrain`] | slope, roughness and relief from a height map; the hazard index `R`; route hazard `c = sum alpha R` |
-//! | [`conflict`] | one decision round of `shared_paths`: the conflict types (a)–(d), corners, reservations; the [`Resolver`](conflict::Resolver); [`Pibt`](conflict::Pibt), priority inheritance (`rules = "pibt"`); [`Lacam`](conflict::Lacam), PIBT made complete (`rules = "lacam"`) |
-//! | [`round`] | the decision round: [`Arbiter`](round::Arbiter) keeps the rows, runs the resolver, tallies the decisions, replans (hybrid mode) |
 //! | [`process`] | the `hnav-coordinator` process: `new`/`run`, its ports and state, the [`Waiter`](hnav_runtime::transport::Waiter) loop, round deadline, log-then-commit (through [`LogWriter`](hnav_runtime::consensus_log::LogWriter)), restart from the log |
 //! | [`replication`] | one replica's Raft peer ([`Replica`](replication::Replica), the `raft` crate): propose round records, take the committed ones; the building block of the replicated consensus log |
+//! | [`round`] | the decision round: [`Arbiter`](round::Arbiter) keeps the rows, runs the resolver, tallies the decisions, replans (hybrid mode) |
+//! | [`conflict`] | one decision round of `shared_paths`: the conflict types (a)–(d), corners, reservations; the [`Resolver`](conflict::Resolver); [`Pibt`](conflict::Pibt), priority inheritance (`rules = "pibt"`); [`Lacam`](conflict::Lacam), PIBT made complete (`rules = "lacam"`) |
+//! | [`planner`] | the [`Planner`](planner::Planner) trait; A*, Basic Theta*, Lazy Theta*; line of sight; single queries for the bench |
+//! | [`terrain`] | slope, roughness and relief from a height map; the hazard index `R`; route hazard `c = sum alpha R` |
 //! | [`error`] | [`PlanError`], every way a caller's input can be unusable |
 //!
 //! ```

@@ -9,9 +9,13 @@
 //! An import is a `use` of an item of the file's own crate (`crate::`, `super::`, `self::` or
 //! a path relative to the module) and any such path written in code; it is resolved through
 //! re-exports to the file that defines the item. A parent's `mod child;` is containment, not
-//! an import. Test code counts like any other: a `#[cfg(test)]` module or file of the crate is
-//! one of its files, and integration tests, examples and benches are crates of their own whose
-//! files are checked for rings too. Other crates (`hnav_runtime::...` from `hnav-agent`) are
+//! an import; neither is a file's use of what its own enclosing modules define
+//! (`super::Error` in `state.rs` beside its `mod.rs`): a child is a part of its parent.
+//!
+//! Test code (`#[cfg(test)]` modules, uses and files) is left out: it is not compiled into the
+//! product, and a unit test of a low module may well drive it through a higher one that uses
+//! it (the waiter's tests build a `Transport`, which hands out waiters). Integration tests,
+//! examples and benches are crates of their own, checked for rings among their own files. Other crates (`hnav_runtime::...` from `hnav-agent`) are
 //! outside this check: Cargo already refuses a cycle between crates.
 
 mod graph;

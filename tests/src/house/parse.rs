@@ -13,6 +13,8 @@ pub struct Scope {
     pub parent: usize,
     /// Names of items defined at its top level (`fn`, `struct`, `enum`, `macro_rules!`, ...).
     pub defs: Vec<String>,
+    /// Compiled for tests only (`#[cfg(test)]` on it or on a scope around it).
+    pub test: bool,
 }
 
 /// What a `use` leaf brings into scope.
@@ -38,6 +40,8 @@ pub struct UseLeaf {
     pub bind: Bind,
     /// `pub use` (any visibility): a re-export, not a use of the item by this file.
     pub export: bool,
+    /// In test-only code: a `#[cfg(test)]` use or scope.
+    pub test: bool,
 }
 
 /// A `mod name;` declaration: a module in another file.
@@ -49,6 +53,8 @@ pub struct ModDecl {
     pub name: String,
     /// A `#[path = "..."]` attribute on it.
     pub path_attr: Option<String>,
+    /// Test-only: `#[cfg(test)]` on it or on a scope around it.
+    pub test: bool,
 }
 
 /// A path in code (not in a `use`) of two or more segments, with the scope it is written in.
@@ -92,6 +98,7 @@ pub fn parse(src: &str) -> Parsed {
     let mut inline_next: Option<usize> = None;
     let mut path_attr: Option<String> = None;
     let mut macro_export = false;
+    let mut cfg_test = false;
     let mut i = 0;
     while i < t.len() {
         let (scope, body) = *stack.last().expect("the file's scope is never popped");
@@ -109,35 +116,41 @@ pub fn parse(src: &str) -> Parsed {
                     stack.pop();
                 }
                 depth = depth.saturating_sub(1);
-                (path_attr, macro_export) = (None, false);
+                (path_attr, macro_export, cfg_test) = (None, false, false);
                 i += 1;
             }
             Tok::Punct(';') => {
-                (path_attr, macro_export) = (None, false);
+                (path_attr, macro_export, cfg_test) = (None, false, false);
                 i += 1;
             }
             Tok::Punct('#') => {
-                let (end, attr_path, export) = attribute(&t, i);
-                path_attr = attr_path.or(path_attr);
-                macro_export |= export;
+                let (end, attr) = attribute(&t, i);
+                path_attr = attr.path.or(path_attr);
+                macro_export |= attr.macro_export;
+                cfg_test |= attr.cfg_test;
                 i = end;
             }
             Tok::Ident(kw) if kw == "mod" => match (t.get(i + 1), t.get(i + 2)) {
                 (Some(Tok::Ident(name)), Some(Tok::Punct(';'))) => {
                     let path_attr = path_attr.take();
+                    let test = cfg_test || p.scopes[scope].test;
                     p.mods.push(ModDecl {
                         scope,
                         name: name.clone(),
                         path_attr,
+                        test,
                     });
                     i += 2;
                 }
                 (Some(Tok::Ident(name)), Some(Tok::Punct('{'))) => {
+                    let test = cfg_test || p.scopes[scope].test;
                     p.scopes.push(Scope {
                         name: name.clone(),
                         parent: scope,
                         defs: Vec::new(),
+                        test,
                     });
+                    cfg_test = false;
                     inline_next = Some(p.scopes.len() - 1);
                     i += 2;
                 }
@@ -148,6 +161,7 @@ pub fn parse(src: &str) -> Parsed {
                 let mut leaves = Vec::new();
                 use_tree(&t, &mut pos, Vec::new(), false, &mut leaves);
                 let export = visible(&t, i);
+                let test = cfg_test || p.scopes[scope].test;
                 p.uses
                     .extend(leaves.into_iter().map(|(path, bind)| UseLeaf {
                         scope,
@@ -155,6 +169,7 @@ pub fn parse(src: &str) -> Parsed {
                         path,
                         bind,
                         export,
+                        test,
                     }));
                 i = pos;
             }
@@ -192,15 +207,22 @@ pub fn parse(src: &str) -> Parsed {
     p
 }
 
-/// An attribute `#[...]` or `#![...]` at `i`: the index after it, its `path = "..."` and
-/// whether it is `macro_export`.
-fn attribute(t: &[Tok], i: usize) -> (usize, Option<String>, bool) {
+/// What an attribute says that matters here.
+#[derive(Default)]
+struct Attr {
+    path: Option<String>,
+    macro_export: bool,
+    cfg_test: bool,
+}
+
+/// An attribute `#[...]` or `#![...]` at `i`: the index after it, and what it says.
+fn attribute(t: &[Tok], i: usize) -> (usize, Attr) {
     let mut j = i + 1;
     if t.get(j) == Some(&Tok::Punct('!')) {
         j += 1;
     }
     if t.get(j) != Some(&Tok::Punct('[')) {
-        return (i + 1, None, false);
+        return (i + 1, Attr::default());
     }
     let start = j + 1;
     let mut level = 0;
@@ -222,8 +244,13 @@ fn attribute(t: &[Tok], i: usize) -> (usize, Option<String>, bool) {
         [Tok::Ident(k), Tok::Punct('='), Tok::Str(s)] if k == "path" => Some(s.clone()),
         _ => None,
     };
-    let export = matches!(body.first(), Some(Tok::Ident(k)) if k == "macro_export");
-    (j + 1, path, export)
+    let ident = |k: usize, s: &str| matches!(body.get(k), Some(Tok::Ident(x)) if x == s);
+    let attr = Attr {
+        path,
+        macro_export: ident(0, "macro_export"),
+        cfg_test: ident(0, "cfg") && ident(2, "test") && body.len() == 4,
+    };
+    (j + 1, attr)
 }
 
 /// Whether the item whose keyword is at `i` is `pub` or `pub(...)`.

@@ -79,26 +79,39 @@ fn a_ring_and_an_import_back_up_the_table_are_both_named() {
 }
 
 #[test]
-fn a_ring_between_a_module_file_and_its_child_through_super() {
+fn a_child_using_its_parent_and_test_code_make_no_ring_but_siblings_in_a_binary_do() {
     let ws = workspace(&[
         ("Cargo.toml", "[workspace]\nmembers = [\"a\"]\n"),
         ("a/src/main.rs", "mod run;\nfn main() { run::go(); }\n"),
         (
             "a/src/run/mod.rs",
-            "mod host;\npub struct Part;\npub fn go() { host::start(); }\n",
+            "mod host;\nmod slots;\npub struct Part;\npub fn go() { host::start(); }\n",
         ),
+        // `super::Part` is the parent's: containment. The test module's import is left out.
         (
             "a/src/run/host.rs",
-            "pub fn start() { let _ = super::Part; }\n",
+            "pub fn start() { let _ = super::Part; crate::run::slots::n(); }\n\
+             #[cfg(test)]\nmod tests { use crate::run::slots::Spy; }\n",
+        ),
+        (
+            "a/src/run/slots.rs",
+            "pub fn n() {}\npub struct Spy;\n#[cfg(test)]\nuse super::host::start;\n",
         ),
     ]);
+    let f = check(ws.path());
+    assert!(f.rings.is_empty(), "{f:?}");
+    std::fs::write(
+        ws.path().join("a/src/run/slots.rs"),
+        "pub fn n() { super::host::start() }\n",
+    )
+    .expect("write");
     let f = check(ws.path());
     assert_eq!(f.rings.len(), 1, "{f:?}");
     assert_eq!(
         f.rings[0].files,
         vec![
             Path::new("a/src/run/host.rs"),
-            Path::new("a/src/run/mod.rs")
+            Path::new("a/src/run/slots.rs")
         ]
     );
 }

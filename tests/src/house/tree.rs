@@ -32,6 +32,8 @@ pub struct File {
     /// Its path, relative to the workspace.
     pub path: PathBuf,
     parsed: Parsed,
+    /// Compiled for tests only: declared under `#[cfg(test)]`, or inside such a file.
+    test: bool,
     /// The module of each of its scopes.
     modules: Vec<usize>,
 }
@@ -72,7 +74,7 @@ impl Crate {
             modules: Vec::new(),
             macros: BTreeMap::new(),
         };
-        c.add_file(ws, root.to_path_buf(), None, String::new())?;
+        c.add_file(ws, root.to_path_buf(), None, String::new(), false)?;
         Ok(c)
     }
 
@@ -82,6 +84,7 @@ impl Crate {
         path: PathBuf,
         parent: Option<usize>,
         name: String,
+        test: bool,
     ) -> Result<(), String> {
         let src = std::fs::read_to_string(ws.join(&path))
             .map_err(|e| format!("{}: {e}", path.display()))?;
@@ -102,7 +105,7 @@ impl Crate {
         let decls: Vec<_> = parsed
             .mods
             .iter()
-            .map(|d| (d.scope, d.name.clone(), d.path_attr.clone()))
+            .map(|d| (d.scope, d.name.clone(), d.path_attr.clone(), test || d.test))
             .collect();
         let inline_dirs: Vec<PathBuf> = (0..parsed.scopes.len())
             .map(|s| inline_dir(&parsed, s))
@@ -110,10 +113,11 @@ impl Crate {
         self.files.push(File {
             path: path.clone(),
             parsed,
+            test,
             modules: modules.clone(),
         });
         let own_dir = children_dir(&path, parent.is_none());
-        for (scope, name, attr) in decls {
+        for (scope, name, attr, child_test) in decls {
             let child = match attr {
                 Some(a) if scope == 0 => path.parent().unwrap_or(Path::new("")).join(a),
                 Some(a) => own_dir.join(&inline_dirs[scope]).join(a),
@@ -134,7 +138,7 @@ impl Crate {
                     child.display()
                 ));
             }
-            self.add_file(ws, child, Some(modules[scope]), name)?;
+            self.add_file(ws, child, Some(modules[scope]), name, child_test)?;
         }
         Ok(())
     }
@@ -170,9 +174,10 @@ impl Crate {
     }
 
     /// Every import of one file of the crate by another.
+    /// Test code is left out (see the [house rules](super)).
     pub fn edges(&self) -> Vec<Edge> {
         let mut out = Vec::new();
-        for (f, file) in self.files.iter().enumerate() {
+        for (f, file) in self.files.iter().enumerate().filter(|(_, file)| !file.test) {
             let ancestors = self.ancestor_files(f);
             let mut add = |t: Target| {
                 if let Target::Item(to, name) = t {
@@ -185,7 +190,7 @@ impl Crate {
                     }
                 }
             };
-            for u in file.parsed.uses.iter().filter(|u| !u.export) {
+            for u in file.parsed.uses.iter().filter(|u| !u.export && !u.test) {
                 let m = file.modules[u.scope];
                 match (&u.bind, self.resolve(m, &u.path, FUEL)) {
                     (Bind::Glob, Target::Module(g)) => {
@@ -194,7 +199,12 @@ impl Crate {
                     (_, t) => add(t),
                 }
             }
-            for p in &file.parsed.paths {
+            for p in file
+                .parsed
+                .paths
+                .iter()
+                .filter(|p| !file.parsed.scopes[p.scope].test)
+            {
                 add(self.resolve_local(file.modules[p.scope], &p.segs));
             }
         }
