@@ -275,11 +275,8 @@ fn code_path(t: &[Tok], i: usize) -> (Vec<String>, usize) {
             _ => return (segs, i + 1),
         }
     }
-    loop {
-        match t.get(j) {
-            Some(Tok::Ident(s)) => segs.push(s.clone()),
-            _ => break,
-        }
+    while let Some(Tok::Ident(s)) = t.get(j) {
+        segs.push(s.clone());
         j += 1;
         if t.get(j) == Some(&Tok::Path) && matches!(t.get(j + 1), Some(Tok::Ident(_))) {
             j += 1;
