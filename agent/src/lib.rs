@@ -9,18 +9,23 @@
 //! odometry in, candidates and wheel commands out, commits applied; messages and transport
 //! live in `hnav-runtime`.
 //!
+//! **Must not depend on**: any HNAV crate but `hnav-runtime` (the coordinator, the sim and the operator's side are reached only through its messages), nor on the operator's libraries (plotters, ratatui, mcap, indicatif).
+//!
+//! Modules, highest first (a module uses only those below it in this table; imports never run
+//! back up):
+//!
 //! | module | what |
 //! |---|---|
-//! | [`neural_map`] | the network (eq. 3.2–3.4, §2.8–2.11): options, the `f32` fast path [`NeuralMap`], the `f64` [`ReferenceMap`], Table 2-2's weight matrix, §2.10 repair |
-//! | [`path_constructor`] | gradient ascent (eq. 3.5 ascent form, Fig. 3-7 corners, eq. 3.7 heading, seed 001's sign flip); [`Walker`] for step-by-step use with the coordinator's direction masks |
-//! | [`navigator`] | one agent's decision-round logic: its `shared_paths` row, candidates, what each verdict does, waypoints; its guide: the neural map climbed, or a [`route::RoutePlanner`]'s route followed (`planner = "pso"`, `"ga-fuzzy"`) |
-//! | [`controller`] | the wheel controller that drives the robot to the centre of the committed cell |
-//! | [`odometry`] | §D.2 dead reckoning from Hall ticks: [`odometry::DeadReckoning`], a pure function of the tick stream |
 //! | [`process`] | the `hnav-agent` process: ports, the round loop in lockstep and realtime, map snapshots, the restart checkpoint |
+//! | [`navigator`] | one agent's decision-round logic: its `shared_paths` row, candidates, what each verdict does, waypoints; its guide: the neural map climbed, or a [`route::RoutePlanner`]'s route followed (`planner = "pso"`, `"ga-fuzzy"`) |
 //! | [`pso`] | seed 003's particle swarm with virtual obstacles at swarm-detected local minima, a [`route::RoutePlanner`] |
+//! | [`controller`] | the wheel controller that drives the robot to the centre of the committed cell |
 //! | [`ga_fuzzy`] | seed 004: the GA over time-indexed grids ([`ga_fuzzy::GaPlanner`], route planner `"ga-fuzzy"`) and the fuzzy controller |
-//! | [`route`] | [`route::RoutePlanner`]: the seeds' planners that answer with a whole route (PSO, GA) |
 //! | [`plan`] | [`plan_query`]: one start-goal query, answered with a JSON-ready [`PlanResult`](hnav_runtime::plan::PlanResult) |
+//! | [`path_constructor`] | gradient ascent (eq. 3.5 ascent form, Fig. 3-7 corners, eq. 3.7 heading, seed 001's sign flip); [`Walker`] for step-by-step use with the coordinator's direction masks |
+//! | [`route`] | [`route::RoutePlanner`]: the seeds' planners that answer with a whole route (PSO, GA) |
+//! | [`neural_map`] | the network (eq. 3.2–3.4, §2.8–2.11): options, the `f32` fast path [`NeuralMap`], the `f64` [`ReferenceMap`], Table 2-2's weight matrix, §2.10 repair |
+//! | [`odometry`] | §D.2 dead reckoning from Hall ticks: [`odometry::DeadReckoning`], a pure function of the tick stream |
 //! | [`error`] | [`Error`]: bad cells and bad options, never a panic |
 //!
 //! ```

@@ -17,7 +17,7 @@ use zenoh::{Session, Wait};
 use crate::delay::{Delay, DelayLine};
 use crate::hosts::{self, HostsView, Peers};
 use crate::outlet::{AheadLine, Outlet};
-use crate::port::{self, Port};
+use crate::port::{self, Counts, Port};
 use crate::session::{self, Endpoints, SessionError};
 use crate::topics::TopicSpec;
 
@@ -52,44 +52,6 @@ pub enum BridgeError {
         /// Zenoh's words.
         why: String,
     },
-}
-
-/// What a bridge has moved so far.
-#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
-pub struct Counts {
-    /// Samples of this host's processes sent to Zenoh.
-    pub out: u64,
-    /// Samples of other hosts published into this host's iceoryx2.
-    pub r#in: u64,
-    /// Samples from Zenoh dropped as invalid (wrong type name, size or field range).
-    pub dropped: u64,
-    /// Samples from Zenoh dropped because the inbox was full.
-    pub overflow: u64,
-    /// Puts Zenoh refused.
-    pub failed: u64,
-}
-
-impl Counts {
-    /// Counts one put to Zenoh, sent or refused.
-    pub(crate) fn put(&mut self, topic: &str, put: Result<(), String>) {
-        match put {
-            Ok(()) => self.out += 1,
-            Err(e) => {
-                self.failed += 1;
-                tracing::debug!(topic, "zenoh put failed: {e}");
-            }
-        }
-    }
-}
-
-impl core::fmt::Display for Counts {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(
-            f,
-            "out={} in={} dropped={} overflow={} failed={}",
-            self.out, self.r#in, self.dropped, self.overflow, self.failed
-        )
-    }
 }
 
 /// Ends a [`Bridge::run`] from another thread (a bridge inside a benchmark or a test).

@@ -6,16 +6,22 @@
 //! already has a distributed engine for this (dora-rs joins its daemons with Zenoh, ROS 2 has
 //! rmw_zenoh); HNAV uses it instead of a protocol of its own.
 //!
-//! - [`topics`]: which topics cross, with their payload types and QoS.
-//! - [`session`]: the Zenoh session (endpoints, no multicast scouting).
-//! - [`hosts`]: the other hosts of a placed run, followed by Zenoh liveliness tokens: the
-//!   bridge's `Up` once all are heard, `Down`/`Restarted` for the robots of a host cut off
-//!   and back.
-//! - [`delay`]: a test-only delay on every sample from another host.
-//! - [`Bridge`]: one host's end: the ports, the loop, the counters.
-//! - `outlet` (private): a port's way out to Zenoh; in a realtime run the samples that must
-//!   not be dropped (lifecycle, `ready`) go through a thread of their own, so that a link
-//!   that cannot take them never holds the loop.
+//! **Must not depend on**: any HNAV crate but `hnav-runtime` (the processes whose topics it
+//! carries are reached only through their messages), nor on the operator's libraries
+//! (plotters, ratatui, mcap, indicatif).
+//!
+//! Modules, highest first (a module uses only those below it in this table; imports never run
+//! back up):
+//!
+//! | module | what it holds |
+//! |---|---|
+//! | `bridge` | [`Bridge`]: one host's end: the ports, the loop, the counters |
+//! | `port` | one topic's two ends: iceoryx2 in and out, Zenoh in and out, and their [`Counts`] |
+//! | `outlet` | a port's way out to Zenoh; in a realtime run the samples that must not be dropped (lifecycle, `ready`) go through a thread of their own, so that a link that cannot take them never holds the loop |
+//! | [`hosts`] | the other hosts of a placed run, followed by Zenoh liveliness tokens: the bridge's `Up` once all are heard, `Down`/`Restarted` for the robots of a host cut off and back |
+//! | [`session`] | the Zenoh session (endpoints, no multicast scouting) |
+//! | [`delay`] | a test-only delay on every sample from another host |
+//! | [`topics`] | which topics cross, with their payload types and QoS |
 //!
 //! Out of iceoryx2 a sample is read in place and its bytes go straight into Zenoh's buffer;
 //! into iceoryx2 the bytes are written into a loaned sample, checked there ([`Wire`]) and
@@ -32,4 +38,5 @@ mod port;
 pub mod session;
 pub mod topics;
 
-pub use bridge::{Bridge, BridgeError, Counts, Stopper};
+pub use bridge::{Bridge, BridgeError, Stopper};
+pub use port::Counts;

@@ -14,9 +14,46 @@ use hnav_runtime::transport::{
 };
 use zenoh::bytes::ZBytes;
 
-use crate::bridge::Counts;
 use crate::outlet::Outlet;
 use crate::topics::{Payload, TopicSpec};
+
+/// What a bridge has moved so far.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct Counts {
+    /// Samples of this host's processes sent to Zenoh.
+    pub out: u64,
+    /// Samples of other hosts published into this host's iceoryx2.
+    pub r#in: u64,
+    /// Samples from Zenoh dropped as invalid (wrong type name, size or field range).
+    pub dropped: u64,
+    /// Samples from Zenoh dropped because the inbox was full.
+    pub overflow: u64,
+    /// Puts Zenoh refused.
+    pub failed: u64,
+}
+
+impl Counts {
+    /// Counts one put to Zenoh, sent or refused.
+    pub(crate) fn put(&mut self, topic: &str, put: Result<(), String>) {
+        match put {
+            Ok(()) => self.out += 1,
+            Err(e) => {
+                self.failed += 1;
+                tracing::debug!(topic, "zenoh put failed: {e}");
+            }
+        }
+    }
+}
+
+impl core::fmt::Display for Counts {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "out={} in={} dropped={} overflow={} failed={}",
+            self.out, self.r#in, self.dropped, self.overflow, self.failed
+        )
+    }
+}
 
 /// A topic's two directions, whatever its payload type.
 pub(crate) trait Port {

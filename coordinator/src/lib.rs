@@ -8,8 +8,13 @@
 //! planners, and the terrain-hazard model they can plan with, after seed 002 (a thesis on
 //! Lazy Theta* for s-bots on rough terrain).
 //!
-//! Modules, highest first: a module may import only modules listed below it (no two files of
-//! the crate import each other, directly or through a ring).
+//! **Must not depend on**: any HNAV crate but `hnav-runtime`: never on `hnav-operator`
+//! (which starts this process) nor on another process crate (agent, sim, bridge); what they
+//! share with it (messages, topics, the consensus log's format) is the runtime's. Nor on the
+//! operator's libraries (plotters, ratatui, mcap, indicatif).
+//!
+//! Modules, highest first (a module uses only those below it in this table; imports never run
+//! back up; no two files of the crate import each other, directly or through a ring):
 //!
 //! | module | concept |
 //! |---|---|
@@ -21,11 +26,6 @@
 //! | [`terrain`] | slope, roughness and relief from a height map; the hazard index `R`; route hazard `c = sum alpha R` |
 //! | [`mod@line_of_sight`] | line of sight between cell centres and the exact cell walk behind it, which the planners and the route hazard share |
 //! | [`error`] | [`PlanError`], every way a caller's input can be unusable |
-//!
-//! The crate depends on `hnav-runtime` only among the workspace's crates: never on
-//! `hnav-operator` (which starts this process) nor on another process crate (agent, sim,
-//! bridge); what they share with it (messages, topics, the consensus log's format) is the
-//! runtime's.
 //!
 //! ```
 //! use hnav_coordinator::planner::{LazyTheta, Planner, PlannerConfig};

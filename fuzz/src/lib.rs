@@ -8,6 +8,21 @@
 //! accepted input round-trips where a writer exists. It returns an [`Outcome`], the class of
 //! what happened (`ok`, or the error variant), which the campaigns count as their coverage.
 //!
+//! **Must not depend on**: any HNAV crate but `hnav-runtime`, whose readers it feeds, nor on
+//! the AFL++ runtime (only `fuzz/afl`, outside the workspace, links it).
+//!
+//! Modules, highest first (a module uses only those below it in this table; imports never run
+//! back up):
+//!
+//! | module | what it holds |
+//! |---|---|
+//! | `payload` | the `payload` target: every `msg` payload decoded from raw shared-memory bytes |
+//! | `log` | the `record` and `log` targets: consensus-log payloads and segment directories |
+//! | `text` | the `map`, `scen` and `scenario` targets: the text formats |
+//! | `mutate` | [`Mutator`]: the campaign's seeded byte mutations of a corpus input |
+//!
+//! The targets:
+//!
 //! | target | reader | round trip |
 //! |---|---|---|
 //! | `map` | `grid::read_map` (MovingAI `.map`) | `write_map` then `read_map` gives the same grid |

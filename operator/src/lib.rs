@@ -4,10 +4,10 @@
 //! read back a run. The `hnav` binary (`src/bin/hnav/`) is a thin layer of command-line verbs
 //! over these modules.
 //!
-//! **Must not be depended on by a process crate** (`hnav-agent`, `hnav-coordinator`,
-//! `hnav-sim`, `hnav-bridge`): the supervisor starts those binaries by path and never links
-//! them, and they never link plotters, ratatui, mcap or indicatif. `hnav-bench` and
-//! `hnav-tests` may use it. It depends on `hnav-runtime` only.
+//! **Must not depend on**: any HNAV crate but `hnav-runtime`: the supervisor starts the
+//! process binaries by path and never links them. **Must not be depended on by a process
+//! crate** (`hnav-agent`, `hnav-coordinator`, `hnav-sim`, `hnav-bridge`): they never link
+//! plotters, ratatui, mcap or indicatif. `hnav-bench` and `hnav-tests` may use it.
 //!
 //! Modules, highest first (a module uses only those below it in this table; imports never run
 //! back up):

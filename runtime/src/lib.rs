@@ -25,11 +25,12 @@
 //! | [`placement`] | `hosts.toml`: which host runs which process of a run across hosts, and how their bridges reach each other |
 //! | [`scenario`] | the TOML description of a run, validated with file/line errors |
 //! | [`rejected`] | the classes of hostile or malformed messages a receiver drops, and their counts for the run summary |
+//! | [`layout`] | the table of every payload's size, alignment and field offsets, and of the topic that carries it, for clients in other languages (`hnav layout --json`) |
 //! | [`topics`] | the run's service names and their QoS, defined once for every process |
 //! | [`transport`] | run-scoped iceoryx2 services: publisher+notifier, subscriber+listener, the one [`Waiter`](transport::Waiter) every process blocks in |
-//! | [`msg`] | `#[repr(C)]` zero-copy payloads (Candidate, Commit, WheelCommand, ...) and their layouts |
 //! | [`plan`] | [`PlanResult`](plan::PlanResult), the answer to one planning query, whichever planner gave it |
 //! | [`grid`] | occupancy grids, terrain, coordinates, octile neighbours, MovingAI `.map`/`.scen` files |
+//! | [`msg`] | `#[repr(C)]` zero-copy payloads (Candidate, Commit, WheelCommand, ...) and their layouts |
 //! | [`logging`] | `tracing` set-up shared by the binaries, with iceoryx2's own logs routed into it |
 //! | [`file_lock`] | exclusive `flock` locks that name their holder: a run's directory, its run id, its consensus log |
 //! | [`durable`] | files that must survive a crash: whole-file replace, checkpoint slots, framed append logs |
@@ -46,6 +47,7 @@ pub mod grid;
 pub mod hash;
 pub mod health;
 pub mod launch;
+pub mod layout;
 pub mod logging;
 pub mod msg;
 pub mod placement;

@@ -1,10 +1,8 @@
-//! Errors of the stepper and its process: bad parameters and bad inputs, never a panic, and
-//! a failing transport.
+//! Errors of the stepper: bad parameters and bad inputs, never a panic. The process around it
+//! adds its own ([`crate::process::SimProcessError`]: transport, checkpoint), so the model
+//! knows nothing of the process.
 
-use hnav_runtime::transport::TransportError;
-
-/// What went wrong building or driving a [`crate::World`], or running the `hnav-sim` process
-/// around it ([`crate::process::SimProcess`]).
+/// What went wrong building or driving a [`crate::World`].
 #[derive(Debug, thiserror::Error)]
 pub enum SimError {
     /// A robot or sim parameter is out of range.
@@ -41,12 +39,4 @@ pub enum SimError {
         /// Robot index.
         robot: usize,
     },
-    /// The run's transport failed: a port could not be opened, a send, receive or wait failed,
-    /// or the supervisor never answered the start-up handshake.
-    #[error(transparent)]
-    Transport(#[from] TransportError),
-    /// The restart checkpoint `DIR/sim.ckpt.{0,1}` could not be written, or a restarted sim could
-    /// not use the one it found.
-    #[error("sim checkpoint {0}")]
-    Checkpoint(#[from] crate::process::CheckpointError),
 }

@@ -7,16 +7,21 @@
 //! ([`World::from_scenario`]). Poses and geometry use nalgebra (`Point2`, `UnitComplex`,
 //! `Isometry2`); see [`world`] for why the inner loop needs no separate scalar form.
 //!
+//! **Must not depend on**: any HNAV crate but `hnav-runtime` (the agents and the coordinator are reached only through its messages), nor on the operator's libraries (plotters, ratatui, mcap, indicatif) (`hnav-agent` only as a dev-dependency, for the odometry tests).
+//!
+//! Modules, highest first (a module uses only those below it in this table; imports never run
+//! back up):
+//!
 //! | module | what |
 //! |---|---|
+//! | [`process`] | the `hnav-sim` process: [`process::SimProcess`] (`new`, `run`), its ports and state, lockstep and realtime; [`process::SimOutcome`]; [`process::SimProcessError`]: the model's errors, transport and checkpoint failures |
+//! | [`world`] | [`World`]: N robots, struct-of-arrays, fixed step, odometry and Truth |
 //! | [`robot`] | [`RobotModel`]: validated parameters; motor lag, speed and acceleration limits, braking |
 //! | [`kinematics`] | §D.2 wheel increments and the exact-arc pose update as a rigid motion (nalgebra `Isometry2`, `UnitComplex` headings) |
 //! | [`hall`] | tick quantisation and seeded wheel-slip noise (ChaCha) |
 //! | [`collision`] | disc–disc and disc–blocked-cell contacts (`Point2` geometry), recorded when they begin with time, robots or cell, and positions |
 //! | [`watchdog`] | stale commands are replaced by braking |
-//! | [`world`] | [`World`]: N robots, struct-of-arrays, fixed step, odometry and Truth |
-//! | [`process`] | the `hnav-sim` process: [`process::SimProcess`] (`new`, `run`), its ports and state, lockstep and realtime; [`process::SimOutcome`] |
-//! | [`error`] | [`SimError`]: bad parameters and inputs, never a panic, and transport failures |
+//! | [`error`] | [`SimError`]: bad parameters and inputs, never a panic |
 //!
 //! ```
 //! use hnav_runtime::grid::geometry::cell_centre_pose;

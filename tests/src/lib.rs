@@ -16,10 +16,29 @@
 //!   multi-host tests (`tests/multi_host.rs`);
 //! - [`docs`]: what `tests/docs.rs` checks in the markdown (commands, links, paths).
 //!
+//! **Must not depend on**: `hnav-bench` or `hnav-fuzz` outside its test binaries (the chaos
+//! campaign is a dev-dependency): the helpers here are what the tests share, not what they
+//! measure.
+//!
+//! Modules, highest first (a module uses only those below it in this table; imports never run
+//! back up):
+//!
+//! | module | what it holds |
+//! |---|---|
+//! | [`house`] | the workspace's import rules checked over its sources: rings of files, imports back up a `lib.rs` table |
+//! | [`docs`] | what `tests/docs.rs` checks in the markdown: commands against `--help`, links, paths |
+//! | [`swarm`] | one `hnav run` of a test: its scenario, its run directory, its log's digest |
+//! | [`rogue`] | the hostile candidates `hnav-rogue` forges |
+//! | [`lost_wakeup`] | both halves of the lost-wake-up reproducer |
+//! | [`netns`] | hosts on one machine: network namespaces, a switch, loss, partitions |
+//! | [`tmux`] | a terminal of a test's own for full-screen programs |
+//! | [`pattern`] | the deterministic payloads both sides of a test agree on |
+//!
 //! Tests that SIGKILL processes live in their own test binaries (`tests/*_kill.rs`).
 //! Tests that send other signals do too (`tests/waiter_signals.rs`).
 
 pub mod docs;
+pub mod house;
 pub mod lost_wakeup;
 pub mod netns;
 pub mod pattern;

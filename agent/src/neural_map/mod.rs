@@ -20,7 +20,8 @@
 //! | here | options ([`NeuralMapOptions`] and its enums), [`StopRule`], [`BuildReport`], the [`ActivationField`] and [`NeuralDynamics`] traits |
 //! | [`fast`] | [`NeuralMap`]: the `f32` fast path with an extended exponent (no underflow), double buffers, a growing bounding box |
 //! | [`reference`](mod@reference) | [`ReferenceMap`]: the plain `f64` reference implementation (exact where `f64` does not underflow) |
-//! | [`weights`] | [`Weights`] and the dense [`WeightMatrix`] builder (Table 2-2) |
+//! | [`weights`] | [`Weights`]: the link weights of eq. 3.2 |
+//! | [`matrix`] | the dense [`WeightMatrix`] builder (Table 2-2) |
 //! | [`repair`] | §2.10: partial correction and rebuild with partial activation |
 //! | `topology` (private) | which neurons are linked and each denominator: the one network definition both implementations build from |
 //! | `driver` (private) | the stop rules ([`StopRule`]), written once for both implementations |
@@ -49,6 +50,7 @@
 mod driver;
 pub mod fast;
 mod kernel;
+pub mod matrix;
 pub mod reference;
 pub mod repair;
 mod topology;
@@ -61,8 +63,9 @@ use serde::{Deserialize, Serialize};
 use crate::error::Error;
 
 pub use fast::NeuralMap;
+pub use matrix::WeightMatrix;
 pub use reference::ReferenceMap;
-pub use weights::{WeightMatrix, Weights};
+pub use weights::Weights;
 
 /// The activation function `phi`.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]

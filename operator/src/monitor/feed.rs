@@ -4,11 +4,55 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use super::health::HealthRow;
-use super::state::RunInfo;
 use crate::supervisor::registry::LiveRunError;
-use hnav_runtime::msg::{Commit, Lifecycle, Progress, Truth};
-use hnav_runtime::scenario::ScenarioError;
+use hnav_runtime::grid::Grid;
+use hnav_runtime::msg::{Commit, Lifecycle, Pose, Progress, Truth};
+use hnav_runtime::scenario::{Scenario, ScenarioError};
 use hnav_runtime::transport::TransportError;
+
+/// The static picture of a run: what does not change while it runs.
+#[derive(Debug, Clone)]
+pub struct RunInfo {
+    /// The run id.
+    pub run_id: String,
+    /// `lockstep` or `realtime`.
+    pub mode: String,
+    /// The map.
+    pub grid: Grid,
+    /// Each agent's start cell (0-based row-major index, as in the messages).
+    pub starts: Vec<u32>,
+    /// Each agent's goal cell (0-based row-major index).
+    pub goals: Vec<u32>,
+    /// Side of a cell in metres, to place ground-truth poses.
+    pub cell_size_m: f64,
+}
+
+impl RunInfo {
+    /// The picture of `scenario` run as `run_id`.
+    pub fn of(run_id: &str, scenario: &Scenario) -> RunInfo {
+        let grid = scenario.map.grid.clone();
+        // Messages name cells by their 0-based row-major index, not the 1-based cell id.
+        let id = |c| u32::try_from(grid.index(c)).unwrap_or(hnav_runtime::msg::NO_CELL);
+        RunInfo {
+            run_id: run_id.to_string(),
+            mode: scenario.sim.clock.to_string(),
+            starts: scenario.agents.iter().map(|a| id(a.start)).collect(),
+            goals: scenario.agents.iter().map(|a| id(a.goal)).collect(),
+            cell_size_m: scenario.robot.cell_size_m,
+            grid,
+        }
+    }
+
+    /// The cell (0-based row-major index) of a ground-truth pose, if it is on the map.
+    pub fn cell_of(&self, pose: &Pose) -> Option<u32> {
+        let (x, y) = (
+            (pose.x_m / self.cell_size_m).floor(),
+            (pose.y_m / self.cell_size_m).floor(),
+        );
+        let (w, h) = (f64::from(self.grid.width()), f64::from(self.grid.height()));
+        (x >= 0.0 && y >= 0.0 && x < w && y < h).then(|| y as u32 * self.grid.width() + x as u32)
+    }
+}
 
 /// How a run's view came to its end.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

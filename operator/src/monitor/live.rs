@@ -17,9 +17,9 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
+use super::feed::RunInfo;
 use super::feed::{Feed, FeedError, RunEnd, Update, Waited};
 use super::health::{HealthRow, HealthSampler};
-use super::state::RunInfo;
 use crate::supervisor::registry::LiveRunError;
 use crate::supervisor::registry::{RunRecord, RunRegistry};
 use hnav_runtime::consensus_log::reader::LogReader;

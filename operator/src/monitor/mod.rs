@@ -10,7 +10,7 @@
 //! A [`Feed`](feed::Feed) is a source of [`Update`](feed::Update)s: the message contracts
 //! themselves (a [`Truth`](hnav_runtime::msg::Truth), a [`Commit`](hnav_runtime::msg::Commit), ...) plus
 //! the process-health rows and the end of the run, and the static picture of the run
-//! ([`RunInfo`](state::RunInfo): map, starts, goals). [`ViewState`](state::ViewState) folds
+//! ([`RunInfo`](feed::RunInfo): map, starts, goals). [`ViewState`](state::ViewState) folds
 //! updates into what the screen shows (each agent's state, the round rate, the latest
 //! decisions) and [`view::draw`] renders it with ratatui into any backend, the terminal or
 //! ratatui's `TestBackend`. Nothing past the feed knows where the data came from.

@@ -32,8 +32,8 @@ use std::time::{Duration, Instant};
 
 use iceoryx2_bb_posix::signal::SignalHandler;
 
+use super::feed::RunInfo;
 use super::feed::{Feed, FeedError, RunEnd, Update, Waited};
-use super::state::RunInfo;
 use crate::recording::{self, PoseSample, PoseSource, TrajectoryReader};
 use crate::report::MAP_FILE;
 use hnav_runtime::consensus_log::read_decided;

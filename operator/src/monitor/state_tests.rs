@@ -1,4 +1,5 @@
 use super::*;
+use hnav_runtime::grid::Grid;
 
 /// A 4 x 2 room, cells 1 m wide, agent 0 from cell 0 to cell 2, agent 1 from 4 to 7.
 fn view() -> ViewState {

@@ -40,11 +40,9 @@
 //! | `lifecycle` | the supervisor's protocol: [`Role`] and its names, [`LifecycleEvent`], [`StopReason`], [`StartupPhase`], [`Lifecycle`] and its constructors |
 //! | `map` | the neural-map snapshot: [`MapHeader`], [`ActivationKind`] |
 //! | `health` | a process's proof of life: [`Heartbeat`] |
-//! | [`layout`] | the table of every payload's size, alignment and field offsets, for clients in other languages (`hnav layout --json`) |
 //! | [`wire`] | a payload as its bytes, checked on arrival, for links that leave the host ([`Wire`]) |
 
 mod health;
-pub mod layout;
 mod lifecycle;
 mod map;
 mod motion;

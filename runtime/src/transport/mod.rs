@@ -42,6 +42,7 @@ mod bell;
 mod channel;
 mod error;
 mod node;
+mod nodes;
 mod qos;
 mod run;
 mod slice;
@@ -50,7 +51,8 @@ mod waiter;
 pub use bell::{Bell, BellWatch, BELL_ENV, BELL_LISTENER};
 pub use channel::{Drained, PublisherId, Receiver, Sender, Wakeup};
 pub use error::TransportError;
-pub use node::{CleanupReport, NodeInfo, NodeLiveness, Transport, TransportBuilder};
+pub use node::{Transport, TransportBuilder};
+pub use nodes::{CleanupReport, NodeInfo, NodeLiveness};
 pub use qos::{Delivery, Qos};
 pub use run::{
     ipc_root, is_domain_name, purge_run, run_config, run_iceoryx2_files, run_shm_files, RunId,

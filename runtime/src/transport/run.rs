@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use iceoryx2::config::Config;
 use iceoryx2::prelude::{FileName, Path as IoxPath, SemanticString, ServiceName};
 
+use super::nodes::cleanup_dead_nodes_in;
 use super::{Ipc, TransportError};
 
 /// Where POSIX shared memory lives on Linux; iceoryx2 names its segments with the config prefix.
@@ -340,7 +341,7 @@ pub fn run_iceoryx2_files(run: &RunId) -> Vec<PathBuf> {
 /// exited cleanly.
 pub fn purge_run(run: &RunId) -> Result<usize, TransportError> {
     let config = run_config(run);
-    let report = super::node::cleanup_dead_nodes_in(&config)?;
+    let report = cleanup_dead_nodes_in(&config)?;
     if report.alive > 0 {
         return Err(TransportError::Iceoryx {
             op: "purge run",

@@ -35,13 +35,30 @@ use hnav_runtime::launch::{LifecyclePorts, StartOutcome};
 use hnav_runtime::msg::Role;
 use hnav_runtime::scenario::params::ClockMode;
 use hnav_runtime::scenario::Scenario;
-use hnav_runtime::transport::{Transport, Waiter, Wake};
+use hnav_runtime::transport::{Transport, TransportError, Waiter, Wake};
 
 use crate::error::SimError;
 use crate::world::World;
 pub use checkpoint::{CheckpointError, Restored, SimCheckpoint};
 use ports::Ports;
 use state::State;
+
+/// What stopped the `hnav-sim` process: its world refused a parameter or an input, its
+/// transport failed, or its checkpoint could not be written or used.
+#[derive(Debug, thiserror::Error)]
+pub enum SimProcessError {
+    /// The world refused a parameter or an input.
+    #[error(transparent)]
+    Model(#[from] SimError),
+    /// The run's transport failed: a port could not be opened, a send, receive or wait failed,
+    /// or the supervisor never answered the start-up handshake.
+    #[error(transparent)]
+    Transport(#[from] TransportError),
+    /// The restart checkpoint `DIR/sim.ckpt.{0,1}` could not be written, or a restarted sim could
+    /// not use the one it found.
+    #[error("sim checkpoint {0}")]
+    Checkpoint(#[from] CheckpointError),
+}
 
 /// How a run of the process ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -72,7 +89,7 @@ pub struct SimProcess<'t> {
 impl<'t> SimProcess<'t> {
     /// Builds the world from `scenario` (robots at their start cells' centres, facing their
     /// `start_heading_deg`) and opens the ports.
-    pub fn new(transport: &'t Transport, scenario: &Scenario) -> Result<Self, SimError> {
+    pub fn new(transport: &'t Transport, scenario: &Scenario) -> Result<Self, SimProcessError> {
         let world = World::from_scenario(scenario)?;
         let ports = Ports::open(transport, world.robots())?;
         let heart = Heartbeat::open(
@@ -138,7 +155,7 @@ impl<'t> SimProcess<'t> {
     /// Joined to the lifecycle protocol, announces itself and waits for the start (unless
     /// resuming, the scenario's start-up timeout at most); then runs until a stop request or, if given,
     /// `max_periods` control periods.
-    pub fn run(&mut self, max_periods: Option<u64>) -> Result<SimOutcome, SimError> {
+    pub fn run(&mut self, max_periods: Option<u64>) -> Result<SimOutcome, SimProcessError> {
         if let Some(life) = &self.ports.life {
             let started = life.handshake(self.transport, self.resume, self.startup_timeout)?;
             if started == StartOutcome::Stopped {
@@ -171,7 +188,7 @@ fn run_loop(
     waiter: &Waiter,
     heart: &Heartbeat,
     max_periods: Option<u64>,
-) -> Result<bool, SimError> {
+) -> Result<bool, SimProcessError> {
     let period_wall = st.period_wall();
     // Realtime periods are due from the loop's start on, counted from the period it starts
     // at (a resumed sim's is not 0).

@@ -9,8 +9,7 @@ use hnav_runtime::scenario::params::ClockMode;
 
 use super::checkpoint::SimCheckpoint;
 use super::ports::Ports;
-use super::SimOutcome;
-use crate::error::SimError;
+use super::{SimOutcome, SimProcessError};
 use crate::world::World;
 
 /// What the loop of [`SimProcess`](super::SimProcess) mutates.
@@ -75,7 +74,7 @@ impl State {
     /// dropped; a restarted sim, which starts again at period 0, holds at every fault round
     /// once more (one resumed from its checkpoint, at those from its period on), and the
     /// supervisor resumes those already done at once.
-    pub(crate) fn holding(&mut self, ports: &Ports) -> Result<bool, SimError> {
+    pub(crate) fn holding(&mut self, ports: &Ports) -> Result<bool, SimProcessError> {
         while self.holds.front().is_some_and(|&p| p < self.period) {
             self.holds.pop_front();
             self.hold_sent = false;
@@ -111,7 +110,7 @@ impl State {
     /// a command it sent for this period is void (the brake overrode it); a restarted one
     /// counts again from its first fresh command (it needs this period's odometry before it
     /// can send one). A `Resume` for the period held at ends the hold.
-    pub(crate) fn on_lifecycle(&mut self, ports: &Ports) -> Result<LifecycleNews, SimError> {
+    pub(crate) fn on_lifecycle(&mut self, ports: &Ports) -> Result<LifecycleNews, SimProcessError> {
         let Some(l) = &ports.life else {
             return Ok(LifecycleNews {
                 stop: false,
@@ -168,7 +167,7 @@ impl State {
     /// last one may have gone out before it subscribed: sends it again and waits for the agent
     /// from this period on. One that has already rejoined (its first fresh command came in
     /// before the event) needs nothing, and its command must not be forgotten.
-    fn resend_odometry(&mut self, ports: &Ports, restarted: &[u32]) -> Result<(), SimError> {
+    fn resend_odometry(&mut self, ports: &Ports, restarted: &[u32]) -> Result<(), SimProcessError> {
         let Some(last) = self.period.checked_sub(1) else {
             return Ok(());
         };
@@ -194,7 +193,7 @@ impl State {
     /// [`Waiter`](hnav_runtime::transport::Waiter)), and acted on before them too, which is
     /// why this is not `drain_pending`: a robot whose publisher died and which still sent a
     /// fresh command counts as live from that command, not as down.
-    pub(crate) fn drain(&mut self, ports: &Ports) -> Result<bool, SimError> {
+    pub(crate) fn drain(&mut self, ports: &Ports) -> Result<bool, SimProcessError> {
         let now = self.world.time_ns();
         let realtime = self.clock == ClockMode::Realtime;
         let mut any = false;
@@ -241,7 +240,7 @@ impl State {
     }
 
     /// Steps one control period, checkpoints it, and publishes odometry and truth for it.
-    pub(crate) fn advance(&mut self, ports: &Ports) -> Result<(), SimError> {
+    pub(crate) fn advance(&mut self, ports: &Ports) -> Result<(), SimProcessError> {
         for _ in 0..self.world.steps_per_odometry() {
             self.world.step();
         }
@@ -256,7 +255,7 @@ impl State {
 
     /// Publishes every robot's odometry and the truth of the world as it stands, as the
     /// reading of `period`.
-    fn publish(&self, ports: &Ports, period: u64) -> Result<(), SimError> {
+    fn publish(&self, ports: &Ports, period: u64) -> Result<(), SimProcessError> {
         for (i, tx) in ports.odom.iter().enumerate() {
             if let Some(o) = self.world.odometry(i as u32, period) {
                 tx.send(o)?;
@@ -271,7 +270,7 @@ impl State {
     /// there is one, and publishes the last stepped period's odometry and truth again (its
     /// predecessor may have died between checkpointing and publishing them). Returns the
     /// period resumed at.
-    pub(crate) fn resume(&mut self, ports: &Ports) -> Result<Option<u64>, SimError> {
+    pub(crate) fn resume(&mut self, ports: &Ports) -> Result<Option<u64>, SimProcessError> {
         let Some(c) = &self.checkpoint else {
             return Ok(None);
         };

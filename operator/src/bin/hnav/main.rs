@@ -139,7 +139,7 @@ fn main() -> ExitCode {
         Command::Report(args) => report_cmd::run(args),
         Command::Log { command } => log_cmd::run(command),
         Command::Layout { json } => {
-            let table = hnav_runtime::msg::layout::layouts();
+            let table = hnav_runtime::layout::layouts();
             if json {
                 hnav_runtime::outln!("{}", table.to_json());
             } else {

@@ -1,6 +1,7 @@
 //! The layout table of every payload: what a client in another language (the Python client's
 //! `ctypes` mirrors, `clients/python/hnav/msg.py`) must reproduce byte for byte, and which
-//! topic carries which type.
+//! topic carries which type. Above both [`crate::msg`] and [`crate::topics`], which it
+//! joins.
 //!
 //! Printed by the hidden `hnav layout --json`; the Python client's layout test compares its
 //! mirrors with it field by field (`tests/tests/python_client.rs`).
@@ -10,7 +11,7 @@ use core::mem::{align_of, offset_of, size_of};
 use iceoryx2::prelude::ZeroCopySend;
 use serde::Serialize;
 
-use super::{
+use crate::msg::{
     Candidate, Commit, Decision, Estimate, Heartbeat, Lifecycle, MapHeader, Odometry, Pose,
     Progress, Truth, WheelCommand, MAX_AGENTS,
 };
@@ -232,7 +233,7 @@ impl Layouts {
         serde_json::to_string_pretty(self).unwrap_or_default()
     }
 
-    /// The table as text, one line per type (as in the [`msg`](super) docs).
+    /// The table as text, one line per type (as in the [`msg`](crate::msg) docs).
     pub fn render(&self) -> String {
         let mut out = String::new();
         for t in &self.types {
