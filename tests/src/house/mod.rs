@@ -148,7 +148,9 @@ fn table_of_contents(lib_rs: &str) -> Vec<String> {
         .iter()
         .skip_while(|r| r.starts_with("|-") || r.starts_with("| -"))
         .take_while(|r| r.starts_with('|'))
-        .filter_map(|r| r.split('`').nth(1).map(str::to_string))
+        .filter_map(|r| r.split('`').nth(1))
+        // A rustdoc disambiguator (`mod@line_of_sight`, where a function shares the name).
+        .map(|m| m.strip_prefix("mod@").unwrap_or(m).to_string())
         .collect()
 }
 
