@@ -45,6 +45,10 @@ pub trait DiskFile {
 
     /// The file's length.
     fn len(&self) -> io::Result<u64>;
+    /// Whether the file holds no bytes.
+    fn is_empty(&self) -> io::Result<bool> {
+        Ok(self.len()? == 0)
+    }
 }
 
 /// The machine's file system.
