@@ -172,8 +172,8 @@ impl DiskFile for FaultFile {
         }
     }
 
-    fn len(&self) -> io::Result<u64> {
-        DiskFile::len(&self.file)
+    fn size(&self) -> io::Result<u64> {
+        self.file.size()
     }
 }
 

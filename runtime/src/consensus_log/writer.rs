@@ -186,7 +186,7 @@ impl<D: Disk> LogWriter<D> {
             }
             file.sync_data().map_err(io)?;
         }
-        let len = file.len().map_err(|e| LogError::io(&path, e))?;
+        let len = file.size().map_err(|e| LogError::io(&path, e))?;
         let records = contents.records.len() as u64;
         let file = Appender::new(file, len);
         let writer = Self::new(

@@ -76,11 +76,6 @@ impl<F: DiskFile> Appender<F> {
         self.poisoned
     }
 
-    /// Marks the file's durable state unknown (its owner saw a failure the appender did not).
-    pub fn poison(&mut self) {
-        self.poisoned = true;
-    }
-
     /// The open file (to rewrite a header in place).
     pub fn file(&self) -> &F {
         &self.file

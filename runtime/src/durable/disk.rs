@@ -43,12 +43,8 @@ pub trait DiskFile {
     /// Makes the file's data durable (`fdatasync`).
     fn sync_data(&self) -> io::Result<()>;
 
-    /// The file's length.
-    fn len(&self) -> io::Result<u64>;
-    /// Whether the file holds no bytes.
-    fn is_empty(&self) -> io::Result<bool> {
-        Ok(self.len()? == 0)
-    }
+    /// The file's length in bytes.
+    fn size(&self) -> io::Result<u64>;
 }
 
 /// The machine's file system.
@@ -97,7 +93,7 @@ impl DiskFile for File {
         File::sync_data(self)
     }
 
-    fn len(&self) -> io::Result<u64> {
+    fn size(&self) -> io::Result<u64> {
         Ok(self.metadata()?.len())
     }
 }
