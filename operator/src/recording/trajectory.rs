@@ -22,7 +22,7 @@
 //! ```
 //!
 //! ```
-//! use hnav_runtime::recording::{PoseSample, PoseSource, TrajectoryHeader, TrajectoryReader, TrajectoryWriter};
+//! use hnav_operator::recording::{PoseSample, PoseSource, TrajectoryHeader, TrajectoryReader, TrajectoryWriter};
 //! let dir = tempfile::tempdir().unwrap();
 //! let path = dir.path().join("trajectories.bin");
 //! let header = TrajectoryHeader { robots: 2, rate_hz: 20, cell_size_m: 0.16, width: 12, height: 12, truncated: false, control_period_us: 10_000 };
