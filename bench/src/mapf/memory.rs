@@ -55,12 +55,14 @@ impl Sampler {
     /// Samples the supervisor `supervisor` and every process the run registry in
     /// `registry` lists for `run` (missing files and processes that exited meanwhile are
     /// skipped: a sample is best effort, and the peak of a process that exited between two
-    /// samples is the last one read).
-    pub fn sample(&mut self, supervisor: u32, registry: &Path, run: &RunId) {
+    /// samples is the last one read). Returns whether the registry listed the run's
+    /// processes.
+    pub fn sample(&mut self, supervisor: u32, registry: &Path, run: &RunId) -> bool {
         let mut pids = vec![(supervisor, None)];
         if let Ok(Some(record)) = RunRegistry::at(registry).find(run) {
             pids.extend(record.processes.iter().map(|p| (p.pid, Some(p.role))));
         }
+        let listed = pids.len() > 1;
         let mut pss_sum = 0;
         for (pid, role) in pids {
             let Some(hwm) = status_kib(pid, "VmHWM:") else {
@@ -74,6 +76,7 @@ impl Sampler {
         }
         self.pss_sum_kib = self.pss_sum_kib.max(pss_sum);
         self.samples += 1;
+        listed
     }
 
     /// What the samples showed.

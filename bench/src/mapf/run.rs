@@ -16,6 +16,10 @@ use crate::swarm_run::{hnav_run_spec, read_summary, run_files, verify_log};
 
 /// How often the processes' memory is sampled while a run goes on.
 const SAMPLE_EVERY: Duration = Duration::from_secs(2);
+/// How often it is sampled until the run's processes are in the registry: a short run (8
+/// agents, lockstep, 1.5 s) ended between a first sample taken before they were spawned and
+/// the next one 2 s later, and its row had no agent's memory at all.
+const FIRST_SAMPLE_EVERY: Duration = Duration::from_millis(50);
 /// How long `hnav run` gets to stop its processes and write its summary after a SIGINT:
 /// its stop grace (3 s, twice) and the summary, with room for a slow stop of hundreds of
 /// processes on a loaded machine.
@@ -64,8 +68,12 @@ pub fn run_instance(
     let mut sampler = Sampler::default();
     let mut capped = false;
     let exit = loop {
-        sampler.sample(child.pid(), &registry, &run);
-        if let Some(exit) = child.wait(Some(SAMPLE_EVERY)) {
+        let every = if sampler.sample(child.pid(), &registry, &run) {
+            SAMPLE_EVERY
+        } else {
+            FIRST_SAMPLE_EVERY
+        };
+        if let Some(exit) = child.wait(Some(every)) {
             break exit;
         }
         if !capped && started.elapsed() >= place.wall_limit {
