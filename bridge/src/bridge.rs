@@ -16,7 +16,7 @@ use zenoh::{Session, Wait};
 
 use crate::delay::{Delay, DelayLine};
 use crate::hosts::{self, HostsView, Peers};
-use crate::outlet::{AheadLine, Outlet};
+use crate::outlet::Outlet;
 use crate::port::{self, Counts, Port};
 use crate::session::{self, Endpoints, SessionError};
 use crate::topics::TopicSpec;
@@ -39,9 +39,6 @@ pub enum BridgeError {
     /// The test-only delay ([`crate::delay::DELAY_ENV`]) is malformed.
     #[error("{0}")]
     Delay(String),
-    /// The thread for puts that may wait did not start.
-    #[error("cannot start the bridge's ahead thread: {0}")]
-    Thread(std::io::Error),
     /// A Zenoh publisher or subscriber was not declared.
     #[error("zenoh: declare {what} on {key}: {why}")]
     Declare {
@@ -112,8 +109,6 @@ pub struct Bridge {
     overflow: Arc<AtomicU64>,
     stopper: Stopper,
     counts: Counts,
-    // After the outlets that feed it: its thread makes its last puts, then ends.
-    ahead: Option<AheadLine>,
     // Declared last: dropped after the publishers and subscribers that live in it.
     _session: Session,
 }
@@ -146,14 +141,7 @@ impl Bridge {
         let overflow = Arc::new(AtomicU64::new(0));
         let mut ports = Vec::with_capacity(topics.len());
         let mut publishers = Vec::with_capacity(topics.len());
-        // With droppable topics (a realtime run) the others' puts may wait for a congested
-        // link: they go through a thread of their own ([`crate::outlet`]).
         let best_effort = topics.iter().any(|t| t.droppable);
-        let ahead = if best_effort {
-            Some(AheadLine::start().map_err(BridgeError::Thread)?)
-        } else {
-            None
-        };
         let mut subscribers = Vec::with_capacity(topics.len());
         for (i, spec) in topics.iter().enumerate() {
             ports.push(port::open(&transport, spec)?);
@@ -179,10 +167,7 @@ impl Bridge {
                 .allowed_destination(Locality::Remote)
                 .wait()
                 .map_err(|e| declare("publisher", e))?;
-            publishers.push(match &ahead {
-                Some(line) if !spec.droppable => Outlet::ahead(publisher, line),
-                _ => Outlet::direct(publisher),
-            });
+            publishers.push(Outlet::direct(publisher));
             let (tx, ring, overflow) = (tx.clone(), bell.try_clone()?, Arc::clone(&overflow));
             subscribers.push(
                 session
@@ -223,7 +208,6 @@ impl Bridge {
             overflow,
             stopper,
             counts: Counts::default(),
-            ahead,
             _session: session,
         })
     }
@@ -262,7 +246,6 @@ impl Bridge {
     pub fn counts(&self) -> Counts {
         Counts {
             overflow: self.overflow.load(Ordering::Relaxed),
-            failed: self.counts.failed + self.ahead.as_ref().map_or(0, AheadLine::failed),
             ..self.counts
         }
     }

@@ -17,7 +17,7 @@
 //! |---|---|
 //! | `bridge` | [`Bridge`]: one host's end: the ports, the loop, the counters |
 //! | `port` | one topic's two ends: iceoryx2 in and out, Zenoh in and out, and their [`Counts`] |
-//! | `outlet` | a port's way out to Zenoh; in a realtime run the samples that must not be dropped (lifecycle, `ready`) go through a thread of their own, so that a link that cannot take them never holds the loop |
+//! | `outlet` | a port's way out to Zenoh, and the record of a put that held the bridge's loop |
 //! | [`hosts`] | the other hosts of a placed run, followed by Zenoh liveliness tokens: the bridge's `Up` once all are heard, `Down`/`Restarted` for the robots of a host cut off and back |
 //! | [`session`] | the Zenoh session (endpoints, no multicast scouting) |
 //! | [`delay`] | a test-only delay on every sample from another host |
