@@ -167,7 +167,7 @@ impl Bridge {
                 .allowed_destination(Locality::Remote)
                 .wait()
                 .map_err(|e| declare("publisher", e))?;
-            publishers.push(Outlet::direct(publisher));
+            publishers.push(Outlet::new(publisher));
             let (tx, ring, overflow) = (tx.clone(), bell.try_clone()?, Arc::clone(&overflow));
             subscribers.push(
                 session

@@ -25,8 +25,8 @@ pub(crate) struct Outlet {
 }
 
 impl Outlet {
-    /// Puts from the bridge's loop.
-    pub(crate) fn direct(publisher: Publisher<'static>) -> Self {
+    /// Puts through `publisher`, from the bridge's loop.
+    pub(crate) fn new(publisher: Publisher<'static>) -> Self {
         Outlet { publisher }
     }
 

@@ -208,7 +208,7 @@ impl RunSummary {
                     && (p.y_m / cell).floor() == f64::from(a.goal.y)
             })
         };
-        let agents = (0..scenario.agents.len())
+        let agents: Vec<AgentSummary> = (0..scenario.agents.len())
             .map(|i| AgentSummary {
                 id: i as u32,
                 reached_goal: reached(i),
@@ -220,7 +220,7 @@ impl RunSummary {
                 lost: false,
             })
             .collect();
-        let all_home = !scenario.agents.is_empty() && (0..scenario.agents.len()).all(reached);
+        let all_home = !agents.is_empty() && agents.iter().all(|a| a.reached_goal);
         let end = match progress.map(|p| p.done) {
             Some(hnav_runtime::msg::Progress::ALL_AT_GOAL) => "all-at-goal",
             Some(hnav_runtime::msg::Progress::TIME_LIMIT) => "time-limit",
