@@ -371,7 +371,7 @@ agents = [2, 3]
 "#;
 
     #[test]
-    fn a_placement_names_each_process_host_and_the_mesh() {
+    fn a_placement_names_each_process_host_and_the_star() {
         let p = Placement::parse(THREE, "hosts.toml", 4).unwrap();
         assert_eq!(p.hosts().len(), 3);
         assert_eq!(p.host_of(Role::Sim, 0).unwrap().name, "base");
