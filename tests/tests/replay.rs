@@ -168,7 +168,12 @@ fn a_lockstep_run_with_a_fault_plan_replays_identically() {
     replays_identically(
         "replay-plan",
         "3",
-        &["--kill", "agent:1@round:40", "--freeze", "agent:2@round:60+0.2s"],
+        &[
+            "--kill",
+            "agent:1@round:40",
+            "--freeze",
+            "agent:2@round:60+0.2s",
+        ],
     );
 }
 

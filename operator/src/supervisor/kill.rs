@@ -8,6 +8,9 @@
 //! supervisor then reacts as to any other death or freeze: it reaps and restarts a killed
 //! process under its role's policy, and hang detection deals with one stopped too long.
 //!
+//! Where hosts of a run across hosts share this machine, the target is looked for in the part
+//! of the host that runs it.
+//!
 //! In a run with coordinator replicas, `coordinator` names the replica that leads: the one
 //! whose role file (`DIR/log/<id>/raft-role.json`, what `hnav ps` shows) says `leader` in the
 //! highest term. `coordinator:ID` names one replica whatever its role.
@@ -125,6 +128,7 @@ pub fn kill(
         FaultTarget::Sim => (Role::Sim, 0),
     };
     let name = target_arg(target);
+    let record = target_host_part(registry, run, record, role, index);
     let Some(p) = record
         .processes
         .iter()
@@ -195,6 +199,25 @@ pub fn kill(
         round,
         journal: record.dir.join(super::events::EVENTS_FILE),
     })
+}
+
+/// The record of the part of run `run` that runs `role`/`index`: `record`, unless another
+/// host runs it and that host's part runs on this machine too (hosts of a run across hosts
+/// sharing a machine, each in its own domain).
+fn target_host_part(
+    registry: &RunRegistry,
+    run: &str,
+    record: RunRecord,
+    role: Role,
+    index: u32,
+) -> RunRecord {
+    let host = record
+        .processes
+        .iter()
+        .find(|p| p.role == role && p.index == index)
+        .and_then(|p| p.host.as_deref());
+    host.and_then(|h| registry.live_host_part(run, h))
+        .unwrap_or(record)
 }
 
 /// The index of the process `coordinator` names: 0 for a single coordinator, else the
@@ -396,8 +419,7 @@ mod tests {
     /// `hnav kill` a while.
     fn long_log(dir: &Path, rounds: u64) {
         use hnav_runtime::consensus_log::{LogWriter, Record, RoundRecord, RunHeader};
-        let (mut w, _) =
-            LogWriter::open(dir, hnav_runtime::scenario::FsyncPolicy::None).unwrap();
+        let (mut w, _) = LogWriter::open(dir, hnav_runtime::scenario::FsyncPolicy::None).unwrap();
         w.append(&Record::Header(RunHeader {
             version: hnav_runtime::consensus_log::FORMAT_VERSION,
             scenario_hash: 1,
@@ -437,7 +459,13 @@ mod tests {
                 how: format!("{status}"),
             });
         });
-        let k = kill(&registry, "kill-order", FaultTarget::Agent(1), Signal::SIGKILL).unwrap();
+        let k = kill(
+            &registry,
+            "kill-order",
+            FaultTarget::Agent(1),
+            Signal::SIGKILL,
+        )
+        .unwrap();
         supervisor.join().unwrap();
         assert_eq!(k.round, 100_000);
         let text = std::fs::read_to_string(&k.journal).unwrap();
@@ -445,12 +473,18 @@ mod tests {
             .lines()
             .map(|l| serde_json::from_str(l).unwrap())
             .collect();
-        let names: Vec<&str> = events.iter().map(|e| e["event"].as_str().unwrap()).collect();
+        let names: Vec<&str> = events
+            .iter()
+            .map(|e| e["event"].as_str().unwrap())
+            .collect();
         assert_eq!(
             names,
             ["signalled", "exited"],
             "the journal must read in the order things happened:\n{text}"
         );
-        assert!(events[0]["t_ns"].as_u64() <= events[1]["t_ns"].as_u64(), "{text}");
+        assert!(
+            events[0]["t_ns"].as_u64() <= events[1]["t_ns"].as_u64(),
+            "{text}"
+        );
     }
 }
