@@ -15,7 +15,7 @@ use serde::Serialize;
 use super::registry::{process_alive, RunEntry, RunRegistry};
 use hnav_runtime::consensus_log::ReplicaRole;
 use hnav_runtime::msg::Role;
-use hnav_runtime::transport::{NodeLiveness, RunId, Transport};
+use hnav_runtime::transport::{NodeLiveness, Transport};
 
 /// A process's state as `hnav ps` shows it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -99,7 +99,7 @@ impl RunStatus {
     /// Looks up the state of every process of `entry`.
     pub fn of(entry: RunEntry) -> RunStatus {
         let record = entry.record;
-        let mut dead: Vec<DeadNode> = match RunId::new(&record.run_id) {
+        let mut dead: Vec<DeadNode> = match record.run() {
             Ok(run) => match Transport::nodes_of(&run) {
                 Ok(nodes) => nodes
                     .into_iter()

@@ -82,6 +82,11 @@ pub struct RunSummary {
     /// Why `DIR/report.svg` could not be drawn, if it could not (the run still counts).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub report_error: Option<String>,
+    /// On a host of a run across hosts without the coordinator: the host whose consensus
+    /// log has the agents' steps, length, conflicts and replans (here they are 0, not
+    /// known); the table prints `-` for them and says where they are.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub counts_on_host: Option<String>,
 }
 
 impl RunSummary {
@@ -184,13 +189,15 @@ impl RunSummary {
             lost: Vec::new(),
             recording: None,
             report_error: None,
+            counts_on_host: None,
         })
     }
 
     /// The summary of a host of a run across hosts that does not run the coordinator: the
     /// consensus log is on another host, so only what crossed the bridge is known here (the
     /// last ground truth and the coordinator's last progress). Steps, conflicts and replans
-    /// are zero: `hnav log show` on the coordinator's host has them.
+    /// are zero, not known: `hnav log show` on the coordinator's host has them (the caller
+    /// names it in [`RunSummary::counts_on_host`]).
     pub fn from_truth(
         run_id: &str,
         scenario: &hnav_runtime::scenario::Scenario,
@@ -244,6 +251,7 @@ impl RunSummary {
             lost: Vec::new(),
             recording: None,
             report_error: None,
+            counts_on_host: None,
         }
     }
 
@@ -270,9 +278,20 @@ impl RunSummary {
                 (false, true, false) => "unreachable",
                 (false, false, false) => "NO",
             };
+            s += &match self.counts_on_host {
+                None => format!(
+                    "{:>5}  {:>4}  {:>5}  {:>6.2}  {:>9}  {:>7}\n",
+                    a.id, goal, a.steps, a.length, a.conflicts, a.replans
+                ),
+                Some(_) => format!(
+                    "{:>5}  {goal:>4}  {:>5}  {:>6}  {:>9}  {:>7}\n",
+                    a.id, "-", "-", "-", "-"
+                ),
+            };
+        }
+        if let Some(host) = &self.counts_on_host {
             s += &format!(
-                "{:>5}  {:>4}  {:>5}  {:>6.2}  {:>9}  {:>7}\n",
-                a.id, goal, a.steps, a.length, a.conflicts, a.replans
+                "(steps, length, conflicts, replans: in the consensus log on host {host}; goals, collisions and rounds: from what crossed the bridge)\n"
             );
         }
         let at_goal = self.agents.iter().filter(|a| a.reached_goal).count();
@@ -339,5 +358,23 @@ mod tests {
         assert!(!one_away.agents[2].reached_goal);
         let no_truth = RunSummary::from_truth("r", &s, None, Some(&not_done), 1.0);
         assert_eq!(no_truth.end, "incomplete");
+    }
+
+    #[test]
+    fn a_host_without_the_log_prints_no_made_up_counts() {
+        let s = demo();
+        let mut home = RunSummary::from_truth("r", &s, Some(&truth(&s, None)), None, 1.0);
+        home.counts_on_host = Some("base".into());
+        let table = home.render();
+        assert!(
+            table.contains("    0   yes      -       -          -        -\n"),
+            "{table}"
+        );
+        assert!(!table.contains("0.00"), "{table}");
+        assert!(
+            table
+                .contains("(steps, length, conflicts, replans: in the consensus log on host base;"),
+            "{table}"
+        );
     }
 }

@@ -50,7 +50,8 @@ pub struct RunArgs {
     /// Seed of the sim's noise and of generated agents [default: the scenario's sim.seed].
     #[arg(long, value_name = "S")]
     pub seed: Option<u64>,
-    /// Run directory (log, summary, process logs) [default: target/hnav-out/NAME].
+    /// Run directory (log, summary, process logs) [default: target/hnav-out/NAME, with --host
+    /// HOST target/hnav-out/NAME-HOST].
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Run id (letters, digits, '-', '_') [default: a fresh unique one]. Tests pass their own
@@ -81,7 +82,8 @@ pub struct RunArgs {
     pub freeze: Vec<String>,
     /// Run this host's part of a run across hosts: its processes and its bridge, as the
     /// placement file says (every host runs the same command with its own NAME and the same
-    /// --run ID).
+    /// --run ID). Its processes meet in the iceoryx2 domain NAME (HNAV_DOMAIN, if set, wins),
+    /// so hosts of one run may share a machine.
     #[arg(long, value_name = "NAME")]
     pub host: Option<String>,
     /// The placement file for --host [default: hosts.toml beside the scenario].
@@ -167,7 +169,7 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
         Ok((s, faults, host))
     });
     let (name, faults, host) = match placed {
-        Ok((s, faults, host)) => (default_run_dir(&s), faults, host),
+        Ok((s, faults, host)) => (default_run_dir(&s, a.host.as_deref()), faults, host),
         Err(e) => {
             hnav_runtime::errln!("error: {e}");
             return ExitCode::from(2);
@@ -191,8 +193,9 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
         Ok(summary) => {
             hnav_runtime::out!("{}", summary.render());
             hnav_runtime::outln!("summary   {}", dir.join("summary.json").display());
-            if summary.log.as_os_str().is_empty() {
-                // A host of a run across hosts without the coordinator.
+            if let Some(host) = &summary.counts_on_host {
+                hnav_runtime::outln!("log       on host {host} (the coordinator's)");
+            } else if summary.log.as_os_str().is_empty() {
                 hnav_runtime::outln!("log       on the coordinator's host");
             } else {
                 hnav_runtime::outln!("log       {}", summary.log.display());

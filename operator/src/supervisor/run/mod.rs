@@ -108,7 +108,10 @@ pub struct RunOptions {
 /// Runs the scenario to its end and returns the summary (also written to `DIR/summary.json`).
 pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     let scenario = opts.args.scenario()?;
-    let run = opts.args.run_id()?;
+    let run = match &opts.host {
+        Some(h) => h.run_id(opts.args.run_id()?)?,
+        None => opts.args.run_id()?,
+    };
     let dir = opts.args.dir.clone().ok_or(RunError::NoRunDir)?;
     let registry = RunRegistry::default_location();
     for cleaned in clean_dead_runs(&registry) {
@@ -160,6 +163,7 @@ fn run_owned(
         &dir,
         bell.as_ref(),
         host,
+        run.domain(),
     );
     let journal = RunEvents::create(&dir);
     // The last ground truth seen: a sample does not outlive its publisher, so a sim that is
@@ -264,9 +268,10 @@ fn summarize(
     ended: Ended,
 ) -> Result<RunSummary, RunError> {
     let (truth, progress) = (ended.seen.truth.as_ref(), ended.seen.progress.as_ref());
-    if host.is_some_and(|h| !h.this().coordinator) {
-        let summary =
+    if let Some(h) = host.filter(|h| !h.this().coordinator) {
+        let mut summary =
             RunSummary::from_truth(run.as_str(), scenario, truth, progress, ended.elapsed_s);
+        summary.counts_on_host = Some(h.coordinator_host().to_string());
         summary.write_json(dir).map_err(io(dir))?;
         return Ok(summary);
     }
@@ -353,9 +358,14 @@ fn start_up(
         .start_roll(transport, &children, &mut roll, left)?)
 }
 
-/// The run directory `hnav run` uses when none is given: `target/hnav-out/<scenario name>`.
-pub fn default_run_dir(scenario: &Scenario) -> PathBuf {
-    hnav_runtime::scenario::default_out_dir(&scenario.name)
+/// The run directory `hnav run` uses when none is given: `target/hnav-out/<scenario name>`,
+/// and for host `NAME` of a run across hosts (`host`) `target/hnav-out/<scenario name>-NAME`,
+/// so that hosts sharing a machine do not share a directory.
+pub fn default_run_dir(scenario: &Scenario, host: Option<&str>) -> PathBuf {
+    match host {
+        None => hnav_runtime::scenario::default_out_dir(&scenario.name),
+        Some(h) => hnav_runtime::scenario::default_out_dir(&format!("{}-{h}", scenario.name)),
+    }
 }
 
 /// A fresh run id for `hnav run`.
