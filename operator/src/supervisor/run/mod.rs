@@ -187,6 +187,7 @@ fn run_owned(
         end: result?,
         seen,
         lost: slots.lost_agents(),
+        restarts: slots.restarts(),
         recording,
         elapsed_s: started.elapsed().as_secs_f64(),
     };
@@ -249,6 +250,8 @@ struct Ended {
     seen: Seen,
     /// The agents gone for good and why, by index.
     lost: Vec<(u32, String)>,
+    /// Restarts per process restarted at least once.
+    restarts: std::collections::BTreeMap<String, u32>,
     recording: Option<RecordingSummary>,
     elapsed_s: f64,
 }
@@ -265,8 +268,9 @@ fn summarize(
 ) -> Result<RunSummary, RunError> {
     let (truth, progress) = (ended.seen.truth.as_ref(), ended.seen.progress.as_ref());
     if host.is_some_and(|h| !h.this().coordinator) {
-        let summary =
+        let mut summary =
             RunSummary::from_truth(run.as_str(), scenario, truth, progress, ended.elapsed_s);
+        summary.restarts = ended.restarts;
         summary.write_json(dir).map_err(io(dir))?;
         return Ok(summary);
     }
@@ -274,6 +278,8 @@ fn summarize(
     let cell_m = scenario.robot.cell_size_m;
     let mut summary = RunSummary::from_log(run.as_str(), &log, truth, cell_m, ended.elapsed_s)?;
     summary.mark_lost(&ended.lost);
+    summary.rules = scenario.coordinator.rules.name().to_string();
+    summary.restarts = ended.restarts;
     if let End::CannotGoOn(why) = ended.end {
         summary.cannot_go_on = Some(why);
     }
