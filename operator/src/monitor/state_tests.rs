@@ -6,6 +6,7 @@ fn view() -> ViewState {
     ViewState::new(RunInfo {
         run_id: "t".into(),
         mode: "lockstep".into(),
+        rules: "lacam".into(),
         grid: Grid::new(4, 2).unwrap(),
         starts: vec![0, 4],
         goals: vec![2, 7],
