@@ -17,7 +17,9 @@ use hnav_runtime::consensus_log::{
     ReplanRecord, RoundRecord, RunHeader, FORMAT_VERSION,
 };
 use hnav_runtime::launch::ProcessArgs;
-use hnav_runtime::msg::{ActivationKind, ConflictKind, Lifecycle, MapHeader, Role, Verdict, NO_CELL};
+use hnav_runtime::msg::{
+    ActivationKind, ConflictKind, Lifecycle, MapHeader, Role, Verdict, NO_CELL,
+};
 use hnav_runtime::scenario::FsyncPolicy;
 
 const SCENARIO: &str = r#"
@@ -356,8 +358,13 @@ fn a_kill_and_its_restart_are_on_the_lifecycle_channel() {
     let schema = channel.schema.as_ref().unwrap();
     assert_eq!(schema.name, "hnav.Lifecycle");
     let schema: serde_json::Value = serde_json::from_slice(&schema.data).unwrap();
-    for field in ["round", "process", "role", "index", "event", "restarts", "cell"] {
-        assert!(schema["properties"].get(field).is_some(), "{field}: {schema}");
+    for field in [
+        "round", "process", "role", "index", "event", "restarts", "cell",
+    ] {
+        assert!(
+            schema["properties"].get(field).is_some(),
+            "{field}: {schema}"
+        );
     }
     let events: Vec<(u64, serde_json::Value)> = mcap::MessageStream::new(&bytes)
         .unwrap()

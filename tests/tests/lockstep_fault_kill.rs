@@ -40,8 +40,14 @@ fn run(tag: &str, scenario: &Path, dir: &Path, registry: &Path) -> Vec<u8> {
         "{summary}"
     );
     let svg = std::fs::read_to_string(dir.join("report.svg")).unwrap();
-    assert!(svg.contains("round 40: agent-1 down, restarted at ["), "{svg}");
-    assert!(svg.contains("round 90: coordinator down, restarted"), "{svg}");
+    assert!(
+        svg.contains("round 40: agent-1 down, restarted at ["),
+        "{svg}"
+    );
+    assert!(
+        svg.contains("round 90: coordinator down, restarted"),
+        "{svg}"
+    );
     assert!(svg.contains("2 process restarts"), "{svg}");
     let mcap = dir.join("run.mcap");
     hnav_operator::export::export_mcap(dir, &mcap).unwrap();
@@ -52,7 +58,12 @@ fn run(tag: &str, scenario: &Path, dir: &Path, registry: &Path) -> Vec<u8> {
         .filter(|m| m.channel.topic == "/lifecycle")
         .map(|m| {
             let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
-            format!("{} {} {}", v["round"], v["process"].as_str().unwrap(), v["event"].as_str().unwrap())
+            format!(
+                "{} {} {}",
+                v["round"],
+                v["process"].as_str().unwrap(),
+                v["event"].as_str().unwrap()
+            )
         })
         .collect();
     assert_eq!(

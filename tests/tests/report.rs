@@ -163,12 +163,16 @@ fn check_report(dir: &Path, scenario: &Scenario, summary: &serde_json::Value) {
         .map(str::trim)
         .collect();
     assert!(
-        texts.iter().any(|t| t.starts_with("agent 0 neural map after round")),
+        texts
+            .iter()
+            .any(|t| t.starts_with("agent 0 neural map after round")),
         "{texts:?}"
     );
     assert_eq!(summary["rules"], "dissertation");
     assert!(
-        texts.iter().any(|t| t.starts_with("6 robots, dissertation rules, ")),
+        texts
+            .iter()
+            .any(|t| t.starts_with("6 robots, dissertation rules, ")),
         "the title names the rules: {texts:?}"
     );
     // The cell coordinates along the edges: 0 to 11 once for x and once for y.

@@ -172,10 +172,7 @@ fn down_and_lost_come_from_the_lifecycle_topic() {
 fn a_restart_stays_in_view_under_a_flood_of_holds() {
     let mut v = view();
     let now = Instant::now();
-    v.apply(
-        Update::Lifecycle(&Lifecycle::down(Role::Agent, 1, 0)),
-        now,
-    );
+    v.apply(Update::Lifecycle(&Lifecycle::down(Role::Agent, 1, 0)), now);
     v.apply(
         Update::Lifecycle(&Lifecycle::restarted(Role::Agent, 1, 1)),
         now,
@@ -193,7 +190,11 @@ fn a_restart_stays_in_view_under_a_flood_of_holds() {
     let events: Vec<_> = v.events.iter().map(|e| e.event.name()).collect();
     assert_eq!(events, ["down", "restarted"]);
     // One line per robot's waiting request, with its latest round and count.
-    let lines: Vec<(u32, u64, u32)> = v.recent.iter().map(|l| (l.agent, l.round, l.times)).collect();
+    let lines: Vec<(u32, u64, u32)> = v
+        .recent
+        .iter()
+        .map(|l| (l.agent, l.round, l.times))
+        .collect();
     assert_eq!(lines, [(0, 500, 500), (1, 500, 500)]);
     // Another cell asked is another line.
     v.apply(

@@ -175,7 +175,10 @@ fn draw_side(frame: &mut Frame, state: &ViewState, area: Rect) {
     };
     frame.render_widget(panel(proc_lines, " processes: pid state restarts cpu "), p);
     let event_lines: Vec<Line> = if state.events.is_empty() {
-        vec![Line::styled(" (none)", Style::default().fg(Color::DarkGray))]
+        vec![Line::styled(
+            " (none)",
+            Style::default().fg(Color::DarkGray),
+        )]
     } else {
         state.events.iter().rev().map(event_line).collect()
     };
@@ -212,7 +215,12 @@ fn event_line(e: &ProcessEvent) -> Line<'static> {
         _ => Color::LightRed,
     };
     Line::styled(
-        format!(" r{:<7} {} {}", e.round, e.role.node_name(e.index), e.event.name()),
+        format!(
+            " r{:<7} {} {}",
+            e.round,
+            e.role.node_name(e.index),
+            e.event.name()
+        ),
         Style::default().fg(colour),
     )
 }

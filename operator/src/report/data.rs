@@ -295,7 +295,11 @@ impl RunData {
         };
         let v: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| bad(format!("not JSON: {e}")))?;
-        self.rules = v.get("rules").and_then(serde_json::Value::as_str).filter(|r| !r.is_empty()).map(str::to_string);
+        self.rules = v
+            .get("rules")
+            .and_then(serde_json::Value::as_str)
+            .filter(|r| !r.is_empty())
+            .map(str::to_string);
         self.collisions = v
             .get("collisions")
             .and_then(serde_json::Value::as_u64)

@@ -66,11 +66,7 @@ fn draw_all(root: &Area<'_>, data: &RunData, layout: &Layout, events: &[String])
     let [first, second] = title(data);
     let x = layout.map.x - super::layout::AXIS_LEFT;
     let top = layout.map.y - AXIS_TOP - CAPTION_PX - TITLE_PX;
-    root.draw(&Text::new(
-        first,
-        (x, top),
-        ("sans-serif", 18).into_font(),
-    ))?;
+    root.draw(&Text::new(first, (x, top), ("sans-serif", 18).into_font()))?;
     root.draw(&Text::new(
         second,
         (x, top + 22),
@@ -233,7 +229,11 @@ fn draw_axes(root: &Area<'_>, map: &Panel) -> DrawResult {
     };
     for c in labelled(map.cols) {
         let (x, _) = map.centre(c, 0);
-        root.draw(&Text::new(c.to_string(), (x, map.y - AXIS_TOP / 2), centred.clone()))?;
+        root.draw(&Text::new(
+            c.to_string(),
+            (x, map.y - AXIS_TOP / 2),
+            centred.clone(),
+        ))?;
     }
     for r in labelled(map.rows) {
         let (_, y) = map.centre(0, r);
@@ -328,7 +328,10 @@ pub fn map_story(
     let round = header.round;
     if goal.is_some_and(|g| g != target) {
         return [
-            format!("toward waypoint [{}, {}], set after round {round}", target.0, target.1),
+            format!(
+                "toward waypoint [{}, {}], set after round {round}",
+                target.0, target.1
+            ),
             "by a replan: its last rebuild".to_string(),
         ];
     }

@@ -165,7 +165,10 @@ impl Layout {
         let right = (x - GAP)
             .max(captions)
             .max(MARGIN + columns * LEGEND_COLUMN);
-        let events_at = (MARGIN, legend.1 + legend_rows as i32 * LEGEND_LINE + GAP / 2);
+        let events_at = (
+            MARGIN,
+            legend.1 + legend_rows as i32 * LEGEND_LINE + GAP / 2,
+        );
         let event_lines = match events {
             0 => 0,
             n => 1 + n.min(MAX_EVENT_LINES + 1) as i32,

@@ -150,7 +150,9 @@ impl Tally {
 
     /// Rounds waited (held), of all agents.
     pub fn waited(&self) -> u32 {
-        self.agents.iter().fold(0, |n, a| n.saturating_add(a.waited))
+        self.agents
+            .iter()
+            .fold(0, |n, a| n.saturating_add(a.waited))
     }
 
     /// Replans of all agents.
@@ -251,7 +253,10 @@ mod tests {
         use Counted::*;
         assert_eq!(
             counted,
-            [Conflict, StillHeld, StillHeld, Conflict, Conflict, StillHeld, Waited, Waited, Conflict]
+            [
+                Conflict, StillHeld, StillHeld, Conflict, Conflict, StillHeld, Waited, Waited,
+                Conflict
+            ]
         );
         // Held in rounds 1-4, 7-9; refused in 5-6.
         assert_eq!((t.conflicts(), t.waited()), (4, 7));

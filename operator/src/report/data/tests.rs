@@ -192,7 +192,10 @@ fn the_log_gives_committed_cells_and_marks_at_the_agents_cell() {
         .collect();
     assert_eq!(
         events,
-        vec![(2, 1, "down", Some((2, 2))), (2, 1, "restarted", Some((2, 2)))]
+        vec![
+            (2, 1, "down", Some((2, 2))),
+            (2, 1, "restarted", Some((2, 2)))
+        ]
     );
     assert_eq!(
         d.replans,
@@ -307,9 +310,19 @@ fn the_drawing_holds_one_element_per_mark() {
         .map(|l| l.split("/>").next().unwrap_or(""))
         .collect();
     let stroke = |c: &str| lines.iter().filter(|l| l.contains(c)).count();
-    assert_eq!((stroke("#1F77B4"), stroke("#FF7F0E"), stroke("#404040")), (2, 2, 2), "{lines:?}");
+    assert_eq!(
+        (stroke("#1F77B4"), stroke("#FF7F0E"), stroke("#404040")),
+        (2, 2, 2),
+        "{lines:?}"
+    );
     // The process events under the legend, the cell coordinates, the title's rules.
-    assert!(svg.contains("round 2: agent-1 down, restarted at [2, 2]"), "{svg}");
-    assert!(svg.contains("rules not known"), "the fixture's summary names none");
+    assert!(
+        svg.contains("round 2: agent-1 down, restarted at [2, 2]"),
+        "{svg}"
+    );
+    assert!(
+        svg.contains("rules not known"),
+        "the fixture's summary names none"
+    );
     assert!(svg.contains("1 process restarts"), "{svg}");
 }
