@@ -243,7 +243,7 @@ fn the_tutorials_two_hosts_on_one_machine_run_with_the_same_run_id() {
     assert!(!robots.contains("0.00"), "{robots}");
     assert!(
         robots.contains(&format!(
-            "(steps, length, conflicts, replans: in the consensus log on host {};",
+            "(steps, length, conflicts, waited, replans: in the consensus log on host {};",
             names[0]
         )) && robots.contains(&format!(
             "log       on host {} (the coordinator's)",

@@ -2,9 +2,11 @@
 //!
 //! Per-agent numbers are the [`Tally`] of the consensus log, the durable record of what was
 //! decided: accepted moves (steps and their octile length from the start in the log's
-//! header), refused or held requests (conflicts) and global replans. Whether a robot reached its goal
-//! comes from the sim's ground truth — its true pose lies in its goal cell — not from what the
-//! agents believed.
+//! header), conflicts (requests refused or held for another robot or the map, each once),
+//! rounds waited (held) and global replans. Whether a robot reached its goal comes from
+//! the sim's ground truth — its true pose lies in its goal cell — not from what the agents
+//! believed. The conflict rules the run ran and each process's restarts come from the
+//! supervisor, which started the run and its processes.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -26,8 +28,12 @@ pub struct AgentSummary {
     pub steps: u32,
     /// Length of the accepted moves in cells (straight 1, diagonal sqrt 2).
     pub length: f64,
-    /// Refused or held requests.
+    /// Requests refused or held for another robot or the map, each once however many rounds
+    /// it waited ([`Tally`]).
     pub conflicts: u32,
+    /// Rounds in which its request was held: the time it waited (for a cell to be left, for
+    /// another robot's turn; under `lacam`, every hold is a wait for the plan).
+    pub waited: u32,
     /// Global replans.
     pub replans: u32,
     /// Whether the agent reported its goal unreachable (an unreachable record in the log).
@@ -55,6 +61,9 @@ pub struct RunSummary {
     pub run_id: String,
     /// `lockstep` or `realtime`.
     pub mode: String,
+    /// The conflict rules the coordinator ran (`[coordinator] rules`: `lacam`, `pibt` or
+    /// `dissertation`); empty when not known.
+    pub rules: String,
     /// Per agent.
     pub agents: Vec<AgentSummary>,
     /// Collisions the sim recorded on ground truth.
@@ -76,6 +85,9 @@ pub struct RunSummary {
     pub rejected: BTreeMap<String, u64>,
     /// The robots lost during the run, by index; empty when none was.
     pub lost: Vec<LostRobot>,
+    /// Restarts per process (`sim`, `coordinator`, `agent-3`, ...) of every process the
+    /// supervisor restarted at least once; empty when none was.
+    pub restarts: BTreeMap<String, u32>,
     /// What the recorder wrote into `DIR/recording/`; absent with `hnav run --no-record`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub recording: Option<super::recorder::RecordingSummary>,
@@ -161,6 +173,7 @@ impl RunSummary {
                 steps: t.steps,
                 length: t.length,
                 conflicts: t.conflicts,
+                waited: t.waited,
                 replans: t.replans,
                 unreachable: unreachable.contains(&id),
                 lost: lost.contains(&id),
@@ -178,6 +191,7 @@ impl RunSummary {
         Ok(RunSummary {
             run_id: run_id.to_string(),
             mode: header.map(|h| h.clock.clone()).unwrap_or_default(),
+            rules: String::new(),
             agents,
             collisions: truth.map_or(0, |t| t.collisions),
             rounds,
@@ -187,6 +201,7 @@ impl RunSummary {
             cannot_go_on: None,
             rejected: read_rejected(log_dir.parent().unwrap_or(Path::new("."))),
             lost: Vec::new(),
+            restarts: BTreeMap::new(),
             recording: None,
             report_error: None,
             counts_on_host: None,
@@ -222,6 +237,7 @@ impl RunSummary {
                 steps: 0,
                 length: 0.0,
                 conflicts: 0,
+                waited: 0,
                 replans: 0,
                 unreachable: false,
                 lost: false,
@@ -240,6 +256,7 @@ impl RunSummary {
         RunSummary {
             run_id: run_id.to_string(),
             mode: scenario.sim.clock.to_string(),
+            rules: scenario.coordinator.rules.name().to_string(),
             agents,
             collisions: truth.map_or(0, |t| t.collisions),
             rounds: progress.map_or(0, |p| p.round),
@@ -249,6 +266,7 @@ impl RunSummary {
             cannot_go_on: None,
             rejected: BTreeMap::new(),
             lost: Vec::new(),
+            restarts: BTreeMap::new(),
             recording: None,
             report_error: None,
             counts_on_host: None,
@@ -268,9 +286,11 @@ impl RunSummary {
         Ok(path)
     }
 
-    /// The table `hnav run` prints.
+    /// The table `hnav run` prints: a line per agent, the run's line (naming the rules it
+    /// ran, so that runs under different rules are not compared by mistake) and, when any
+    /// process was restarted, its restarts.
     pub fn render(&self) -> String {
-        let mut s = String::from("agent  goal  steps  length  conflicts  replans\n");
+        let mut s = String::from("agent  goal  steps  length  conflicts  waited  replans\n");
         for a in &self.agents {
             let goal = match (a.reached_goal, a.unreachable, a.lost) {
                 (true, _, _) => "yes",
@@ -280,23 +300,28 @@ impl RunSummary {
             };
             s += &match self.counts_on_host {
                 None => format!(
-                    "{:>5}  {:>4}  {:>5}  {:>6.2}  {:>9}  {:>7}\n",
-                    a.id, goal, a.steps, a.length, a.conflicts, a.replans
+                    "{:>5}  {:>4}  {:>5}  {:>6.2}  {:>9}  {:>6}  {:>7}\n",
+                    a.id, goal, a.steps, a.length, a.conflicts, a.waited, a.replans
                 ),
                 Some(_) => format!(
-                    "{:>5}  {goal:>4}  {:>5}  {:>6}  {:>9}  {:>7}\n",
-                    a.id, "-", "-", "-", "-"
+                    "{:>5}  {goal:>4}  {:>5}  {:>6}  {:>9}  {:>6}  {:>7}\n",
+                    a.id, "-", "-", "-", "-", "-"
                 ),
             };
         }
         if let Some(host) = &self.counts_on_host {
             s += &format!(
-                "(steps, length, conflicts, replans: in the consensus log on host {host}; goals, collisions and rounds: from what crossed the bridge)\n"
+                "(steps, length, conflicts, waited, replans: in the consensus log on host {host}; goals, collisions and rounds: from what crossed the bridge)\n"
             );
         }
         let at_goal = self.agents.iter().filter(|a| a.reached_goal).count();
+        let rules = if self.rules.is_empty() {
+            String::new()
+        } else {
+            format!("{} rules, ", self.rules)
+        };
         s += &format!(
-            "{} of {} at goal, {} collisions, {} rounds, {:.2} s wall ({}, {})\n",
+            "{} of {} at goal, {} collisions, {} rounds, {:.2} s wall ({}, {rules}{})\n",
             at_goal,
             self.agents.len(),
             self.collisions,
@@ -305,6 +330,14 @@ impl RunSummary {
             self.mode,
             self.end
         );
+        if !self.restarts.is_empty() {
+            let each: Vec<String> = self
+                .restarts
+                .iter()
+                .map(|(p, n)| format!("{p} {n}"))
+                .collect();
+            s += &format!("restarts: {}\n", each.join(", "));
+        }
         s
     }
 }
@@ -373,7 +406,7 @@ mod tests {
         assert!(!table.contains("0.00"), "{table}");
         assert!(
             table
-                .contains("(steps, length, conflicts, replans: in the consensus log on host base;"),
+                .contains("(steps, length, conflicts, waited, replans: in the consensus log on host base;"),
             "{table}"
         );
     }

@@ -191,6 +191,7 @@ fn run_owned(
         end: result?,
         seen,
         lost: slots.lost_agents(),
+        restarts: slots.restarts(),
         recording,
         elapsed_s: started.elapsed().as_secs_f64(),
     };
@@ -253,6 +254,8 @@ struct Ended {
     seen: Seen,
     /// The agents gone for good and why, by index.
     lost: Vec<(u32, String)>,
+    /// Restarts per process restarted at least once.
+    restarts: std::collections::BTreeMap<String, u32>,
     recording: Option<RecordingSummary>,
     elapsed_s: f64,
 }
@@ -272,6 +275,7 @@ fn summarize(
         let mut summary =
             RunSummary::from_truth(run.as_str(), scenario, truth, progress, ended.elapsed_s);
         summary.counts_on_host = Some(h.coordinator_host().to_string());
+        summary.restarts = ended.restarts;
         summary.write_json(dir).map_err(io(dir))?;
         return Ok(summary);
     }
@@ -279,6 +283,8 @@ fn summarize(
     let cell_m = scenario.robot.cell_size_m;
     let mut summary = RunSummary::from_log(run.as_str(), &log, truth, cell_m, ended.elapsed_s)?;
     summary.mark_lost(&ended.lost);
+    summary.rules = scenario.coordinator.rules.name().to_string();
+    summary.restarts = ended.restarts;
     if let End::CannotGoOn(why) = ended.end {
         summary.cannot_go_on = Some(why);
     }

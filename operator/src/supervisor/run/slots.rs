@@ -188,6 +188,15 @@ impl Slots {
             .collect()
     }
 
+    /// Restarts per process (by node name) of every process restarted at least once.
+    pub(super) fn restarts(&self) -> std::collections::BTreeMap<String, u32> {
+        self.slots
+            .iter()
+            .filter(|s| s.tracker.restarts() > 0)
+            .map(|s| (s.spec.role.node_name(s.spec.index), s.tracker.restarts()))
+            .collect()
+    }
+
     /// What state each agent is in now (`Roster`), for a sim or a coordinator that was down
     /// and missed their events.
     fn roster(&self) -> impl Iterator<Item = Action> + '_ {
