@@ -1,6 +1,6 @@
 //! Parsers of command-line values that say what a value must be in the words of the
 //! command line (`--agents 0` or `--agents -1`), instead of leaving it to the scenario
-//! ("the scenario has no [[agents]]") or to clap's tip about `--`.
+//! (`the scenario has no [[agents]]`) or to clap's tip about `--`.
 
 /// `--agents N`: a whole number from 1. The upper limit is the scenario's to check, with a
 /// message that names it (`msg::MAX_AGENTS`).
