@@ -3,7 +3,7 @@
 //! ```text
 //!  hnav top  RUN  lockstep  lacam rules  round 1234  2093 rounds/s  at goal 3/6  conflicts 12 ...
 //! ┌ map ───────────────────┐┌ agents ──────────────────────────┐
-//! │  . . 0 . + .           ││ 0  moving      (3,4) -> (9,9)    │
+//! │  . . 0 . + .           ││ 0  moving      [3, 4] -> [9, 9]  │
 //! │  ...                   │├ processes ───────────────────────┤
 //! │                        ││ agent 0  pid 4242  running  0  12%│
 //! │                        │├ process events ──────────────────┤
@@ -238,7 +238,22 @@ fn state_style(s: AgentState) -> Style {
 
 fn cell_text(grid: &Grid, id: Option<u32>) -> String {
     match id.and_then(|i| grid.cell_at(i as usize)) {
-        Some(c) => format!("({},{})", c.x, c.y),
+        // `[x, y]`, as every other output of HNAV writes a cell.
+        Some(c) => c.to_string(),
         None => "(off map)".to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_agents_panel_writes_cells_as_every_other_output_does() {
+        let grid = Grid::new(5, 4).unwrap();
+        // Cell index 17 on a 5-wide grid: column 2, row 3.
+        assert_eq!(cell_text(&grid, Some(17)), "[2, 3]");
+        assert_eq!(cell_text(&grid, Some(99)), "(off map)");
+        assert_eq!(cell_text(&grid, None), "(off map)");
     }
 }
