@@ -8,7 +8,8 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use hnav_operator::supervisor::child::{Child, ChildError, ChildSpec, ExitInfo, Signal};
 use hnav_operator::supervisor::exit_fd::WatchMode;
-use hnav_operator::supervisor::registry::{pid_alive, RunRecord, RunRegistry};
+use hnav_operator::supervisor::proc_stat::pid_alive;
+use hnav_operator::supervisor::registry::{RunRecord, RunRegistry};
 use hnav_operator::supervisor::restart::{GiveUpReason, RestartDecision, RestartTracker};
 use hnav_operator::supervisor::stop::{stop_all, StopHow};
 use hnav_runtime::msg::Role;

@@ -6,7 +6,8 @@ use std::os::unix::process::CommandExt;
 use std::process::Command;
 
 use hnav_operator::supervisor::clean::{clean_dead_runs, clean_run, CleanError};
-use hnav_operator::supervisor::registry::{pid_alive, RunRegistry};
+use hnav_operator::supervisor::proc_stat::pid_alive;
+use hnav_operator::supervisor::registry::RunRegistry;
 use hnav_runtime::msg::Role;
 use hnav_runtime::transport::RunId;
 

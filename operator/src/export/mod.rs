@@ -21,6 +21,7 @@
 //! recording file, or a scenario that cannot be loaded, leaves its channels out and is
 //! reported in [`ExportReport::notes`]; a damaged file is an error naming it and the offset.
 
+mod messages;
 pub mod schemas;
 
 use std::collections::BTreeMap;
@@ -28,27 +29,24 @@ use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
 
-use base64::Engine as _;
 use serde_json::{json, Value};
 
 use crate::invocation::Invocation;
-use crate::recording::{
-    self, MapReader, MapSnapshot, PoseSample, PoseSource, RecordingError, TrajectoryReader,
-};
-use hnav_runtime::consensus_log::{read_decided, LogError, LoggedDecision, Record, RunHeader};
-use hnav_runtime::msg::{ConflictKind, LifecycleEvent, Role, Verdict, NO_CELL};
+use crate::recording::{self, MapReader, PoseSource, RecordingError, TrajectoryReader};
+use hnav_runtime::consensus_log::{read_decided, LogError, Record, RunHeader};
+use hnav_runtime::msg::{LifecycleEvent, Role, Verdict, NO_CELL};
 use hnav_runtime::scenario::Scenario;
+pub use messages::FRAME;
+use messages::{
+    cell, decision_message, grid_message, neural_map_message, pose_message, stamp, NUMERIC_UINT8,
+};
 
-/// The frame every pose and grid is in.
-pub const FRAME: &str = "map";
 /// The control period assumed when the run's scenario cannot be loaded (the default
 /// `[sim]`: 100 Hz odometry, 1 ms steps).
 pub const DEFAULT_PERIOD_NS: u64 = 10_000_000;
 /// The cell size assumed without the scenario and the trajectory file (the default
 /// `[robot] cell_size_m`).
 pub const DEFAULT_CELL_SIZE_M: f64 = 0.16;
-/// `log10_activation` of a neuron at exactly 0 (below the smallest `f32`).
-const LOG10_OF_ZERO: f32 = -46.0;
 
 /// Why an export failed.
 #[derive(Debug, thiserror::Error)]
@@ -329,89 +327,6 @@ fn log_channels(
         }
     }
     Ok(())
-}
-
-const NUMERIC_UINT8: u8 = 1;
-const NUMERIC_FLOAT32: u8 = 7;
-const DIRECTIONS: [&str; 8] = ["N", "NE", "E", "SE", "S", "SW", "W", "NW"];
-
-fn stamp(t_ns: u64) -> Value {
-    json!({"sec": t_ns / 1_000_000_000, "nsec": t_ns % 1_000_000_000})
-}
-
-fn cell(index: u32, width: u32) -> Value {
-    if index == NO_CELL || width == 0 {
-        Value::Null
-    } else {
-        json!([index % width, index / width])
-    }
-}
-
-fn decision_message(t: u64, round: u64, d: &LoggedDecision, width: u32) -> Value {
-    let name = |n: Option<&str>, code: u8| n.map_or_else(|| code.to_string(), str::to_string);
-    json!({
-        "timestamp": stamp(t),
-        "round": round,
-        "agent": d.agent,
-        "verdict": name(Verdict::from_u8(d.verdict).map(Verdict::name), d.verdict),
-        "kind": name(ConflictKind::from_u8(d.kind).map(ConflictKind::name), d.kind),
-        "refused": (0..8).filter(|b| d.refused & (1 << b) != 0).map(|b| DIRECTIONS[b]).collect::<Vec<_>>(),
-        "cell": cell(d.cell, width),
-        "waypoint": cell(d.waypoint, width),
-    })
-}
-
-fn pose_message(s: &PoseSample) -> Value {
-    let half = f64::from(s.theta_rad) / 2.0;
-    json!({
-        "timestamp": stamp(s.t_ns),
-        "frame_id": FRAME,
-        "pose": {
-            "position": {"x": f64::from(s.x_m), "y": f64::from(s.y_m), "z": 0.0},
-            "orientation": {"x": 0.0, "y": 0.0, "z": half.sin(), "w": half.cos()}
-        }
-    })
-}
-
-/// A `foxglove.Grid` at the frame's origin: `columns` cells of `cell_m` a row, each
-/// `cell_stride` bytes of `data` holding `fields` (name, offset, numeric type).
-fn grid_message(
-    t_ns: u64,
-    (columns, cell_m): (u32, f64),
-    cell_stride: u32,
-    fields: &[(&str, u32, u8)],
-    data: &[u8],
-) -> Value {
-    json!({
-        "timestamp": stamp(t_ns),
-        "frame_id": FRAME,
-        "pose": {
-            "position": {"x": 0.0, "y": 0.0, "z": 0.0},
-            "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}
-        },
-        "column_count": columns,
-        "cell_size": {"x": cell_m, "y": cell_m},
-        "row_stride": columns * cell_stride,
-        "cell_stride": cell_stride,
-        "fields": fields.iter().map(|(name, offset, ty)| json!({"name": name, "offset": offset, "type": ty})).collect::<Vec<_>>(),
-        "data": base64::engine::general_purpose::STANDARD.encode(data),
-    })
-}
-
-/// A neural map as a grid of its activations and their log10, since the wave front decays
-/// geometrically and a linear colour scale shows only the cells next to the target.
-fn neural_map_message(snap: &MapSnapshot, cell_m: f64) -> Value {
-    let mut data = Vec::with_capacity(snap.values.len() * 8);
-    for &v in &snap.values {
-        let log = if v > 0.0 { v.log10() } else { LOG10_OF_ZERO };
-        data.extend_from_slice(&v.to_le_bytes());
-        data.extend_from_slice(&log.to_le_bytes());
-    }
-    let fields = [
-        ("activation", 0, NUMERIC_FLOAT32),
-        ("log10_activation", 4, NUMERIC_FLOAT32),
-    ];
-    grid_message(snap.t_ns, (snap.header.width, cell_m), 8, &fields, &data)
 }
 
 /// The MCAP writer with one schema per name, one channel per topic and a count per channel.

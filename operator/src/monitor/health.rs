@@ -5,8 +5,9 @@
 use std::collections::HashMap;
 use std::time::Instant;
 
+use crate::supervisor::proc_stat::process_cpu_ticks;
 use crate::supervisor::ps::{ProcessState, RunStatus};
-use crate::supervisor::registry::{process_cpu_ticks, RunEntry, RunRecord};
+use crate::supervisor::registry::{RunEntry, RunRecord};
 use hnav_runtime::msg::Role;
 
 /// One process of the run.

@@ -16,7 +16,8 @@ use std::time::{Duration, Instant};
 use nix::sys::signal::{killpg, Signal};
 use nix::unistd::Pid;
 
-use super::registry::{process_alive, RegistryError, RunRecord, RunRegistry};
+use super::proc_stat::process_alive;
+use super::registry::{RegistryError, RunRecord, RunRegistry};
 use hnav_runtime::transport::{
     purge_run, run_iceoryx2_files, run_shm_files, RunId, TransportError,
 };

@@ -30,7 +30,8 @@ use nix::unistd::Pid;
 
 use super::child::Signal;
 use super::events::{RunEvent, RunEvents};
-use super::registry::{process_alive, LiveRunError, RunRecord, RunRegistry};
+use super::proc_stat::process_alive;
+use super::registry::{LiveRunError, RunRecord, RunRegistry};
 use hnav_runtime::consensus_log::{read_decided, ReplicaRole};
 use hnav_runtime::msg::Role;
 use hnav_runtime::scenario::fault_arg::target_arg;

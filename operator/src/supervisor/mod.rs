@@ -28,12 +28,14 @@
 //! | [`exit_fd`] | the pidfd (or waiter-thread pipe) that makes a child's exit wake the supervisor's `Waiter` |
 //! | [`events`] | the run's event journal `DIR/events.jsonl`: signals, exits, hangs, respawns, each stamped with the host's monotonic clock |
 //! | [`run_dir`] | a run's hold on its output directory: the directory lock, and `--force` for a finished run's outputs |
+//! | [`proc_stat`] | a process as `/proc` sees it: alive, its start time (a reused pid is not the process), its CPU time |
 
 pub mod child;
 pub mod clean;
 pub mod events;
 pub mod exit_fd;
 pub mod kill;
+pub mod proc_stat;
 pub mod ps;
 pub mod recorder;
 pub mod registry;

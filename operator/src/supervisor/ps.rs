@@ -12,7 +12,8 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use super::registry::{process_alive, RunEntry, RunRegistry};
+use super::proc_stat::process_alive;
+use super::registry::{RunEntry, RunRegistry};
 use hnav_runtime::consensus_log::ReplicaRole;
 use hnav_runtime::msg::Role;
 use hnav_runtime::transport::{NodeLiveness, Transport};

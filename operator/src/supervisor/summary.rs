@@ -400,13 +400,14 @@ mod tests {
         home.counts_on_host = Some("base".into());
         let table = home.render();
         assert!(
-            table.contains("    0   yes      -       -          -        -\n"),
+            table.contains("    0   yes      -       -          -       -        -\n"),
             "{table}"
         );
         assert!(!table.contains("0.00"), "{table}");
         assert!(
-            table
-                .contains("(steps, length, conflicts, waited, replans: in the consensus log on host base;"),
+            table.contains(
+                "(steps, length, conflicts, waited, replans: in the consensus log on host base;"
+            ),
             "{table}"
         );
     }
