@@ -270,6 +270,11 @@ fn the_demo_run_exports_to_mcap_with_every_channel() {
     expected.insert("/commits".into(), rounds);
     expected.insert("/decisions".into(), decisions);
     expected.insert("/replans".into(), replans);
+    let lifecycle = log
+        .iter()
+        .filter(|r| matches!(r, Record::Lifecycle(_)))
+        .count() as u64;
+    expected.insert("/lifecycle".into(), lifecycle);
 
     let out_file = tmp.path().join("demo.mcap");
     let out = std::process::Command::new(workspace_bin("hnav"))

@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::time::Duration;
 
-use hnav_runtime::consensus_log::{read_decided, read_log, Record, FORMAT_VERSION};
+use hnav_runtime::consensus_log::{read_decided, read_log, EndReason, Record, FORMAT_VERSION};
 use hnav_tests::swarm::{records_digest, repo_root, verify_log, SwarmRun};
 use hnav_tests::TestRun;
 
@@ -131,4 +131,56 @@ fn hnav_ps_shows_each_replicas_role_and_term() {
     let r = replicas(&listed);
     let indices: Vec<u64> = r.iter().filter_map(|p| p["index"].as_u64()).collect();
     assert_eq!(indices, [1, 2, 3], "{listed}");
+}
+
+/// A replica stopped by SIGTERM leaves the cluster, not the run: the leader, told to stop by
+/// a signal rather than by the supervisor's `Stop`, logged the run's end (`stopped`) into the
+/// replicated log, so the replica elected after it found the run over and decided nothing
+/// more (the run then waited for ever). Now the others go on and bring every robot home.
+#[test]
+fn a_leader_stopped_by_sigterm_leaves_the_run_to_the_others() {
+    let tmp = tempfile::tempdir().unwrap();
+    let registry = tmp.path().join("runs");
+    let dir = tmp.path().join("out");
+    let mut test_run = TestRun::new("rterm");
+    let scenario = repo_root().join("scenarios/demo.toml");
+    let args = [
+        "--mode",
+        "lockstep",
+        "--replicas",
+        "3",
+        "--term",
+        "coordinator@round:300",
+    ];
+    let mut swarm =
+        SwarmRun::start(&mut test_run, &scenario, &dir, &registry, &args).expect("hnav run starts");
+    // The demo takes a few seconds in lockstep; a run that stopped deciding never ends.
+    let status = swarm.finish(Duration::from_secs(180));
+    let status = status.unwrap_or_else(|e| panic!("{e}\n{}", swarm.log_tails()));
+    assert!(status.success(), "{status}\n{}", swarm.log_tails());
+    let s = swarm.summary().unwrap();
+    assert_eq!(s["end"], "all-at-goal", "{s}\n{}", swarm.log_tails());
+    let mut ended = 0;
+    for id in 1..=3 {
+        let log = dir.join("log").join(id.to_string());
+        let (ok, report) = verify_log(&log);
+        assert!(ok, "replica {id}'s log does not verify:\n{report}");
+        let records = read_decided(&log).unwrap().records;
+        let ends: Vec<_> = records
+            .iter()
+            .filter_map(|r| match r {
+                Record::End(e) => Some(e.reason),
+                _ => None,
+            })
+            .collect();
+        // The stopped one ends its log where it stopped, without an end record of its own.
+        assert!(
+            ends.iter().all(|&r| r == EndReason::AllAtGoal) && ends.len() <= 1,
+            "replica {id} logged the ends {ends:?}"
+        );
+        ended += ends.len();
+    }
+    // The one that led at the end logged it (the other may have stopped before it heard the
+    // commit).
+    assert!(ended >= 1, "no replica logged the run's end");
 }

@@ -147,9 +147,16 @@ impl<'t> CoordinatorProcess<'t> {
             .as_ref()
             .map(|l| waiter.attach(l.inbox()))
             .transpose()?;
-        let reason = rounds(p, &self.life, st, &waiter, &self.heart)?;
-        if !st.ended() {
-            st.end(reason)?;
+        match rounds(p, &self.life, st, &waiter, &self.heart)? {
+            // A replica's own termination signal takes it out of the cluster, not the run
+            // out of the world: an end logged now would be replicated, and the replica
+            // elected next would find the run over and decide nothing more.
+            Stop::Signal if link.is_some() => {
+                tracing::info!("replica stops on a signal; the others go on");
+            }
+            Stop::Signal if !st.ended() => st.end(EndReason::Stopped)?,
+            Stop::Run(reason) if !st.ended() => st.end(reason)?,
+            Stop::Signal | Stop::Run(_) => {}
         }
         st.sync()?;
         st.report_rejections();
@@ -193,15 +200,22 @@ fn follow(
     }
 }
 
-/// Decides rounds until the supervisor's `Stop` or a termination signal; returns why the run
-/// ends.
+/// Why [`rounds`] returned.
+enum Stop {
+    /// The run ends, for the reason the supervisor gave.
+    Run(EndReason),
+    /// This process got SIGTERM or SIGINT.
+    Signal,
+}
+
+/// Decides rounds until the supervisor's `Stop` or a termination signal.
 fn rounds(
     p: &Ports,
     life: &LifecyclePorts,
     st: &mut State,
     waiter: &Waiter,
     heart: &Heartbeat,
-) -> Result<EndReason, CoordinatorError> {
+) -> Result<Stop, CoordinatorError> {
     // A failed beat inside a long decision shows again at the loop's own beat.
     let mut tick = || {
         let _ = heart.beat();
@@ -216,7 +230,7 @@ fn rounds(
         // round closes, so it is logged at the same round in every lockstep run.
         st.collect(p)?;
         if let Some(reason) = st.hear_supervisor(p, life)? {
-            return Ok(reason);
+            return Ok(Stop::Run(reason));
         }
         if st.ready() {
             st.close_round(p, waiter, &mut tick)?;
@@ -237,7 +251,7 @@ fn rounds(
         match waiter.wait(heart.until(until)?)? {
             // A passed deadline closes the round on the next pass, after one more drain.
             Wake::Data | Wake::TimedOut => {}
-            Wake::Stop => return Ok(EndReason::Stopped),
+            Wake::Stop => return Ok(Stop::Signal),
         }
     }
 }
