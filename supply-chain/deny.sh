@@ -25,5 +25,9 @@ git -C "$db" -c user.name=hnav -c user.email=hnav@example.invalid -c commit.gpgs
 # cargo-deny takes the newer of the commit's date and .git/HEAD's modification time.
 touch -d "$date" "$db/.git/HEAD"
 
-# --offline: no fetch of the database (and `cargo metadata` reads only what is on disk).
+# cargo-deny reads the whole graph for deny.toml's target (`cargo metadata`), optional
+# dependencies the build never downloads too (nalgebra's glam conversions, ...): fetch them
+# from crates.io first; a no-op where they are on disk already.
+cargo fetch --locked --target x86_64-unknown-linux-gnu
+# --offline: no fetch of the database (GitHub), and `cargo metadata` reads only what is on disk.
 cargo deny --offline --locked --color never check "${@:-all}"
