@@ -63,7 +63,8 @@ pub struct Help {
     pub text: String,
 }
 
-/// Every markdown file under `root` (hidden directories and `target/` left out), scanned.
+/// Every markdown file under `root` (hidden directories, `target/` and [`THIRD_PARTY`] left
+/// out), scanned.
 pub fn read_docs(root: &Path) -> std::io::Result<Vec<Doc>> {
     let mut files = Vec::new();
     walk(root, root, &mut files)?;
@@ -80,6 +81,10 @@ pub fn read_docs(root: &Path) -> std::io::Result<Vec<Doc>> {
         .collect()
 }
 
+/// Directories of others' markdown kept in the repository as data, not as HNAV's docs: the
+/// RustSec advisory database that `supply-chain/deny.sh` checks against.
+pub const THIRD_PARTY: &[&str] = &["supply-chain/advisory-db"];
+
 fn walk(root: &Path, dir: &Path, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
     for entry in std::fs::read_dir(dir)? {
         let entry = entry?;
@@ -87,7 +92,8 @@ fn walk(root: &Path, dir: &Path, out: &mut Vec<PathBuf>) -> std::io::Result<()> 
         let name = entry.file_name();
         let name = name.to_string_lossy();
         if entry.file_type()?.is_dir() {
-            if !name.starts_with('.') && name != "target" {
+            let third_party = THIRD_PARTY.iter().any(|t| path == root.join(t));
+            if !name.starts_with('.') && name != "target" && !third_party {
                 walk(root, &path, out)?;
             }
         } else if name.ends_with(".md") {
