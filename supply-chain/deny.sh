@@ -6,8 +6,7 @@
 # supply-chain/advisory-db/ (refreshed by supply-chain/refresh-advisory-db.sh on a machine
 # with internet). cargo-deny opens a database as a git checkout named after its URL under
 # `db-path` and judges its age by the checkout's commit, so the copy is committed there as
-# one commit dated like the upstream commit it copies: `maximum-db-staleness` in deny.toml
-# then measures the copy's real age, not the time of this run.
+# one commit dated like the upstream commit it copies, so that its age is the copy's real age.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -24,6 +23,14 @@ git -C "$db" -c user.name=hnav -c user.email=hnav@example.invalid -c commit.gpgs
     commit --quiet -m "rustsec/advisory-db $commit"
 # cargo-deny takes the newer of the commit's date and .git/HEAD's modification time.
 touch -d "$date" "$db/.git/HEAD"
+
+# deny.toml lets any age pass (a commit's CI result must not change with the calendar): say
+# it here instead.
+age_days=$(( ($(date +%s) - $(date -d "$date" +%s)) / 86400 ))
+if [ "$age_days" -gt 180 ]; then
+    echo "warning: the advisory database copy is $age_days days old (of $date);" \
+        "refresh it: supply-chain/refresh-advisory-db.sh" >&2
+fi
 
 # cargo-deny reads the whole graph for deny.toml's target (`cargo metadata`), optional
 # dependencies the build never downloads too (nalgebra's glam conversions, ...): fetch them
