@@ -26,7 +26,8 @@ pub enum Nemesis {
     Pause,
     /// The cluster split in two, both ways.
     Partition,
-    /// Links cut one way only.
+    /// Links cut one way only: one link, or everything a replica sends, or everything it
+    /// would receive.
     OneWay,
     /// The leader cut off from everyone, both ways.
     LeaderIsolated,
@@ -151,6 +152,10 @@ pub enum Action {
     Partition(Vec<u64>, Vec<u64>, u64),
     /// The link from the first to the second cut.
     Cut(Target, Target, u64),
+    /// Every link from the target cut: it hears, but is not heard.
+    Mute(Target, u64),
+    /// Every link to the target cut: it is heard, but hears nothing.
+    Deafen(Target, u64),
     /// Every link of the target cut both ways.
     Isolate(Target, u64),
     /// Two majorities sharing only the target.
@@ -222,6 +227,8 @@ fn action(kind: Nemesis, n: u64, rng: &mut Rng) -> Action {
             let (a, b) = split(n, rng);
             Action::Partition(a, b, d)
         }
+        Nemesis::OneWay if rng.chance(25) => Action::Mute(t, d),
+        Nemesis::OneWay if rng.chance(33) => Action::Deafen(t, d),
         Nemesis::OneWay => {
             let to = rng.range(1, n + 1);
             let from = if rng.chance(50) {
@@ -286,6 +293,8 @@ impl fmt::Display for Action {
             Action::Pause(t, d) => write!(f, "pause {t} for {d}ms"),
             Action::Partition(a, b, d) => write!(f, "partition {}|{} for {d}ms", ids(a), ids(b)),
             Action::Cut(a, b, d) => write!(f, "cut {a}>{b} for {d}ms"),
+            Action::Mute(t, d) => write!(f, "mute {t} for {d}ms"),
+            Action::Deafen(t, d) => write!(f, "deafen {t} for {d}ms"),
             Action::Isolate(t, d) => write!(f, "isolate {t} for {d}ms"),
             Action::Bridge(t, d) => write!(f, "bridge {t} for {d}ms"),
             Action::Ring(d) => write!(f, "ring for {d}ms"),
@@ -411,6 +420,8 @@ fn parse_action(
             Action::Cut(target(a)?, target(b)?, dur(w)?)
         }
         ["isolate", t, ..] => Action::Isolate(target(t)?, dur(w)?),
+        ["mute", t, ..] => Action::Mute(target(t)?, dur(w)?),
+        ["deafen", t, ..] => Action::Deafen(target(t)?, dur(w)?),
         ["bridge", t, ..] => Action::Bridge(target(t)?, dur(w)?),
         ["ring", ..] => Action::Ring(dur(w)?),
         ["net", "slow", ..] => Action::Net(NetFault::Slow, dur(w)?),

@@ -71,6 +71,16 @@ impl World {
                 let (a, b) = (self.resolve(a) as u64 + 1, self.resolve(b) as u64 + 1);
                 a != b && self.cut(vec![(a, b)], ms)
             }
+            Action::Mute(t, ms) => {
+                let x = self.resolve(t) as u64 + 1;
+                let links = self.others(x).map(|y| (x, y)).collect();
+                self.cut(links, ms)
+            }
+            Action::Deafen(t, ms) => {
+                let x = self.resolve(t) as u64 + 1;
+                let links = self.others(x).map(|y| (y, x)).collect();
+                self.cut(links, ms)
+            }
             Action::Isolate(t, ms) => {
                 let x = self.resolve(t) as u64 + 1;
                 let links = self.others(x).flat_map(|y| [(x, y), (y, x)]).collect();
