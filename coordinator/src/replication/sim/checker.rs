@@ -7,7 +7,7 @@
 //! |---|---|
 //! | one leader per term | every replica's role and term after every call |
 //! | log matching | the logs of the running replicas pairwise, whenever a new leader is seen and at the end: where two hold an entry of the same index and term, they hold the same entries up to it |
-//! | leader completeness | a new leader's log holds every entry any replica has handed out as committed, at its index and term |
+//! | leader completeness | a new leader's log holds every entry that leaders of earlier terms committed (as far as their commit indices reached), at its index and term; a leader of an earlier term elected late need not hold a later term's |
 //! | same record at the same index | each committed entry handed out is compared with what any replica handed out at its index before |
 //! | none applied twice | a replica hands out rising indices, and the coordinator applies no record twice |
 //! | no acknowledged record lost | an acknowledged record is the committed entry at its index, and every replica has handed it out by the end |
@@ -85,6 +85,8 @@ pub type LogEntry = (u64, Vec<u8>);
 #[derive(Debug, Default)]
 pub struct Checker {
     leaders: BTreeMap<u64, u64>,
+    /// Term -> the highest commit index its leader reached.
+    leader_commits: BTreeMap<u64, u64>,
     /// Every committed entry any replica handed out: index -> (term, data).
     committed: BTreeMap<u64, (u64, Vec<u8>)>,
     /// Per replica (0-based): the last index it handed out in this incarnation.
@@ -215,16 +217,35 @@ impl Checker {
         }
     }
 
-    /// Leader `id`'s log (`term(index)`, `None` past its end) against every committed entry.
-    pub fn complete(&mut self, at: Time, id: u64, term: impl Fn(u64) -> Option<u64>) {
+    /// The leader of `term` knows entries up to `index` committed.
+    pub fn leader_committed(&mut self, term: u64, index: u64) {
+        let c = self.leader_commits.entry(term).or_default();
+        *c = (*c).max(index);
+    }
+
+    /// Leader `id` of `term`, whose log says `log_term(index)` (`None` past its end), against
+    /// every committed entry up to the highest index a leader of an earlier term committed:
+    /// Raft's leader completeness speaks of leaders of later terms, and a leader of an earlier
+    /// term may win its election after a later term has committed more.
+    pub fn complete(
+        &mut self,
+        at: Time,
+        id: u64,
+        term: u64,
+        log_term: impl Fn(u64) -> Option<u64>,
+    ) {
+        let Some(&upto) = self.leader_commits.range(..term).map(|(_, i)| i).max() else {
+            return;
+        };
         let missing = self
             .committed
-            .iter()
-            .find(|(&index, (t, _))| term(index) != Some(*t));
+            .range(..=upto)
+            .find(|(&index, (t, _))| log_term(index) != Some(*t));
         if let Some((index, (t, _))) = missing {
             let detail = format!(
-                "leader {id} holds term {:?} at index {index}, committed in term {t}",
-                term(*index)
+                "leader {id} of term {term} holds term {:?} at index {index}, committed in term \
+                 {t} before term {term}",
+                log_term(*index)
             );
             self.fail(at, Property::LeaderCompleteness, detail);
         }

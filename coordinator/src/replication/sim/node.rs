@@ -240,6 +240,13 @@ impl Node {
         Some(entries.into_iter().map(|e| (e.term, e.data.to_vec())).collect())
     }
 
+    /// The highest index the replica knows committed (0 while down).
+    pub fn committed_index(&self) -> u64 {
+        self.process
+            .as_ref()
+            .map_or(0, |p| p.replica.committed_index())
+    }
+
     /// The term of the replica's entry at `index`, if it holds one.
     pub fn term_at(&self, index: u64) -> Option<u64> {
         let p = self.process.as_ref()?;

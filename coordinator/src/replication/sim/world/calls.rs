@@ -10,6 +10,7 @@ use raft::eraftpb::Message;
 
 use super::super::super::error::ReplicaError;
 use super::super::super::lead::Lead;
+use super::super::super::peer::Role;
 use super::super::super::link::MAX_MESSAGE_BYTES;
 use super::super::disk::Fired;
 use super::super::node::Called;
@@ -117,8 +118,13 @@ impl World {
                 if self.checker.role(self.now, id, role, term) {
                     self.note(|| format!("n{id} leads term {term}"));
                     let node = &self.nodes[i];
-                    self.checker.complete(self.now, id, |index| node.term_at(index));
+                    self.checker
+                        .complete(self.now, id, term, |index| node.term_at(index));
                     self.check_logs();
+                }
+                if role == Role::Leader {
+                    let committed = self.nodes[i].committed_index();
+                    self.checker.leader_committed(term, committed);
                 }
             }
             match self.decide(i) {
