@@ -242,10 +242,10 @@ impl Checker {
             .range(..=upto)
             .find(|(&index, (t, _))| log_term(index) != Some(*t));
         if let Some((index, (t, _))) = missing {
+            let held = log_term(*index).map_or("nothing".to_string(), |h| format!("term {h}"));
             let detail = format!(
-                "leader {id} of term {term} holds term {:?} at index {index}, committed in term \
-                 {t} before term {term}",
-                log_term(*index)
+                "leader {id} of term {term} holds {held} at index {index}, committed in term {t} \
+                 before term {term}"
             );
             self.fail(at, Property::LeaderCompleteness, detail);
         }
