@@ -123,8 +123,10 @@ impl Bridge {
         endpoints: &Endpoints,
         peers: Option<Peers>,
     ) -> Result<Self, BridgeError> {
-        let transport = Transport::builder(run).node_name("bridge").create()?;
+        // The session first: a client waits in it for its hub, and a bridge stopped while it
+        // waits then leaves nothing in this host's shared memory.
         let session = session::open(endpoints)?;
+        let transport = Transport::builder(run).node_name("bridge").create()?;
         let bell = Bell::create()?;
         let (inbox_tx, inbox) = crossbeam_channel::bounded(INBOX);
         let (delay, tx) = match Delay::from_env().map_err(BridgeError::Delay)? {

@@ -11,7 +11,7 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use hnav_bridge::hosts::{PeerHost, Peers};
-use hnav_bridge::session::Endpoints;
+use hnav_bridge::session::{Endpoints, Mode};
 use hnav_bridge::{topics, Bridge};
 use hnav_runtime::placement::Placement;
 use hnav_runtime::transport::RunId;
@@ -71,6 +71,7 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let mut endpoints = Endpoints {
         listen: args.listen.clone(),
         connect: args.connect.clone(),
+        ..Endpoints::default()
     };
     let mut peers = None;
     if let (Some(file), Some(name)) = (&args.hosts, &args.host) {
@@ -80,6 +81,11 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             .listen
             .extend(placement.hosts()[me].listen.iter().cloned());
         endpoints.connect.extend(placement.connect_of(me));
+        endpoints.mode = if placement.is_hub(me) {
+            Mode::Router
+        } else {
+            Mode::Client
+        };
         peers = Some(Peers {
             me: name.clone(),
             index: me as u32,

@@ -3,7 +3,8 @@
 //!
 //! The consensus log's header holds the scenario's hash and seed but not the scenario: the
 //! processes load it from its file with the command line's overrides (`--agents`, `--seed`,
-//! `--mode`, the faults), see [`hnav_runtime::launch`]. This file keeps exactly those: the scenario
+//! `--mode`, `--replicas`, the faults), see [`hnav_runtime::launch`]. This file keeps exactly
+//! those: the scenario
 //! file's absolute path, the overrides, and the hash of the scenario they gave. The scenario
 //! is referred to, not copied: a scenario names its map by a path relative to itself, so a
 //! copy would have to move the map too. The hash makes a reference safe: a replay recomputes
@@ -30,6 +31,11 @@ pub struct Invocation {
     pub seed: Option<u64>,
     /// `--mode`, if given.
     pub mode: Option<ClockMode>,
+    /// `--replicas N`, if given: a replay must run as many coordinator replicas, or it writes
+    /// a single coordinator's log (another header version) instead of replicas' logs.
+    /// Missing in the files of runs that predate it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replicas: Option<u32>,
     /// The command line's faults, in the processes' `--fault` spelling (`kill=agent:1@round:40`).
     pub faults: Vec<String>,
     /// The scenario hash of the scenario these gave, as `0x` and 16 hex digits (the log's
@@ -72,6 +78,7 @@ impl Invocation {
             agents: args.agents,
             seed: args.seed,
             mode: args.mode,
+            replicas: args.replicas,
             faults: args.faults.iter().map(fault_arg::to_process_arg).collect(),
             scenario_hash: format!("{:#018x}", scenario.scenario_hash()),
         }
@@ -117,7 +124,7 @@ impl Invocation {
             agents: self.agents,
             seed: self.seed,
             mode: self.mode,
-            replicas: None,
+            replicas: self.replicas,
             dir: Some(dir.to_path_buf()),
             resume: false,
             faults: self
@@ -148,7 +155,7 @@ mod tests {
             agents: Some(1),
             seed: Some(7),
             mode: Some(ClockMode::Realtime),
-            replicas: None,
+            replicas: Some(3),
             dir: None,
             resume: false,
             faults: vec![fault_arg::parse_process_arg("kill=agent:0@round:5").unwrap()],
@@ -159,8 +166,11 @@ mod tests {
         inv.write(tmp.path()).unwrap();
         let back = Invocation::read(tmp.path()).unwrap();
         assert_eq!(back, inv);
-        let again = back.process_args("r2", tmp.path()).scenario().unwrap();
+        let again = back.process_args("r2", tmp.path());
+        assert_eq!(again.replicas, Some(3));
+        let again = again.scenario().unwrap();
         assert_eq!(again.scenario_hash(), s.scenario_hash());
+        assert_eq!(again.coordinator.replicas, 3);
         assert_eq!(inv.scenario_hash, format!("{:#018x}", s.scenario_hash()));
     }
 

@@ -55,7 +55,7 @@ fn check_exit_codes_are_the_documented_ones() {
     let help = text(&hnav(&["check", "--help"]));
     assert!(
         help.contains(
-            "Exit 0 when the scenario is valid and the report is written, 1 when it is valid but"
+            "Exit 0 when the scenario is valid (and the report asked for is written), 1 when it is"
         ),
         "{help}"
     );
@@ -95,4 +95,97 @@ fn check_prints_huge_numbers_readably() {
     let err = text(&o);
     assert!(err.contains("got -1e300"), "{err}");
     assert!(err.len() < 200, "{err}");
+}
+
+#[test]
+fn check_writes_nothing_unless_a_report_is_asked_for() {
+    let tmp = tempfile::tempdir().unwrap();
+    let good = write(tmp.path(), "good.toml", SCENARIO);
+    let run_in = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_hnav"))
+            .args(args)
+            .current_dir(tmp.path())
+            .output()
+            .expect("hnav runs")
+    };
+    let o = run_in(&["check", &good]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let files: Vec<String> = std::fs::read_dir(tmp.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(files, ["good.toml"], "{}", text(&o));
+    assert!(!text(&o).contains("report "), "{}", text(&o));
+    let o = run_in(&["check", &good, "--report", "r.json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(text(&o).contains("report    r.json"), "{}", text(&o));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(tmp.path().join("r.json")).unwrap()).unwrap();
+    assert_eq!(json["name"], "u");
+}
+
+#[test]
+fn a_value_of_the_wrong_type_is_named_in_the_formats_words() {
+    let tmp = tempfile::tempdir().unwrap();
+    let bad = write(
+        tmp.path(),
+        "fast.toml",
+        &format!("{SCENARIO}speed = \"fast\"\n"),
+    );
+    let o = hnav(&["check", &bad]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    let err = text(&o);
+    assert!(
+        err.contains("fast.toml:7: speed: expected a number, got the string \"fast\""),
+        "{err}"
+    );
+    assert!(!err.contains("f64"), "{err}");
+}
+
+#[test]
+fn an_agent_count_below_one_is_refused_in_the_command_lines_words() {
+    let tmp = tempfile::tempdir().unwrap();
+    let good = write(tmp.path(), "good.toml", SCENARIO);
+    for verb in ["check", "run"] {
+        for n in ["0", "-1"] {
+            let o = hnav(&[verb, &good, "--agents", n]);
+            let err = text(&o);
+            assert_eq!(o.status.code(), Some(2), "{verb} --agents {n}: {err}");
+            assert!(
+                err.contains(&format!("invalid value '{n}' for '--agents <N>'"))
+                    && err.contains("at least one agent"),
+                "{verb} --agents {n}: {err}"
+            );
+            assert!(
+                !err.contains("[[agents]]") && !err.contains("'-- "),
+                "{verb} --agents {n}: {err}"
+            );
+        }
+    }
+    let o = hnav(&["check", &good, "--seed", "-1"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("S is a whole number from 0"),
+        "{}",
+        text(&o)
+    );
+}
+
+#[test]
+fn run_force_help_names_every_output_it_replaces() {
+    let help = text(&hnav(&["run", "--help"]));
+    let force = help
+        .split("--force")
+        .nth(1)
+        .expect("--force in the help")
+        .split("\n      --")
+        .next()
+        .unwrap()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    for output in hnav_operator::supervisor::run_dir::RUN_OUTPUTS {
+        assert!(force.contains(output), "{output} not in: {force}");
+    }
+    assert!(force.contains("other files there are kept"), "{force}");
 }

@@ -13,11 +13,13 @@ use hnav_operator::recording::{
     self, MapWriter, PoseSample, PoseSource, TrajectoryHeader, TrajectoryWriter,
 };
 use hnav_runtime::consensus_log::{
-    AgentEntry, EndReason, EndRecord, LogWriter, LoggedDecision, Record, ReplanRecord, RoundRecord,
-    RunHeader, FORMAT_VERSION,
+    AgentEntry, EndReason, EndRecord, LifecycleRecord, LogWriter, LoggedDecision, Record,
+    ReplanRecord, RoundRecord, RunHeader, FORMAT_VERSION,
 };
 use hnav_runtime::launch::ProcessArgs;
-use hnav_runtime::msg::{ActivationKind, ConflictKind, MapHeader, Verdict, NO_CELL};
+use hnav_runtime::msg::{
+    ActivationKind, ConflictKind, Lifecycle, MapHeader, Role, Verdict, NO_CELL,
+};
 use hnav_runtime::scenario::FsyncPolicy;
 
 const SCENARIO: &str = r#"
@@ -49,7 +51,8 @@ fn decision(agent: u32, verdict: Verdict, cell: u32) -> LoggedDecision {
 }
 
 /// A run directory with a scenario, its invocation and a log of `ROUNDS` rounds of two
-/// decisions each (agent 0 moving, agent 1 held), one replan and an end.
+/// decisions each (agent 0 moving, agent 1 held), one replan, agent 1 killed and restarted
+/// after round 4 (as `hnav kill RUN agent:1` and the supervisor log it) and an end.
 fn run_dir(dir: &Path) {
     let scenario_path = dir.join("fixture.toml");
     std::fs::write(&scenario_path, SCENARIO).unwrap();
@@ -108,6 +111,15 @@ fn run_dir(dir: &Path) {
             ],
         }))
         .unwrap();
+        if round == 4 {
+            for event in [
+                Lifecycle::down(Role::Agent, 1, 0),
+                Lifecycle::restarted(Role::Agent, 1, 1),
+            ] {
+                log.append(&Record::Lifecycle(LifecycleRecord::new(round, &event)))
+                    .unwrap();
+            }
+        }
     }
     log.append(&Record::End(EndRecord {
         round: ROUNDS,
@@ -229,6 +241,7 @@ fn every_channel_reads_back_with_its_schema_and_count() {
         ("/commits", ("hnav.CommittedCells", ROUNDS)),
         ("/decisions", ("hnav.Decision", 2 * ROUNDS)),
         ("/replans", ("hnav.Replan", 1)),
+        ("/lifecycle", ("hnav.Lifecycle", 2)),
     ]
     .into_iter()
     .collect();
@@ -307,7 +320,10 @@ fn missing_recording_files_leave_the_log_channels_and_say_so() {
     assert!(notes.contains("trajectories.bin missing"), "{notes}");
     assert!(notes.contains("maps.bin missing"), "{notes}");
     let topics: Vec<String> = read_back(&out).into_keys().collect();
-    assert_eq!(topics, ["/commits", "/decisions", "/map", "/replans"]);
+    assert_eq!(
+        topics,
+        ["/commits", "/decisions", "/lifecycle", "/map", "/replans"]
+    );
 }
 
 #[test]
@@ -324,4 +340,51 @@ fn a_damaged_recording_names_the_file_and_offset_and_leaves_no_output() {
     let e = export_mcap(tmp.path(), &out).unwrap_err().to_string();
     assert!(e.contains("maps.bin: at byte 8:"), "{e}");
     assert!(!out.exists());
+}
+
+#[test]
+fn a_kill_and_its_restart_are_on_the_lifecycle_channel() {
+    let tmp = tempfile::tempdir().unwrap();
+    run_dir(tmp.path());
+    let out = tmp.path().join("run.mcap");
+    export_mcap(tmp.path(), &out).unwrap();
+    let bytes = std::fs::read(&out).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().expect("a summary");
+    let channel = summary
+        .channels
+        .values()
+        .find(|c| c.topic == "/lifecycle")
+        .expect("a /lifecycle channel");
+    let schema = channel.schema.as_ref().unwrap();
+    assert_eq!(schema.name, "hnav.Lifecycle");
+    let schema: serde_json::Value = serde_json::from_slice(&schema.data).unwrap();
+    for field in [
+        "round", "process", "role", "index", "event", "restarts", "cell",
+    ] {
+        assert!(
+            schema["properties"].get(field).is_some(),
+            "{field}: {schema}"
+        );
+    }
+    let events: Vec<(u64, serde_json::Value)> = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(Result::unwrap)
+        .filter(|m| m.channel.topic == "/lifecycle")
+        .map(|m| (m.log_time, serde_json::from_slice(&m.data).unwrap()))
+        .collect();
+    // Logged after round 4, at 4 control periods of 10 ms; agent 1 held at its start [3, 0].
+    let expect = |event: &str, restarts: u32| {
+        serde_json::json!({
+            "timestamp": {"sec": 0, "nsec": 40_000_000},
+            "round": 4, "process": "agent-1", "role": "agent", "index": 1,
+            "event": event, "restarts": restarts, "cell": [3, 0],
+        })
+    };
+    assert_eq!(
+        events,
+        vec![
+            (40_000_000, expect("down", 0)),
+            (40_000_000, expect("restarted", 1))
+        ]
+    );
 }

@@ -12,15 +12,17 @@
 //! # A robot's computer: its agent.
 //! [[host]]
 //! name = "robot-0"
-//! listen = ["tcp/10.0.0.2:7447"]
 //! agents = "0"            # or a list: [0, 1], or ranges: "0-7,9"
 //! ```
 //!
-//! Every host listens on its `listen` endpoints and connects to those of every host listed
-//! before it, so the hosts form a full mesh with each link opened from one side only (Zenoh's
-//! peers do not relay for each other). Each process runs on exactly one host; the file is
-//! checked against the run's agent count before anything starts, and every problem names the
-//! file and line.
+//! The hosts form a star: the first host (the hub, normally the base station) listens on its
+//! `listen` endpoints as a Zenoh router, and every other host connects to it as a Zenoh
+//! client, so that only the hub's address need be known and a host that drops away touches
+//! nothing but its own link. (A full mesh of Zenoh peers was used before: with it, one peer
+//! cut off could stall the traffic between the two still linked for as long as it was away;
+//! see `docs/explanation/between-hosts.md`.) Only the hub has `listen`. Each process runs on
+//! exactly one host; the file is checked against the run's agent count before anything
+//! starts, and every problem names the file and line.
 
 use std::path::{Path, PathBuf};
 
@@ -89,7 +91,8 @@ pub struct Host {
     /// Its name: 1 to 16 ASCII letters, digits, `-`, `_` (the spelling of an iceoryx2
     /// domain, so that hosts sharing one machine can use it as theirs).
     pub name: String,
-    /// The Zenoh endpoints its bridge listens on (`tcp/10.0.0.1:7447`).
+    /// The Zenoh endpoints its bridge listens on (`tcp/10.0.0.1:7447`): the hub's only;
+    /// empty for every other host.
     pub listen: Vec<String>,
     /// Whether it runs the sim.
     pub sim: bool,
@@ -128,7 +131,8 @@ struct RawFile {
 #[serde(deny_unknown_fields)]
 struct RawHost {
     name: Spanned<String>,
-    listen: Spanned<Vec<String>>,
+    #[serde(default)]
+    listen: Option<Spanned<Vec<String>>>,
     #[serde(default)]
     sim: bool,
     #[serde(default)]
@@ -185,12 +189,8 @@ impl Placement {
                     format!("host `{name}` again (host {} has that name)", first + 1),
                 ));
             }
-            if h.listen.get_ref().is_empty() {
-                return Err(invalid(
-                    h.listen.span().start,
-                    format!("host `{name}` listens nowhere: the others could not reach it"),
-                ));
-            }
+            let listen = check_listen(name, i, h.listen.as_ref())
+                .map_err(|(at, what)| invalid(at.unwrap_or(start), what))?;
             for (flag, holder, what) in [
                 (h.sim, &mut sim, "the sim"),
                 (h.coordinator, &mut coordinator, "the coordinator"),
@@ -222,7 +222,7 @@ impl Placement {
             }
             hosts.push(Host {
                 name: name.clone(),
-                listen: h.listen.get_ref().clone(),
+                listen,
                 sim: h.sim,
                 coordinator: h.coordinator,
                 agents: mine,
@@ -274,12 +274,41 @@ impl Placement {
         self.hosts.iter().find(|h| h.runs(role, index))
     }
 
-    /// The endpoints host `i` connects to: those its predecessors in the file listen on.
+    /// The endpoints host `i` connects to: the hub's, for every host but the hub.
     pub fn connect_of(&self, i: usize) -> Vec<String> {
-        self.hosts[..i.min(self.hosts.len())]
-            .iter()
-            .flat_map(|h| h.listen.iter().cloned())
-            .collect()
+        match i {
+            0 => Vec::new(),
+            _ => self.hosts[0].listen.clone(),
+        }
+    }
+
+    /// Whether host `i` is the hub: the first host, the Zenoh router the others connect to.
+    pub fn is_hub(&self, i: usize) -> bool {
+        i == 0
+    }
+}
+
+/// The `listen` of host number `i` (from 0) named `name`: the hub must listen somewhere, no
+/// other host may (it would wait for connections that never come). An error is the line it
+/// is on, if any, and what is wrong.
+fn check_listen(
+    name: &str,
+    i: usize,
+    listen: Option<&Spanned<Vec<String>>>,
+) -> Result<Vec<String>, (Option<usize>, String)> {
+    let at = listen.map(|l| l.span().start);
+    let endpoints = listen.map_or_else(Vec::new, |l| l.get_ref().clone());
+    match (i, endpoints.is_empty()) {
+        (0, true) => Err((
+            at,
+            format!("host `{name}` is the hub (the first host) and listens nowhere: the others could not reach it"),
+        )),
+        (0, false) => Ok(endpoints),
+        (_, _) if listen.is_none() => Ok(Vec::new()),
+        (_, _) => Err((
+            at,
+            format!("host `{name}` has `listen`, but only the first host (the hub) listens: the others connect to it"),
+        )),
     }
 }
 
@@ -334,25 +363,24 @@ coordinator = true
 
 [[host]]
 name = "robots-a"
-listen = ["tcp/10.0.0.2:7447"]
 agents = "0-1"
 
 [[host]]
 name = "robots-b"
-listen = ["tcp/10.0.0.3:7447"]
 agents = [2, 3]
 "#;
 
     #[test]
-    fn a_placement_names_each_process_host_and_the_mesh() {
+    fn a_placement_names_each_process_host_and_the_star() {
         let p = Placement::parse(THREE, "hosts.toml", 4).unwrap();
         assert_eq!(p.hosts().len(), 3);
         assert_eq!(p.host_of(Role::Sim, 0).unwrap().name, "base");
         assert_eq!(p.host_of(Role::Coordinator, 2).unwrap().name, "base");
         assert_eq!(p.host_of(Role::Agent, 1).unwrap().name, "robots-a");
         assert_eq!(p.host_of(Role::Agent, 3).unwrap().name, "robots-b");
-        assert!(p.connect_of(0).is_empty());
-        assert_eq!(p.connect_of(2), ["tcp/10.0.0.1:7447", "tcp/10.0.0.2:7447"]);
+        assert!(p.connect_of(0).is_empty() && p.is_hub(0) && !p.is_hub(1));
+        assert_eq!(p.connect_of(1), ["tcp/10.0.0.1:7447"]);
+        assert_eq!(p.connect_of(2), ["tcp/10.0.0.1:7447"]);
         assert_eq!(p.index_of("robots-b").unwrap(), 2);
         let e = p.index_of("nope").unwrap_err().to_string();
         assert_eq!(
@@ -370,41 +398,53 @@ agents = [2, 3]
         };
         // Agent 4 does not exist in a 4-agent run (line 16: the agents of robots-b).
         let e = err(&THREE.replace("[2, 3]", "[2, 3, 4]"), 4);
-        assert_eq!(e, "h.toml:16: agent 4: the run has 4 agents (0-3)");
+        assert_eq!(e, "h.toml:14: agent 4: the run has 4 agents (0-3)");
         // Nobody runs agent 3.
         let e = err(&THREE.replace("[2, 3]", "[2]"), 4);
         assert_eq!(e, "h.toml: no host runs agent 3 (the run has 4 agents)");
         // Two hosts claim agent 1.
         let e = err(&THREE.replace("[2, 3]", "[1, 2, 3]"), 4);
-        assert_eq!(e, "h.toml:16: agent 1 is on host `robots-a` already");
+        assert_eq!(e, "h.toml:14: agent 1 is on host `robots-a` already");
         // A second sim.
         let e = err(
             &THREE.replace("agents = [2, 3]", "agents = [2, 3]\nsim = true"),
             4,
         );
         assert!(
-            e.starts_with("h.toml:13: the sim is on host `base` already"),
+            e.starts_with("h.toml:12: the sim is on host `base` already"),
             "{e}"
         );
         // A typo in a key.
         let e = err(
-            &THREE.replace("listen = [\"tcp/10.0.0.3", "lisen = [\"tcp/10.0.0.3"),
+            &THREE.replace("listen = [\"tcp/10.0.0.1", "lisen = [\"tcp/10.0.0.1"),
             4,
         );
-        assert!(e.starts_with("h.toml:15: unknown field `lisen`"), "{e}");
+        assert!(e.starts_with("h.toml:4: unknown field `lisen`"), "{e}");
         // A bad range.
         let e = err(&THREE.replace("\"0-1\"", "\"1-x\""), 4);
         assert_eq!(
             e,
-            "h.toml:11: agents `1-x`: `1-x` is no index or range `A-B`"
+            "h.toml:10: agents `1-x`: `1-x` is no index or range `A-B`"
         );
         // A name that could not be a domain.
         let e = err(&THREE.replace("robots-a", "robots a"), 4);
         assert!(e.starts_with("h.toml:9: host name `robots a`"), "{e}");
-        // No listen endpoint.
-        let e = err(&THREE.replace("[\"tcp/10.0.0.3:7447\"]", "[]"), 4);
+        // The hub without a listen endpoint.
+        let e = err(&THREE.replace("[\"tcp/10.0.0.1:7447\"]", "[]"), 4);
         assert!(
-            e.starts_with("h.toml:15: host `robots-b` listens nowhere"),
+            e.starts_with("h.toml:4: host `base` is the hub (the first host) and listens nowhere"),
+            "{e}"
+        );
+        // A robot host that listens: nobody would connect to it.
+        let e = err(
+            &THREE.replace(
+                "agents = [2, 3]",
+                "agents = [2, 3]\nlisten = [\"tcp/10.0.0.3:7447\"]",
+            ),
+            4,
+        );
+        assert!(
+            e.starts_with("h.toml:15: host `robots-b` has `listen`, but only the first host"),
             "{e}"
         );
     }

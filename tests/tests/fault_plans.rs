@@ -1,8 +1,9 @@
 //! Fault plans from the command line (`hnav run --kill/--term/--freeze`) and against a live
 //! run (`hnav kill`): a lockstep freeze and a kill in seconds are as reproducible as a
 //! scenario's kill at a round, a realtime kill in seconds ends with every robot at goal, and
-//! `hnav kill` restarts an agent of a running swarm; bad faults and targets are refused
-//! before anything is spawned.
+//! `hnav kill` restarts an agent of a running swarm (its `signalled` line before the
+//! `exited` line of the death it caused); bad faults and targets are refused before anything
+//! is spawned.
 //!
 //! In its own test binary because it SIGKILLs and SIGSTOPs processes.
 
@@ -241,6 +242,17 @@ fn hnav_kill_restarts_an_agent_of_a_live_run_and_refuses_what_it_cannot_do() {
                 && e["fault"].is_null()
         })
         .unwrap_or_else(|| panic!("hnav kill's line: {ev:?}"));
+    // The journal reads in the order things happened (issue 34): the signal, then the death.
+    let exited = ev
+        .iter()
+        .position(|e| e["event"] == "exited" && e["node"] == "agent-0")
+        .unwrap_or_else(|| panic!("agent 0's exit: {ev:?}"));
+    assert!(
+        signalled < exited && ev[signalled]["t_ns"].as_u64() <= ev[exited]["t_ns"].as_u64(),
+        "hnav kill's `signalled` line must come before the `exited` line it caused:\n{:#}\n{:#}",
+        ev[signalled],
+        ev[exited]
+    );
     assert!(
         ev[signalled..]
             .iter()

@@ -24,13 +24,57 @@ fn faulty_scenario(dir: &Path) -> PathBuf {
     path
 }
 
-/// Runs `scenario` in lockstep into `dir`; returns the log segment's bytes.
+/// Runs `scenario` in lockstep into `dir`; returns the log segment's bytes. Every view of
+/// the run shows its two faults: the summary's restarts, the report's process events and
+/// agent-down mark, the MCAP export's lifecycle channel.
 fn run(tag: &str, scenario: &Path, dir: &Path, registry: &Path) -> Vec<u8> {
     let mut run = TestRun::new(tag);
     let mut swarm = SwarmRun::start(&mut run, scenario, dir, registry, &["--mode", "lockstep"])
         .expect("hnav run starts");
     let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
     assert!(status.success(), "{status}\n{}", swarm.log_tails());
+    let summary = swarm.summary().unwrap();
+    assert_eq!(
+        summary["restarts"],
+        serde_json::json!({"agent-1": 1, "coordinator": 1}),
+        "{summary}"
+    );
+    let svg = std::fs::read_to_string(dir.join("report.svg")).unwrap();
+    assert!(
+        svg.contains("round 40: agent-1 down, restarted at ["),
+        "{svg}"
+    );
+    assert!(
+        svg.contains("round 90: coordinator down, restarted"),
+        "{svg}"
+    );
+    assert!(svg.contains("2 process restarts"), "{svg}");
+    let mcap = dir.join("run.mcap");
+    hnav_operator::export::export_mcap(dir, &mcap).unwrap();
+    let bytes = std::fs::read(&mcap).unwrap();
+    let events: Vec<String> = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(Result::unwrap)
+        .filter(|m| m.channel.topic == "/lifecycle")
+        .map(|m| {
+            let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+            format!(
+                "{} {} {}",
+                v["round"],
+                v["process"].as_str().unwrap(),
+                v["event"].as_str().unwrap()
+            )
+        })
+        .collect();
+    assert_eq!(
+        events,
+        [
+            "40 agent-1 down",
+            "40 agent-1 restarted",
+            "90 coordinator down",
+            "90 coordinator restarted"
+        ]
+    );
     let (ok, report) = verify_log(&dir.join("log"));
     assert!(ok, "log does not verify:\n{report}");
     std::fs::read(dir.join("log/seg-00000000.hlog")).unwrap()

@@ -1,6 +1,7 @@
 //! The Python client (`clients/python/`) against the Rust side: its `ctypes` mirrors match the
 //! layout table of `hnav layout --json` field by field, and its example joins a live run by
-//! its id and prints commits, ground truth and an agent's neural map.
+//! its id and prints commits, ground truth and an agent's neural map; given a run id that no
+//! run has, it leaves nothing of it in `/dev/shm` or iceoryx2's root (issue 34).
 //!
 //! The Python is the virtual environment's with the pinned `iceoryx2` package: `$HNAV_PYTHON`,
 //! else `target/py-venv/bin/python` (made by the command in docs/how-to/python-client.md). Without either the tests
@@ -10,6 +11,7 @@ use std::path::PathBuf;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
+use hnav_runtime::transport::{run_iceoryx2_files, run_shm_files};
 use hnav_tests::swarm::{repo_root, workspace_bin, SwarmRun};
 use hnav_tests::TestRun;
 use nix::sys::signal::Signal;
@@ -145,4 +147,36 @@ fn the_python_example_watches_a_live_run() {
     assert!(rows.iter().all(|r| r.chars().count() == 12 + 4), "{text}");
     // The map's pillars are blocked cells: '@' where demo.toml has them ([2,2]).
     assert_eq!(rows[2].chars().nth(3 + 2), Some('@'), "{text}");
+}
+
+#[test]
+fn a_mistyped_run_id_leaves_nothing_behind() {
+    let Some(python) = python() else { return };
+    // No run has this id; whatever the example left of it is purged when this drops.
+    let typo = TestRun::new("pytypo");
+    let example = repo_root().join("clients/python/examples/watch_run.py");
+    // Bounded by the example's own --timeout.
+    let out = Command::new(&python)
+        .arg(&example)
+        .arg(typo.run.as_str())
+        .args(["--timeout", "1"])
+        .output()
+        .expect("python runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        run_shm_files(&typo.run),
+        Vec::<PathBuf>::new(),
+        "left in /dev/shm by the example with a mistyped run id ({stderr})"
+    );
+    assert_eq!(
+        run_iceoryx2_files(&typo.run),
+        Vec::<PathBuf>::new(),
+        "left under iceoryx2's root"
+    );
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains(&format!("error: no live run '{}'", typo.run))
+            && stderr.contains("within 1.0 s (`hnav ps` lists the live runs)"),
+        "{stderr}"
+    );
 }

@@ -3,8 +3,10 @@
 //! A lockstep run replays identically; the same log with one decision altered (re-encoded
 //! through the log's own writer, so `hnav log verify` still passes and only the content
 //! differs) is reported at that round and agent; a run whose scenario changed since, and a
-//! realtime run, are refused. Every `hnav run` and every replay has a test's own run id, so
-//! its shared memory is removed whatever happens.
+//! realtime run, are refused. A lockstep run with coordinator replicas, and one with a fault
+//! plan, replay identically too (issue 34: the invocation did not record `--replicas`, so
+//! the replay ran one coordinator and differed at the header). Every `hnav run` and every
+//! replay has a test's own run id, so its shared memory is removed whatever happens.
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
@@ -135,6 +137,43 @@ fn a_lockstep_run_replays_identically_and_an_altered_decision_is_found() {
         err.contains("demo.toml: the scenario (with the run's --agents, --seed, --mode and faults) hashes to 0x")
             && err.contains("the scenario file or its map changed since the run"),
         "{err}"
+    );
+}
+
+/// A lockstep run of the demo cut to its first `agents` robots with `extra` arguments; its
+/// `hnav log replay` must print `N rounds replayed, identical` for the summary's N.
+fn replays_identically(tag: &str, agents: &str, extra: &[&str]) {
+    let tmp = tempfile::tempdir().unwrap();
+    let registry = tmp.path().join("runs");
+    let scenario = demo(tmp.path(), |t| t);
+    let dir = tmp.path().join("run");
+    let mut args = vec!["--mode", "lockstep", "--agents", agents, "--no-record"];
+    args.extend_from_slice(extra);
+    assert_eq!(run(tag, &scenario, &dir, &registry, &args), Some(0));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let rounds = summary["rounds"].as_u64().unwrap();
+    let (code, out, err) = replay(&dir, &registry);
+    assert_eq!(code, Some(0), "{out}{err}");
+    assert_eq!(out.trim(), format!("{rounds} rounds replayed, identical"));
+}
+
+#[test]
+fn a_lockstep_run_with_three_replicas_replays_identically() {
+    replays_identically("replay-raft", "2", &["--replicas", "3"]);
+}
+
+#[test]
+fn a_lockstep_run_with_a_fault_plan_replays_identically() {
+    replays_identically(
+        "replay-plan",
+        "3",
+        &[
+            "--kill",
+            "agent:1@round:40",
+            "--freeze",
+            "agent:2@round:60+0.2s",
+        ],
     );
 }
 

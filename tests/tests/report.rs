@@ -135,9 +135,10 @@ fn check_report(dir: &Path, scenario: &Scenario, summary: &serde_json::Value) {
     let conflicts = sum(summary, "conflicts");
     assert!(conflicts > 0);
     assert_eq!(elements(&doc, "line").len() as u64, 2 * (conflicts + 1));
+    // Replan triangles and the legend's triangle and agent-down diamond (no process died).
     assert_eq!(
         elements(&doc, "polygon").len() as u64,
-        sum(summary, "replans") + 1
+        sum(summary, "replans") + 2
     );
     let rings = elements(&doc, "circle")
         .iter()
@@ -162,9 +163,26 @@ fn check_report(dir: &Path, scenario: &Scenario, summary: &serde_json::Value) {
         .map(str::trim)
         .collect();
     assert!(
-        texts.iter().any(|t| t.starts_with("agent 0 neural map")),
+        texts
+            .iter()
+            .any(|t| t.starts_with("agent 0 neural map after round")),
         "{texts:?}"
     );
+    assert_eq!(summary["rules"], "dissertation");
+    assert!(
+        texts
+            .iter()
+            .any(|t| t.starts_with("6 robots, dissertation rules, ")),
+        "the title names the rules: {texts:?}"
+    );
+    // The cell coordinates along the edges: 0 to 11 once for x and once for y.
+    for n in 0..12 {
+        let label = n.to_string();
+        assert!(
+            texts.iter().filter(|t| **t == label).count() >= 2,
+            "{n}: {texts:?}"
+        );
+    }
     for i in 0..robots {
         assert!(texts.contains(&format!("robot {i}").as_str()), "{texts:?}");
     }

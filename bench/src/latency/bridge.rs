@@ -76,11 +76,11 @@ pub(crate) fn measure(
     let ends = [
         Endpoints {
             listen: vec![endpoint.clone()],
-            connect: Vec::new(),
+            ..Endpoints::default()
         },
         Endpoints {
-            listen: Vec::new(),
             connect: vec![endpoint],
+            ..Endpoints::default()
         },
     ];
     let out = std::thread::scope(|s| -> Result<Samples> {

@@ -246,7 +246,8 @@ mod tests {
                 agent,
                 verdict: verdict as u8,
                 refused: 0,
-                kind: 0,
+                // A hold for a cell being left: a conflict.
+                kind: hnav_runtime::msg::ConflictKind::Reserved as u8,
                 cell,
                 waypoint: NO_CELL,
             });

@@ -1,13 +1,16 @@
 #!/usr/bin/env python3
 """Watch a live HNAV run from Python: its commits, ground truth and one agent's neural map.
 
-    python examples/watch_run.py RUN_ID [--agent I] [--commits N] [--timeout S]
+    python examples/watch_run.py RUN_ID [--host NAME] [--agent I] [--commits N] [--timeout S]
 
-RUN_ID is the run's id (`hnav run --run ID`, or the one `hnav ps` lists). Prints each commit
+RUN_ID is the run's id (`hnav run --run ID`, or the one `hnav ps` lists); `--host NAME` joins
+host NAME's part of a run across hosts (`hnav run --host NAME`), on that host. Prints each commit
 as it arrives (`commit R: a0 accept [x,y], a1 hold, ...`), the ground truth every 100 commits
 (`truth period P: ...`), and at the end the agent's latest neural map as a log-scale heatmap
 (`map agent I round R: W x H ...` and H rows of W glyphs). Exits 0 once N commits were seen;
-1 when the run ended (no commit for `--timeout` seconds) before that.
+1 when the run ended (no commit for `--timeout` seconds) before that; 2 when no run RUN_ID is
+live within `--timeout` seconds (nothing is left behind: no node is made in a run that is not
+there).
 """
 
 import argparse
@@ -70,6 +73,9 @@ def heatmap(values, width: int, height: int):
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("run_id", metavar="RUN_ID")
+    parser.add_argument(
+        "--host", default=None, help="the host's part of a run across hosts (its domain)"
+    )
     parser.add_argument("--agent", type=int, default=0, help="whose neural map (default 0)")
     parser.add_argument("--commits", type=int, default=200, help="stop after N commits")
     parser.add_argument(
@@ -78,15 +84,22 @@ def main() -> int:
     a = parser.parse_args()
 
     try:
-        run = Run(a.run_id, node_name="watch-run")
-        # The map first: its header gives the width that turns cell indices into [x,y], and a
-        # late joiner gets the agent's last snapshot at once (the topic keeps it as history).
-        maps = run.subscribe(f"map/{a.agent}", a.timeout)
-        commits = run.subscribe("commit", a.timeout)
-        truth = run.subscribe("truth", a.timeout)
+        # Waits for the run to be live before making a node in it (a mistyped id leaves
+        # nothing behind); the node goes when `with` ends, however it ends.
+        with Run(a.run_id, node_name="watch-run", wait_s=a.timeout, domain=a.host) as run:
+            return watch(run, a)
     except RunError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
+
+
+def watch(run: Run, a) -> int:
+    """Subscribes, then prints what the docstring says; the exit code of `main`."""
+    # The map first: its header gives the width that turns cell indices into [x,y], and a
+    # late joiner gets the agent's last snapshot at once (the topic keeps it as history).
+    maps = run.subscribe(f"map/{a.agent}", a.timeout)
+    commits = run.subscribe("commit", a.timeout)
+    truth = run.subscribe("truth", a.timeout)
 
     deadline = time.monotonic() + a.timeout
     snapshot = newest_map(maps, None)  # (header, values), copied out of shared memory

@@ -240,7 +240,8 @@ fn pibt_moves_an_agent_that_asked_nothing_and_replans_nobody() {
         assert_eq!(d.len(), 1, "{d:?}");
         assert_eq!(d[0].verdict, Verdict::Hold as u8);
     }
-    // A push is a step, a hold a conflict.
+    // A push is a step; four holds for the same cell are one conflict and four rounds waited.
     assert_eq!(a.tally().agents()[1].steps, 1, "{:?}", a.tally());
-    assert_eq!(a.tally().agents()[0].conflicts, 4);
+    let t = a.tally().agents()[0];
+    assert_eq!((t.conflicts, t.waited), (1, 4), "{t:?}");
 }

@@ -14,6 +14,7 @@
 //! | `/commits` | `hnav.CommittedCells` | `log/` | round: the cells its commit gave |
 //! | `/decisions` | `hnav.Decision` | `log/` | decision of every round |
 //! | `/replans` | `hnav.Replan` | `log/` | replan record |
+//! | `/lifecycle` | `hnav.Lifecycle` | `log/` | process down, restarted or lost (field `cell`: an agent's robot's cell then) |
 //!
 //! Poses and grids are in one frame, `map`: metres, x along columns, y along rows (the sim's
 //! frame; cell `(x, y)` spans `[x c, (x + 1) c) x [y c, (y + 1) c)`), z up. A missing
@@ -35,7 +36,7 @@ use crate::recording::{
     self, MapReader, MapSnapshot, PoseSample, PoseSource, RecordingError, TrajectoryReader,
 };
 use hnav_runtime::consensus_log::{read_decided, LogError, LoggedDecision, Record, RunHeader};
-use hnav_runtime::msg::{ConflictKind, Verdict, NO_CELL};
+use hnav_runtime::msg::{ConflictKind, LifecycleEvent, Role, Verdict, NO_CELL};
 use hnav_runtime::scenario::Scenario;
 
 /// The frame every pose and grid is in.
@@ -252,7 +253,7 @@ fn write_all(
     log_channels(w, records, info)
 }
 
-/// `/commits`, `/decisions` and `/replans`, from the consensus log.
+/// `/commits`, `/decisions`, `/replans` and `/lifecycle`, from the consensus log.
 fn log_channels(
     w: &mut Mcap<impl Write + Seek>,
     records: &[Record],
@@ -263,9 +264,12 @@ fn log_channels(
         ("/commits", schemas::COMMITTED_CELLS),
         ("/decisions", schemas::DECISION),
         ("/replans", schemas::REPLAN),
+        ("/lifecycle", schemas::LIFECYCLE),
     ] {
         w.channel(topic, schema)?;
     }
+    // Each robot's cell (its start, then its last accepted move), for the lifecycle events.
+    let mut at: Vec<u32> = info.header.agents.iter().map(|a| a.start).collect();
     for r in records {
         let Some(round) = r.round() else { continue };
         let t = round.saturating_mul(info.period_ns);
@@ -280,6 +284,11 @@ fn log_channels(
                 let commit = json!({"timestamp": stamp(t), "round": round, "cells": cells});
                 w.message("/commits", schemas::COMMITTED_CELLS, t, &commit)?;
                 for d in &rec.decisions {
+                    if Verdict::from_u8(d.verdict) == Some(Verdict::Accept) {
+                        if let Some(c) = at.get_mut(d.agent as usize) {
+                            *c = d.cell;
+                        }
+                    }
                     w.message(
                         "/decisions",
                         schemas::DECISION,
@@ -298,6 +307,23 @@ fn log_channels(
                     "waypoints": p.waypoints.iter().map(|&c| cell(c, width)).collect::<Vec<_>>(),
                 });
                 w.message("/replans", schemas::REPLAN, t, &msg)?;
+            }
+            Record::Lifecycle(l) => {
+                let role = Role::from_u8(l.role);
+                let agent_cell = (role == Some(Role::Agent))
+                    .then(|| at.get(l.index as usize).copied())
+                    .flatten();
+                let msg = json!({
+                    "timestamp": stamp(t),
+                    "round": round,
+                    "process": role.map_or_else(|| l.role.to_string(), |r| r.node_name(l.index)),
+                    "role": role.map_or_else(|| l.role.to_string(), |r| r.name().to_string()),
+                    "index": l.index,
+                    "event": LifecycleEvent::from_u8(l.event).map_or_else(|| l.event.to_string(), |e| e.name().to_string()),
+                    "restarts": l.restarts,
+                    "cell": agent_cell.map_or(Value::Null, |c| cell(c, width)),
+                });
+                w.message("/lifecycle", schemas::LIFECYCLE, t, &msg)?;
             }
             _ => {}
         }

@@ -17,6 +17,8 @@ pub const COMMITTED_CELLS: &str = "hnav.CommittedCells";
 pub const DECISION: &str = "hnav.Decision";
 /// One global replan.
 pub const REPLAN: &str = "hnav.Replan";
+/// One process event: a process down, restarted or lost.
+pub const LIFECYCLE: &str = "hnav.Lifecycle";
 
 fn time() -> Value {
     json!({
@@ -151,6 +153,21 @@ pub fn schema(name: &str) -> Vec<u8> {
                 "planner": {"type": "string"},
                 "found": {"type": "boolean"},
                 "waypoints": {"type": "array", "items": cell()}
+            }
+        }),
+        LIFECYCLE => json!({
+            "title": LIFECYCLE,
+            "description": "A process of the run down, restarted or lost, as the consensus log holds it",
+            "type": "object",
+            "properties": {
+                "timestamp": time(),
+                "round": {"type": "integer", "description": "the last round committed when it was logged"},
+                "process": {"type": "string", "description": "sim, coordinator, agent-<i> (as hnav ps names it)"},
+                "role": {"enum": ["sim", "coordinator", "agent", "bridge"]},
+                "index": {"type": "integer", "description": "agent index or replica id, else 0"},
+                "event": {"enum": ["down", "restarted", "lost"]},
+                "restarts": {"type": "integer", "description": "restarts of the process so far"},
+                "cell": cell()
             }
         }),
         other => json!({"title": other, "type": "object"}),

@@ -17,6 +17,9 @@ pub struct RunInfo {
     pub run_id: String,
     /// `lockstep` or `realtime`.
     pub mode: String,
+    /// The conflict rules the run runs (`lacam`, `pibt`, `dissertation`); empty when not
+    /// known.
+    pub rules: String,
     /// The map.
     pub grid: Grid,
     /// Each agent's start cell (0-based row-major index, as in the messages).
@@ -36,6 +39,7 @@ impl RunInfo {
         RunInfo {
             run_id: run_id.to_string(),
             mode: scenario.sim.clock.to_string(),
+            rules: scenario.coordinator.rules.name().to_string(),
             starts: scenario.agents.iter().map(|a| id(a.start)).collect(),
             goals: scenario.agents.iter().map(|a| id(a.goal)).collect(),
             cell_size_m: scenario.robot.cell_size_m,

@@ -69,7 +69,10 @@ pub fn find_run(registry: &RunRegistry, arg: Option<&str>) -> Result<RunRecord, 
         wanted.is_some() && dir.canonicalize().ok() == wanted
     });
     match found {
-        Some(e) => Ok(registry.find_live(&e.record.run_id)?.1),
+        Some(e) => {
+            let id = e.record.run().map_err(LiveRunError::from)?;
+            Ok(registry.find_live_id(&id)?)
+        }
         None => Err(FeedError::NotFound {
             run: arg.to_string(),
             dir: registry.dir().to_path_buf(),
@@ -125,7 +128,7 @@ impl LiveFeed {
             run: run_id.clone(),
             source,
         };
-        let run = RunId::new(&run_id).map_err(transport_err)?;
+        let run = record.run().map_err(transport_err)?;
         let transport = Transport::builder(&run)
             .node_name("hnav-top")
             .create()
@@ -172,8 +175,8 @@ impl LiveFeed {
             return None;
         }
         self.next_health = now + HEALTH_PERIOD;
-        match self.registry.find_live(self.run.as_str()) {
-            Ok((_, record)) => {
+        match self.registry.find_live_id(&self.run) {
+            Ok(record) => {
                 self.sampler.sample(&record, now, &mut self.rows);
                 apply(Update::Health(&self.rows));
                 None

@@ -355,6 +355,7 @@ fn run_info(
     Ok(RunInfo {
         run_id: name,
         mode: format!("{} playback x{speed}", header.clock),
+        rules: rules_of(&dir.join("summary.json")),
         grid,
         starts: header.agents.iter().map(|a| a.start).collect(),
         goals: header.agents.iter().map(|a| a.goal).collect(),
@@ -375,6 +376,15 @@ fn cell_centre(c: u32, width: u32, cell_size_m: f32) -> Pose {
 
 /// The simulated times at which the collision count rose (`summary.json`'s
 /// `recording.collisions_at_ns`), sorted; none when the summary is absent.
+/// The rules a run ran, as its summary says; empty when it does not.
+fn rules_of(summary: &Path) -> String {
+    std::fs::read_to_string(summary)
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .and_then(|v| v.get("rules").and_then(|r| r.as_str()).map(str::to_string))
+        .unwrap_or_default()
+}
+
 fn collision_times(path: &PathBuf) -> Result<Vec<u64>, FeedError> {
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,

@@ -1,5 +1,12 @@
 //! What the live view shows, folded from a feed's [`Update`]s: each agent's state, the round
-//! and its rate, the latest decisions and process events, the processes' health.
+//! and its rate, the latest decisions and, apart from them, the process events (down,
+//! restarted, lost), the processes' health.
+//!
+//! Process events are kept in their own list ([`ViewState::events`]): a run under `lacam` or
+//! `pibt` holds a waiting robot every round, and among the latest decisions a restart would
+//! scroll away at once. Among the decisions, a robot's hold or block that repeats its
+//! previous one (same verdict, kind and cell: the same request still waiting) updates that
+//! line's round and count instead of adding a line.
 //!
 //! ## An agent's state
 //!
@@ -147,31 +154,35 @@ impl AgentView {
     }
 }
 
-/// One line of the latest-records panel.
+/// One line of the latest decisions: a decision other than "held, nothing asked", or a run
+/// of the same hold or block of one agent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum RecentLine {
-    /// A decision other than "held, nothing asked".
-    Decision {
-        /// The round.
-        round: u64,
-        /// The agent.
-        agent: u32,
-        /// What was decided.
-        verdict: Verdict,
-        /// Why (for a block or hold).
-        kind: ConflictKind,
-    },
-    /// A process went down, was restarted or lost.
-    Process {
-        /// The round last seen when it was announced.
-        round: u64,
-        /// Its role.
-        role: Role,
-        /// Its agent index, else 0.
-        index: u32,
-        /// Down, restarted or lost.
-        event: LifecycleEvent,
-    },
+pub struct RecentLine {
+    /// The round of the latest decision of the line.
+    pub round: u64,
+    /// The agent.
+    pub agent: u32,
+    /// What was decided.
+    pub verdict: Verdict,
+    /// Why (for a block or hold).
+    pub kind: ConflictKind,
+    /// The cell decided (accepted, or the one asked for and refused or held).
+    pub cell: u32,
+    /// The rounds the line stands for: 1, or how many times a hold or block repeated.
+    pub times: u32,
+}
+
+/// A process went down, was restarted or lost.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ProcessEvent {
+    /// The round last seen when it was announced.
+    pub round: u64,
+    /// Its role.
+    pub role: Role,
+    /// Its agent index (or replica id), else 0.
+    pub index: u32,
+    /// Down, restarted or lost.
+    pub event: LifecycleEvent,
 }
 
 /// Rounds per second over the last second, from (time, round) samples.
@@ -246,8 +257,10 @@ pub struct ViewState {
     /// Commits the view did not receive since the first it did (it reads at its own pace;
     /// the coordinator never waits for it).
     pub missed_commits: u64,
-    /// The latest decisions and process events, newest last.
+    /// The latest decisions, newest last.
     pub recent: VecDeque<RecentLine>,
+    /// The latest process events (down, restarted, lost), newest last.
+    pub events: VecDeque<ProcessEvent>,
     /// The run's processes.
     pub health: Vec<HealthRow>,
     /// Set once the run is over.
@@ -274,6 +287,7 @@ impl ViewState {
             collisions: 0,
             missed_commits: 0,
             recent: VecDeque::with_capacity(RECENT),
+            events: VecDeque::with_capacity(RECENT),
             health: Vec::new(),
             ended: None,
             rate: RateMeter::default(),
@@ -352,11 +366,13 @@ impl ViewState {
         };
         agent.decide(verdict, kind, d.cell);
         if !(verdict == Verdict::Hold && kind == ConflictKind::None) {
-            self.push_recent(RecentLine::Decision {
+            self.push_recent(RecentLine {
                 round,
                 agent: d.agent,
                 verdict,
                 kind,
+                cell: d.cell,
+                times: 1,
             });
         }
     }
@@ -402,7 +418,10 @@ impl ViewState {
             event,
             LifecycleEvent::Down | LifecycleEvent::Restarted | LifecycleEvent::Lost
         ) {
-            self.push_recent(RecentLine::Process {
+            if self.events.len() == RECENT {
+                self.events.pop_front();
+            }
+            self.events.push_back(ProcessEvent {
                 round: self.round,
                 role,
                 index: l.index,
@@ -418,7 +437,23 @@ impl ViewState {
         }
     }
 
+    /// Adds a decision's line; a hold or block that repeats the agent's latest line (the
+    /// same request still waiting) moves that line to the end with its count raised.
     fn push_recent(&mut self, line: RecentLine) {
+        let same = |l: &RecentLine| {
+            (l.verdict, l.kind, l.cell) == (line.verdict, line.kind, line.cell)
+                && line.verdict != Verdict::Accept
+        };
+        if let Some(k) = self.recent.iter().rposition(|l| l.agent == line.agent) {
+            if same(&self.recent[k]) {
+                if let Some(mut old) = self.recent.remove(k) {
+                    old.round = line.round;
+                    old.times = old.times.saturating_add(1);
+                    self.recent.push_back(old);
+                }
+                return;
+            }
+        }
         if self.recent.len() == RECENT {
             self.recent.pop_front();
         }

@@ -6,6 +6,7 @@ fn view() -> ViewState {
     ViewState::new(RunInfo {
         run_id: "t".into(),
         mode: "lockstep".into(),
+        rules: "lacam".into(),
         grid: Grid::new(4, 2).unwrap(),
         starts: vec![0, 4],
         goals: vec![2, 7],
@@ -145,12 +146,9 @@ fn down_and_lost_come_from_the_lifecycle_topic() {
         now,
     );
     let events: Vec<_> = v
-        .recent
+        .events
         .iter()
-        .map(|l| match l {
-            RecentLine::Process { role, event, .. } => (role.name(), event.name()),
-            RecentLine::Decision { .. } => ("decision", ""),
-        })
+        .map(|e| (e.role.name(), e.event.name()))
         .collect();
     assert_eq!(
         events,
@@ -161,12 +159,63 @@ fn down_and_lost_come_from_the_lifecycle_topic() {
             ("coordinator", "down")
         ]
     );
+    assert!(v.recent.is_empty(), "process events are not decisions");
     assert_eq!(v.ended, None);
     v.apply(
         Update::Lifecycle(&Lifecycle::stop(hnav_runtime::msg::StopReason::Requested)),
         now,
     );
     assert_eq!(v.ended, Some(RunEnd::Stopped));
+}
+
+#[test]
+fn a_restart_stays_in_view_under_a_flood_of_holds() {
+    let mut v = view();
+    let now = Instant::now();
+    v.apply(Update::Lifecycle(&Lifecycle::down(Role::Agent, 1, 0)), now);
+    v.apply(
+        Update::Lifecycle(&Lifecycle::restarted(Role::Agent, 1, 1)),
+        now,
+    );
+    // lacam: both robots wait for their turn, held every round for the same cell.
+    for round in 1..=500 {
+        v.apply(
+            Update::Commit(&commit(
+                round,
+                &[(0, V::Hold, K::Reserved, 1), (1, V::Hold, K::Reserved, 5)],
+            )),
+            now,
+        );
+    }
+    let events: Vec<_> = v.events.iter().map(|e| e.event.name()).collect();
+    assert_eq!(events, ["down", "restarted"]);
+    // One line per robot's waiting request, with its latest round and count.
+    let lines: Vec<(u32, u64, u32)> = v
+        .recent
+        .iter()
+        .map(|l| (l.agent, l.round, l.times))
+        .collect();
+    assert_eq!(lines, [(0, 500, 500), (1, 500, 500)]);
+    // Another cell asked is another line.
+    v.apply(
+        Update::Commit(&commit(501, &[(0, V::Hold, K::Reserved, 2)])),
+        now,
+    );
+    assert_eq!(v.recent.len(), 3);
+    // Drawn: the events pane keeps the restart.
+    let mut t = ratatui::Terminal::new(ratatui::backend::TestBackend::new(120, 30)).unwrap();
+    t.draw(|f| super::super::view::draw(f, &v, now, super::super::view::Hints::default()))
+        .unwrap();
+    let text: String = t
+        .backend()
+        .buffer()
+        .content()
+        .iter()
+        .map(|c| c.symbol())
+        .collect();
+    assert!(text.contains("process events"), "{text}");
+    assert!(text.contains("agent-1 restarted"), "{text}");
+    assert!(text.contains("reserved x500"), "{text}");
 }
 
 #[test]
@@ -186,12 +235,9 @@ fn the_latest_records_skip_idle_holds_and_keep_ten() {
     let rounds: Vec<u64> = v
         .recent
         .iter()
-        .map(|l| match l {
-            RecentLine::Decision { round, agent, .. } => {
-                assert_eq!(*agent, 0);
-                *round
-            }
-            RecentLine::Process { .. } => 0,
+        .map(|l| {
+            assert_eq!(l.agent, 0);
+            l.round
         })
         .collect();
     assert_eq!(rounds, (6..=15).collect::<Vec<_>>());

@@ -1,13 +1,16 @@
 //! The whole screen of `hnav top`, drawn from a [`ViewState`] into any ratatui backend.
 //!
 //! ```text
-//!  hnav top  RUN  lockstep  round 1234  2093 rounds/s  at goal 3/6  conflicts 12 ...
+//!  hnav top  RUN  lockstep  lacam rules  round 1234  2093 rounds/s  at goal 3/6  conflicts 12 ...
 //! ┌ map ───────────────────┐┌ agents ──────────────────────────┐
-//! │  . . 0 . + .           ││ 0  moving      (3,4) -> (9,9)    │
+//! │  . . 0 . + .           ││ 0  moving      [3, 4] -> [9, 9]  │
 //! │  ...                   │├ processes ───────────────────────┤
 //! │                        ││ agent 0  pid 4242  running  0  12%│
+//! │                        │├ process events ──────────────────┤
+//! │                        ││ r40      agent-1 down             │
 //! │                        │├ latest decisions ────────────────┤
 //! │                        ││ r1234  a3  block  head-on         │
+//! │                        ││ r1290  a2  hold   reserved x57    │
 //! └────────────────────────┘└──────────────────────────────────┘
 //!  q / Esc / Ctrl-C quit                       (or: run ended: ...)
 //! ```
@@ -21,7 +24,7 @@ use ratatui::widgets::{Block, Borders, Paragraph};
 use ratatui::Frame;
 
 use super::map::{agent_color, agent_label, MapWidget};
-use super::state::{AgentState, RecentLine, ViewState};
+use super::state::{AgentState, ProcessEvent, RecentLine, ViewState};
 use hnav_runtime::grid::Grid;
 
 /// Columns the side panel takes.
@@ -70,6 +73,11 @@ fn header_line(state: &ViewState, now: Instant) -> Line<'static> {
     let mut spans = vec![
         Span::styled(" hnav top  ", bold),
         Span::raw(format!("{}  {}  ", state.info.run_id, state.info.mode)),
+        Span::raw(if state.info.rules.is_empty() {
+            String::new()
+        } else {
+            format!("{} rules  ", state.info.rules)
+        }),
         Span::styled(format!("round {}", state.round), bold),
         Span::raw(format!(
             "  {:.0} rounds/s  at goal {}/{}",
@@ -113,9 +121,11 @@ fn status_line(state: &ViewState, hints: Hints) -> Line<'static> {
 fn draw_side(frame: &mut Frame, state: &ViewState, area: Rect) {
     let agents = u16::try_from(state.agents.len()).unwrap_or(u16::MAX);
     let procs = u16::try_from(state.health.len().max(1)).unwrap_or(u16::MAX);
-    let [a, p, r] = Layout::vertical([
+    let events = u16::try_from(state.events.len().max(1)).unwrap_or(u16::MAX);
+    let [a, p, e, r] = Layout::vertical([
         Constraint::Max(agents.saturating_add(2)),
         Constraint::Max(procs.saturating_add(2)),
+        Constraint::Max(events.saturating_add(2)),
         Constraint::Min(3),
     ])
     .areas(area);
@@ -164,6 +174,15 @@ fn draw_side(frame: &mut Frame, state: &ViewState, area: Rect) {
             .collect()
     };
     frame.render_widget(panel(proc_lines, " processes: pid state restarts cpu "), p);
+    let event_lines: Vec<Line> = if state.events.is_empty() {
+        vec![Line::styled(
+            " (none)",
+            Style::default().fg(Color::DarkGray),
+        )]
+    } else {
+        state.events.iter().rev().map(event_line).collect()
+    };
+    frame.render_widget(panel(event_lines, " process events "), e);
     let recent: Vec<Line> = state.recent.iter().rev().map(recent_line).collect();
     frame.render_widget(panel(recent, " latest decisions "), r);
 }
@@ -173,32 +192,37 @@ fn panel<'a>(lines: Vec<Line<'a>>, title: &'a str) -> Paragraph<'a> {
 }
 
 fn recent_line(l: &RecentLine) -> Line<'static> {
-    match *l {
-        RecentLine::Decision {
-            round,
-            agent,
-            verdict,
-            kind,
-        } => {
-            let why = match kind {
-                hnav_runtime::msg::ConflictKind::None => "",
-                k => k.name(),
-            };
-            Line::raw(format!(
-                " r{round:<7} a{agent:<4}{:<8}{why}",
-                verdict.name()
-            ))
-        }
-        RecentLine::Process {
-            round,
-            role,
-            index,
-            event,
-        } => Line::styled(
-            format!(" r{round:<7} {} {}", role.node_name(index), event.name()),
-            Style::default().fg(Color::LightRed),
+    let why = match l.kind {
+        hnav_runtime::msg::ConflictKind::None => "",
+        k => k.name(),
+    };
+    let times = if l.times > 1 {
+        format!(" x{}", l.times)
+    } else {
+        String::new()
+    };
+    Line::raw(format!(
+        " r{:<7} a{:<4}{:<8}{why}{times}",
+        l.round,
+        l.agent,
+        l.verdict.name()
+    ))
+}
+
+fn event_line(e: &ProcessEvent) -> Line<'static> {
+    let colour = match e.event {
+        hnav_runtime::msg::LifecycleEvent::Restarted => Color::Yellow,
+        _ => Color::LightRed,
+    };
+    Line::styled(
+        format!(
+            " r{:<7} {} {}",
+            e.round,
+            e.role.node_name(e.index),
+            e.event.name()
         ),
-    }
+        Style::default().fg(colour),
+    )
 }
 
 fn state_style(s: AgentState) -> Style {
@@ -214,7 +238,22 @@ fn state_style(s: AgentState) -> Style {
 
 fn cell_text(grid: &Grid, id: Option<u32>) -> String {
     match id.and_then(|i| grid.cell_at(i as usize)) {
-        Some(c) => format!("({},{})", c.x, c.y),
+        // `[x, y]`, as every other output of HNAV writes a cell.
+        Some(c) => c.to_string(),
         None => "(off map)".to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_agents_panel_writes_cells_as_every_other_output_does() {
+        let grid = Grid::new(5, 4).unwrap();
+        // Cell index 17 on a 5-wide grid: column 2, row 3.
+        assert_eq!(cell_text(&grid, Some(17)), "[2, 3]");
+        assert_eq!(cell_text(&grid, Some(99)), "(off map)");
+        assert_eq!(cell_text(&grid, None), "(off map)");
     }
 }

@@ -1,6 +1,10 @@
 //! What the report shows, gathered from a run directory: the map copy (`map.map`), the
 //! consensus log (`log/`), the recording (`recording/`) and the summary (`summary.json`).
 //!
+//! Conflicts are the log's [`Tally`]'s, the summary's count: a mark where a request was
+//! first refused or held, not one per round it waited. Process events (down, restarted,
+//! lost) are the log's lifecycle records.
+//!
 //! Only the log is required. Without a recording the report has no trajectories, neural
 //! maps or collision marks, and says so in [`RunData::notes`]; so it does for an agent with
 //! no recorded snapshot.
@@ -8,9 +12,9 @@
 use std::path::Path;
 
 use crate::recording::{self, MapReader, MapSnapshot, PoseSource, TrajectoryReader};
-use hnav_runtime::consensus_log::{read_decided, Record, RunHeader};
+use hnav_runtime::consensus_log::{read_decided, Counted, Record, RunHeader, Tally};
 use hnav_runtime::grid::read_map_file;
-use hnav_runtime::msg::Verdict;
+use hnav_runtime::msg::{LifecycleEvent, Role};
 
 use super::{ReportError, MAP_FILE};
 
@@ -26,6 +30,21 @@ pub struct Mark {
     pub cell: CellXy,
     /// The round.
     pub round: u64,
+}
+
+/// A process event of the log: a process down, restarted or lost.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LifeMark {
+    /// The last round committed when it was logged.
+    pub round: u64,
+    /// The process's role.
+    pub role: Role,
+    /// Its agent index (or replica id), else 0.
+    pub index: u32,
+    /// Down, restarted or lost.
+    pub event: LifecycleEvent,
+    /// For an agent, its robot's cell then (its start, or its last accepted move).
+    pub cell: Option<CellXy>,
 }
 
 /// A robot's true position when the sim's collision count rose, in cell units.
@@ -56,10 +75,17 @@ pub struct RunData {
     pub goals: Vec<CellXy>,
     /// Per robot: the cells of its accepted moves, in order.
     pub committed: Vec<Vec<CellXy>>,
-    /// Refused or held decisions.
+    /// Conflicts: requests refused or held for another robot or the map, each marked once
+    /// where it was first decided.
     pub conflicts: Vec<Mark>,
+    /// Rounds waited (requests held), all agents.
+    pub waited: u32,
     /// Global replans.
     pub replans: Vec<Mark>,
+    /// Processes down, restarted or lost, in log order.
+    pub lifecycle: Vec<LifeMark>,
+    /// The conflict rules the run ran, from the summary; `None` when it does not say.
+    pub rules: Option<String>,
     /// Rounds committed.
     pub rounds: u64,
     /// Per robot: its true positions over time, in cell units.
@@ -141,29 +167,61 @@ impl RunData {
             ..RunData::default()
         };
         let mut at = data.starts.clone();
+        let mut tally = Tally::from_header(header);
         for r in &contents.records {
-            let Record::Round(round) = r else { continue };
-            data.rounds = data.rounds.max(round.round);
-            for d in &round.decisions {
-                let i = d.agent as usize;
-                let Some(cell) = at.get_mut(i) else { continue };
-                let mark = Mark {
-                    agent: d.agent,
-                    cell: *cell,
-                    round: round.round,
-                };
-                match Verdict::from_u8(d.verdict) {
-                    Some(Verdict::Accept) => {
-                        *cell = xy(d.cell);
-                        data.committed[i].push(*cell);
-                    }
-                    Some(Verdict::Block | Verdict::Hold) => data.conflicts.push(mark),
-                    Some(Verdict::Replan) => data.replans.push(mark),
-                    None => {}
+            match r {
+                Record::Round(round) => data.fold_round(round, &mut tally, &mut at, xy),
+                Record::Lifecycle(l) => {
+                    let (Some(role), Some(event)) =
+                        (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
+                    else {
+                        continue;
+                    };
+                    let cell = (role == Role::Agent)
+                        .then(|| at.get(l.index as usize).copied())
+                        .flatten();
+                    data.lifecycle.push(LifeMark {
+                        round: l.round,
+                        role,
+                        index: l.index,
+                        event,
+                        cell,
+                    });
                 }
+                _ => {}
             }
         }
+        data.waited = tally.waited();
         Ok(data)
+    }
+
+    /// One round's decisions, marked at each agent's cell (`at`, moved by accepted moves).
+    fn fold_round(
+        &mut self,
+        round: &hnav_runtime::consensus_log::RoundRecord,
+        tally: &mut Tally,
+        at: &mut [CellXy],
+        xy: impl Fn(u32) -> CellXy,
+    ) {
+        self.rounds = self.rounds.max(round.round);
+        for d in &round.decisions {
+            let i = d.agent as usize;
+            let Some(cell) = at.get_mut(i) else { continue };
+            let mark = Mark {
+                agent: d.agent,
+                cell: *cell,
+                round: round.round,
+            };
+            match tally.fold(d) {
+                Counted::Step => {
+                    *cell = xy(d.cell);
+                    self.committed[i].push(*cell);
+                }
+                Counted::Conflict => self.conflicts.push(mark),
+                Counted::Replan => self.replans.push(mark),
+                Counted::StillHeld | Counted::Waited | Counted::Nothing => {}
+            }
+        }
     }
 
     /// The obstacles, from the map copy.
@@ -237,6 +295,11 @@ impl RunData {
         };
         let v: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| bad(format!("not JSON: {e}")))?;
+        self.rules = v
+            .get("rules")
+            .and_then(serde_json::Value::as_str)
+            .filter(|r| !r.is_empty())
+            .map(str::to_string);
         self.collisions = v
             .get("collisions")
             .and_then(serde_json::Value::as_u64)

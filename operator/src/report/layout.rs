@@ -1,5 +1,7 @@
-//! Where everything lands on the report's canvas, in pixels: the map panel on the left, one
-//! heatmap panel per chosen agent beside it, the legend under both.
+//! Where everything lands on the report's canvas, in pixels: the map panel on the left (its
+//! cell coordinates along its top and left edges), one heatmap panel per chosen agent beside
+//! it (what it shows in lines under it), the legend under both, and the run's process events
+//! (down, restarted, lost) under the legend.
 //!
 //! Cells are square; the map's cells are at most [`MAX_CELL_PX`] and the map at most about
 //! [`MAP_PX`] on its longer side, heatmap cells half as large (at least one pixel each).
@@ -20,11 +22,21 @@ pub const GAP: i32 = 30;
 pub const LEGEND_LINE: i32 = 20;
 /// One legend column.
 pub const LEGEND_COLUMN: i32 = 170;
-/// Room for a heatmap's caption and scale line, which may be wider than a small map.
-pub const CAPTION_WIDTH: i32 = 230;
+/// Room for a heatmap's caption and the lines under it, which may be wider than a small map.
+pub const CAPTION_WIDTH: i32 = 330;
+/// Lines under a heatmap: its scale and which map it is (round, target, why).
+pub const HEATMAP_LINES: i32 = 3;
+/// Room for the row numbers left of the map.
+pub const AXIS_LEFT: i32 = 30;
+/// Room for the column numbers above the map.
+pub const AXIS_TOP: i32 = 16;
+/// The fewest pixels between two coordinate labels along an edge.
+pub const AXIS_SPACING_PX: f64 = 24.0;
+/// The process events listed under the legend at most (the rest is counted in one more line).
+pub const MAX_EVENT_LINES: usize = 8;
 /// Marker kinds in the legend after the robots (start, goal, committed cell, conflict,
-/// replan, collision).
-pub const LEGEND_MARKERS: usize = 6;
+/// replan, agent down, collision).
+pub const LEGEND_MARKERS: usize = 7;
 
 /// A grid drawn on the canvas: its top-left pixel, its cells' size and count.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -97,16 +109,30 @@ pub struct Layout {
     pub legend: (i32, i32),
     /// Legend entries per column.
     pub legend_rows: usize,
+    /// The top-left corner of the process events' lines.
+    pub events: (i32, i32),
 }
 
 impl Layout {
-    /// The layout of a `cols` x `rows` map with `heatmaps` neural maps and `robots` robots.
+    /// The layout of a `cols` x `rows` map with `heatmaps` neural maps and `robots` robots,
+    /// without process events.
     pub fn new(cols: u32, rows: u32, heatmaps: usize, robots: usize) -> Self {
+        Self::with_events(cols, rows, heatmaps, robots, 0)
+    }
+
+    /// [`Layout::new`] with `events` lines of process events under the legend.
+    pub fn with_events(
+        cols: u32,
+        rows: u32,
+        heatmaps: usize,
+        robots: usize,
+        events: usize,
+    ) -> Self {
         let longer = f64::from(cols.max(rows).max(1));
         let cell = (MAP_PX / longer).clamp(1.0, MAX_CELL_PX);
-        let top = MARGIN + TITLE_PX + CAPTION_PX;
+        let top = MARGIN + TITLE_PX + CAPTION_PX + AXIS_TOP;
         let map = Panel {
-            x: MARGIN,
+            x: MARGIN + AXIS_LEFT,
             y: top,
             cell,
             cols,
@@ -129,7 +155,7 @@ impl Layout {
             .collect();
         let bottom = heatmaps
             .iter()
-            .map(|p| p.bottom() + CAPTION_PX)
+            .map(|p| p.bottom() + HEATMAP_LINES * CAPTION_PX)
             .fold(map.bottom(), i32::max);
         let captions = heatmaps.last().map_or(0, |p| p.x + CAPTION_WIDTH);
         let legend = (MARGIN, bottom + GAP);
@@ -139,13 +165,36 @@ impl Layout {
         let right = (x - GAP)
             .max(captions)
             .max(MARGIN + columns * LEGEND_COLUMN);
+        let events_at = (
+            MARGIN,
+            legend.1 + legend_rows as i32 * LEGEND_LINE + GAP / 2,
+        );
+        let event_lines = match events {
+            0 => 0,
+            n => 1 + n.min(MAX_EVENT_LINES + 1) as i32,
+        };
         Layout {
             width: (right + MARGIN) as u32,
-            height: (legend.1 + legend_rows as i32 * LEGEND_LINE + MARGIN) as u32,
+            height: (events_at.1 + event_lines * LEGEND_LINE + MARGIN) as u32,
             map,
             heatmaps,
             legend,
             legend_rows,
+            events: events_at,
+        }
+    }
+
+    /// The coordinate labels of `n` cells of `cell` pixels: every `step`-th cell from 0, the
+    /// step 1, 2 or 5 times a power of ten so that labels stay [`AXIS_SPACING_PX`] apart.
+    pub fn axis_step(n: u32, cell: f64) -> u32 {
+        let mut base = 1u32;
+        loop {
+            for s in [base, base.saturating_mul(2), base.saturating_mul(5)] {
+                if f64::from(s) * cell >= AXIS_SPACING_PX || s >= n.max(1) || s == u32::MAX {
+                    return s;
+                }
+            }
+            base = base.saturating_mul(10);
         }
     }
 
@@ -175,6 +224,29 @@ mod tests {
         let b = l.map.cell_rect(4, 4);
         assert_eq!(a[1].0, b[0].0);
         assert!(l.legend.1 > l.map.bottom());
+    }
+
+    #[test]
+    fn coordinate_labels_stay_apart() {
+        assert_eq!(Layout::axis_step(12, 40.0), 1);
+        assert_eq!(Layout::axis_step(32, 20.0), 2);
+        assert_eq!(Layout::axis_step(128, 5.0), 5);
+        assert_eq!(Layout::axis_step(2000, 1.0), 50);
+        assert_eq!(Layout::axis_step(3, 1.0), 5, "one label, at 0");
+    }
+
+    #[test]
+    fn process_events_make_room_under_the_legend() {
+        let plain = Layout::new(12, 12, 1, 6);
+        let with = Layout::with_events(12, 12, 1, 6, 2);
+        assert_eq!(with.map, plain.map);
+        assert_eq!(with.height as i32, plain.height as i32 + 3 * LEGEND_LINE);
+        assert!(with.events.1 > with.legend.1);
+        let many = Layout::with_events(12, 12, 1, 6, 100);
+        assert_eq!(
+            many.height as i32,
+            plain.height as i32 + (2 + MAX_EVENT_LINES as i32) * LEGEND_LINE
+        );
     }
 
     #[test]

@@ -1,4 +1,5 @@
-//! The report's colours and marker sizes, and the heatmap's log scale.
+//! The report's colours and the heatmap's log scale. A robot's marks (start, goal, committed
+//! cells, trajectory, conflicts, replans, its agent down) are all in [`robot`]'s colour.
 
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
@@ -7,10 +8,6 @@ use plotters::style::colors::colormaps::ViridisRGB;
 pub const OBSTACLE: RGBColor = RGBColor(64, 64, 64);
 /// The frame of a panel.
 pub const FRAME: RGBColor = RGBColor(160, 160, 160);
-/// Conflict crosses.
-pub const CONFLICT: RGBColor = RGBColor(0, 0, 0);
-/// Replan triangles.
-pub const REPLAN: RGBColor = RGBColor(90, 0, 120);
 /// Collision rings.
 pub const COLLISION: RGBColor = RGBColor(228, 26, 28);
 

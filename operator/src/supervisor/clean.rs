@@ -69,6 +69,8 @@ pub enum CleanError {
 pub struct Cleaned {
     /// The run id.
     pub run_id: String,
+    /// Its iceoryx2 domain (a host's part of a run across hosts), if any.
+    pub domain: Option<String>,
     /// Processes of the run that were still alive and were killed.
     pub killed: usize,
     /// Files removed from `/dev/shm` and iceoryx2's root directory.
@@ -81,8 +83,11 @@ impl core::fmt::Display for Cleaned {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         write!(
             f,
-            "cleaned run {}: {} process(es) killed, {} shared-memory file(s) removed{}",
+            "cleaned run {}{}: {} process(es) killed, {} shared-memory file(s) removed{}",
             self.run_id,
+            self.domain
+                .as_ref()
+                .map_or(String::new(), |d| format!(" (host {d})")),
             self.killed,
             self.files,
             if self.registered {
@@ -95,7 +100,8 @@ impl core::fmt::Display for Cleaned {
 }
 
 /// Cleans `run`: refused while its supervisor is alive. A run the registry does not know is
-/// cleaned too (its shared memory, if no process of it is alive).
+/// cleaned too (its shared memory, if no process of it is alive). See [`clean_named`] for a
+/// run named by id alone.
 pub fn clean_run(registry: &RunRegistry, run: &RunId) -> Result<Cleaned, CleanError> {
     let record = registry.find(run)?;
     if let Some(r) = record.as_ref().filter(|r| r.supervisor_alive()) {
@@ -111,6 +117,29 @@ pub fn clean_run(registry: &RunRegistry, run: &RunId) -> Result<Cleaned, CleanEr
         tracing::warn!("{e}");
     }
     result
+}
+
+/// Cleans the run named `run` (`hnav clean RUN`): `run` itself, and where hosts of a run
+/// across hosts ran here, each host's part (in its own domain, with its own registry entry).
+pub fn clean_named(registry: &RunRegistry, run: &RunId) -> Vec<Result<Cleaned, CleanError>> {
+    let parts: Vec<RunRecord> = registry
+        .list_runs()
+        .into_iter()
+        .map(|e| e.record)
+        .filter(|r| r.run_id == run.as_str() && r.domain.is_some() && run.domain().is_none())
+        .collect();
+    let mut results = vec![clean_run(registry, run)];
+    for part in parts {
+        results.push(
+            part.run()
+                .map_err(|source| CleanError::BadId {
+                    run: part.run_id.clone(),
+                    source,
+                })
+                .and_then(|id| clean_run(registry, &id)),
+        );
+    }
+    results
 }
 
 fn clean_claimed(run: &RunId, record: Option<&RunRecord>) -> Result<Cleaned, CleanError> {
@@ -131,6 +160,7 @@ fn clean_claimed(run: &RunId, record: Option<&RunRecord>) -> Result<Cleaned, Cle
     }
     Ok(Cleaned {
         run_id: run.to_string(),
+        domain: run.domain().map(str::to_string),
         killed,
         files,
         registered: record.is_some(),
@@ -145,7 +175,7 @@ pub fn clean_dead_runs(registry: &RunRegistry) -> Vec<Result<Cleaned, CleanError
         .into_iter()
         .filter(|e| e.stale)
         .map(|e| {
-            let run = RunId::new(&e.record.run_id).map_err(|source| CleanError::BadId {
+            let run = e.record.run().map_err(|source| CleanError::BadId {
                 run: e.record.run_id.clone(),
                 source,
             })?;

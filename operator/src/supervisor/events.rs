@@ -12,6 +12,12 @@
 //! journal too); a failed write (a full disk) costs the journal, never the run: it is
 //! reported once and the journal stops.
 //!
+//! Lines are in the order things happened. Every line is written under an exclusive `flock`
+//! of the file, and a writer that makes something happen that another writer will see and
+//! record holds the lock across both ([`RunEvents::hold`]): `hnav kill` takes it, signals,
+//! writes its `signalled` line and only then lets go, so the supervisor, woken by the death
+//! at once, writes its `exited` after it (issue 34: it used to come first).
+//!
 //! ```json
 //! {"t_ns":81234567890,"event":"signalled","node":"agent-3","pid":4242,"signal":"SIGKILL","fault":0,"round":40}
 //! ```
@@ -154,15 +160,38 @@ impl RunEvents {
         self.out.borrow().is_some()
     }
 
-    /// Appends `event`, stamped now, in one write.
+    /// Appends `event`, stamped now, in one write under the file's lock.
     pub fn record(&self, event: RunEvent) {
+        self.hold().record(event);
+    }
+
+    /// Takes the file's exclusive lock (waiting for another writer's line, or its [`Held`]
+    /// span, to end) until the [`Held`] is dropped: lines the other writers record meanwhile
+    /// come after the ones recorded through it.
+    pub fn hold(&self) -> Held<'_> {
+        let locked = match self.out.borrow().as_ref().map(File::lock) {
+            Some(Ok(())) => true,
+            // Unlocked, the line is still written; only its order is not guaranteed.
+            Some(Err(e)) => {
+                tracing::debug!("event journal {} not locked: {e}", self.path.display());
+                false
+            }
+            None => false,
+        };
+        Held {
+            journal: self,
+            locked,
+        }
+    }
+
+    fn write_line(&self, event: &RunEvent) {
         let mut slot = self.out.borrow_mut();
         let Some(out) = slot.as_mut() else {
             return;
         };
         let stamped = Stamped {
             t_ns: monotonic_ns(),
-            event: &event,
+            event,
         };
         let written = serde_json::to_vec(&stamped)
             .map_err(std::io::Error::from)
@@ -173,6 +202,30 @@ impl RunEvents {
         if let Err(e) = written {
             tracing::warn!("event journal {} stopped: {e}", self.path.display());
             *slot = None;
+        }
+    }
+}
+
+/// A journal locked against every other writer of the file ([`RunEvents::hold`]); unlocked
+/// when dropped.
+pub struct Held<'j> {
+    journal: &'j RunEvents,
+    locked: bool,
+}
+
+impl Held<'_> {
+    /// Appends `event`, stamped now, in one write.
+    pub fn record(&self, event: RunEvent) {
+        self.journal.write_line(&event);
+    }
+}
+
+impl Drop for Held<'_> {
+    fn drop(&mut self) {
+        if self.locked {
+            if let Some(out) = self.journal.out.borrow().as_ref() {
+                let _ = out.unlock();
+            }
         }
     }
 }
@@ -243,6 +296,32 @@ mod tests {
             .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["event"].to_string())
             .collect();
         assert_eq!(events, ["\"up\"", "\"signalled\"", "\"exited\""]);
+    }
+
+    #[test]
+    fn a_held_journal_keeps_every_other_writer_out_until_dropped() {
+        let dir = tempfile::tempdir().unwrap();
+        let supervisor = RunEvents::create(dir.path());
+        let kill = RunEvents::append(dir.path());
+        let other = File::open(dir.path().join(EVENTS_FILE)).unwrap();
+        let held = kill.hold();
+        assert!(
+            matches!(other.try_lock(), Err(std::fs::TryLockError::WouldBlock)),
+            "another writer could write while the journal is held"
+        );
+        held.record(RunEvent::Up {
+            node: "sim".into(),
+            pid: 1,
+        });
+        drop(held);
+        other.try_lock().expect("free once the hold is dropped");
+        other.unlock().unwrap();
+        supervisor.record(RunEvent::Up {
+            node: "sim".into(),
+            pid: 2,
+        });
+        let text = std::fs::read_to_string(dir.path().join(EVENTS_FILE)).unwrap();
+        assert_eq!(text.lines().count(), 2, "{text}");
     }
 
     #[test]

@@ -8,14 +8,19 @@
 //! supervisor then reacts as to any other death or freeze: it reaps and restarts a killed
 //! process under its role's policy, and hang detection deals with one stopped too long.
 //!
+//! Where hosts of a run across hosts share this machine, the target is looked for in the part
+//! of the host that runs it.
+//!
 //! In a run with coordinator replicas, `coordinator` names the replica that leads: the one
 //! whose role file (`DIR/log/<id>/raft-role.json`, what `hnav ps` shows) says `leader` in the
 //! highest term. `coordinator:ID` names one replica whatever its role.
 //!
 //! The signal is recorded in the run's journal `DIR/events.jsonl` as a `signalled` line with
-//! no fault index, appended next to the supervisor's own lines ([`RunEvents::append`]); its
-//! `round` is the last round the run's consensus log holds at that moment (a replicated run:
-//! the replica that decided the most).
+//! no fault index, appended next to the supervisor's own lines ([`RunEvents::append`]) under
+//! the journal's lock, held from just before the signal ([`RunEvents::hold`]), so that it
+//! precedes the supervisor's `exited` line of the same death; its `round` is the last round
+//! the run's consensus log holds just before the signal (a replicated run: the replica that
+//! decided the most).
 
 use std::path::{Path, PathBuf};
 
@@ -123,6 +128,7 @@ pub fn kill(
         FaultTarget::Sim => (Role::Sim, 0),
     };
     let name = target_arg(target);
+    let record = target_host_part(registry, run, record, role, index);
     let Some(p) = record
         .processes
         .iter()
@@ -160,6 +166,11 @@ pub fn kill(
         return Err(not_running());
     }
     let pid = i32::try_from(p.pid).map_err(|_| not_running())?;
+    let round = last_round(&record.dir.join("log"));
+    let journal = RunEvents::append(&record.dir);
+    // Held from before the signal until its line is written: the supervisor, woken by the
+    // death at once, writes its `exited` line after this one.
+    let held = journal.hold();
     match send_signal(Pid::from_raw(pid), signal) {
         Ok(()) => {}
         Err(Errno::ESRCH) => return Err(not_running()),
@@ -173,15 +184,14 @@ pub fn kill(
             })
         }
     }
-    let round = last_round(&record.dir.join("log"));
-    let journal = RunEvents::append(&record.dir);
-    journal.record(RunEvent::Signalled {
+    held.record(RunEvent::Signalled {
         node: role.node_name(index),
         pid: p.pid,
         signal: signal.to_string(),
         fault: None,
         round,
     });
+    drop(held);
     Ok(Killed {
         node: role.node_name(index),
         pid: p.pid,
@@ -189,6 +199,25 @@ pub fn kill(
         round,
         journal: record.dir.join(super::events::EVENTS_FILE),
     })
+}
+
+/// The record of the part of run `run` that runs `role`/`index`: `record`, unless another
+/// host runs it and that host's part runs on this machine too (hosts of a run across hosts
+/// sharing a machine, each in its own domain).
+fn target_host_part(
+    registry: &RunRegistry,
+    run: &str,
+    record: RunRecord,
+    role: Role,
+    index: u32,
+) -> RunRecord {
+    let host = record
+        .processes
+        .iter()
+        .find(|p| p.role == role && p.index == index)
+        .and_then(|p| p.host.as_deref());
+    host.and_then(|h| registry.live_host_part(run, h))
+        .unwrap_or(record)
 }
 
 /// The index of the process `coordinator` names: 0 for a single coordinator, else the
@@ -383,6 +412,79 @@ mod tests {
                 "run `kill-dead` is dead: its supervisor (pid {}) is gone (`hnav clean kill-dead` removes what it left)",
                 record.supervisor_pid
             )
+        );
+    }
+
+    /// A log of `rounds` empty rounds in `dir`: long enough that reading its last round takes
+    /// `hnav kill` a while.
+    fn long_log(dir: &Path, rounds: u64) {
+        use hnav_runtime::consensus_log::{LogWriter, Record, RoundRecord, RunHeader};
+        let (mut w, _) = LogWriter::open(dir, hnav_runtime::scenario::FsyncPolicy::None).unwrap();
+        w.append(&Record::Header(RunHeader {
+            version: hnav_runtime::consensus_log::FORMAT_VERSION,
+            scenario_hash: 1,
+            seed: 1,
+            clock: "lockstep".into(),
+            width: 1,
+            height: 1,
+            agents: Vec::new(),
+        }))
+        .unwrap();
+        for round in 1..=rounds {
+            w.append(&Record::Round(RoundRecord::new(round, &[], &[])))
+                .unwrap();
+        }
+        w.sync().unwrap();
+    }
+
+    #[test]
+    fn the_signal_is_journalled_before_the_exit_it_causes() {
+        let tmp = tempfile::tempdir().unwrap();
+        let mut sleeper = std::process::Command::new("sleep")
+            .arg("30")
+            .spawn()
+            .unwrap();
+        let registry = registry_with(tmp.path(), "kill-order", sleeper.id());
+        let dir = tmp.path().join("dir");
+        long_log(&dir.join("log"), 100_000);
+        // The supervisor's part, as its watch does it: the death wakes it, it reaps the
+        // child and journals the exit at once.
+        let pid = sleeper.id();
+        let journal_dir = dir.clone();
+        let supervisor = std::thread::spawn(move || {
+            let status = sleeper.wait().unwrap();
+            RunEvents::append(&journal_dir).record(RunEvent::Exited {
+                node: "agent-1".into(),
+                pid,
+                how: format!("{status}"),
+            });
+        });
+        let k = kill(
+            &registry,
+            "kill-order",
+            FaultTarget::Agent(1),
+            Signal::SIGKILL,
+        )
+        .unwrap();
+        supervisor.join().unwrap();
+        assert_eq!(k.round, 100_000);
+        let text = std::fs::read_to_string(&k.journal).unwrap();
+        let events: Vec<serde_json::Value> = text
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        let names: Vec<&str> = events
+            .iter()
+            .map(|e| e["event"].as_str().unwrap())
+            .collect();
+        assert_eq!(
+            names,
+            ["signalled", "exited"],
+            "the journal must read in the order things happened:\n{text}"
+        );
+        assert!(
+            events[0]["t_ns"].as_u64() <= events[1]["t_ns"].as_u64(),
+            "{text}"
         );
     }
 }

@@ -15,7 +15,7 @@ use serde::Serialize;
 use super::registry::{process_alive, RunEntry, RunRegistry};
 use hnav_runtime::consensus_log::ReplicaRole;
 use hnav_runtime::msg::Role;
-use hnav_runtime::transport::{NodeLiveness, RunId, Transport};
+use hnav_runtime::transport::{NodeLiveness, Transport};
 
 /// A process's state as `hnav ps` shows it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -99,7 +99,7 @@ impl RunStatus {
     /// Looks up the state of every process of `entry`.
     pub fn of(entry: RunEntry) -> RunStatus {
         let record = entry.record;
-        let mut dead: Vec<DeadNode> = match RunId::new(&record.run_id) {
+        let mut dead: Vec<DeadNode> = match record.run() {
             Ok(run) => match Transport::nodes_of(&run) {
                 Ok(nodes) => nodes
                     .into_iter()
@@ -187,6 +187,54 @@ impl PsReport {
         serde_json::to_string_pretty(self).unwrap_or_else(|_| r#"{"runs": []}"#.to_string())
     }
 
+    /// The runs `arg` names: a run id, or a run directory (as a path from here). `None` when
+    /// no run of the report is either.
+    pub fn select(&self, arg: &str) -> Option<PsReport> {
+        let wanted = std::path::Path::new(arg).canonicalize().ok();
+        let runs: Vec<RunStatus> = self
+            .runs
+            .iter()
+            .filter(|r| {
+                r.run_id == arg
+                    || r.dir == std::path::Path::new(arg)
+                    || (wanted.is_some() && r.dir.canonicalize().ok() == wanted)
+            })
+            .cloned()
+            .collect();
+        (!runs.is_empty()).then_some(PsReport { runs })
+    }
+
+    /// One line per run (`hnav ps`): RUN, DIR, and its processes counted by state, with the
+    /// Raft leader of a run with replicas (`10 running, leader coordinator:2 (term 2)`); a
+    /// dead run is marked after its id, and a note under the table names `hnav clean RUN`.
+    /// `hnav ps RUN` shows the processes ([`PsReport::render_table`]).
+    pub fn render_summary(&self) -> String {
+        if self.runs.is_empty() {
+            return "no live runs\n".to_string();
+        }
+        let mut rows: Vec<[String; 3]> = vec![["RUN".into(), "DIR".into(), "PROCESSES".into()]];
+        for run in &self.runs {
+            let id = if run.stale {
+                format!("{} (dead)", run.run_id)
+            } else {
+                run.run_id.clone()
+            };
+            rows.push([id, run.dir.display().to_string(), process_counts(run)]);
+        }
+        let mut out = aligned(&rows);
+        out.push_str(&dead_run_notes(&self.runs));
+        let any_dead = self.runs.iter().any(|r| {
+            !r.dead_nodes.is_empty() || r.processes.iter().any(|p| p.state == ProcessState::Dead)
+        });
+        if any_dead {
+            out.push_str(DEAD_NOTE);
+        }
+        if self.runs.iter().any(|r| !r.stale) {
+            out.push_str("`hnav ps RUN` lists a run's processes\n");
+        }
+        out
+    }
+
     /// A table with the columns RUN, DIR, ROLE, INDEX, PID, STATE (with a replica's Raft role
     /// and term: `running (leader, term 2)`), one row per process and
     /// per unmatched dead node; a dead run (its supervisor gone) is marked after its id, and
@@ -247,34 +295,87 @@ impl PsReport {
                 rows.push([id, dir, "-".into(), "-".into(), "-".into(), "-".into()]);
             }
         }
-        let mut widths = [0usize; 6];
-        for row in &rows {
-            for (w, cell) in widths.iter_mut().zip(row) {
-                *w = (*w).max(cell.chars().count());
-            }
-        }
-        let mut out = String::new();
-        for row in &rows {
-            let line: Vec<String> = row
-                .iter()
-                .zip(widths)
-                .map(|(cell, w)| format!("{cell:<w$}"))
-                .collect();
-            out.push_str(line.join("  ").trim_end());
-            out.push('\n');
-        }
-        for run in self.runs.iter().filter(|r| r.stale) {
-            out.push_str(&format!(
-                "run {} is dead (its supervisor, pid {}, is gone): `hnav clean {}` removes what it left\n",
-                run.run_id, run.supervisor_pid, run.run_id
-            ));
-        }
+        let mut out = aligned(&rows);
+        out.push_str(&dead_run_notes(&self.runs));
         if any_dead {
-            out.push_str(
-                "* dead: the process died without leaving the run; its iceoryx2 node and shared \
-                 memory remain until cleaned up\n",
-            );
+            out.push_str(DEAD_NOTE);
         }
         out
     }
+}
+
+/// The footnote of a process marked `dead *`.
+const DEAD_NOTE: &str = "* dead: the process died without leaving the run; its iceoryx2 node and \
+                         shared memory remain until cleaned up\n";
+
+/// `rows` as text, each column as wide as its widest cell, two spaces apart.
+fn aligned<const N: usize>(rows: &[[String; N]]) -> String {
+    let mut widths = [0usize; N];
+    for row in rows {
+        for (w, cell) in widths.iter_mut().zip(row) {
+            *w = (*w).max(cell.chars().count());
+        }
+    }
+    let mut out = String::new();
+    for row in rows {
+        let line: Vec<String> = row
+            .iter()
+            .zip(widths)
+            .map(|(cell, w)| format!("{cell:<w$}"))
+            .collect();
+        out.push_str(line.join("  ").trim_end());
+        out.push('\n');
+    }
+    out
+}
+
+/// A line for each dead run (its supervisor gone) naming the command that cleans it up.
+fn dead_run_notes(runs: &[RunStatus]) -> String {
+    runs.iter()
+        .filter(|r| r.stale)
+        .map(|run| {
+            format!(
+                "run {} is dead (its supervisor, pid {}, is gone): `hnav clean {}` removes what it left\n",
+                run.run_id, run.supervisor_pid, run.run_id
+            )
+        })
+        .collect()
+}
+
+/// A run's processes counted by state, in the order running, remote, exited, dead
+/// (`150 running, 2 exited`), and the Raft leader if a replica says it leads.
+fn process_counts(run: &RunStatus) -> String {
+    let states = [
+        ProcessState::Running,
+        ProcessState::Remote,
+        ProcessState::Exited,
+        ProcessState::Dead,
+    ];
+    let mut parts: Vec<String> = states
+        .iter()
+        .filter_map(|s| {
+            let n = run.processes.iter().filter(|p| p.state == *s).count();
+            let word = match s {
+                ProcessState::Remote => "on other hosts",
+                ProcessState::Dead => "dead *",
+                s => s.as_str(),
+            };
+            (n > 0).then(|| format!("{n} {word}"))
+        })
+        .collect();
+    if !run.dead_nodes.is_empty() {
+        parts.push(format!("{} dead node(s) *", run.dead_nodes.len()));
+    }
+    if parts.is_empty() {
+        parts.push("none".into());
+    }
+    let mut text = parts.join(", ");
+    let leader = run.processes.iter().find(|p| {
+        p.state == ProcessState::Running && p.raft.as_ref().is_some_and(|r| r.role == "leader")
+    });
+    if let Some(p) = leader {
+        let term = p.raft.as_ref().map_or(0, |r| r.term);
+        text += &format!(", leader coordinator:{} (term {term})", p.index);
+    }
+    text
 }

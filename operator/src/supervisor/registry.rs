@@ -1,7 +1,10 @@
 //! The on-disk list of live runs, so that `hnav ps` (a separate, short-lived process) can
 //! find every supervisor on the machine and the processes it started.
 //!
-//! Each supervisor owns one JSON file, `<runs dir>/<run_id>.json`, holding a [`RunRecord`].
+//! Each supervisor owns one JSON file, `<runs dir>/<key>.json`, holding a [`RunRecord`]; the
+//! key is the run id, or `<run_id>.<domain>` for a run in an iceoryx2 domain (`HNAV_DOMAIN`,
+//! or the host's name for `hnav run --host NAME`): the supervisors of two hosts of one run
+//! across hosts can then share a machine, each with its own entry.
 //! It rewrites the file after every spawn and restart, and removes it when the run ends.
 //! Writes go through [`replace_file`] (a synced temporary file renamed over the old one): a
 //! reader sees either the old record or the new one, never a torn one, and after a crash of
@@ -13,9 +16,13 @@
 //! to another process: every record keeps the start time of each pid it names (from
 //! `/proc/<pid>/stat`), so a reused pid is never taken for the run's process.
 //!
-//! A supervisor also holds an exclusive lock on `<runs dir>/<run_id>.lock` for its lifetime
+//! A supervisor also holds an exclusive lock on `<runs dir>/<key>.lock` for its lifetime
 //! ([`RunRegistry::claim`]): a second `hnav run` with the same id is refused before it
 //! touches anything, and the kernel drops the lock when the supervisor dies.
+//!
+//! A run asked for by id alone ([`RunRegistry::find_live`]) is the entry of that id outside
+//! any domain; failing that, its host's part on this machine, and where several hosts of it
+//! run here, the part that runs the coordinator (the one with the log).
 //!
 //! The directory is `$HNAV_RUNS_DIR` if that is set, else `<temp dir>/hnav-runs`.
 //! Tests use [`RunRegistry::at`] rather than the environment, which all the tests of one
@@ -29,7 +36,7 @@ use hnav_runtime::durable::replace_file;
 use hnav_runtime::file_lock::{try_lock, FileLock, TryLock};
 use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::msg::Role;
-use hnav_runtime::transport::RunId;
+use hnav_runtime::transport::{RunId, TransportError};
 
 /// The environment variable that overrides the registry directory.
 pub const RUNS_DIR_ENV: &str = "HNAV_RUNS_DIR";
@@ -117,9 +124,13 @@ impl RunRegistry {
         &self.dir
     }
 
-    /// A new record of `run` (output directory `dir`) for this process as its supervisor,
-    /// started now, with no processes yet. Nothing is written until [`RunRecord::write`].
+    /// A new record of `run` (output directory `dir`, made absolute: the tools that read it,
+    /// `hnav kill` writing to the run's journal, run elsewhere) for this process as its
+    /// supervisor, started now, with no processes yet. Nothing is written until
+    /// [`RunRecord::write`].
     pub fn new_record(&self, run: &RunId, dir: impl Into<PathBuf>) -> RunRecord {
+        let dir: PathBuf = dir.into();
+        let dir = std::path::absolute(&dir).unwrap_or(dir);
         let started_unix_ms = std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
             .map(|d| d.as_millis() as u64)
@@ -127,13 +138,14 @@ impl RunRegistry {
         let supervisor_pid = std::process::id();
         RunRecord {
             run_id: run.as_str().to_string(),
-            dir: dir.into(),
+            dir,
             supervisor_pid,
             supervisor_start_ticks: process_start_ticks(supervisor_pid),
             started_unix_ms,
             processes: Vec::new(),
             process_args: Vec::new(),
-            file: self.dir.join(format!("{}.json", run.as_str())),
+            domain: run.domain().map(str::to_string),
+            file: self.record_path(run),
         }
     }
 
@@ -185,26 +197,77 @@ impl RunRegistry {
     }
 
     /// The record of the live run `run`: known to the registry and its supervisor alive.
+    /// The id is the record's: in a host part's domain when that is what was found.
     pub fn find_live(&self, run: &str) -> Result<(RunId, RunRecord), LiveRunError> {
         let id = RunId::new(run)?;
-        let record = self.find(&id)?.ok_or_else(|| LiveRunError::UnknownRun {
-            run: run.into(),
+        let record = match self.find(&id)? {
+            Some(r) => r,
+            None => self
+                .host_part(&id)
+                .ok_or_else(|| LiveRunError::UnknownRun {
+                    run: run.into(),
+                    dir: self.dir.clone(),
+                })?,
+        };
+        let record = Self::alive(record)?;
+        Ok((record.run()?, record))
+    }
+
+    /// The record of the live run `run`, its domain included (no other host's part).
+    pub fn find_live_id(&self, run: &RunId) -> Result<RunRecord, LiveRunError> {
+        let record = self.find(run)?.ok_or_else(|| LiveRunError::UnknownRun {
+            run: run.as_str().into(),
             dir: self.dir.clone(),
         })?;
-        if !record.supervisor_alive() {
-            return Err(LiveRunError::DeadRun {
-                run: run.into(),
+        Self::alive(record)
+    }
+
+    /// `record`, if its supervisor is alive.
+    fn alive(record: RunRecord) -> Result<RunRecord, LiveRunError> {
+        if record.supervisor_alive() {
+            Ok(record)
+        } else {
+            Err(LiveRunError::DeadRun {
+                run: record.run_id,
                 pid: record.supervisor_pid,
-            });
+            })
         }
-        Ok((id, record))
+    }
+
+    /// For an id outside any domain: the part of run `run` that a host of a run across hosts
+    /// runs on this machine (in the host's domain); of several, the one that runs the
+    /// coordinator, else the oldest; live parts before dead ones.
+    fn host_part(&self, run: &RunId) -> Option<RunRecord> {
+        if run.domain().is_some() {
+            return None;
+        }
+        let mut parts: Vec<RunEntry> = self
+            .list_runs()
+            .into_iter()
+            .filter(|e| e.record.run_id == run.as_str() && e.record.domain.is_some())
+            .collect();
+        let coordinator = |r: &RunRecord| {
+            r.processes
+                .iter()
+                .any(|p| p.role == Role::Coordinator && p.host.is_none())
+        };
+        // Stable: the registry's order (oldest first) among equals.
+        parts.sort_by_key(|e| (e.stale, !coordinator(&e.record)));
+        parts.into_iter().next().map(|e| e.record)
+    }
+
+    /// The live part of run `run` that host `host` of a run across hosts runs on this
+    /// machine, if one does (`hnav kill` of a process of another host).
+    pub fn live_host_part(&self, run: &str, host: &str) -> Option<RunRecord> {
+        let id = RunId::new(run).ok()?.in_domain(host).ok()?;
+        self.find_live_id(&id).ok()
     }
 
     /// Claims `run` for this process (a supervisor starting it in `dir`, or `hnav clean`
     /// removing it) until the claim is released or the process dies. Refused with
     /// [`RegistryError::InUse`] while another process holds it.
     pub fn claim(&self, run: &RunId, dir: &Path) -> Result<RunClaim, RegistryError> {
-        let path = self.dir.join(format!("{}.lock", run.as_str()));
+        let path = self.dir.join(format!("{}.lock", key(run)));
         let fields = [
             ("run", run.as_str().to_string()),
             ("pid", std::process::id().to_string()),
@@ -222,7 +285,16 @@ impl RunRegistry {
     }
 
     fn record_path(&self, run: &RunId) -> PathBuf {
-        self.dir.join(format!("{}.json", run.as_str()))
+        self.dir.join(format!("{}.json", key(run)))
+    }
+}
+
+/// The name of `run`'s files in the registry: its id, or `<id>.<domain>` in a domain (`.` is
+/// in no id and no domain, so no two runs share a key).
+fn key(run: &RunId) -> String {
+    match run.domain() {
+        None => run.as_str().to_string(),
+        Some(domain) => format!("{}.{domain}", run.as_str()),
     }
 }
 
@@ -283,6 +355,10 @@ pub struct RunRecord {
     /// the same scenario; empty in records of supervisors that predate it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub process_args: Vec<String>,
+    /// The iceoryx2 domain the run's processes here meet in ([`RunId::domain`]): the host's
+    /// name for a host of a run across hosts, or `HNAV_DOMAIN`; none outside a domain.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub domain: Option<String>,
     #[serde(skip)]
     file: PathBuf,
 }
@@ -306,6 +382,17 @@ impl RunRecord {
     /// The file this record is written to (or was read from).
     pub fn path(&self) -> &Path {
         &self.file
+    }
+
+    /// The run's id in its domain, as its processes here name their shared memory. A record
+    /// that names no domain (also those of supervisors that predate the field) takes
+    /// `HNAV_DOMAIN`'s, as its supervisor did.
+    pub fn run(&self) -> Result<RunId, TransportError> {
+        let id = RunId::new(&self.run_id)?;
+        match &self.domain {
+            Some(d) => id.in_domain(d),
+            None => Ok(id),
+        }
     }
 
     /// Whether the supervisor that wrote this record still runs.
@@ -523,6 +610,53 @@ mod tests {
         assert!(
             process_cpu_ticks(me).unwrap() >= before + 2,
             "no CPU time counted in 5 s of computing"
+        );
+    }
+
+    #[test]
+    fn two_hosts_of_one_run_share_a_registry_each_in_its_domain() {
+        let tmp = tempfile::tempdir().unwrap();
+        let registry = RunRegistry::at(tmp.path());
+        let id = RunId::new("across-1").unwrap();
+        let (base, robots) = (
+            id.clone().in_domain("base").unwrap(),
+            id.clone().in_domain("robot-0").unwrap(),
+        );
+        let _b = registry.claim(&base, Path::new("out-base")).unwrap();
+        let _r = registry.claim(&robots, Path::new("out-robots")).unwrap();
+        assert!(
+            matches!(
+                registry.claim(&base, Path::new("x")),
+                Err(RegistryError::InUse { .. })
+            ),
+            "one host's part is still claimed once only"
+        );
+        let me = std::process::id();
+        let mut r = registry.new_record(&robots, "out-robots");
+        r.set_process(Role::Agent, 0, me, 0);
+        r.set_remote(Role::Coordinator, 0, "base");
+        r.write().unwrap();
+        let mut b = registry.new_record(&base, "out-base");
+        b.set_process(Role::Coordinator, 0, me, 0);
+        b.set_remote(Role::Agent, 0, "robot-0");
+        b.write().unwrap();
+        assert_eq!(registry.list_runs().len(), 2);
+        // By id alone: the part with the coordinator, in its domain.
+        let (found, record) = registry.find_live("across-1").unwrap();
+        let cwd = std::env::current_dir().unwrap();
+        assert_eq!((found, record.dir), (base.clone(), cwd.join("out-base")));
+        assert_eq!(
+            registry
+                .live_host_part("across-1", "robot-0")
+                .unwrap()
+                .run()
+                .unwrap(),
+            robots
+        );
+        assert!(registry.live_host_part("across-1", "robot-1").is_none());
+        assert_eq!(
+            registry.find_live_id(&robots).unwrap().dir,
+            cwd.join("out-robots")
         );
     }
 

@@ -2,19 +2,32 @@
 //! exactly as its consensus log says.
 //!
 //! A lockstep run is a function of its scenario and seed (`docs/explanation/design.md`),
-//! so the same scenario, seed, agents and fault plan must write the same log. The replay
-//! takes them from `DIR/invocation.json` ([`crate::invocation`]), refuses a scenario whose
+//! so the same scenario, seed, agents, coordinator replicas and fault plan must write the same
+//! log. The replay takes them from `DIR/invocation.json` ([`crate::invocation`]), refuses a
+//! scenario whose
 //! hash is no longer the log header's (the file or its map changed since), runs it through
 //! the supervisor library ([`super::run::run`], as `hnav run` does) under a fresh run id
 //! into a temporary run directory, and compares the two logs decoded, record by record
 //! ([`hnav_runtime::consensus_log::compare()`]). The temporary directory is removed afterwards,
 //! whatever happened.
+//!
+//! A run with coordinator replicas is replayed with as many replicas (an `invocation.json`
+//! older than its `replicas` field: as many as the log has replica directories). On each
+//! side the log compared is the one [`read_decided`] takes from `DIR/log`: the replica that
+//! decided the most, the lowest id among equals. In lockstep every replica decides the very
+//! records a single coordinator decides (`tests/tests/replicas.rs`), so which replica led
+//! when does not matter; only how far each had learned of the commits when the run ended
+//! does, and the one that decided the most knew all of them.
 
 use std::path::{Path, PathBuf};
 
 use super::run::{run, RunError, RunOptions};
 use crate::invocation::{Invocation, InvocationError, FILE as INVOCATION};
-use hnav_runtime::consensus_log::{compare, read_decided, Comparison, LogError, Record, RunHeader};
+use hnav_runtime::consensus_log::{
+    compare, read_decided, replica_dirs, Comparison, LogError, Record, RunHeader,
+    REPLICATED_VERSION,
+};
+use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::scenario::{ClockMode, ScenarioError};
 use hnav_runtime::transport::RunId;
 
@@ -126,7 +139,8 @@ pub fn replay(opts: &ReplayOptions) -> Result<Replayed, ReplayError> {
     let invocation = Invocation::read(&dir).map_err(|source| ReplayError::Invocation { source })?;
     let run_id = opts.run.clone().unwrap_or_else(|| RunId::unique("replay"));
     let tmp = TempRunDir(std::env::temp_dir().join(format!("hnav-{}", run_id.as_str())));
-    let args = invocation.process_args(run_id.as_str(), &tmp.0);
+    let mut args = invocation.process_args(run_id.as_str(), &tmp.0);
+    replicas_from_log(&mut args, &header, &log_dir)?;
     let scenario = args.scenario()?;
     if scenario.scenario_hash() != header.scenario_hash {
         return Err(ReplayError::HashMismatch {
@@ -153,6 +167,20 @@ pub fn replay(opts: &ReplayOptions) -> Result<Replayed, ReplayError> {
         comparison: compare(&logged, &replayed, header.width),
         header,
     })
+}
+
+/// An `invocation.json` written before it recorded `--replicas` leaves the replicas to the
+/// scenario; a log of replicas says how many the run had.
+fn replicas_from_log(
+    args: &mut ProcessArgs,
+    header: &RunHeader,
+    log_dir: &Path,
+) -> Result<(), ReplayError> {
+    if args.replicas.is_none() && header.version == REPLICATED_VERSION {
+        let n = replica_dirs(log_dir)?.len();
+        args.replicas = u32::try_from(n).ok().filter(|&n| n > 1);
+    }
+    Ok(())
 }
 
 /// The replay's run directory, removed when dropped (also when the replay failed).

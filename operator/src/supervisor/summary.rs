@@ -2,9 +2,11 @@
 //!
 //! Per-agent numbers are the [`Tally`] of the consensus log, the durable record of what was
 //! decided: accepted moves (steps and their octile length from the start in the log's
-//! header), refused or held requests (conflicts) and global replans. Whether a robot reached its goal
-//! comes from the sim's ground truth — its true pose lies in its goal cell — not from what the
-//! agents believed.
+//! header), conflicts (requests refused or held for another robot or the map, each once),
+//! rounds waited (held) and global replans. Whether a robot reached its goal comes from
+//! the sim's ground truth — its true pose lies in its goal cell — not from what the agents
+//! believed. The conflict rules the run ran and each process's restarts come from the
+//! supervisor, which started the run and its processes.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -26,8 +28,12 @@ pub struct AgentSummary {
     pub steps: u32,
     /// Length of the accepted moves in cells (straight 1, diagonal sqrt 2).
     pub length: f64,
-    /// Refused or held requests.
+    /// Requests refused or held for another robot or the map, each once however many rounds
+    /// it waited ([`Tally`]).
     pub conflicts: u32,
+    /// Rounds in which its request was held: the time it waited (for a cell to be left, for
+    /// another robot's turn; under `lacam`, every hold is a wait for the plan).
+    pub waited: u32,
     /// Global replans.
     pub replans: u32,
     /// Whether the agent reported its goal unreachable (an unreachable record in the log).
@@ -55,6 +61,9 @@ pub struct RunSummary {
     pub run_id: String,
     /// `lockstep` or `realtime`.
     pub mode: String,
+    /// The conflict rules the coordinator ran (`[coordinator] rules`: `lacam`, `pibt` or
+    /// `dissertation`); empty when not known.
+    pub rules: String,
     /// Per agent.
     pub agents: Vec<AgentSummary>,
     /// Collisions the sim recorded on ground truth.
@@ -76,12 +85,20 @@ pub struct RunSummary {
     pub rejected: BTreeMap<String, u64>,
     /// The robots lost during the run, by index; empty when none was.
     pub lost: Vec<LostRobot>,
+    /// Restarts per process (`sim`, `coordinator`, `agent-3`, ...) of every process the
+    /// supervisor restarted at least once; empty when none was.
+    pub restarts: BTreeMap<String, u32>,
     /// What the recorder wrote into `DIR/recording/`; absent with `hnav run --no-record`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub recording: Option<super::recorder::RecordingSummary>,
     /// Why `DIR/report.svg` could not be drawn, if it could not (the run still counts).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub report_error: Option<String>,
+    /// On a host of a run across hosts without the coordinator: the host whose consensus
+    /// log has the agents' steps, length, conflicts and replans (here they are 0, not
+    /// known); the table prints `-` for them and says where they are.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub counts_on_host: Option<String>,
 }
 
 impl RunSummary {
@@ -156,6 +173,7 @@ impl RunSummary {
                 steps: t.steps,
                 length: t.length,
                 conflicts: t.conflicts,
+                waited: t.waited,
                 replans: t.replans,
                 unreachable: unreachable.contains(&id),
                 lost: lost.contains(&id),
@@ -173,6 +191,7 @@ impl RunSummary {
         Ok(RunSummary {
             run_id: run_id.to_string(),
             mode: header.map(|h| h.clock.clone()).unwrap_or_default(),
+            rules: String::new(),
             agents,
             collisions: truth.map_or(0, |t| t.collisions),
             rounds,
@@ -182,15 +201,18 @@ impl RunSummary {
             cannot_go_on: None,
             rejected: read_rejected(log_dir.parent().unwrap_or(Path::new("."))),
             lost: Vec::new(),
+            restarts: BTreeMap::new(),
             recording: None,
             report_error: None,
+            counts_on_host: None,
         })
     }
 
     /// The summary of a host of a run across hosts that does not run the coordinator: the
     /// consensus log is on another host, so only what crossed the bridge is known here (the
     /// last ground truth and the coordinator's last progress). Steps, conflicts and replans
-    /// are zero: `hnav log show` on the coordinator's host has them.
+    /// are zero, not known: `hnav log show` on the coordinator's host has them (the caller
+    /// names it in [`RunSummary::counts_on_host`]).
     pub fn from_truth(
         run_id: &str,
         scenario: &hnav_runtime::scenario::Scenario,
@@ -215,6 +237,7 @@ impl RunSummary {
                 steps: 0,
                 length: 0.0,
                 conflicts: 0,
+                waited: 0,
                 replans: 0,
                 unreachable: false,
                 lost: false,
@@ -233,6 +256,7 @@ impl RunSummary {
         RunSummary {
             run_id: run_id.to_string(),
             mode: scenario.sim.clock.to_string(),
+            rules: scenario.coordinator.rules.name().to_string(),
             agents,
             collisions: truth.map_or(0, |t| t.collisions),
             rounds: progress.map_or(0, |p| p.round),
@@ -242,8 +266,10 @@ impl RunSummary {
             cannot_go_on: None,
             rejected: BTreeMap::new(),
             lost: Vec::new(),
+            restarts: BTreeMap::new(),
             recording: None,
             report_error: None,
+            counts_on_host: None,
         }
     }
 
@@ -260,9 +286,11 @@ impl RunSummary {
         Ok(path)
     }
 
-    /// The table `hnav run` prints.
+    /// The table `hnav run` prints: a line per agent, the run's line (naming the rules it
+    /// ran, so that runs under different rules are not compared by mistake) and, when any
+    /// process was restarted, its restarts.
     pub fn render(&self) -> String {
-        let mut s = String::from("agent  goal  steps  length  conflicts  replans\n");
+        let mut s = String::from("agent  goal  steps  length  conflicts  waited  replans\n");
         for a in &self.agents {
             let goal = match (a.reached_goal, a.unreachable, a.lost) {
                 (true, _, _) => "yes",
@@ -270,14 +298,30 @@ impl RunSummary {
                 (false, true, false) => "unreachable",
                 (false, false, false) => "NO",
             };
+            s += &match self.counts_on_host {
+                None => format!(
+                    "{:>5}  {:>4}  {:>5}  {:>6.2}  {:>9}  {:>6}  {:>7}\n",
+                    a.id, goal, a.steps, a.length, a.conflicts, a.waited, a.replans
+                ),
+                Some(_) => format!(
+                    "{:>5}  {goal:>4}  {:>5}  {:>6}  {:>9}  {:>6}  {:>7}\n",
+                    a.id, "-", "-", "-", "-", "-"
+                ),
+            };
+        }
+        if let Some(host) = &self.counts_on_host {
             s += &format!(
-                "{:>5}  {:>4}  {:>5}  {:>6.2}  {:>9}  {:>7}\n",
-                a.id, goal, a.steps, a.length, a.conflicts, a.replans
+                "(steps, length, conflicts, waited, replans: in the consensus log on host {host}; goals, collisions and rounds: from what crossed the bridge)\n"
             );
         }
         let at_goal = self.agents.iter().filter(|a| a.reached_goal).count();
+        let rules = if self.rules.is_empty() {
+            String::new()
+        } else {
+            format!("{} rules, ", self.rules)
+        };
         s += &format!(
-            "{} of {} at goal, {} collisions, {} rounds, {:.2} s wall ({}, {})\n",
+            "{} of {} at goal, {} collisions, {} rounds, {:.2} s wall ({}, {rules}{})\n",
             at_goal,
             self.agents.len(),
             self.collisions,
@@ -286,6 +330,14 @@ impl RunSummary {
             self.mode,
             self.end
         );
+        if !self.restarts.is_empty() {
+            let each: Vec<String> = self
+                .restarts
+                .iter()
+                .map(|(p, n)| format!("{p} {n}"))
+                .collect();
+            s += &format!("restarts: {}\n", each.join(", "));
+        }
         s
     }
 }
@@ -339,5 +391,23 @@ mod tests {
         assert!(!one_away.agents[2].reached_goal);
         let no_truth = RunSummary::from_truth("r", &s, None, Some(&not_done), 1.0);
         assert_eq!(no_truth.end, "incomplete");
+    }
+
+    #[test]
+    fn a_host_without_the_log_prints_no_made_up_counts() {
+        let s = demo();
+        let mut home = RunSummary::from_truth("r", &s, Some(&truth(&s, None)), None, 1.0);
+        home.counts_on_host = Some("base".into());
+        let table = home.render();
+        assert!(
+            table.contains("    0   yes      -       -          -        -\n"),
+            "{table}"
+        );
+        assert!(!table.contains("0.00"), "{table}");
+        assert!(
+            table
+                .contains("(steps, length, conflicts, waited, replans: in the consensus log on host base;"),
+            "{table}"
+        );
     }
 }

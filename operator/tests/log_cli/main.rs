@@ -10,4 +10,5 @@ mod cli;
 #[path = "../../../runtime/tests/consensus_log/fixtures.rs"]
 mod fixtures;
 mod run_dir;
+mod show_filters;
 mod summary;

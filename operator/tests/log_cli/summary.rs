@@ -13,8 +13,9 @@ use super::fixtures::{header, round, write_log, ONE_SEGMENT};
 #[test]
 fn the_summary_is_the_tally_of_the_log_and_the_truth_of_the_goals() {
     let tmp = tempfile::tempdir().unwrap();
-    // Agent 0 moves 11 -> 22 (diagonal) and stays, agent 1 is blocked every round; in round 5
-    // agent 0 goes on to 33 (diagonal) and agent 1 is replanned.
+    // Agent 0 moves 11 -> 22 (diagonal) and stays, agent 1 is blocked every round for the same
+    // cell (one conflict: the same refusal repeated); in round 5 agent 0 goes on to 33
+    // (diagonal) and agent 1 is replanned.
     let mut records = vec![header(2)];
     records.extend((1..=4).map(|n| round(n, 2)));
     let decision = |agent, verdict: Verdict, cell| LoggedDecision {
@@ -48,7 +49,10 @@ fn the_summary_is_the_tally_of_the_log_and_the_truth_of_the_goals() {
     };
     assert_eq!((a.id, a.steps, a.conflicts, a.replans), (0, 5, 0, 0));
     assert_eq!(a.length, 2.0 * std::f64::consts::SQRT_2);
-    assert_eq!((b.id, b.steps, b.conflicts, b.replans), (1, 0, 4, 1));
+    assert_eq!(
+        (b.id, b.steps, b.conflicts, b.waited, b.replans),
+        (1, 0, 1, 0, 1)
+    );
     assert_eq!(b.length, 0.0);
     assert!(!a.reached_goal && !b.reached_goal, "no truth, no goal");
 

@@ -35,13 +35,15 @@
 //! | [`reader`] | [`LogReader`], [`read_log`]: records in order, torn tail vs corruption |
 //! | [`verify`](mod@verify) | [`verify()`]: a [`VerifyReport`] on whether a log is intact |
 //! | [`show`] | one-line text and JSON renderings of records |
-//! | [`tally`] | [`Tally`]: per-agent steps, octile length, conflicts and replans of the decisions |
+//! | [`filter`] | [`RecordFilter`]: which records `hnav log show` prints, by round, agent and kind |
+//! | [`tally`] | [`Tally`]: per-agent steps, octile length, conflicts, rounds waited for the plan and replans of the decisions |
 //! | [`replicated`] | a replica's log (version [`REPLICATED_VERSION`]): Raft entries and hard state in the same frames; [`resolve`], [`read_decided`] |
 //! | [`compare`](mod@compare) | [`compare()`]: two logs record by record, the first [`Divergence`] in words (`hnav log replay`) |
 //! | [`error`] | [`LogError`], [`FrameProblem`] |
 
 pub mod compare;
 pub mod error;
+pub mod filter;
 pub mod frame;
 pub mod reader;
 pub mod record;
@@ -54,6 +56,7 @@ pub mod writer;
 
 pub use compare::{compare, Comparison, Divergence};
 pub use error::{FrameProblem, LogError};
+pub use filter::RecordFilter;
 pub use frame::{
     decode_record, encode_frame, encode_record, FRAME_HEADER_LEN, MAGIC, MAX_RECORD_LEN,
 };
@@ -67,7 +70,7 @@ pub use replicated::{
     is_replicated, read_decided, replica_dirs, resolve, Decided, ReplicaRole, Resolved, ROLE_FILE,
 };
 pub use segment::{list_segments, segment_name, segment_path, DEFAULT_SEGMENT_BYTES};
-pub use tally::{AgentTally, Tally};
+pub use tally::{AgentTally, Counted, Tally};
 pub use verify::{verify, KindCounts, VerifyReport, VerifyStatus};
 pub use writer::{LogWriter, Recovered, WriterOptions, BATCH_INTERVAL, BATCH_RECORDS, WRITER_LOCK};
 

@@ -24,6 +24,18 @@ pub fn cell(index: u32, width: u32) -> String {
     }
 }
 
+/// `x` to at most three decimals, trailing zeros dropped (`3.333`, `0.5`, `2`): a speed or
+/// priority as people read it (the JSON keeps every digit).
+pub fn rounded(x: f64) -> String {
+    let s = format!("{x:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.into()
+    }
+}
+
 /// One line describing `record`; `width` is the grid width from the log's header (0 if
 /// unknown) for printing cells as `[x, y]`.
 pub fn describe(record: &Record, width: u32) -> String {
@@ -48,8 +60,8 @@ pub fn describe(record: &Record, width: u32) -> String {
                     "{sep}a{i} {}->{} speed {} priority {}",
                     cell(a.start, h.width),
                     cell(a.goal, h.width),
-                    a.speed,
-                    a.priority
+                    rounded(a.speed),
+                    rounded(a.priority)
                 );
             }
         }

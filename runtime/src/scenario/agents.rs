@@ -22,7 +22,11 @@ pub(super) fn with_agent_count(
 ) -> Result<Scenario, ScenarioError> {
     let at = Loc::new(&s.source_name, 0);
     if n == 0 {
-        return Err(ScenarioError::NoAgents { at });
+        return Err(ScenarioError::InvalidParameter {
+            at,
+            key: "--agents".into(),
+            problem: "must be at least 1 (a run needs a robot), got 0".into(),
+        });
     }
     if n > MAX_AGENTS {
         return Err(ScenarioError::TooManyAgents {

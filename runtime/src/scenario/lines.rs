@@ -12,18 +12,40 @@ use super::error::{Loc, ScenarioError};
 /// Byte offset to 1-based line.
 pub(crate) struct Lines<'a> {
     pub(crate) source_name: &'a str,
+    text: &'a str,
     starts: Vec<usize>,
 }
 
 impl<'a> Lines<'a> {
-    pub(crate) fn new(text: &str, source_name: &'a str) -> Self {
+    pub(crate) fn new(text: &'a str, source_name: &'a str) -> Self {
         let starts = std::iter::once(0)
             .chain(text.match_indices('\n').map(|(i, _)| i + 1))
             .collect();
         Lines {
             source_name,
+            text,
             starts,
         }
+    }
+
+    /// The key whose value starts at `offset`: the bare key before the last `=` of that
+    /// line up to `offset` (`speed` for `speed = "fast"`, `policy` inside `agent = { policy =
+    /// 3 }`), if there is one.
+    fn key_before(&self, offset: usize) -> Option<&'a str> {
+        let offset = offset.min(self.text.len());
+        let line = self.starts[self.line(offset) - 1];
+        let before = self.text.get(line..offset)?;
+        let eq = before.rfind('=')?;
+        let key = before[..eq]
+            .rsplit(['{', ',', '['])
+            .next()
+            .unwrap_or("")
+            .trim();
+        let bare = !key.is_empty()
+            && key
+                .bytes()
+                .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-' || b == b'.');
+        bare.then_some(key)
     }
 
     pub(crate) fn line(&self, offset: usize) -> usize {
@@ -58,5 +80,80 @@ pub(super) fn toml_error(e: &toml::de::Error, lines: &Lines<'_>) -> ScenarioErro
     if let Some((key, _)) = message.strip_prefix("missing field `").and_then(quoted) {
         return ScenarioError::MissingKey { at, key };
     }
+    let key = e.span().and_then(|s| lines.key_before(s.start));
+    let message = type_in_words(&message, key).unwrap_or(message);
     ScenarioError::Toml { at, message }
+}
+
+/// serde's `invalid type: string "fast", expected f64` (or `invalid value: ...`) in the
+/// words of the scenario format: `speed: expected a number, got the string "fast"`. `None`
+/// for any other message.
+fn type_in_words(message: &str, key: Option<&str>) -> Option<String> {
+    let rest = message
+        .strip_prefix("invalid type: ")
+        .or_else(|| message.strip_prefix("invalid value: "))?;
+    let (got, expected) = rest.rsplit_once(", expected ")?;
+    let plain = |s: &str| s.trim_matches('`').to_string();
+    let got = if let Some(s) = got.strip_prefix("string ") {
+        format!("the string {s}")
+    } else if let Some(n) = got
+        .strip_prefix("integer ")
+        .or_else(|| got.strip_prefix("floating point "))
+        .or_else(|| got.strip_prefix("boolean "))
+    {
+        plain(n)
+    } else {
+        match got {
+            "sequence" => "a list".into(),
+            "map" => "a table".into(),
+            other => other.into(),
+        }
+    };
+    let expected = match expected {
+        "f32" | "f64" => "a number",
+        "u8" | "u16" | "u32" | "u64" | "usize" => "a whole number, 0 or more",
+        "i8" | "i16" | "i32" | "i64" | "isize" => "a whole number",
+        "a boolean" => "true or false",
+        "a string" => "a string in quotes",
+        "a sequence" => "a list [...]",
+        other => other,
+    };
+    Some(match key {
+        Some(k) => format!("{k}: expected {expected}, got {got}"),
+        None => format!("expected {expected}, got {got}"),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn serde_type_errors_are_said_in_the_formats_words() {
+        let words = |m: &str, k| type_in_words(m, k);
+        assert_eq!(
+            words("invalid type: string \"fast\", expected f64", Some("speed")).unwrap(),
+            "speed: expected a number, got the string \"fast\""
+        );
+        assert_eq!(
+            words("invalid value: integer `-1`, expected u32", Some("step_ms")).unwrap(),
+            "step_ms: expected a whole number, 0 or more, got -1"
+        );
+        assert_eq!(
+            words("invalid type: integer `1`, expected a boolean", None).unwrap(),
+            "expected true or false, got 1"
+        );
+        assert_eq!(words("unknown variant `x`, expected `a`", None), None);
+    }
+
+    #[test]
+    fn the_key_is_the_one_before_the_value() {
+        let text = "name = \"t\"\nspeed = \"fast\"\nagent = { policy = 3 }\nrows = [1, \"a\"]\n";
+        let lines = Lines::new(text, "t.toml");
+        let at = |s: &str| text.find(s).unwrap();
+        assert_eq!(lines.key_before(at("\"fast")), Some("speed"));
+        assert_eq!(lines.key_before(at("3 }")), Some("policy"));
+        assert_eq!(lines.key_before(at("\"a\"]")), Some("rows"));
+        assert_eq!(lines.key_before(0), None);
+    }
 }

@@ -1,5 +1,9 @@
 //! Scenarios: the TOML description of a run, validated with file/line errors.
 //!
+//! A walk-through of the format is `docs/tutorials/write-a-scenario.md`; every key, what it
+//! decides and its default, `docs/reference/scenario.md`. [`KEYS`] lists every key, and a
+//! test holds the block below, that page and the tutorial to it.
+//!
 //! # Format
 //!
 //! ```toml
@@ -43,6 +47,9 @@
 //! replan_after_rounds = 3
 //! time_limit_s = 120.0                 # lockstep: simulated time, in rounds; realtime: wall clock
 //! rules = "lacam"                      # or "dissertation" (the seeds' reproductions), "pibt": docs/explanation/conflict-rules.md
+//! replicas = 1                         # 1, 3 or 5 coordinator replicas agreeing by Raft; not in the hash
+//! raft_heartbeat_ms = 50               # the replicas' tick
+//! election_ms = 500                    # at least 3 heartbeats; Raft randomises it up to twice that
 //!
 //! [restart]                            # per role; default for each role as shown
 //! agent = { policy = "on-failure", max_restarts = 3, backoff_ms = 100 }
@@ -81,9 +88,11 @@
 //!                                      # `hnav run --kill/--term/--freeze`, [`fault_arg`])
 //! at_round = 10                        # exactly one of at_round and at_s (seconds after
 //!                                      # Start; in lockstep the round of that simulated time)
+//! # at_s = 1.5                         # ... or the time instead of the round
 //! action = "kill"                      # or "freeze": SIGSTOP, then SIGCONT after for_s
 //! role = "agent"                       # or "coordinator", "sim"
-//! index = 0                            # agent number; only (and always) with role = "agent"
+//! index = 0                            # agent number (always with role = "agent"); with role =
+//!                                      # "coordinator", a replica, 1 to replicas
 //! signal = "KILL"                      # kill only: or "TERM"; default "KILL"
 //! # for_s = 0.3                        # freeze only: seconds stopped; omitted = never continued
 //! ```
@@ -151,6 +160,7 @@ pub use params::{
     GiveUpAction, Planner, RestartConfig, RestartPolicy, RestartRule, RobotParams, Rules,
     RunParams, SimParams,
 };
+pub use raw::KEYS;
 pub use record::RecordParams;
 pub use report::{default_out_dir, ScenarioReport};
 
@@ -382,7 +392,7 @@ impl Scenario {
     /// goals, start != goal, goal reachable under the map's corner-cutting rule; speed 1,
     /// default priority). Same scenario and seed, same agents, on every platform.
     ///
-    /// Fails with [`ScenarioError::NoAgents`] for `n == 0`,
+    /// Fails with [`ScenarioError::InvalidParameter`] (`--agents`) for `n == 0`,
     /// [`ScenarioError::FaultAgentOutOfRange`] if a fault targets a dropped agent, and
     /// [`ScenarioError::NotEnoughFreeCells`] if the map cannot hold `n` agents.
     pub fn with_agent_count(&self, n: usize, seed: u64) -> Result<Scenario, ScenarioError> {
@@ -398,5 +408,7 @@ mod tests;
 mod tests_faults;
 #[cfg(test)]
 mod tests_generate;
+#[cfg(test)]
+mod tests_keys;
 #[cfg(test)]
 mod tests_run;

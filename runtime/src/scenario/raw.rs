@@ -11,6 +11,102 @@ use toml::Spanned;
 
 use super::params::{ClockMode, FsyncPolicy, GiveUpAction, Planner, RestartPolicy, Rules};
 
+/// Every key of the format, table by table as the structs below (and `health`'s and
+/// `record`'s) take them: `""` is the top level, `restart.ROLE` each role's rule, `agents`
+/// and `faults` one entry of the arrays of tables. The docs that describe the format are
+/// checked against it, and a test checks it against what the parser accepts.
+pub const KEYS: &[(&str, &[&str])] = &[
+    (
+        "",
+        &[
+            "name",
+            "allow_unreachable",
+            "map",
+            "robot",
+            "sim",
+            "coordinator",
+            "restart",
+            "run",
+            "health",
+            "record",
+            "agents",
+            "faults",
+        ],
+    ),
+    ("map", &["file", "rows", "corner_cutting"]),
+    (
+        "robot",
+        &[
+            "wheel_radius_m",
+            "axle_track_m",
+            "body_radius_m",
+            "max_wheel_speed_rad_s",
+            "max_wheel_accel_rad_s2",
+            "motor_lag_s",
+            "ticks_per_rev",
+            "pole_pairs",
+            "gear_ratio",
+            "cell_size_m",
+        ],
+    ),
+    (
+        "sim",
+        &[
+            "step_ms",
+            "odometry_hz",
+            "clock",
+            "seed",
+            "slip_std",
+            "watchdog_ms",
+            "slip_hold_s",
+            "lockstep_deadline_ms",
+        ],
+    ),
+    (
+        "coordinator",
+        &[
+            "round_deadline_ms",
+            "fsync",
+            "replan_after_rounds",
+            "time_limit_s",
+            "rules",
+            "replicas",
+            "raft_heartbeat_ms",
+            "election_ms",
+        ],
+    ),
+    ("run", &["startup_timeout_s"]),
+    ("restart", &["agent", "coordinator", "sim", "on_give_up"]),
+    ("restart.ROLE", &["policy", "max_restarts", "backoff_ms"]),
+    (
+        "health",
+        &[
+            "heartbeat_ms",
+            "agent_hang_ms",
+            "coordinator_hang_ms",
+            "sim_hang_ms",
+        ],
+    ),
+    ("record", &["trajectory_hz", "max_mb", "maps"]),
+    (
+        "agents",
+        &[
+            "start",
+            "goal",
+            "speed",
+            "priority",
+            "start_heading_deg",
+            "planner",
+        ],
+    ),
+    (
+        "faults",
+        &[
+            "at_round", "at_s", "action", "role", "index", "signal", "for_s",
+        ],
+    ),
+];
+
 /// Top level.
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]

@@ -202,13 +202,20 @@ impl ScenarioReport {
         o
     }
 
-    /// Writes `scenario-report.json` into `dir` (created if needed) and returns its path.
+    /// Writes [`REPORT_FILE`] into `dir` (created if needed) and returns its path.
     pub fn write_json(&self, dir: &Path) -> std::io::Result<PathBuf> {
-        std::fs::create_dir_all(dir)?;
-        let path = dir.join("scenario-report.json");
-        let json = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
-        std::fs::write(&path, json + "\n")?;
+        let path = dir.join(REPORT_FILE);
+        self.write_json_to(&path)?;
         Ok(path)
+    }
+
+    /// Writes the report as JSON to `path` (its directory created if needed).
+    pub fn write_json_to(&self, path: &Path) -> std::io::Result<()> {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)?;
+        }
+        let json = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
+        std::fs::write(path, json + "\n")
     }
 }
 
@@ -232,6 +239,9 @@ fn tidy_path(p: &Path) -> PathBuf {
     }
     out.iter().collect()
 }
+
+/// The name of the report [`ScenarioReport::write_json`] writes into a directory.
+pub const REPORT_FILE: &str = "scenario-report.json";
 
 /// The default output directory of a scenario, `target/hnav-out/<name>`, with every character
 /// outside `[A-Za-z0-9._-]` replaced by `_` so a name cannot escape the directory.

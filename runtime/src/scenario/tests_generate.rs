@@ -41,10 +41,12 @@ fn agent_count_truncates_and_grows() {
     let s = parse(BASE).unwrap();
     let one = s.with_agent_count(1, 0).unwrap();
     assert_eq!(one.agents, s.agents[..1].to_vec());
-    assert!(matches!(
-        s.with_agent_count(0, 0),
-        Err(ScenarioError::NoAgents { .. })
-    ));
+    // The scenario has agents: it is the count that is wrong, and the message says so.
+    let e = s.with_agent_count(0, 0).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "t.toml: --agents must be at least 1 (a run needs a robot), got 0"
+    );
 
     let many = s.with_agent_count(12, 99).unwrap();
     assert_eq!(many.agents.len(), 12);

@@ -10,11 +10,17 @@
 //!   top-level directory of the repository, no component a placeholder in capitals like
 //!   `TARGET`) names a path that exists.
 //!
+//! - every key of the scenario format ([`hnav_runtime::scenario::KEYS`]) is named by each
+//!   text that describes the format ([`missing_keys`]);
+//! - the blocks a page marks to be run ([`runnable`]) run as written, in a [`sandbox`].
+//!
 //! Fenced blocks tagged with a language other than `sh`, `bash`, `shell` or `console` (`text`
 //! for output, `toml`) are not read for commands: what a program printed is not a command.
 
 pub mod command;
 pub mod markdown;
+pub mod runnable;
+pub mod sandbox;
 
 use std::collections::HashMap;
 use std::fmt;
@@ -286,9 +292,73 @@ pub fn check_paths(root: &Path, docs: &[Doc]) -> Vec<Problem> {
     problems
 }
 
+/// The keys of the scenario format ([`hnav_runtime::scenario::KEYS`], as `table.key`) that
+/// `text` does not name: a table as `[table]` or `[[table]]`, any other key as `key =` or
+/// in a code span.
+pub fn missing_keys(text: &str) -> Vec<String> {
+    let mut missing = Vec::new();
+    for (table, keys) in hnav_runtime::scenario::KEYS {
+        for key in *keys {
+            let named = if table.is_empty() && !["name", "allow_unreachable"].contains(key) {
+                text.contains(&format!("[{key}]")) || text.contains(&format!("[[{key}]]"))
+            } else {
+                text.contains(&format!("{key} =")) || text.contains(&format!("`{key}`"))
+            };
+            if !named {
+                missing.push(format!("{table}.{key}"));
+            }
+        }
+    }
+    missing
+}
+
+/// The ```toml block of a Rust file's module docs (`//!` lines), without the `//! `.
+pub fn module_doc_toml(rust: &str) -> String {
+    let mut out = String::new();
+    let mut inside = false;
+    for line in rust.lines() {
+        let Some(doc) = line.strip_prefix("//!") else {
+            continue;
+        };
+        let doc = doc.strip_prefix(' ').unwrap_or(doc);
+        match (inside, doc.trim()) {
+            (false, "```toml") => inside = true,
+            (true, "```") => break,
+            (true, _) => {
+                out.push_str(doc);
+                out.push('\n');
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn keys_are_named_as_tables_assignments_or_spans() {
+        let all: String = hnav_runtime::scenario::KEYS
+            .iter()
+            .flat_map(|(t, keys)| keys.iter().map(move |k| (t, k)))
+            .map(|(t, k)| {
+                if t.is_empty() && !["name", "allow_unreachable"].contains(k) {
+                    format!("[{k}]\n")
+                } else {
+                    format!("{k} = 1\n")
+                }
+            })
+            .collect();
+        assert!(missing_keys(&all).is_empty());
+        let without = all.replace("election_ms = 1", "election = 1");
+        assert_eq!(missing_keys(&without), ["coordinator.election_ms"]);
+        assert_eq!(
+            module_doc_toml("//! a\n//! ```toml\n//! x = 1\n//!\n//! ```\nfn f() {}\n"),
+            "x = 1\n\n"
+        );
+    }
 
     /// A fake `hnav`: `run` (flags `--force`, `--replicas`) and `log` with `verify`.
     fn fake(_bin: &str, path: &[String]) -> Help {

@@ -229,7 +229,7 @@ pub fn render(rows: &[Row], options: Options) -> String {
         c.1
     );
     let quick = if options.quick { " --quick" } else { "" };
-    let _ = writeln!(s, "Made by `cargo run --release -p hnav-bench -- experiment fidelity{quick} --seed {}` (the full run writes this file; `--json` prints the rows). Generated: edit `bench/src/experiment/fidelity/`, not this file.\n", options.seed);
+    let _ = writeln!(s, "Made by `cargo run --release -p hnav-bench -- experiment fidelity{quick} --seed {}` (the full run writes this file; `--json` prints the rows). Generated: edit `bench/src/experiment/fidelity/`, not this file. Which works the seeds are: [sources](../reference/sources.md).\n", options.seed);
     let _ = writeln!(s, "Every row is computed by running the code: the other experiments' measurements ([pso.md](pso.md), [hnav-vs-astar.md](hnav-vs-astar.md), [ga-fuzzy.md](ga-fuzzy.md), `hnav-bench seed002`), the neural map and path constructor, and the tick harness of the conflict experiments (`bench/src/tick.rs`). *Reproduced*: equal, or a statistical published value inside our 95 % interval. *Reproduced under a stated reading*: the same, with a choice the source leaves open (named). *Differs*: why, and where it is explained. Rows marked (time) are wall times on this machine: listed, never held by the test (`bench/tests/fidelity.rs`).\n");
     let _ = writeln!(
         s,

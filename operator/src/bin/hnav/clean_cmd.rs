@@ -7,7 +7,7 @@
 
 use std::process::ExitCode;
 
-use hnav_operator::supervisor::clean::{clean_dead_runs, clean_run};
+use hnav_operator::supervisor::clean::{clean_dead_runs, clean_named};
 use hnav_operator::supervisor::registry::RunRegistry;
 use hnav_runtime::transport::RunId;
 
@@ -24,7 +24,7 @@ pub fn run(args: CleanArgs) -> ExitCode {
     let registry = RunRegistry::default_location();
     let results = match args.run {
         Some(id) => match RunId::new(&id) {
-            Ok(run) => vec![clean_run(&registry, &run)],
+            Ok(run) => clean_named(&registry, &run),
             Err(e) => {
                 eprintln!("error: {e}");
                 return ExitCode::from(2);

@@ -3,7 +3,8 @@
 //!
 //! Exit codes of `verify`: 0 intact, 1 not intact (torn tail, corruption, order problems),
 //! 2 the directory cannot be read as a log at all (missing, unreadable, no segments).
-//! `show`: 0 every complete record printed (a torn tail is noted on stderr), 1 reading stopped
+//! `show`: 0 every complete record printed (those `--round`, `--agent` and `--kind` keep; a
+//! torn tail is noted on stderr), 1 reading stopped
 //! at corruption (records before it are printed), 2 unreadable as for `verify`.
 //! `replay` (`log_replay_cmd`): 0 identical, 1 diverged, 2 not a replayable run.
 //! `export` (`log_export_cmd`): 0 written, 1 the output cannot be written, 2 unreadable input.
@@ -13,14 +14,16 @@
 //! most (saying which on stderr); a replica's own directory can be named as well.
 
 use std::io::Write;
+use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::Subcommand;
+use hnav_runtime::consensus_log::filter::{parse_kind, parse_rounds};
 use hnav_runtime::consensus_log::show::{describe, to_json};
 use hnav_runtime::consensus_log::{
     list_segments, read_decided, replica_dirs, segment_name, verify, LogReader, Record,
-    VerifyStatus,
+    RecordFilter, VerifyStatus,
 };
 
 /// `hnav log` subcommands.
@@ -33,13 +36,27 @@ pub enum LogCommand {
         /// it in log/).
         dir: PathBuf,
     },
-    /// Print one line per record.
+    /// Print one line per record (speeds and priorities to three decimals; --json keeps
+    /// every digit). --round, --agent and --kind narrow what is printed; together, a record
+    /// must pass each.
     Show {
         /// The log directory or the run directory.
         dir: PathBuf,
         /// One JSON object per line instead of text.
         #[arg(long)]
         json: bool,
+        /// Only rounds A to B, both included: A..B, A.., ..B, or one round A (records without
+        /// a round, the header, are left out).
+        #[arg(long, value_name = "A..B", value_parser = parse_rounds)]
+        round: Option<RangeInclusive<u64>>,
+        /// Only what concerns agent N: its decisions (a round without one is left out), its
+        /// lifecycle events, replans and unreachable reports.
+        #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = crate::arg_values::agent_index)]
+        agent: Option<u32>,
+        /// Only records of these kinds (comma-separated or repeated): header, round,
+        /// lifecycle, replan, unreachable, end, raft-entry, raft-state.
+        #[arg(long, value_name = "KIND", value_delimiter = ',', value_parser = parse_kind)]
+        kind: Vec<String>,
     },
     /// Run a lockstep run again from its scenario and seed and check that every round
     /// decides as logged: exit 0 identical, 1 diverged (the first divergence is printed), 2
@@ -55,7 +72,20 @@ pub enum LogCommand {
 pub fn run(cmd: LogCommand) -> ExitCode {
     match cmd {
         LogCommand::Verify { dir } => verify_cmd(&log_dir(&dir)),
-        LogCommand::Show { dir, json } => show_cmd(&log_dir(&dir), json),
+        LogCommand::Show {
+            dir,
+            json,
+            round,
+            agent,
+            kind,
+        } => {
+            let filter = RecordFilter {
+                rounds: round,
+                agent,
+                kinds: kind,
+            };
+            show_cmd(&log_dir(&dir), json, &filter)
+        }
         LogCommand::Replay(args) => crate::log_replay_cmd::run(args),
         LogCommand::Export(args) => crate::log_export_cmd::run(args),
     }
@@ -110,7 +140,7 @@ fn verify_cmd(dir: &Path) -> ExitCode {
     ExitCode::from(worst)
 }
 
-fn show_cmd(dir: &Path, json: bool) -> ExitCode {
+fn show_cmd(dir: &Path, json: bool, filter: &RecordFilter) -> ExitCode {
     let dir = if replicas_in(dir).is_empty() {
         dir.to_path_buf()
     } else {
@@ -149,6 +179,9 @@ fn show_cmd(dir: &Path, json: bool) -> ExitCode {
         if let Record::Header(h) = &record {
             width = h.width;
         }
+        let Some(record) = filter.apply(&record) else {
+            continue;
+        };
         let written = if json {
             writeln!(out, "{}", to_json(&pos, &record, width))
         } else {

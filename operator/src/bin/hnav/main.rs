@@ -6,9 +6,11 @@
 //!
 //! Exit codes: 0 all good, 1 checks ran and found problems (or the report could not be
 //! written), 2 the input could not be loaded or is invalid (and for usage errors, via clap).
-//! For `hnav check`: 0 the scenario is valid and its report written, 1 it is valid but the
-//! report could not be written, 2 it is invalid or cannot be read (`docs/reference/cli.md`).
+//! For `hnav check`: 0 the scenario is valid (and the report asked for with `--report` is
+//! written), 1 it is valid but that report could not be written, 2 it is invalid or cannot
+//! be read (`docs/reference/cli.md`).
 
+mod arg_values;
 mod clean_cmd;
 mod kill_cmd;
 mod log_cmd;
@@ -25,7 +27,8 @@ use std::process::ExitCode;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use hnav_runtime::grid::check::check_map;
-use hnav_runtime::scenario::{default_out_dir, Scenario, ScenarioReport};
+use hnav_runtime::scenario::report::REPORT_FILE;
+use hnav_runtime::scenario::{Scenario, ScenarioReport};
 
 /// HNAV swarm-robot runtime.
 #[derive(Parser, Debug)]
@@ -37,22 +40,26 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Load and validate a scenario, print a summary and write scenario-report.json.
+    /// Load and validate a scenario and print a summary (each agent's shortest path); with
+    /// --report FILE also write it as JSON. Writes nothing else.
     ///
-    /// Exit 0 when the scenario is valid and the report is written, 1 when it is valid but
-    /// the report cannot be written, 2 when it is invalid or cannot be read (`file:line:
-    /// problem` on stderr).
+    /// Exit 0 when the scenario is valid (and the report asked for is written), 1 when it is
+    /// valid but the report cannot be written, 2 when it is invalid or cannot be read
+    /// (`file:line: problem` on stderr).
     Check {
         /// The scenario TOML file.
         scenario: PathBuf,
-        /// Output directory [default: target/hnav-out/NAME, NAME = the scenario name].
-        #[arg(long)]
+        /// Write the summary as JSON to FILE.
+        #[arg(long, value_name = "FILE")]
+        report: Option<PathBuf>,
+        /// Write the summary as JSON to DIR/scenario-report.json (as --report does).
+        #[arg(long, value_name = "DIR", conflicts_with = "report")]
         out: Option<PathBuf>,
         /// Use exactly N agents (the first N, or extra seeded random ones).
-        #[arg(long, value_name = "N")]
+        #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = arg_values::agent_count)]
         agents: Option<usize>,
         /// Seed for generated agents [default: the scenario's sim.seed].
-        #[arg(long, value_name = "S")]
+        #[arg(long, value_name = "S", allow_negative_numbers = true, value_parser = arg_values::seed)]
         seed: Option<u64>,
     },
     /// MovingAI map tools.
@@ -121,10 +128,16 @@ fn main() -> ExitCode {
     match cli.command {
         Command::Check {
             scenario,
+            report,
             out,
             agents,
             seed,
-        } => check(scenario, out, agents, seed),
+        } => check(
+            scenario,
+            report.or_else(|| out.map(|d| d.join(REPORT_FILE))),
+            agents,
+            seed,
+        ),
         Command::Map {
             command: MapCommand::Check { map, scen },
         } => map_check(map, scen),
@@ -151,9 +164,10 @@ fn main() -> ExitCode {
     }
 }
 
+/// `hnav check`: `report` is the JSON file to write, if one was asked for.
 fn check(
     path: PathBuf,
-    out: Option<PathBuf>,
+    report_file: Option<PathBuf>,
     agents: Option<usize>,
     seed: Option<u64>,
 ) -> ExitCode {
@@ -173,14 +187,16 @@ fn check(
     };
     let report = ScenarioReport::new(&scenario);
     hnav_runtime::out!("{}", report.render());
-    let dir = out.unwrap_or_else(|| default_out_dir(&scenario.name));
-    match report.write_json(&dir) {
-        Ok(p) => {
-            hnav_runtime::outln!("report    {}", p.display());
+    let Some(file) = report_file else {
+        return ExitCode::SUCCESS;
+    };
+    match report.write_json_to(&file) {
+        Ok(()) => {
+            hnav_runtime::outln!("report    {}", file.display());
             ExitCode::SUCCESS
         }
         Err(e) => {
-            hnav_runtime::errln!("error: {}: cannot write report: {e}", dir.display());
+            hnav_runtime::errln!("error: {}: cannot write report: {e}", file.display());
             ExitCode::from(1)
         }
     }

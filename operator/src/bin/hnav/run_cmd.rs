@@ -1,6 +1,7 @@
 //! `hnav run SCENARIO [--agents N] [--mode lockstep|realtime] [--seed S] [--out DIR]
-//! [--force] [--no-record] [--kill|--term|--freeze TARGET@WHEN[+SECONDSs]]...
-//! [--host NAME [--hosts FILE]]`: the supervisor. The work
+//! [--run ID] [--replicas N] [--force] [--no-record] [--bin-dir DIR]
+//! [--kill|--term|--freeze TARGET@WHEN[+SECONDSs]]... [--host NAME [--hosts FILE]]`: the
+//! supervisor. The work
 //! is in `hnav_operator::supervisor::run`; the faults' syntax in
 //! `hnav_runtime::scenario::fault_arg`.
 //!
@@ -21,6 +22,7 @@ use clap::ArgMatches;
 use hnav_operator::supervisor::run::{
     default_run_dir, new_run_id, run, HostPart, RunError, RunOptions,
 };
+use hnav_operator::supervisor::run_dir::RUN_OUTPUTS;
 use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::scenario::fault_arg::{self, FaultArgError, FaultFlag};
 use hnav_runtime::scenario::{ClockMode, FaultSpec, Scenario};
@@ -38,7 +40,7 @@ pub struct RunArgs {
     /// The scenario TOML file.
     pub scenario: PathBuf,
     /// Use exactly N agents (the scenario's first N, or extra seeded random ones).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = crate::arg_values::agent_count)]
     pub agents: Option<usize>,
     /// Clock mode [default: the scenario's sim.clock].
     #[arg(long, value_name = "lockstep|realtime")]
@@ -48,18 +50,19 @@ pub struct RunArgs {
     #[arg(long, value_name = "N")]
     pub replicas: Option<u32>,
     /// Seed of the sim's noise and of generated agents [default: the scenario's sim.seed].
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", allow_negative_numbers = true, value_parser = crate::arg_values::seed)]
     pub seed: Option<u64>,
-    /// Run directory (log, summary, process logs) [default: target/hnav-out/NAME].
+    /// Run directory (log, summary, process logs) [default: target/hnav-out/NAME, with --host
+    /// HOST target/hnav-out/NAME-HOST].
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Run id (letters, digits, '-', '_') [default: a fresh unique one]. Tests pass their own
     /// so they can clean the run's shared memory up even if the supervisor dies.
     #[arg(long, value_name = "ID")]
     pub run: Option<String>,
-    /// Replace the outputs of a finished run in the run directory (its log/, agents/, logs/
-    /// and summary.json; nothing else there is touched).
-    #[arg(long)]
+    /// Replace the outputs of a finished run in the run directory (every one a run writes
+    /// there, listed in the help from `run_dir::RUN_OUTPUTS`); other files there are kept.
+    #[arg(long, help = force_help())]
     pub force: bool,
     /// Write no recording (DIR/recording/: trajectories and neural maps); the report is then
     /// drawn without trajectories.
@@ -81,12 +84,21 @@ pub struct RunArgs {
     pub freeze: Vec<String>,
     /// Run this host's part of a run across hosts: its processes and its bridge, as the
     /// placement file says (every host runs the same command with its own NAME and the same
-    /// --run ID).
+    /// --run ID). Its processes meet in the iceoryx2 domain NAME (HNAV_DOMAIN, if set, wins),
+    /// so hosts of one run may share a machine.
     #[arg(long, value_name = "NAME")]
     pub host: Option<String>,
     /// The placement file for --host [default: hosts.toml beside the scenario].
     #[arg(long, value_name = "FILE", requires = "host")]
     pub hosts: Option<PathBuf>,
+}
+
+/// `--force`'s help: the outputs it removes, from the one list the refusal also names.
+fn force_help() -> String {
+    format!(
+        "Replace the outputs of a finished run in the run directory: {}; other files there are kept",
+        RUN_OUTPUTS.join(", ")
+    )
 }
 
 /// The command line's faults in the order they were written (`matches` says where each
@@ -167,7 +179,7 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
         Ok((s, faults, host))
     });
     let (name, faults, host) = match placed {
-        Ok((s, faults, host)) => (default_run_dir(&s), faults, host),
+        Ok((s, faults, host)) => (default_run_dir(&s, a.host.as_deref()), faults, host),
         Err(e) => {
             hnav_runtime::errln!("error: {e}");
             return ExitCode::from(2);
@@ -191,8 +203,9 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
         Ok(summary) => {
             hnav_runtime::out!("{}", summary.render());
             hnav_runtime::outln!("summary   {}", dir.join("summary.json").display());
-            if summary.log.as_os_str().is_empty() {
-                // A host of a run across hosts without the coordinator.
+            if let Some(host) = &summary.counts_on_host {
+                hnav_runtime::outln!("log       on host {host} (the coordinator's)");
+            } else if summary.log.as_os_str().is_empty() {
                 hnav_runtime::outln!("log       on the coordinator's host");
             } else {
                 hnav_runtime::outln!("log       {}", summary.log.display());

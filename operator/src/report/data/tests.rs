@@ -3,10 +3,11 @@ use std::path::Path;
 use super::*;
 use crate::recording::{MapWriter, PoseSample, TrajectoryHeader, TrajectoryWriter};
 use hnav_runtime::consensus_log::{
-    AgentEntry, LogWriter, LoggedDecision, Record, RoundRecord, RunHeader, FORMAT_VERSION,
+    AgentEntry, LifecycleRecord, LogWriter, LoggedDecision, Record, RoundRecord, RunHeader,
+    FORMAT_VERSION,
 };
 use hnav_runtime::grid::{write_map, Grid};
-use hnav_runtime::msg::{MapHeader, NO_CELL};
+use hnav_runtime::msg::{ConflictKind, Lifecycle, MapHeader, Verdict, NO_CELL};
 use hnav_runtime::scenario::FsyncPolicy;
 
 const W: u32 = 4;
@@ -23,8 +24,17 @@ fn decision(agent: u32, verdict: Verdict, cell: u32) -> LoggedDecision {
     }
 }
 
+fn held(agent: u32, verdict: Verdict, kind: ConflictKind, cell: u32) -> LoggedDecision {
+    LoggedDecision {
+        kind: kind as u8,
+        ..decision(agent, verdict, cell)
+    }
+}
+
 /// A 4 x 3 run of two agents: agent 0 from (0, 0) moves east twice, is blocked and replanned
-/// on the way; agent 1 from (3, 2) moves once and is held.
+/// on the way; agent 1 from (3, 2) moves once and is held three rounds for the same cell (one
+/// conflict), then once with nothing in the way (no conflict); agent 1's process goes down
+/// and is restarted after round 2.
 fn write_log(dir: &Path) {
     let (mut log, _) = LogWriter::open(dir.join("log"), FsyncPolicy::None).unwrap();
     log.append(&Record::Header(RunHeader {
@@ -56,11 +66,18 @@ fn write_log(dir: &Path) {
             decision(1, Verdict::Accept, 10),
         ],
         vec![
-            decision(0, Verdict::Block, NO_CELL),
+            held(0, Verdict::Block, ConflictKind::HeadOn, NO_CELL),
+            held(1, Verdict::Hold, ConflictKind::Reserved, 9),
+        ],
+        vec![
+            decision(0, Verdict::Replan, NO_CELL),
+            held(1, Verdict::Hold, ConflictKind::Reserved, 9),
+        ],
+        vec![
+            decision(0, Verdict::Accept, 2),
+            held(1, Verdict::Hold, ConflictKind::Reserved, 9),
             decision(1, Verdict::Hold, NO_CELL),
         ],
-        vec![decision(0, Verdict::Replan, NO_CELL)],
-        vec![decision(0, Verdict::Accept, 2)],
     ];
     for (r, decisions) in rounds.into_iter().enumerate() {
         log.append(&Record::Round(RoundRecord {
@@ -70,6 +87,15 @@ fn write_log(dir: &Path) {
             decisions,
         }))
         .unwrap();
+        if r == 1 {
+            for event in [
+                Lifecycle::down(Role::Agent, 1, 0),
+                Lifecycle::restarted(Role::Agent, 1, 1),
+            ] {
+                log.append(&Record::Lifecycle(LifecycleRecord::new(2, &event)))
+                    .unwrap();
+            }
+        }
     }
     log.sync().unwrap();
 }
@@ -150,13 +176,27 @@ fn the_log_gives_committed_cells_and_marks_at_the_agents_cell() {
     assert_eq!(d.starts, vec![(0, 0), (3, 2)]);
     assert_eq!(d.goals, vec![(3, 0), (0, 2)]);
     assert_eq!(d.committed, vec![vec![(1, 0), (2, 0)], vec![(2, 2)]]);
-    // Both refused/held decisions, where each agent stood after round 1's moves.
+    // One conflict each, where each agent stood after round 1's moves: agent 1's hold
+    // repeated for the same cell is the same request, its last hold no conflict.
     let conflicts: Vec<(u32, CellXy, u64)> = d
         .conflicts
         .iter()
         .map(|m| (m.agent, m.cell, m.round))
         .collect();
     assert_eq!(conflicts, vec![(0, (1, 0), 2), (1, (2, 2), 2)]);
+    assert_eq!(d.waited, 4, "agent 1 held in rounds 2, 3 and twice in 4");
+    let events: Vec<(u64, u32, &str, Option<CellXy>)> = d
+        .lifecycle
+        .iter()
+        .map(|l| (l.round, l.index, l.event.name(), l.cell))
+        .collect();
+    assert_eq!(
+        events,
+        vec![
+            (2, 1, "down", Some((2, 2))),
+            (2, 1, "restarted", Some((2, 2)))
+        ]
+    );
     assert_eq!(
         d.replans,
         vec![Mark {
@@ -258,8 +298,31 @@ fn the_drawing_holds_one_element_per_mark() {
     .unwrap();
     let svg = std::fs::read_to_string(&out.path).unwrap();
     let count = |tag: &str| svg.matches(&format!("<{tag} ")).count();
-    // Two trajectories; crosses of two conflicts and the legend's; one replan and the legend's.
+    // Two trajectories; crosses of two conflicts and the legend's; one replan triangle and
+    // the legend's, one agent-down diamond and the legend's.
     assert_eq!(count("polyline"), 2, "{svg}");
     assert_eq!(count("line"), 2 * (2 + 1));
-    assert_eq!(count("polygon"), 1 + 1);
+    assert_eq!(count("polygon"), 2 + 2);
+    // Each cross is in its robot's colour (tab10 blue, orange), the legend's grey.
+    let lines: Vec<&str> = svg
+        .split("<line ")
+        .skip(1)
+        .map(|l| l.split("/>").next().unwrap_or(""))
+        .collect();
+    let stroke = |c: &str| lines.iter().filter(|l| l.contains(c)).count();
+    assert_eq!(
+        (stroke("#1F77B4"), stroke("#FF7F0E"), stroke("#404040")),
+        (2, 2, 2),
+        "{lines:?}"
+    );
+    // The process events under the legend, the cell coordinates, the title's rules.
+    assert!(
+        svg.contains("round 2: agent-1 down, restarted at [2, 2]"),
+        "{svg}"
+    );
+    assert!(
+        svg.contains("rules not known"),
+        "the fixture's summary names none"
+    );
+    assert!(svg.contains("1 process restarts"), "{svg}");
 }

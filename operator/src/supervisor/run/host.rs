@@ -8,6 +8,11 @@
 //! ignores the others. Nothing but the bridge is spawned before the bridge is up, and a bridge
 //! is up only once it hears every other host's bridge, so no `Up` is sent before the far
 //! side can hear it.
+//!
+//! Each host's processes meet in an iceoryx2 domain named after the host ([`HostPart::run_id`];
+//! `HNAV_DOMAIN`, if set, wins), and its supervisor's registry entry carries the domain: two
+//! hosts of one run can share a machine (a trial before the robots' computers, a test) with
+//! the same `--run`, and only their bridges link them, as between machines.
 
 use std::path::{Path, PathBuf};
 
@@ -16,6 +21,7 @@ use crate::supervisor::startup::Roll;
 use hnav_runtime::msg::Role;
 use hnav_runtime::placement::{Host, Placement, PlacementError};
 use hnav_runtime::scenario::{ClockMode, Scenario};
+use hnav_runtime::transport::{RunId, TransportError};
 
 /// This host's part of a run across hosts.
 #[derive(Debug, Clone)]
@@ -48,6 +54,26 @@ impl HostPart {
     /// This host's place in the placement (its bridge's index).
     pub fn index(&self) -> usize {
         self.index
+    }
+
+    /// `run` as this host's processes name it: in the domain named after this host, unless
+    /// `run` is in one already (`HNAV_DOMAIN`). Every host of the run may share one machine.
+    pub fn run_id(&self, run: RunId) -> Result<RunId, TransportError> {
+        match run.domain() {
+            Some(_) => Ok(run),
+            None => run.in_domain(&self.this().name),
+        }
+    }
+
+    /// The host that runs the coordinator (or its replicas): the one with the log.
+    pub fn coordinator_host(&self) -> &str {
+        let hosts = self.placement.hosts();
+        hosts
+            .iter()
+            .find(|h| h.coordinator)
+            .unwrap_or(&hosts[self.index])
+            .name
+            .as_str()
     }
 
     /// `spec` (of `hnav-bridge`) with the arguments for run `run` of `scenario`: in

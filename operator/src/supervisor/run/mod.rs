@@ -108,7 +108,10 @@ pub struct RunOptions {
 /// Runs the scenario to its end and returns the summary (also written to `DIR/summary.json`).
 pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     let scenario = opts.args.scenario()?;
-    let run = opts.args.run_id()?;
+    let run = match &opts.host {
+        Some(h) => h.run_id(opts.args.run_id()?)?,
+        None => opts.args.run_id()?,
+    };
     let dir = opts.args.dir.clone().ok_or(RunError::NoRunDir)?;
     let registry = RunRegistry::default_location();
     for cleaned in clean_dead_runs(&registry) {
@@ -160,6 +163,7 @@ fn run_owned(
         &dir,
         bell.as_ref(),
         host,
+        run.domain(),
     );
     let journal = RunEvents::create(&dir);
     // The last ground truth seen: a sample does not outlive its publisher, so a sim that is
@@ -187,6 +191,7 @@ fn run_owned(
         end: result?,
         seen,
         lost: slots.lost_agents(),
+        restarts: slots.restarts(),
         recording,
         elapsed_s: started.elapsed().as_secs_f64(),
     };
@@ -249,6 +254,8 @@ struct Ended {
     seen: Seen,
     /// The agents gone for good and why, by index.
     lost: Vec<(u32, String)>,
+    /// Restarts per process restarted at least once.
+    restarts: std::collections::BTreeMap<String, u32>,
     recording: Option<RecordingSummary>,
     elapsed_s: f64,
 }
@@ -264,9 +271,11 @@ fn summarize(
     ended: Ended,
 ) -> Result<RunSummary, RunError> {
     let (truth, progress) = (ended.seen.truth.as_ref(), ended.seen.progress.as_ref());
-    if host.is_some_and(|h| !h.this().coordinator) {
-        let summary =
+    if let Some(h) = host.filter(|h| !h.this().coordinator) {
+        let mut summary =
             RunSummary::from_truth(run.as_str(), scenario, truth, progress, ended.elapsed_s);
+        summary.counts_on_host = Some(h.coordinator_host().to_string());
+        summary.restarts = ended.restarts;
         summary.write_json(dir).map_err(io(dir))?;
         return Ok(summary);
     }
@@ -274,6 +283,8 @@ fn summarize(
     let cell_m = scenario.robot.cell_size_m;
     let mut summary = RunSummary::from_log(run.as_str(), &log, truth, cell_m, ended.elapsed_s)?;
     summary.mark_lost(&ended.lost);
+    summary.rules = scenario.coordinator.rules.name().to_string();
+    summary.restarts = ended.restarts;
     if let End::CannotGoOn(why) = ended.end {
         summary.cannot_go_on = Some(why);
     }
@@ -353,9 +364,14 @@ fn start_up(
         .start_roll(transport, &children, &mut roll, left)?)
 }
 
-/// The run directory `hnav run` uses when none is given: `target/hnav-out/<scenario name>`.
-pub fn default_run_dir(scenario: &Scenario) -> PathBuf {
-    hnav_runtime::scenario::default_out_dir(&scenario.name)
+/// The run directory `hnav run` uses when none is given: `target/hnav-out/<scenario name>`,
+/// and for host `NAME` of a run across hosts (`host`) `target/hnav-out/<scenario name>-NAME`,
+/// so that hosts sharing a machine do not share a directory.
+pub fn default_run_dir(scenario: &Scenario, host: Option<&str>) -> PathBuf {
+    match host {
+        None => hnav_runtime::scenario::default_out_dir(&scenario.name),
+        Some(h) => hnav_runtime::scenario::default_out_dir(&format!("{}-{h}", scenario.name)),
+    }
 }
 
 /// A fresh run id for `hnav run`.

@@ -18,7 +18,7 @@ use crate::supervisor::restart::{GiveUpReason, RestartDecision, RestartTracker};
 use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::msg::{Lifecycle, Role, RosterState};
 use hnav_runtime::scenario::{GiveUpAction, RestartPolicy, RestartRule, Scenario};
-use hnav_runtime::transport::{Bell, BELL_ENV};
+use hnav_runtime::transport::{Bell, BELL_ENV, DOMAIN_ENV};
 
 /// One process of the run and what the supervisor knows of it.
 struct Slot {
@@ -49,7 +49,8 @@ impl Slots {
     /// The slots of `scenario`'s processes, started from `bin_dir` with `args` (and agents
     /// with their `--index`), each one's output appended to `dir/logs/<node>.log`; the
     /// coordinator and the agents are handed the commit `bell`, if any. In a run across hosts
-    /// (`host`), only this host's processes, and its bridge first. Nothing is spawned yet.
+    /// (`host`), only this host's processes, and its bridge first. Each is told the run's
+    /// iceoryx2 `domain`, if it has one. Nothing is spawned yet.
     pub(super) fn new(
         args: &ProcessArgs,
         bin_dir: &Path,
@@ -57,6 +58,7 @@ impl Slots {
         dir: &Path,
         bell: Option<&Bell>,
         host: Option<&HostPart>,
+        domain: Option<&str>,
     ) -> Self {
         let mut slots = Vec::with_capacity(3 + scenario.agents.len());
         let runs_here = |role, index| host.is_none_or(|h| h.this().runs(role, index));
@@ -89,6 +91,9 @@ impl Slots {
             }
             if let Some(bell) = bell.filter(|_| matches!(role, Role::Coordinator | Role::Agent)) {
                 spec = spec.env(BELL_ENV, bell.env_value());
+            }
+            if let Some(domain) = domain {
+                spec = spec.env(DOMAIN_ENV, domain);
             }
             slots.push(Slot {
                 spec,
@@ -180,6 +185,15 @@ impl Slots {
             .iter()
             .filter(|s| s.spec.role == Role::Agent)
             .filter_map(|s| s.lost.clone().map(|why| (s.spec.index, why)))
+            .collect()
+    }
+
+    /// Restarts per process (by node name) of every process restarted at least once.
+    pub(super) fn restarts(&self) -> std::collections::BTreeMap<String, u32> {
+        self.slots
+            .iter()
+            .filter(|s| s.tracker.restarts() > 0)
+            .map(|s| (s.spec.role.node_name(s.spec.index), s.tracker.restarts()))
             .collect()
     }
 

@@ -149,6 +149,12 @@ impl<'s> Watch<'s> {
             if let Some(end) = self.until_change(slots)? {
                 return Ok(end);
             }
+            // The end first: in a run across hosts, the host that saw the coordinator's last
+            // progress before this one did sends `Stop`, and a process here that exits on it
+            // has not failed the run (the base host ended "cannot go on" in 1 of 4 runs).
+            if let Some(end) = self.on_progress(slots)? {
+                return Ok(end);
+            }
             let reaped = slots.reap_and_restart();
             self.apply(reaped.todo, slots)?;
             if let Some(why) = reaped.verdict? {
