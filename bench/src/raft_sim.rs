@@ -147,7 +147,11 @@ const TAIL: usize = 40;
 
 fn print_failure(f: &Failure) {
     let c = &f.outcome.config;
-    let v = f.outcome.violation.as_ref().expect("a failure has a violation");
+    let v = f
+        .outcome
+        .violation
+        .as_ref()
+        .expect("a failure has a violation");
     hnav_runtime::outln!(
         "\nFAILED seed {} ({}, {} replicas): {v}",
         c.seed,
@@ -157,7 +161,10 @@ fn print_failure(f: &Failure) {
     hnav_runtime::outln!("  schedule: {}", text(&f.outcome.schedule));
     match &f.shrunk.violation {
         Some(sv) => {
-            hnav_runtime::outln!("  shortest schedule that fails: {}", text(&f.shrunk.schedule));
+            hnav_runtime::outln!(
+                "  shortest schedule that fails: {}",
+                text(&f.shrunk.schedule)
+            );
             hnav_runtime::outln!("  it fails with: {sv}");
         }
         None => hnav_runtime::outln!("  (the shrunk schedule no longer fails with its log on)"),

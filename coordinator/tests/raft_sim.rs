@@ -104,7 +104,10 @@ fn a_leader_of_an_earlier_term_elected_late_need_not_hold_a_later_terms_commits(
     };
     let o = run(&config, dir.path()).expect("runs");
     let log = o.log.join("\n");
-    assert!(log.contains("n2 leads term 3") && log.contains("n3 leads term 2"), "{log}");
+    assert!(
+        log.contains("n2 leads term 3") && log.contains("n3 leads term 2"),
+        "{log}"
+    );
     assert_eq!(o.violation, None, "{log}");
 }
 

@@ -405,8 +405,9 @@ mod tests {
         );
         assert!(!table.contains("0.00"), "{table}");
         assert!(
-            table
-                .contains("(steps, length, conflicts, waited, replans: in the consensus log on host base;"),
+            table.contains(
+                "(steps, length, conflicts, waited, replans: in the consensus log on host base;"
+            ),
             "{table}"
         );
     }

@@ -74,7 +74,13 @@ pub struct Violation {
 
 impl fmt::Display for Violation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{} at {}: {}", self.property.name(), self.at, self.detail)
+        write!(
+            f,
+            "{} at {}: {}",
+            self.property.name(),
+            self.at,
+            self.detail
+        )
     }
 }
 
@@ -296,12 +302,9 @@ impl Checker {
 
     /// The leader acknowledged `record` at `index`: its decision is final.
     pub fn acked(&mut self, at: Time, index: u64, record: &[u8]) {
-        if self
-            .committed
-            .get(&index)
-            .is_some_and(|(_, d)| d != record)
-        {
-            let detail = format!("the record acknowledged at index {index} is not the one committed there");
+        if self.committed.get(&index).is_some_and(|(_, d)| d != record) {
+            let detail =
+                format!("the record acknowledged at index {index} is not the one committed there");
             self.fail(at, Property::AcknowledgedLost, detail);
         }
         self.acked.insert(index, record.to_vec());

@@ -133,7 +133,10 @@ fn gone() -> io::Error {
 }
 
 fn injected(what: &str) -> io::Error {
-    io::Error::new(io::ErrorKind::Other, format!("simulated {what} failure (nemesis)"))
+    io::Error::new(
+        io::ErrorKind::Other,
+        format!("simulated {what} failure (nemesis)"),
+    )
 }
 
 impl SimDisk {
@@ -350,7 +353,12 @@ impl DiskFile for SimFile {
             self.pending(Pending::Write(offset, bytes.to_vec()));
             return Ok(());
         };
-        let k = self.disk.state.borrow_mut().rng.range(0, bytes.len() as u64) as usize;
+        let k = self
+            .disk
+            .state
+            .borrow_mut()
+            .rng
+            .range(0, bytes.len() as u64) as usize;
         self.file.write_all_at(&bytes[..k], offset)?;
         self.pending(Pending::Write(offset, bytes[..k].to_vec()));
         let fired = match fault {

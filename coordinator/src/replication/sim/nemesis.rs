@@ -434,8 +434,9 @@ fn parse_action(
         ["clock", t, "stall", ..] => Action::Clock(target(t)?, ClockFault::Stall(dur(w)?)),
         ["clock", t, "jump", k] => Action::Clock(target(t)?, ClockFault::Jump(num(k)? as u32)),
         ["disk", t, fault, nth] => {
-            let f = DiskFault::from_name(fault)
-                .ok_or(format!("`{fault}` is no disk fault (fail-write, fail-fsync, torn)"))?;
+            let f = DiskFault::from_name(fault).ok_or(format!(
+                "`{fault}` is no disk fault (fail-write, fail-fsync, torn)"
+            ))?;
             Action::Disk(target(t)?, f, num(nth)?.max(1) as u32)
         }
         ["power", t] => Action::Power(target(t)?),

@@ -24,7 +24,7 @@ use super::super::error::ReplicaError;
 use super::super::lead::Lead;
 use super::super::peer::{Committed, Replica, ReplicaConfig, Role};
 use super::checker::LogEntry;
-use super::clock::{Time, TickClock};
+use super::clock::{TickClock, Time};
 use super::disk::{Fired, SimDisk};
 use super::rng::Rng;
 
@@ -237,7 +237,12 @@ impl Node {
         }
         let ctx = raft::GetEntriesContext::empty(false);
         let entries = s.entries(1, last + 1, None, ctx).ok()?;
-        Some(entries.into_iter().map(|e| (e.term, e.data.to_vec())).collect())
+        Some(
+            entries
+                .into_iter()
+                .map(|e| (e.term, e.data.to_vec()))
+                .collect(),
+        )
     }
 
     /// The highest index the replica knows committed (0 while down).

@@ -94,7 +94,11 @@ const SHRUNK: usize = 5;
 
 /// Runs the sweep with its journals under `scratch`; `progress` hears the count of runs
 /// done now and then.
-pub fn sweep(s: &Sweep, scratch: &Path, progress: &(dyn Fn(u64) + Sync)) -> std::io::Result<Report> {
+pub fn sweep(
+    s: &Sweep,
+    scratch: &Path,
+    progress: &(dyn Fn(u64) + Sync),
+) -> std::io::Result<Report> {
     let started = Instant::now();
     let next = AtomicU64::new(0);
     let rows = Mutex::new(vec![Row::default(); s.nemeses.len()]);
@@ -130,11 +134,15 @@ pub fn sweep(s: &Sweep, scratch: &Path, progress: &(dyn Fn(u64) + Sync)) -> std:
                     row.crashes += outcome.crashes;
                     row.commits += outcome.commits;
                     row.violations += u64::from(outcome.violation.is_some());
-                    row.slowest_recovery =
-                        row.slowest_recovery.max(outcome.recovered_after.unwrap_or(0));
+                    row.slowest_recovery = row
+                        .slowest_recovery
+                        .max(outcome.recovered_after.unwrap_or(0));
                 }
                 if outcome.violation.is_some() {
-                    failed.lock().expect("no thread panics holding it").push(outcome);
+                    failed
+                        .lock()
+                        .expect("no thread panics holding it")
+                        .push(outcome);
                 }
                 if (k + 1) % 1000 == 0 {
                     progress(k + 1);

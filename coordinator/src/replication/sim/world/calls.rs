@@ -10,8 +10,8 @@ use raft::eraftpb::Message;
 
 use super::super::super::error::ReplicaError;
 use super::super::super::lead::Lead;
-use super::super::super::peer::Role;
 use super::super::super::link::MAX_MESSAGE_BYTES;
+use super::super::super::peer::Role;
 use super::super::disk::Fired;
 use super::super::node::Called;
 use super::{Ev, Sabotage, World, HEAL};
@@ -76,9 +76,7 @@ impl World {
     }
 
     pub(super) fn restart_later(&mut self, i: usize) {
-        let at = self
-            .now
-            .after(self.rng.range(RESTART_US.0, RESTART_US.1));
+        let at = self.now.after(self.rng.range(RESTART_US.0, RESTART_US.1));
         self.push(at, Ev::Restart(i));
     }
 

@@ -1,11 +1,11 @@
 //! The nemesis's actions on the run, their ends, and the heal. A fault that finds nothing
 //! to hit (a replica that is down already) is not counted.
 
+use super::super::super::peer::Role;
 use super::super::clock::Rate;
 use super::super::disk::Fired;
 use super::super::nemesis::{Action, ClockFault, NetFault, Target};
 use super::super::network::Mode;
-use super::super::super::peer::Role;
 use super::{Ev, Undo, World};
 
 impl World {
@@ -23,7 +23,10 @@ impl World {
                     _ => None,
                 })
                 .max()
-                .map_or((self.now.as_ms() % self.nodes.len() as u64) as usize, |(_, i)| i),
+                .map_or(
+                    (self.now.as_ms() % self.nodes.len() as u64) as usize,
+                    |(_, i)| i,
+                ),
         }
     }
 

@@ -26,7 +26,7 @@ use super::super::peer::ReplicaConfig;
 use super::checker::{Checker, Property, Violation};
 use super::clock::Time;
 use super::disk::SimDisk;
-use super::nemesis::{schedule, Event, NetFault, Nemesis};
+use super::nemesis::{schedule, Event, Nemesis, NetFault};
 use super::network::Network;
 use super::node::Node;
 use super::rng::Rng;
@@ -66,7 +66,11 @@ pub enum Sabotage {
 
 impl Sabotage {
     /// Every deliberate bug.
-    pub const ALL: [Sabotage; 3] = [Sabotage::LyingFsync, Sabotage::EarlyAck, Sabotage::StaleLeader];
+    pub const ALL: [Sabotage; 3] = [
+        Sabotage::LyingFsync,
+        Sabotage::EarlyAck,
+        Sabotage::StaleLeader,
+    ];
 
     /// Its name on the command line.
     pub fn name(self) -> &'static str {
