@@ -133,10 +133,7 @@ fn gone() -> io::Error {
 }
 
 fn injected(what: &str) -> io::Error {
-    io::Error::new(
-        io::ErrorKind::Other,
-        format!("simulated {what} failure (nemesis)"),
-    )
+    io::Error::other(format!("simulated {what} failure (nemesis)"))
 }
 
 impl SimDisk {

@@ -144,7 +144,7 @@ pub fn sweep(
                         .expect("no thread panics holding it")
                         .push(outcome);
                 }
-                if (k + 1) % 1000 == 0 {
+                if (k + 1).is_multiple_of(1000) {
                     progress(k + 1);
                 }
             });
