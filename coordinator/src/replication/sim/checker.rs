@@ -87,7 +87,7 @@ impl fmt::Display for Violation {
 /// One entry of a replica's log, as log matching compares it.
 pub type LogEntry = (u64, Vec<u8>);
 
-/// What the checker has seen; see the [module docs](self).
+/// What the checker has seen, to check the properties listed at the top of its file.
 #[derive(Debug, Default)]
 pub struct Checker {
     leaders: BTreeMap<u64, u64>,

@@ -119,7 +119,7 @@ struct State {
     faults: u64,
 }
 
-/// A replica's simulated disk; see the [module docs](self). Clones share the disk; each
+/// A replica's simulated disk (how it fails: the top of its file). Clones share the disk; each
 /// incarnation of the replica writes through its own [`SimDisk::incarnation`], which dies
 /// with it.
 #[derive(Clone, Debug)]
@@ -194,7 +194,7 @@ impl SimDisk {
         self.alive.set(false);
     }
 
-    /// The crash after a fault, or a power loss: the files are cut back as [`Fired`] says
+    /// The crash after a fault, or a power loss: the files are cut back as `Fired` says
     /// (nothing for a failed write, whose writer cut it back itself or left a torn tail).
     pub fn crash(&self, how: Option<Fired>) -> io::Result<()> {
         self.kill();
