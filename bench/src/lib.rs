@@ -15,6 +15,7 @@
 //! | [`fanout`] | `hnav-bench fanout [--listeners 1,8,32,128,256] [--mechanisms hnav,hnav-bell,eventfd,futex] [--quick] [--out DIR]` | waking N waiting agents per commit: HNAV's publish + notify with and without the commit bell, against one eventfd write and one futex wake; the notifier's cost and the last waiter's wake-up |
 //! | [`round`] | `hnav-bench round [--agents 1,8,32,128,256] [--rounds N] [--fsync every-record,none] [--json] [--out DIR]`, `hnav-bench round --faults [--trials N]` | a decision round's latency against a real `hnav-coordinator` (all candidates in -> commit at every agent); SIGKILL -> `Down` detection and restarted agent -> first decision |
 //! | [`chaos`] | `hnav-bench chaos [--runs N] [--seed S] [--quick] [--only N]` | a seeded campaign of runs with agents, the coordinator or the sim killed or frozen: per-run checks (at goal, no collision, log verifies, every commit seen once, nothing left behind), a table per class and mode, detection and recovery latencies |
+//! | [`raft_sim`] | `hnav-bench raft-sim [--seeds N] [--first S] [--nemesis LIST] [--replicas 3\|5] [--jobs J] [--trace SCHEDULE] [--sabotage BUG]` | the deterministic simulation of the coordinator's replicated log: per nemesis, runs, faults injected, leaders elected, processes crashed, commits, violations and the slowest recovery; each failure's seed and shortest failing schedule |
 //! | [`mapf`] | `hnav-bench mapf --map FILE --scen FILE [--agents 50,100] [--rules dissertation,pibt,lacam] [--json] [--out DIR] [--quick]` | the first-N-entries MAPF instances of a MovingAI `.scen` run by whole swarms: robots at goal, collisions, makespan, sum of lengths against the lower bound, conflicts, replans, wall time, the processes' memory |
 //! | [`swarm_run`] | — | a whole swarm (`hnav run`) started from a benchmark, and what every such run is checked for afterwards |
 //! | [`latency`] | `hnav-bench latency [--quick] --out DIR` | one-way and round-trip latency, 8 B to 40 MiB, of raw iceoryx2, the HNAV transport, a Unix domain socket, TCP loopback and the in-process floors (crossbeam channel, futex wake-up), in a two-thread ping-pong; CSV, markdown and an SVG plot |
@@ -39,6 +40,7 @@ pub mod mapf;
 pub mod neural_map;
 pub mod perf;
 pub mod plan;
+pub mod raft_sim;
 pub mod round;
 pub mod seed002;
 pub mod sim;

@@ -69,6 +69,10 @@ enum Command {
     /// The seeds' experiments, ours beside the paper's tables (`hnav-bench experiment list`
     /// names them).
     Experiment(ExperimentCli),
+    /// The deterministic simulation of the coordinator's replicated log: a sweep of seeds
+    /// under nemeses (kill, pause, partitions, network, clock and disk faults), Raft's
+    /// safety checked on every run; a table per nemesis, failures shrunk with their seed.
+    RaftSim(hnav_bench::raft_sim::RaftSimArgs),
 }
 
 #[derive(Debug, Args)]
@@ -445,6 +449,7 @@ fn main() -> std::process::ExitCode {
         Command::Chaos(args) => chaos(args),
         Command::Mapf(args) => mapf(args),
         Command::Experiment(args) => experiment(args),
+        Command::RaftSim(args) => hnav_bench::raft_sim::main(args),
     };
     match outcome {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -13,21 +13,27 @@
 //! restarted replica runs on is rebuilt from what is left: its entries, term, vote and commit
 //! index. Raft then hands the committed entries out again, so the coordinator's state is
 //! rebuilt by applying them, exactly as a follower applies the leader's.
+//!
+//! The journal writes on a [`Disk`]: the machine's ([`RealDisk`]) in the coordinator, a
+//! simulated one that fails writes and fsyncs and loses power in the simulation
+//! ([`sim`](super::sim)).
 
 use std::path::Path;
 
 use hnav_runtime::consensus_log::{
-    resolve, LogWriter, RaftEntryRecord, RaftStateRecord, Record, RunHeader, REPLICATED_VERSION,
+    resolve, LogWriter, RaftEntryRecord, RaftStateRecord, Record, RunHeader, WriterOptions,
+    REPLICATED_VERSION,
 };
+use hnav_runtime::durable::{Disk, RealDisk};
 use hnav_runtime::scenario::FsyncPolicy;
 use raft::eraftpb::{ConfState, Entry, HardState};
 use raft::storage::MemStorage;
 
 use super::error::ReplicaError;
 
-/// A replica's durable Raft log.
-pub struct Journal {
-    log: LogWriter,
+/// A replica's durable Raft log, written on the disk `D`.
+pub struct Journal<D: Disk = RealDisk> {
+    log: LogWriter<D>,
     /// Records written at the next [`flush`](Journal::flush).
     pending: Vec<Record>,
     /// Whether `pending` holds something Raft needs durable before it speaks (an entry, a
@@ -42,12 +48,25 @@ impl Journal {
     /// storage Raft runs on, holding what the log held.
     pub fn open(
         dir: &Path,
-        mut header: RunHeader,
+        header: RunHeader,
         fsync: FsyncPolicy,
         voters: &[u64],
     ) -> Result<(Journal, MemStorage), ReplicaError> {
+        Journal::open_on(RealDisk, dir, header, WriterOptions::new(fsync), voters)
+    }
+}
+
+impl<D: Disk> Journal<D> {
+    /// [`Journal::open`] on `disk`, its log written as `options` say.
+    pub fn open_on(
+        disk: D,
+        dir: &Path,
+        mut header: RunHeader,
+        options: WriterOptions,
+        voters: &[u64],
+    ) -> Result<(Journal<D>, MemStorage), ReplicaError> {
         header.version = REPLICATED_VERSION;
-        let (mut log, recovered) = LogWriter::open(dir, fsync)?;
+        let (mut log, recovered) = LogWriter::open_on(disk, dir, options)?;
         if recovered.truncated_bytes > 0 {
             tracing::warn!(
                 bytes = recovered.truncated_bytes,

@@ -35,8 +35,10 @@
 //!
 //! | module | concept |
 //! |---|---|
+//! | [`sim`] | the deterministic simulation of the replicated log: real replicas, simulated network, disk and time, a nemesis, a checker |
 //! | `raft_log` | [`RaftLog`]: the peer, journal and link together, as the coordinator uses them |
 //! | `overheard` | [`Overheard`]: the supervisor's liveness events a following replica keeps |
+//! | `lead` | [`Lead`]: when a replica may decide, and when its decision is final |
 //! | `peer` | [`Replica`], [`ReplicaConfig`], [`Role`], [`Committed`]: one voter and its `Ready` cycle |
 //! | `journal` | [`Journal`]: the Raft log on disk, in the consensus-log segments |
 //! | `link` | [`RaftLink`]: the `raft/<i>` topics between replicas |
@@ -48,17 +50,20 @@
 
 mod error;
 mod journal;
+mod lead;
 mod link;
 mod log_bridge;
 mod overheard;
 mod peer;
 mod raft_log;
+pub mod sim;
 #[cfg(test)]
 mod tests;
 mod wire;
 
 pub use error::ReplicaError;
 pub use journal::Journal;
+pub use lead::Lead;
 pub use link::{topic, Inbox, RaftLink, MAX_ENTRIES_BYTES, MAX_MESSAGE_BYTES};
 pub use overheard::Overheard;
 pub use peer::{Committed, Replica, ReplicaConfig, Role};

@@ -8,6 +8,9 @@ use raft::eraftpb::{ConfState, Entry, EntryType, Message};
 use raft::storage::MemStorage;
 use raft::{Config, RawNode, StateRole};
 
+use hnav_runtime::consensus_log::WriterOptions;
+use hnav_runtime::durable::{Disk, RealDisk};
+
 use super::error::ReplicaError;
 use super::journal::Journal;
 use super::link::{RaftLink, MAX_ENTRIES_BYTES};
@@ -76,15 +79,19 @@ pub struct Committed {
     pub data: Vec<u8>,
 }
 
-/// One voter of a Raft cluster, driven by its owner's loop.
-pub struct Replica {
+/// Where the messages that may leave before the storage go the moment they exist.
+type EarlyOut = Box<dyn FnMut(&Message)>;
+
+/// One voter of a Raft cluster, driven by its owner's loop; its journal is written on the
+/// disk `D`.
+pub struct Replica<D: Disk = RealDisk> {
     node: RawNode<MemStorage>,
     /// Where entries and hard states are made durable; `None` keeps them in memory only (the
     /// in-process tests).
-    journal: Option<Journal>,
+    journal: Option<Journal<D>>,
     /// Where the messages that may leave before the storage go at once ([`Replica::send_early`]);
     /// without it they wait in the outbox with the rest.
-    early: Option<std::rc::Rc<RaftLink>>,
+    early: Option<EarlyOut>,
     outbox: Vec<Message>,
     committed: VecDeque<Committed>,
 }
@@ -106,8 +113,40 @@ impl Replica {
         header: hnav_runtime::consensus_log::RunHeader,
         fsync: hnav_runtime::scenario::FsyncPolicy,
     ) -> Result<Self, ReplicaError> {
-        let (journal, storage) = Journal::open(dir, header, fsync, &config.voters)?;
-        let mut replica = Self::restart(config, storage)?;
+        Self::durable_on(RealDisk, config, dir, header, WriterOptions::new(fsync))
+    }
+
+    /// A replica over storage that survived it: its term, vote and entries come back; what it
+    /// had applied is applied again from the start (its owner's state machine starts empty).
+    pub fn restart(config: &ReplicaConfig, storage: MemStorage) -> Result<Self, ReplicaError> {
+        Self::over(config, storage)
+    }
+
+    /// Sends the messages Raft lets leave before the storage (a leader's appends and
+    /// heartbeats) on `link` the moment they exist, instead of queueing them for
+    /// [`take_messages`](Self::take_messages): a leader's own `fdatasync` then runs while its
+    /// followers write theirs, and a round costs one sync on its path instead of two. A
+    /// message that does not go out is Raft's to resend.
+    pub fn send_early(&mut self, link: std::rc::Rc<RaftLink>) {
+        self.send_early_to(move |m| {
+            if let Err(e) = link.send(m) {
+                tracing::debug!(to = m.to, "raft message not sent: {e}");
+            }
+        });
+    }
+}
+
+impl<D: Disk> Replica<D> {
+    /// [`Replica::durable`] with its journal on `disk`, written as `options` say.
+    pub fn durable_on(
+        disk: D,
+        config: &ReplicaConfig,
+        dir: &std::path::Path,
+        header: hnav_runtime::consensus_log::RunHeader,
+        options: WriterOptions,
+    ) -> Result<Self, ReplicaError> {
+        let (journal, storage) = Journal::open_on(disk, dir, header, options, &config.voters)?;
+        let mut replica = Self::over(config, storage)?;
         replica.journal = Some(journal);
         // The committed entries of the journal are ready at once.
         replica.process()?;
@@ -123,9 +162,7 @@ impl Replica {
         }
     }
 
-    /// A replica over storage that survived it: its term, vote and entries come back; what it
-    /// had applied is applied again from the start (its owner's state machine starts empty).
-    pub fn restart(config: &ReplicaConfig, storage: MemStorage) -> Result<Self, ReplicaError> {
+    fn over(config: &ReplicaConfig, storage: MemStorage) -> Result<Self, ReplicaError> {
         if config.id == 0 || !config.voters.contains(&config.id) {
             return Err(ReplicaError::NotAVoter {
                 id: config.id,
@@ -237,13 +274,32 @@ impl Replica {
         self.process()
     }
 
-    /// Sends the messages Raft lets leave before the storage (a leader's appends and
-    /// heartbeats) on `link` the moment they exist, instead of queueing them for
-    /// [`take_messages`](Self::take_messages): a leader's own `fdatasync` then runs while its
-    /// followers write theirs, and a round costs one sync on its path instead of two. A
-    /// message that does not go out is Raft's to resend.
-    pub fn send_early(&mut self, link: std::rc::Rc<RaftLink>) {
-        self.early = Some(link);
+    /// Hands the messages Raft lets leave before the storage to `out` the moment they exist
+    /// ([`send_early`](Replica::send_early) with `out` as the link): the simulation carries
+    /// them on its network, ahead of a write that may fail.
+    pub fn send_early_to(&mut self, out: impl FnMut(&Message) + 'static) {
+        self.early = Some(Box::new(out));
+    }
+
+    /// The election timeout Raft drew for this term, in ticks.
+    pub fn election_timeout(&self) -> usize {
+        self.node.raft.randomized_election_timeout()
+    }
+
+    /// The range Raft draws election timeouts from, in ticks: `[min, max)`, the
+    /// configuration's `[election_ticks, 2 * election_ticks)`.
+    pub fn election_timeout_range(&self) -> (usize, usize) {
+        let e = self.node.raft.election_timeout();
+        (e, 2 * e)
+    }
+
+    /// Sets the election timeout Raft drew; it must lie in
+    /// [`election_timeout_range`](Self::election_timeout_range) (Raft asserts it). Raft draws it from the
+    /// thread's random numbers at every change of role or term and reads it only when a tick
+    /// asks whether the election is due, so an owner that sets it after every call replaces
+    /// the draw with its own: the deterministic simulation draws from its seed.
+    pub fn set_election_timeout(&mut self, ticks: usize) {
+        self.node.raft.set_randomized_election_timeout(ticks);
     }
 
     /// The messages to send to the other replicas, each addressed (`Message::to`). Every one
@@ -265,14 +321,8 @@ impl Replica {
             // Messages of a leader may leave before its own append (Raft's leader writes in
             // parallel with its followers); the rest wait for the storage below.
             let early = ready.take_messages();
-            match &self.early {
-                Some(link) => {
-                    for m in &early {
-                        if let Err(e) = link.send(m) {
-                            tracing::debug!(to = m.to, "raft message not sent: {e}");
-                        }
-                    }
-                }
+            match &mut self.early {
+                Some(out) => early.iter().for_each(out),
                 None => self.outbox.extend(early),
             }
             let store = self.node.store().clone();

@@ -18,6 +18,7 @@ use hnav_runtime::scenario::Scenario;
 use hnav_runtime::transport::Transport;
 
 use super::error::ReplicaError;
+use super::lead::Lead;
 use super::link::RaftLink;
 use super::peer::{Replica, ReplicaConfig, Role};
 
@@ -29,10 +30,8 @@ pub struct RaftLog {
     link: Rc<RaftLink>,
     /// The encoding of the record being proposed, reused.
     buf: Vec<u8>,
-    /// The term this replica leads in, once it has started to decide.
-    led: Option<u64>,
-    /// The index of its last proposal.
-    proposed: u64,
+    /// Whether it decides, and its last proposal.
+    lead: Lead,
     tick: Duration,
     next_tick: Instant,
     /// Records committed by other leaders, in log order, for the coordinator to apply.
@@ -70,8 +69,7 @@ impl RaftLog {
             replica,
             link,
             buf: Vec::new(),
-            led: None,
-            proposed: 0,
+            lead: Lead::new(),
             tick,
             next_tick: Instant::now() + tick,
             applied: Vec::new(),
@@ -111,27 +109,23 @@ impl RaftLog {
     /// Whether it may start to decide: it leads and every earlier leader's committed entry is
     /// applied ([`Replica::can_decide`]). From then on it decides in this term only.
     pub fn take_lead(&mut self) -> bool {
-        if self.led.is_none() && self.replica.can_decide() {
-            self.led = Some(self.replica.term());
-        }
-        self.led.is_some()
+        self.lead.take(&self.replica)
     }
 
     /// Whether it has started to decide.
     pub fn leading(&self) -> bool {
-        self.led.is_some()
+        self.lead.leading()
     }
 
     /// Whether it decided in a term it no longer leads: its state may hold decisions the
     /// cluster never committed, and only a restart from the journal sets that right.
     pub fn deposed(&self) -> Option<u64> {
-        let led = self.led?;
-        (self.replica.role() != Role::Leader || self.replica.term() != led).then_some(led)
+        self.lead.deposed(&self.replica)
     }
 
     /// Whether every proposal is committed: a majority holds it durably.
     pub fn settled(&self) -> bool {
-        self.replica.committed_index() >= self.proposed
+        self.lead.settled(&self.replica)
     }
 
     /// One pass of the replica: the messages that came in, a tick if one is due, the
@@ -210,7 +204,7 @@ impl RaftLog {
         self.buf.clear();
         encode_record(record, &mut self.buf)?;
         self.replica.propose(&self.buf)?;
-        self.proposed = self.replica.last_index();
+        self.lead.proposed(&self.replica);
         self.send()
     }
 
@@ -227,7 +221,7 @@ impl RaftLog {
     /// Moves the committed records this replica did not decide itself into `applied`.
     fn take_committed(&mut self) -> Result<(), ReplicaError> {
         for c in self.replica.take_committed() {
-            if Some(c.term) == self.led {
+            if self.lead.decided_here(&c) {
                 continue;
             }
             let record = decode_record(&c.data)
