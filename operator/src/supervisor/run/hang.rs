@@ -9,7 +9,11 @@
 //! out, see [`super::action`]). Its exit then takes the ordinary path (reaped, `Down`, restarted under its role's policy, or the run cannot go on).
 //!
 //! A process is watched from the moment it is up: a first start from `Start` (before it, the
-//! start-up timeout bounds it), a restart from its `Up`. Beats carry their own
+//! start-up timeout bounds it). A restarted process is watched from its spawn: until its `Up`
+//! its deadline is the start-up timeout (or its role's hang deadline, if longer), since it
+//! may be loading a large map or reading a long log; from its `Up` on, its role's. Before,
+//! a restart that hung before its `Up` was watched by nobody, and a lockstep run waited for
+//! it for ever. Beats carry their own
 //! `CLOCK_MONOTONIC` time, so a supervisor that was itself paused (Ctrl-Z then `fg`, or
 //! SIGSTOP) judges its children by when they beat, not by when it read the beats. When its
 //! children were paused with it, their beats are as old as the pause; so when the supervisor
@@ -44,6 +48,8 @@ struct Watched {
     since_ns: u64,
     /// Declared hung and SIGKILLed; its exit is on its way.
     declared: bool,
+    /// It has announced its `Up` (or is a first start); a restart has not yet.
+    up: bool,
 }
 
 /// The hang deadlines of a run's processes.
@@ -51,6 +57,8 @@ pub(super) struct HangWatch {
     beats: Receiver<Heartbeat>,
     /// Per role: sim, coordinator, agent.
     deadline: [Duration; 3],
+    /// A restarted process's deadline until its `Up`: the start-up timeout.
+    startup: Duration,
     /// One entry per process, in the slots' order: sim, coordinator, agent 0, 1, ...
     nodes: Vec<Option<Watched>>,
     /// Tells when the supervisor itself was away (paused or starved).
@@ -111,31 +119,44 @@ impl HangWatch {
         Ok(Self {
             beats: transport.receiver(topics::HEARTBEAT, topics::heartbeat_qos(n))?,
             deadline,
+            startup: scenario.startup_timeout(),
             nodes: vec![None; AGENTS_FROM + n],
             pause: PauseDetector::new(shortest / 2),
         })
     }
 
-    /// Follows the set of processes that are up: a new incarnation is watched from now, one
-    /// that is gone is forgotten.
+    /// Follows the set of processes that are up or restarting: a new incarnation is watched
+    /// from now, a restart that came up is watched afresh from now under its role's
+    /// deadline, one that is gone is forgotten.
     pub(super) fn follow(&mut self, slots: &Slots) {
         let now = monotonic_ns();
-        let mut up = vec![false; self.nodes.len()];
-        for (role, index, pid) in slots.up() {
+        let mut seen = vec![false; self.nodes.len()];
+        let up = slots.up().map(|p| (p, true));
+        let starting = slots.starting().map(|p| (p, false));
+        for ((role, index, pid), is_up) in up.chain(starting) {
             let Some(k) = self.slot_of(role, index) else {
                 continue;
             };
-            up[k] = true;
-            if self.nodes[k].is_none_or(|w| w.pid != pid) {
-                self.nodes[k] = Some(Watched {
-                    pid,
-                    since_ns: now,
-                    declared: false,
-                });
+            seen[k] = true;
+            let node = &mut self.nodes[k];
+            match node {
+                Some(w) if w.pid == pid && w.up == is_up => {}
+                Some(w) if w.pid == pid => {
+                    w.up = true;
+                    w.since_ns = w.since_ns.max(now);
+                }
+                _ => {
+                    *node = Some(Watched {
+                        pid,
+                        since_ns: now,
+                        declared: false,
+                        up: is_up,
+                    })
+                }
             }
         }
-        for (node, up) in self.nodes.iter_mut().zip(up) {
-            if !up {
+        for (node, seen) in self.nodes.iter_mut().zip(seen) {
+            if !seen {
                 *node = None;
             }
         }
@@ -161,7 +182,10 @@ impl HangWatch {
                 continue;
             };
             let (role, index) = Self::node_of(k);
-            let hang = self.deadline[Self::role_slot(role)];
+            let hang = match self.deadline[Self::role_slot(role)] {
+                d if w.up => d,
+                d => d.max(self.startup),
+            };
             let silent = Duration::from_nanos(now_ns.saturating_sub(w.since_ns));
             if silent <= hang {
                 let due = now + hang.saturating_sub(silent);

@@ -152,6 +152,15 @@ impl Slots {
             .filter_map(|s| Some((s.spec.role, s.spec.index, s.child.as_ref()?.pid())))
     }
 
+    /// Role, index and pid of every restarted process that has not announced its `Up` yet
+    /// (the hang watch gives it the start-up timeout).
+    pub(super) fn starting(&self) -> impl Iterator<Item = (Role, u32, u32)> + '_ {
+        self.slots
+            .iter()
+            .filter(|s| s.announce)
+            .filter_map(|s| Some((s.spec.role, s.spec.index, s.child.as_ref()?.pid())))
+    }
+
     /// The current incarnation of `role`/`index`, if it runs.
     pub(super) fn child(&self, role: Role, index: u32) -> Option<&Child> {
         self.slots
