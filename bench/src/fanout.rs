@@ -60,6 +60,10 @@ const WARMUP: usize = 50;
 const RECHECK: Duration = Duration::from_millis(100);
 /// A point that has not finished a commit for this long is a failure.
 const STUCK: Duration = Duration::from_secs(10);
+/// How long the waiters may take to set up (a node, a receiver and a `Waiter` each) before
+/// the first round: iceoryx2 opens one service's ports one at a time, so 256 waiters on a
+/// busy machine take far longer than one commit may.
+const SETUP: Duration = Duration::from_secs(120);
 
 /// How the notifier wakes the waiters.
 #[derive(Clone, Copy, PartialEq, Eq, Debug, ValueEnum)]
@@ -239,8 +243,8 @@ impl Shared {
         }
     }
 
-    /// The notifier waits until `counter` reaches `n`.
-    fn await_all(&self, counter: &AtomicU32, n: usize) -> Result<()> {
+    /// The notifier waits until `counter` reaches `n`, for at most `bound`.
+    fn await_all(&self, counter: &AtomicU32, n: usize, bound: Duration) -> Result<()> {
         let since = Instant::now();
         loop {
             let c = counter.load(Ordering::Acquire);
@@ -248,8 +252,8 @@ impl Shared {
                 return Ok(());
             }
             check(self)?;
-            if since.elapsed() > STUCK {
-                bail!("{c} of {n} waiters after {} s", STUCK.as_secs());
+            if since.elapsed() > bound {
+                bail!("{c} of {n} waiters after {} s", bound.as_secs());
             }
             futex::wait(counter, c, RECHECK)?;
         }
@@ -352,13 +356,15 @@ fn notify_rounds(
         Vec::with_capacity(measured),
     );
     for r in 1..=total {
-        shared.await_all(&shared.armed, n)?;
+        // The first round's arrivals wait for every waiter's set-up.
+        let bound = if r == 1 { SETUP } else { STUCK };
+        shared.await_all(&shared.armed, n, bound)?;
         shared.armed.store(0, Ordering::Release);
         shared.done.store(0, Ordering::Release);
         let t0 = shared.now_ns();
         notifier.notify(shared, r)?;
         let t1 = shared.now_ns();
-        shared.await_all(&shared.done, n)?;
+        shared.await_all(&shared.done, n, STUCK)?;
         if r as usize > WARMUP {
             let seen = shared.seen_ns.iter().map(|s| s.load(Ordering::Acquire));
             let (lo, hi) = seen.fold((u64::MAX, 0), |(lo, hi), t| (lo.min(t), hi.max(t)));
