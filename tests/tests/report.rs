@@ -100,9 +100,12 @@ fn check_recording(dir: &Path, scenario: &Scenario, summary: &serde_json::Value)
         truth + 6 >= expected && truth <= expected + 12,
         "{truth} truth samples for {sim_s} s of 6 robots at 20 Hz ({expected}), {missed} missed"
     );
+    // An estimate the recorder did not read before the agent's next overwrote it leaves
+    // its sampling time out (counted: a busy machine's run once recorded 6077 of 6228).
+    let estimates_missed = recorded["estimates_missed"].as_u64().unwrap();
     assert!(
-        estimates + 12 * 6 >= expected,
-        "{estimates} estimates for {expected} expected"
+        estimates + estimates_missed + 12 * 6 >= expected,
+        "{estimates} estimates and {estimates_missed} missed for {expected} expected"
     );
     let (maps, torn) = MapReader::open(&rec.join(recording::MAPS))
         .unwrap()

@@ -51,6 +51,9 @@ pub struct RecordingSummary {
     pub dropped: u64,
     /// Ground-truth messages the recorder never saw (gaps in the periods it received).
     pub missed: u64,
+    /// Estimate sampling times (per agent) passed with no estimate seen: on a busy machine
+    /// an agent's newer estimate overwrote the one the recorder had not read yet.
+    pub estimates_missed: u64,
     /// Simulated times (ns since Start) at which the sim's collision count rose.
     pub collisions_at_ns: Vec<u64>,
     /// Why the recording stopped early, if it did (it never stops the run).
@@ -446,6 +449,7 @@ impl State {
             truth_samples,
             estimate_samples,
             maps_dropped,
+            estimates,
             ..
         } = self;
         let mut note = |e: RecordingError| {
@@ -475,6 +479,7 @@ impl State {
         summary.truth_samples = truth_samples;
         summary.estimate_samples = estimate_samples;
         summary.missed = truth.missed;
+        summary.estimates_missed = estimates.iter().map(|c| c.skipped).sum();
         summary.collisions_at_ns = truth.collisions_at_ns;
     }
 }

@@ -6,7 +6,8 @@
 //!   than one was preceded by messages the recorder never saw (its buffer overflowed), which
 //!   are counted as missed. A period seen again (a restarted sim republishes its last one)
 //!   is not sampled twice.
-//! - Estimates: the same boundaries, per agent.
+//! - Estimates: the same boundaries, per agent; a boundary passed without a message (the
+//!   depth-1 buffer was overwritten before the recorder read it) is counted as skipped.
 //! - Neural maps: per agent at most one snapshot per simulated second ([`MAP_INTERVAL_NS`]),
 //!   and always the last one each agent published ([`MapThrottle`]).
 
@@ -19,6 +20,9 @@ pub const MAP_INTERVAL_NS: u64 = 1_000_000_000;
 pub struct SimClock {
     interval_ns: u64,
     next_ns: Option<u64>,
+    /// Boundaries passed with no message taken at them: a later message was the first seen
+    /// past more than one (the messages between were overwritten before the recorder read).
+    pub skipped: u64,
 }
 
 impl SimClock {
@@ -31,14 +35,17 @@ impl SimClock {
                 1_000_000_000 / u64::from(rate_hz)
             },
             next_ns: None,
+            skipped: 0,
         }
     }
 
     /// Whether a message at `t_ns` is the first at or past the next boundary (then the
     /// boundary after `t_ns` becomes the next).
     pub fn take(&mut self, t_ns: u64) -> bool {
-        if self.next_ns.is_some_and(|n| t_ns < n) {
-            return false;
+        match self.next_ns {
+            Some(n) if t_ns < n => return false,
+            Some(n) if self.interval_ns > 0 => self.skipped += (t_ns - n) / self.interval_ns,
+            _ => {}
         }
         self.next_ns = Some(match self.interval_ns {
             0 => t_ns.saturating_add(1),
@@ -165,6 +172,24 @@ mod tests {
         // 20 Hz over 10 ms periods: every fifth.
         assert_eq!(taken, vec![0, 5, 10, 15, 20]);
         assert_eq!(s.missed, 0);
+    }
+
+    #[test]
+    fn boundaries_passed_without_a_message_are_counted_as_skipped() {
+        let mut c = SimClock::new(20);
+        assert!(c.take(0));
+        // The next boundary is 50 ms; a message at 160 ms is the first past 50, 100 and 150:
+        // it is taken for 150, and 50 and 100 went without one.
+        assert!(c.take(16 * PERIOD));
+        assert_eq!(c.skipped, 2);
+        // 200 ms exactly is the next boundary: nothing skipped.
+        assert!(!c.take(19 * PERIOD));
+        assert!(c.take(20 * PERIOD));
+        assert_eq!(c.skipped, 2);
+        // Every message sampled (rate 0): nothing is ever skipped.
+        let mut every = SimClock::new(0);
+        assert!(every.take(0) && every.take(10 * PERIOD));
+        assert_eq!(every.skipped, 0);
     }
 
     #[test]
