@@ -52,7 +52,13 @@ impl State {
         };
         match ev {
             LifecycleEvent::Down | LifecycleEvent::Restarted | LifecycleEvent::Lost => {
+                if role == Role::Coordinator && ev == LifecycleEvent::Restarted && l.index == 0 {
+                    self.roster_due = false;
+                }
                 if role == Role::Agent {
+                    if self.roster_due {
+                        return Ok(());
+                    }
                     self.roster.event(l.index, ev, l.restarts);
                 }
                 self.log_event(role, l.index, ev, l.restarts)
@@ -63,6 +69,16 @@ impl State {
             },
             _ => Ok(()),
         }
+    }
+
+    /// This single coordinator was restarted (`--resume`): until the supervisor's
+    /// `Restarted` for it, an agent's event is not logged. The first sample it hears is the
+    /// lifecycle topic's history, the last event published before it subscribed: one its
+    /// predecessor may have logged already, or the `Lost` of an agent whose `Down` (published
+    /// just before) it never sees. The roster that follows its `Restarted` gives each agent's
+    /// state then, and [`State::reconcile`] logs exactly what the log misses, in order.
+    pub(in crate::process) fn await_roster(&mut self) {
+        self.roster_due = true;
     }
 
     /// A roster entry (sent after this coordinator came up): the records the log misses
@@ -145,7 +161,9 @@ mod tests {
 
     /// A coordinator restarted by the supervisor over the log its predecessor left in `dir`.
     fn restarted(s: &Scenario, dir: &Path) -> State {
-        State::open(s, dir).unwrap()
+        let mut state = State::open(s, dir).unwrap();
+        state.await_roster();
+        state
     }
 
     /// The agents' lifecycle records of the log in `dir`: (index, event, restarts).
