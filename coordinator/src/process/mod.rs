@@ -114,6 +114,10 @@ impl<'t> CoordinatorProcess<'t> {
     /// Announces itself, waits for the start (unless `resume`) and runs rounds until the
     /// supervisor's `Stop` or a termination signal.
     pub fn run(&mut self, resume: bool) -> Result<CoordinatorOutcome, CoordinatorError> {
+        // A replica hears its own `Restarted` while following (see `Overheard`).
+        if resume && self.ports.is_some() {
+            self.state.await_roster();
+        }
         let started = self
             .life
             .handshake(self.transport, resume, self.startup_timeout)?;

@@ -57,6 +57,9 @@ pub(super) struct State {
     events: Vec<Lifecycle>,
     /// A following replica's memory of the supervisor.
     heard: Overheard,
+    /// A restarted single coordinator before its own `Restarted`: the agents' events heard
+    /// until then are not logged, since the roster that follows it says what they were.
+    roster_due: bool,
 }
 
 /// The header a log of `s` must start with.
@@ -148,6 +151,7 @@ impl State {
             dropped: Dropped::load(run_dir),
             events: Vec::new(),
             heard: Overheard::new(n),
+            roster_due: false,
         }
     }
 

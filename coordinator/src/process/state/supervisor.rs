@@ -52,7 +52,13 @@ impl State {
         };
         match ev {
             LifecycleEvent::Down | LifecycleEvent::Restarted | LifecycleEvent::Lost => {
+                if role == Role::Coordinator && ev == LifecycleEvent::Restarted && l.index == 0 {
+                    self.roster_due = false;
+                }
                 if role == Role::Agent {
+                    if self.roster_due {
+                        return Ok(());
+                    }
                     self.roster.event(l.index, ev, l.restarts);
                 }
                 self.log_event(role, l.index, ev, l.restarts)
@@ -63,6 +69,16 @@ impl State {
             },
             _ => Ok(()),
         }
+    }
+
+    /// This single coordinator was restarted (`--resume`): until the supervisor's
+    /// `Restarted` for it, an agent's event is not logged. The first sample it hears is the
+    /// lifecycle topic's history, the last event published before it subscribed: one its
+    /// predecessor may have logged already, or the `Lost` of an agent whose `Down` (published
+    /// just before) it never sees. The roster that follows its `Restarted` gives each agent's
+    /// state then, and [`State::reconcile`] logs exactly what the log misses, in order.
+    pub(in crate::process) fn await_roster(&mut self) {
+        self.roster_due = true;
     }
 
     /// A roster entry (sent after this coordinator came up): the records the log misses
@@ -114,5 +130,123 @@ impl State {
         life: &LifecyclePorts,
     ) -> Result<Option<EndReason>, CoordinatorError> {
         Ok(self.heard.hear(life)?.map(stopped))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use hnav_runtime::consensus_log::{read_log, Record};
+    use hnav_runtime::msg::{Lifecycle, LifecycleEvent, Role, RosterState};
+    use hnav_runtime::scenario::Scenario;
+
+    use super::State;
+
+    const TWO: &str = r#"
+        name = "t"
+        [map]
+        rows = ["........", "........", "........"]
+        [[agents]]
+        start = [0, 1]
+        goal = [7, 1]
+        [[agents]]
+        start = [2, 1]
+        goal = [2, 0]
+    "#;
+
+    fn scenario() -> Scenario {
+        Scenario::from_str(TWO, "test.toml", Path::new(".")).unwrap()
+    }
+
+    /// A coordinator restarted by the supervisor over the log its predecessor left in `dir`.
+    fn restarted(s: &Scenario, dir: &Path) -> State {
+        let mut state = State::open(s, dir).unwrap();
+        state.await_roster();
+        state
+    }
+
+    /// The agents' lifecycle records of the log in `dir`: (index, event, restarts).
+    fn agent_records(state: &mut State, dir: &Path) -> Vec<(u32, LifecycleEvent, u32)> {
+        state.sync().unwrap();
+        let contents = read_log(dir.join("log")).unwrap();
+        contents
+            .records
+            .iter()
+            .filter_map(|r| match r {
+                Record::Lifecycle(l) if l.role == Role::Agent as u8 => Some((
+                    l.index,
+                    LifecycleEvent::from_u8(l.event).unwrap(),
+                    l.restarts,
+                )),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// What a restarted coordinator drains from the lifecycle topic: first the topic's
+    /// history (the last event the supervisor published before it subscribed), then its own
+    /// `Restarted` and the roster.
+    fn drain(state: &mut State, history: Lifecycle, roster: [Lifecycle; 2]) {
+        let own = Lifecycle::restarted(Role::Coordinator, 0, 1);
+        for l in [history, own].iter().chain(&roster) {
+            state.on_lifecycle(l).unwrap();
+        }
+    }
+
+    /// Agent 1 and the coordinator die together and the supervisor reaps the coordinator
+    /// first: it publishes the coordinator's `Down`, then agent 1's `Down` and `Lost`, so the
+    /// restarted coordinator's history is agent 1's `Lost` alone.
+    #[test]
+    fn a_lost_agent_whose_down_a_restarted_coordinator_missed_is_logged_down_then_lost() {
+        let s = scenario();
+        let tmp = tempfile::tempdir().unwrap();
+        drop(State::open(&s, tmp.path()).unwrap());
+        let mut state = restarted(&s, tmp.path());
+        drain(
+            &mut state,
+            Lifecycle::lost(Role::Agent, 1, 0),
+            [
+                Lifecycle::roster(0, RosterState::Up, 0),
+                Lifecycle::roster(1, RosterState::Lost, 0),
+            ],
+        );
+        assert_eq!(
+            agent_records(&mut state, tmp.path()),
+            vec![(1, LifecycleEvent::Down, 0), (1, LifecycleEvent::Lost, 0)]
+        );
+    }
+
+    /// The predecessor logged agent 0's `Restarted` and died before the supervisor published
+    /// anything else: the topic's history replays that `Restarted`, which must not be logged
+    /// twice.
+    #[test]
+    fn an_agent_event_the_predecessor_logged_is_not_logged_again_from_the_topic_history() {
+        let s = scenario();
+        let tmp = tempfile::tempdir().unwrap();
+        let mut first = State::open(&s, tmp.path()).unwrap();
+        for l in [
+            Lifecycle::down(Role::Agent, 0, 0),
+            Lifecycle::restarted(Role::Agent, 0, 1),
+        ] {
+            first.on_lifecycle(&l).unwrap();
+        }
+        drop(first);
+        let mut state = restarted(&s, tmp.path());
+        drain(
+            &mut state,
+            Lifecycle::restarted(Role::Agent, 0, 1),
+            [
+                Lifecycle::roster(0, RosterState::Up, 1),
+                Lifecycle::roster(1, RosterState::Up, 0),
+            ],
+        );
+        assert_eq!(
+            agent_records(&mut state, tmp.path()),
+            vec![
+                (0, LifecycleEvent::Down, 0),
+                (0, LifecycleEvent::Restarted, 1)
+            ]
+        );
     }
 }
