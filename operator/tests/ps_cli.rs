@@ -1,9 +1,12 @@
 //! `hnav ps [RUN] [--json]` run as a binary against registries of its own: one line per
 //! run by default, a run's processes with RUN, everything in JSON.
 
+mod common;
+use common::wait_for_line;
+
 use std::path::Path;
 use std::process::Command;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use hnav_operator::supervisor::child::{Child, ChildSpec, Signal};
 use hnav_operator::supervisor::registry::RunRegistry;
@@ -16,18 +19,6 @@ fn exited_pid() -> u32 {
     let pid = c.id();
     c.wait().unwrap();
     pid
-}
-
-/// Test-only readiness wait: a child writes `needle` once it is ready.
-fn wait_for_line(path: &Path, needle: &str) {
-    let deadline = Instant::now() + Duration::from_secs(10);
-    while Instant::now() < deadline {
-        if std::fs::read_to_string(path).is_ok_and(|s| s.contains(needle)) {
-            return;
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    panic!("{} never printed {needle:?}", path.display());
 }
 
 fn hnav_ps(runs_dir: &Path, json: bool) -> (String, std::process::ExitStatus) {

@@ -2,6 +2,9 @@
 //! exit reporting, waiter wake-ups, restart decisions and the escalating stop; the run
 //! registry. `hnav ps` run as a binary is in `ps_cli.rs`.
 
+mod common;
+use common::wait_for_line;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
@@ -20,18 +23,6 @@ fn sh(dir: &Path, name: &str, script: &str) -> ChildSpec {
     ChildSpec::new(Role::Agent, 0, "/bin/sh", dir.join(format!("{name}.log")))
         .arg("-c")
         .arg(script)
-}
-
-/// Test-only readiness wait: a child prints a line once its signal set-up is done.
-fn wait_for_line(path: &Path, needle: &str) {
-    let deadline = Instant::now() + Duration::from_secs(10);
-    while Instant::now() < deadline {
-        if std::fs::read_to_string(path).is_ok_and(|s| s.contains(needle)) {
-            return;
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    panic!("{} never printed {needle:?}", path.display());
 }
 
 /// Test-only: a pid that is gone (zombies count as gone) within 5 s.

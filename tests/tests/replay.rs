@@ -102,13 +102,8 @@ fn a_lockstep_run_replays_identically_and_an_altered_decision_is_found() {
         ),
         Some(0)
     );
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
-    let rounds = summary["rounds"].as_u64().unwrap();
 
-    let (code, out, err) = replay(&dir, &registry);
-    assert_eq!(code, Some(0), "{out}{err}");
-    assert_eq!(out.trim(), format!("{rounds} rounds replayed, identical"));
+    replays_as_identical(&dir, &registry);
 
     let (round, agent, cell) = alter_one_decision(&dir.join("log"));
     let (ok, report) = verify_log(&dir.join("log"));
@@ -150,10 +145,15 @@ fn replays_identically(tag: &str, agents: &str, extra: &[&str]) {
     let mut args = vec!["--mode", "lockstep", "--agents", agents, "--no-record"];
     args.extend_from_slice(extra);
     assert_eq!(run(tag, &scenario, &dir, &registry, &args), Some(0));
+    replays_as_identical(&dir, &registry);
+}
+
+/// `hnav log replay DIR` prints `N rounds replayed, identical` for the summary's N.
+fn replays_as_identical(dir: &Path, registry: &Path) {
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
     let rounds = summary["rounds"].as_u64().unwrap();
-    let (code, out, err) = replay(&dir, &registry);
+    let (code, out, err) = replay(dir, registry);
     assert_eq!(code, Some(0), "{out}{err}");
     assert_eq!(out.trim(), format!("{rounds} rounds replayed, identical"));
 }
