@@ -4,17 +4,17 @@
 
 use std::collections::VecDeque;
 
-use raft::eraftpb::{ConfState, Entry, EntryType, Message};
-use raft::storage::MemStorage;
-use raft::{Config, RawNode, StateRole};
+use raft::eraftpb::{Entry, EntryType, Message, Snapshot};
+use raft::{Config, GetEntriesContext, RawNode, StateRole, Storage};
 
-use hnav_runtime::consensus_log::WriterOptions;
+use hnav_runtime::consensus_log::{decode_record, AppliedState, WriterOptions};
 use hnav_runtime::durable::{Disk, RealDisk};
 
 use super::error::ReplicaError;
 use super::journal::Journal;
 use super::link::{RaftLink, MAX_ENTRIES_BYTES};
 use super::log_bridge;
+use super::store::Store;
 
 /// A replica's timing and identity.
 #[derive(Debug, Clone)]
@@ -28,6 +28,9 @@ pub struct ReplicaConfig {
     pub election_ticks: usize,
     /// Ticks between the leader's heartbeats; well below `election_ticks`.
     pub heartbeat_ticks: usize,
+    /// Committed entries after which a durable replica takes a snapshot and compacts its
+    /// journal; 0 never.
+    pub snapshot_entries: u64,
 }
 
 impl ReplicaConfig {
@@ -39,6 +42,7 @@ impl ReplicaConfig {
             voters: (1..=n).collect(),
             election_ticks: 10,
             heartbeat_ticks: 1,
+            snapshot_entries: 0,
         }
     }
 }
@@ -85,7 +89,7 @@ type EarlyOut = Box<dyn FnMut(&Message)>;
 /// One voter of a Raft cluster, driven by its owner's loop; its journal is written on the
 /// disk `D`.
 pub struct Replica<D: Disk = RealDisk> {
-    node: RawNode<MemStorage>,
+    node: RawNode<Store>,
     /// Where entries and hard states are made durable; `None` keeps them in memory only (the
     /// in-process tests).
     journal: Option<Journal<D>>,
@@ -94,14 +98,18 @@ pub struct Replica<D: Disk = RealDisk> {
     early: Option<EarlyOut>,
     outbox: Vec<Message>,
     committed: VecDeque<Committed>,
+    /// The state of a snapshot the owner has not taken yet: the journal's on a restart, or
+    /// one the leader sent ([`take_installed`](Replica::take_installed)).
+    installed: Option<AppliedState>,
+    snapshot_entries: u64,
+    /// Snapshots installed from a leader since the start.
+    installs: u64,
 }
 
 impl Replica {
     /// A replica of a new cluster: empty storage that knows the voters.
     pub fn new(config: &ReplicaConfig) -> Result<Self, ReplicaError> {
-        let storage =
-            MemStorage::new_with_conf_state(ConfState::from((config.voters.clone(), Vec::new())));
-        Self::restart(config, storage)
+        Self::restart(config, Store::new(&config.voters))
     }
 
     /// A replica whose Raft log is the journal in `dir` (created with `header` if new,
@@ -117,9 +125,15 @@ impl Replica {
     }
 
     /// A replica over storage that survived it: its term, vote and entries come back; what it
-    /// had applied is applied again from the start (its owner's state machine starts empty).
-    pub fn restart(config: &ReplicaConfig, storage: MemStorage) -> Result<Self, ReplicaError> {
-        Self::over(config, storage)
+    /// had applied is applied again from the start (its owner's state machine starts empty),
+    /// or from its last snapshot ([`take_installed`](Replica::take_installed)).
+    pub fn restart(config: &ReplicaConfig, storage: Store) -> Result<Self, ReplicaError> {
+        let snapshot = storage.last_snapshot();
+        let mut replica = Self::over(config, storage)?;
+        if snapshot.get_metadata().index > 0 {
+            replica.installed = Some(decode_state(&snapshot)?);
+        }
+        Ok(replica)
     }
 
     /// Sends the messages Raft lets leave before the storage (a leader's appends and
@@ -145,9 +159,11 @@ impl<D: Disk> Replica<D> {
         header: hnav_runtime::consensus_log::RunHeader,
         options: WriterOptions,
     ) -> Result<Self, ReplicaError> {
-        let (journal, storage) = Journal::open_on(disk, dir, header, options, &config.voters)?;
+        let (journal, storage, compacted) =
+            Journal::open_on(disk, dir, header, options, &config.voters)?;
         let mut replica = Self::over(config, storage)?;
         replica.journal = Some(journal);
+        replica.installed = compacted;
         // The committed entries of the journal are ready at once.
         replica.process()?;
         Ok(replica)
@@ -162,7 +178,7 @@ impl<D: Disk> Replica<D> {
         }
     }
 
-    fn over(config: &ReplicaConfig, storage: MemStorage) -> Result<Self, ReplicaError> {
+    fn over(config: &ReplicaConfig, storage: Store) -> Result<Self, ReplicaError> {
         if config.id == 0 || !config.voters.contains(&config.id) {
             return Err(ReplicaError::NotAVoter {
                 id: config.id,
@@ -191,6 +207,9 @@ impl<D: Disk> Replica<D> {
             early: None,
             outbox: Vec::new(),
             committed: VecDeque::new(),
+            installed: None,
+            snapshot_entries: config.snapshot_entries,
+            installs: 0,
         })
     }
 
@@ -238,8 +257,32 @@ impl<D: Disk> Replica<D> {
     }
 
     /// The storage, to keep for a restart ([`Replica::restart`]).
-    pub fn storage(&self) -> &MemStorage {
+    pub fn storage(&self) -> &Store {
         self.node.store()
+    }
+
+    /// The index of its last snapshot (0 before the first): every entry up to it is
+    /// compacted away.
+    pub fn snapshot_index(&self) -> u64 {
+        self.node.store().snapshot_index()
+    }
+
+    /// Snapshots it installed from a leader (this process).
+    pub fn installs(&self) -> u64 {
+        self.installs
+    }
+
+    /// Records in its journal now (0 for a replica in memory).
+    pub fn journal_records(&self) -> u64 {
+        self.journal.as_ref().map_or(0, Journal::records)
+    }
+
+    /// The state its owner must start from before the next committed entries, if it is not
+    /// the state it has applied so far: that of the snapshot its journal starts with (after a
+    /// restart) or of one its leader sent (it was too far behind). Take it before
+    /// [`take_committed`](Self::take_committed).
+    pub fn take_installed(&mut self) -> Option<AppliedState> {
+        self.installed.take()
     }
 
     /// Advances its logical clock by one tick (elections, heartbeats).
@@ -327,12 +370,12 @@ impl<D: Disk> Replica<D> {
             }
             let store = self.node.store().clone();
             if !ready.snapshot().is_empty() {
-                return Err(ReplicaError::Snapshot);
+                self.install(&store, ready.snapshot().clone())?;
             }
             self.collect(ready.take_committed_entries());
-            store.wl().append(ready.entries())?;
+            store.mem().wl().append(ready.entries())?;
             if let Some(hs) = ready.hs() {
-                store.wl().set_hardstate(hs.clone());
+                store.mem().wl().set_hardstate(hs.clone());
             }
             if let Some(j) = &mut self.journal {
                 j.entries(ready.entries());
@@ -345,7 +388,7 @@ impl<D: Disk> Replica<D> {
             self.outbox.extend(ready.take_persisted_messages());
             let mut light = self.node.advance(ready);
             if let Some(commit) = light.commit_index() {
-                store.wl().mut_hard_state().set_commit(commit);
+                store.mem().wl().mut_hard_state().set_commit(commit);
                 if let Some(j) = &mut self.journal {
                     j.commit(commit);
                 }
@@ -354,12 +397,76 @@ impl<D: Disk> Replica<D> {
             self.collect(light.take_committed_entries());
             self.node.advance_apply();
         }
+        self.compact_if_due()
+    }
+
+    /// Installs the snapshot a leader sent (this replica lacked the entries it stands for):
+    /// durable in the journal first, then Raft's storage; the committed entries not yet taken
+    /// are superseded by its state.
+    fn install(&mut self, store: &Store, snapshot: Snapshot) -> Result<(), ReplicaError> {
+        let state = decode_state(&snapshot)?;
+        let mut hs = store.mem().rl().hard_state().clone();
+        let meta = snapshot.get_metadata();
+        hs.term = hs.term.max(meta.term);
+        hs.commit = hs.commit.max(meta.index);
+        if let Some(j) = &mut self.journal {
+            j.compact(&snapshot, state.clone(), &hs, &[])?;
+        }
+        tracing::info!(
+            index = meta.index,
+            term = meta.term,
+            "installed the leader's snapshot"
+        );
+        store.compact_to(snapshot, &[], hs)?;
+        self.committed.clear();
+        self.installed = Some(state);
+        self.installs += 1;
+        Ok(())
+    }
+
+    /// Takes a snapshot at the applied index and compacts the journal behind it, once
+    /// `snapshot_entries` entries were applied since the last one (a durable replica only:
+    /// one in memory has no journal to bound).
+    fn compact_if_due(&mut self) -> Result<(), ReplicaError> {
+        let Some(j) = &mut self.journal else {
+            return Ok(());
+        };
+        let store = self.node.store().clone();
+        let base = store.snapshot_index();
+        let applied = self.node.raft.raft_log.applied;
+        if self.snapshot_entries == 0 || applied < base + self.snapshot_entries {
+            return Ok(());
+        }
+        let ctx = || GetEntriesContext::empty(false);
+        let mut state = j.base().clone();
+        for e in store.entries(base + 1, applied + 1, None, ctx())? {
+            if e.get_entry_type() == EntryType::EntryNormal && !e.data.is_empty() {
+                let record = decode_record(&e.data).map_err(|p| {
+                    ReplicaError::Decode(format!("committed entry {}: {p}", e.index))
+                })?;
+                state.fold(&record);
+            }
+        }
+        let last = store.last_index()?;
+        let tail = store.entries(applied + 1, last + 1, None, ctx())?;
+        let mut snapshot = Snapshot::default();
+        snapshot.data = state.encode().into();
+        let meta = snapshot.mut_metadata();
+        meta.index = applied;
+        meta.term = store.term(applied)?;
+        meta.set_conf_state(store.initial_state()?.conf_state);
+        let hs = store.mem().rl().hard_state().clone();
+        j.compact(&snapshot, state, &hs, &tail)?;
+        store.compact_to(snapshot, &tail, hs)?;
         Ok(())
     }
 
     fn collect(&mut self, entries: Vec<Entry>) {
+        // Entries up to an installed snapshot are in its state.
+        let floor = self.node.store().snapshot_index();
         for e in entries {
-            if e.get_entry_type() == EntryType::EntryNormal && !e.data.is_empty() {
+            if e.get_entry_type() == EntryType::EntryNormal && !e.data.is_empty() && e.index > floor
+            {
                 self.committed.push_back(Committed {
                     index: e.index,
                     term: e.term,
@@ -369,4 +476,12 @@ impl<D: Disk> Replica<D> {
             }
         }
     }
+}
+
+/// The applied state a snapshot holds.
+fn decode_state(snapshot: &Snapshot) -> Result<AppliedState, ReplicaError> {
+    AppliedState::decode(&snapshot.data).map_err(|p| {
+        let index = snapshot.get_metadata().index;
+        ReplicaError::Decode(format!("snapshot at index {index}: {p}"))
+    })
 }

@@ -162,7 +162,8 @@ impl RunSummary {
                 Record::Lifecycle(_)
                 | Record::Replan(_)
                 | Record::Raft(_)
-                | Record::RaftState(_) => {}
+                | Record::RaftState(_)
+                | Record::Snapshot(_) => {}
             }
         }
         let mut agents: Vec<AgentSummary> = (0u32..)

@@ -135,7 +135,7 @@ impl Node {
         let early = Rc::new(RefCell::new(Vec::new()));
         let out = Rc::clone(&early);
         replica.send_early_to(move |m| out.borrow_mut().push(m.clone()));
-        let hs = replica.storage().rl().hard_state().clone();
+        let hs = replica.storage().mem().rl().hard_state().clone();
         let seen = (replica.term(), replica.role());
         self.process = Some(Process {
             replica,

@@ -34,7 +34,7 @@ impl World {
     /// Raft's business; a journal that fails is the process's end.
     pub(super) fn step(&mut self, i: usize, m: Message) {
         let called = self.nodes[i].call(|r| match r.step(m) {
-            Err(e @ (ReplicaError::Log(_) | ReplicaError::Snapshot)) => Err(e),
+            Err(e @ (ReplicaError::Log(_) | ReplicaError::Decode(_))) => Err(e),
             _ => Ok(()),
         });
         if let Some(called) = called {

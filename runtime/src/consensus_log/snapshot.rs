@@ -1,0 +1,155 @@
+//! A replica's snapshot ([`SnapshotRecord`]): the applied state of a compacted prefix of its
+//! Raft log, standing in for the entries it replaced.
+//!
+//! A replica that compacts writes its log anew: header, one snapshot record, its hard state,
+//! and the entries after the snapshot's index. The snapshot carries what the coordinator needs
+//! to go on deciding and what the log's readers need of the records it replaced
+//! ([`AppliedState`]): the last round and its record, the per-agent [`Tally`], who is live,
+//! down or lost, the unreachable goals, the end. The individual records of the prefix are
+//! gone: `hnav log show` prints the snapshot as one line, the run summary starts from its
+//! tally, and a replay or an export sees only the records after it.
+//!
+//! The state travels encoded ([`SnapshotRecord::state`], bincode 2 like a record): it is
+//! also the data of the Raft snapshot a leader sends to a replica too far behind.
+
+use serde::{Deserialize, Serialize};
+
+use super::error::FrameProblem;
+use super::record::{EndRecord, Record, RoundRecord, RunHeader, SnapshotRecord, UnreachableRecord};
+use super::tally::Tally;
+use crate::msg::{LifecycleEvent, Role};
+
+/// One agent's liveness, as the coordinator's roster keeps it from the lifecycle records.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct AgentLife {
+    /// Waited for in a round (not down, not lost).
+    pub live: bool,
+    /// Gone for good: its robot stands for the rest of the run.
+    pub lost: bool,
+    /// Its restarts so far, as the supervisor counted them.
+    pub restarts: u32,
+}
+
+impl Default for AgentLife {
+    fn default() -> Self {
+        AgentLife {
+            live: true,
+            lost: false,
+            restarts: 0,
+        }
+    }
+}
+
+impl AgentLife {
+    /// What a lifecycle event says: a `Down` agent is not waited for until it is back, a
+    /// `Lost` one never again; the restarts only grow.
+    pub fn event(&mut self, ev: LifecycleEvent, restarts: u32) {
+        self.restarts = self.restarts.max(restarts);
+        match ev {
+            LifecycleEvent::Down => self.live = false,
+            LifecycleEvent::Restarted => self.live = !self.lost,
+            LifecycleEvent::Lost => (self.live, self.lost) = (false, true),
+            _ => {}
+        }
+    }
+}
+
+/// What a sequence of decided records adds up to: everything a coordinator rebuilds from
+/// them and everything the run summary reads of them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AppliedState {
+    /// Decided records folded (the header not counted).
+    pub records: u64,
+    /// The last decided round, 0 before the first.
+    pub round: u64,
+    /// Its record, for the agents that missed its commit.
+    pub last_round: Option<RoundRecord>,
+    /// The per-agent tally of the decisions.
+    pub tally: Tally,
+    /// Per agent, its liveness.
+    pub agents: Vec<AgentLife>,
+    /// The unreachable goals logged, in log order.
+    pub unreachable: Vec<UnreachableRecord>,
+    /// The end of the run, once logged.
+    pub end: Option<EndRecord>,
+}
+
+impl AppliedState {
+    /// Nothing decided yet in the run `header` describes.
+    pub fn new(header: &RunHeader) -> Self {
+        AppliedState {
+            records: 0,
+            round: 0,
+            last_round: None,
+            tally: Tally::from_header(header),
+            agents: vec![AgentLife::default(); header.agents.len()],
+            unreachable: Vec::new(),
+            end: None,
+        }
+    }
+
+    /// Folds one decided record in, as a restarted coordinator replays it.
+    pub fn fold(&mut self, r: &Record) {
+        match r {
+            Record::Round(rec) => {
+                self.round = self.round.max(rec.round);
+                self.tally.fold_round(rec);
+                self.last_round = Some(rec.clone());
+            }
+            Record::End(e) => self.end = Some(*e),
+            Record::Lifecycle(l) => {
+                let agent = self.agents.get_mut(l.index as usize);
+                if let (Some(Role::Agent), Some(ev), Some(a)) = (
+                    Role::from_u8(l.role),
+                    LifecycleEvent::from_u8(l.event),
+                    agent,
+                ) {
+                    a.event(ev, l.restarts);
+                }
+            }
+            Record::Unreachable(u) => self.unreachable.push(*u),
+            Record::Replan(_) => {}
+            Record::Header(_) | Record::Raft(_) | Record::RaftState(_) | Record::Snapshot(_) => {
+                return
+            }
+        }
+        self.records += 1;
+    }
+
+    /// The state as the bytes of a [`SnapshotRecord`].
+    pub fn encode(&self) -> Vec<u8> {
+        bincode::serde::encode_to_vec(self, bincode::config::standard())
+            .expect("an applied state always encodes")
+    }
+
+    /// The state a [`SnapshotRecord`] holds.
+    pub fn decode(bytes: &[u8]) -> Result<AppliedState, FrameProblem> {
+        let config = bincode::config::standard();
+        match bincode::serde::decode_from_slice(bytes, config) {
+            Ok((state, used)) if used == bytes.len() => Ok(state),
+            Ok((_, used)) => Err(FrameProblem::Undecodable {
+                detail: format!("{} bytes after the snapshot's state", bytes.len() - used),
+            }),
+            Err(e) => Err(FrameProblem::Undecodable {
+                detail: format!("snapshot state: {e}"),
+            }),
+        }
+    }
+}
+
+impl SnapshotRecord {
+    /// A snapshot of `state` at Raft index `index` of term `term`.
+    pub fn new(index: u64, term: u64, voters: Vec<u64>, state: &AppliedState) -> Self {
+        SnapshotRecord {
+            index,
+            term,
+            voters,
+            state: state.encode(),
+        }
+    }
+
+    /// The state it holds.
+    pub fn applied(&self) -> Result<AppliedState, FrameProblem> {
+        AppliedState::decode(&self.state)
+    }
+}
