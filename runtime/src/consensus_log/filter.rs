@@ -11,7 +11,7 @@ use super::record::{RaftEntryRecord, Record};
 use crate::msg::Role;
 
 /// The kinds a filter can name, as [`Record::kind`] spells them.
-pub const KINDS: [&str; 8] = [
+pub const KINDS: [&str; 9] = [
     "header",
     "round",
     "lifecycle",
@@ -20,6 +20,7 @@ pub const KINDS: [&str; 8] = [
     "end",
     "raft-entry",
     "raft-state",
+    "snapshot",
 ];
 
 /// What to keep of a log. The empty filter keeps everything; each part given narrows it.

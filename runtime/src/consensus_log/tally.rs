@@ -136,6 +136,11 @@ impl Tally {
         }
     }
 
+    /// Per agent, the cell it stands on: its start, then that of its last accepted move.
+    pub fn cells(&self) -> &[u32] {
+        &self.cells
+    }
+
     /// Per agent, index = agent number.
     pub fn agents(&self) -> &[AgentTally] {
         &self.agents
