@@ -4,8 +4,8 @@
 
 use std::collections::VecDeque;
 
-use raft::eraftpb::{Entry, EntryType, Message, Snapshot};
-use raft::{Config, GetEntriesContext, RawNode, StateRole, Storage};
+use raft::eraftpb::{Entry, EntryType, Message, MessageType, Snapshot};
+use raft::{Config, GetEntriesContext, RawNode, SnapshotStatus, StateRole, Storage};
 
 use hnav_runtime::consensus_log::{decode_record, AppliedState, WriterOptions};
 use hnav_runtime::durable::{Disk, RealDisk};
@@ -364,6 +364,11 @@ impl<D: Disk> Replica<D> {
             // Messages of a leader may leave before its own append (Raft's leader writes in
             // parallel with its followers); the rest wait for the storage below.
             let early = ready.take_messages();
+            let snapshots: Vec<u64> = early
+                .iter()
+                .filter(|m| m.get_msg_type() == MessageType::MsgSnapshot)
+                .map(|m| m.to)
+                .collect();
             match &mut self.early {
                 Some(out) => early.iter().for_each(out),
                 None => self.outbox.extend(early),
@@ -396,6 +401,12 @@ impl<D: Disk> Replica<D> {
             self.outbox.extend(light.take_messages());
             self.collect(light.take_committed_entries());
             self.node.advance_apply();
+            // A snapshot is reported sent as it leaves, so that the leader probes the
+            // follower again: one lost on the way is found out like a lost append (the
+            // follower refuses the next one) and sent again, instead of being waited for.
+            for to in snapshots {
+                self.node.report_snapshot(to, SnapshotStatus::Finish);
+            }
         }
         self.compact_if_due()
     }
