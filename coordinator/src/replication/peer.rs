@@ -4,10 +4,10 @@
 
 use std::collections::VecDeque;
 
-use raft::eraftpb::{Entry, EntryType, Message, MessageType, Snapshot};
-use raft::{Config, GetEntriesContext, RawNode, SnapshotStatus, StateRole, Storage};
+use raft::eraftpb::{Entry, EntryType, Message, MessageType};
+use raft::{Config, RawNode, SnapshotStatus, StateRole};
 
-use hnav_runtime::consensus_log::{decode_record, AppliedState, WriterOptions};
+use hnav_runtime::consensus_log::{AppliedState, WriterOptions};
 use hnav_runtime::durable::{Disk, RealDisk};
 
 use super::error::ReplicaError;
@@ -15,6 +15,9 @@ use super::journal::Journal;
 use super::link::{RaftLink, MAX_ENTRIES_BYTES};
 use super::log_bridge;
 use super::store::Store;
+use snapshot::decode_state;
+
+mod snapshot;
 
 /// A replica's timing and identity.
 #[derive(Debug, Clone)]
@@ -411,67 +414,6 @@ impl<D: Disk> Replica<D> {
         self.compact_if_due()
     }
 
-    /// Installs the snapshot a leader sent (this replica lacked the entries it stands for):
-    /// durable in the journal first, then Raft's storage; the committed entries not yet taken
-    /// are superseded by its state.
-    fn install(&mut self, store: &Store, snapshot: Snapshot) -> Result<(), ReplicaError> {
-        let state = decode_state(&snapshot)?;
-        let mut hs = store.mem().rl().hard_state().clone();
-        let meta = snapshot.get_metadata();
-        hs.term = hs.term.max(meta.term);
-        hs.commit = hs.commit.max(meta.index);
-        if let Some(j) = &mut self.journal {
-            j.compact(&snapshot, state.clone(), &hs, &[])?;
-        }
-        tracing::info!(
-            index = meta.index,
-            term = meta.term,
-            "installed the leader's snapshot"
-        );
-        store.compact_to(snapshot, &[], hs)?;
-        self.committed.clear();
-        self.installed = Some(state);
-        self.installs += 1;
-        Ok(())
-    }
-
-    /// Takes a snapshot at the applied index and compacts the journal behind it, once
-    /// `snapshot_entries` entries were applied since the last one (a durable replica only:
-    /// one in memory has no journal to bound).
-    fn compact_if_due(&mut self) -> Result<(), ReplicaError> {
-        let Some(j) = &mut self.journal else {
-            return Ok(());
-        };
-        let store = self.node.store().clone();
-        let base = store.snapshot_index();
-        let applied = self.node.raft.raft_log.applied;
-        if self.snapshot_entries == 0 || applied < base + self.snapshot_entries {
-            return Ok(());
-        }
-        let ctx = || GetEntriesContext::empty(false);
-        let mut state = j.base().clone();
-        for e in store.entries(base + 1, applied + 1, None, ctx())? {
-            if e.get_entry_type() == EntryType::EntryNormal && !e.data.is_empty() {
-                let record = decode_record(&e.data).map_err(|p| {
-                    ReplicaError::Decode(format!("committed entry {}: {p}", e.index))
-                })?;
-                state.fold(&record);
-            }
-        }
-        let last = store.last_index()?;
-        let tail = store.entries(applied + 1, last + 1, None, ctx())?;
-        let mut snapshot = Snapshot::default();
-        snapshot.data = state.encode().into();
-        let meta = snapshot.mut_metadata();
-        meta.index = applied;
-        meta.term = store.term(applied)?;
-        meta.set_conf_state(store.initial_state()?.conf_state);
-        let hs = store.mem().rl().hard_state().clone();
-        j.compact(&snapshot, state, &hs, &tail)?;
-        store.compact_to(snapshot, &tail, hs)?;
-        Ok(())
-    }
-
     fn collect(&mut self, entries: Vec<Entry>) {
         // Entries up to an installed snapshot are in its state.
         let floor = self.node.store().snapshot_index();
@@ -487,12 +429,4 @@ impl<D: Disk> Replica<D> {
             }
         }
     }
-}
-
-/// The applied state a snapshot holds.
-fn decode_state(snapshot: &Snapshot) -> Result<AppliedState, ReplicaError> {
-    AppliedState::decode(&snapshot.data).map_err(|p| {
-        let index = snapshot.get_metadata().index;
-        ReplicaError::Decode(format!("snapshot at index {index}: {p}"))
-    })
 }

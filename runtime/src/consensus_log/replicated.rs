@@ -372,4 +372,74 @@ mod tests {
             assert!(e.starts_with(&format!("d: {want}")), "{e}");
         }
     }
+
+    fn snapshot(index: u64, term: u64, state: Vec<u8>) -> Record {
+        Record::Snapshot(SnapshotRecord {
+            index,
+            term,
+            voters: vec![1, 2, 3],
+            state,
+        })
+    }
+
+    fn state_after(records: &[Record]) -> Vec<u8> {
+        let Record::Header(h) = header() else {
+            unreachable!()
+        };
+        let mut s = AppliedState::new(&h);
+        records.iter().for_each(|r| s.fold(r));
+        s.encode()
+    }
+
+    #[test]
+    fn a_snapshot_stands_for_the_entries_up_to_its_index() {
+        let log = vec![
+            header(),
+            snapshot(4, 2, state_after(&[end(1), end(2)])),
+            state(2, 4),
+            entry(2, 5, Some(&end(3))),
+            entry(3, 6, Some(&end(4))),
+            state(3, 5),
+        ];
+        let r = resolve(Path::new("d"), log).unwrap();
+        assert_eq!(r.records, vec![header(), end(3)]);
+        assert_eq!(r.entries, vec![(2, 5)]);
+        assert_eq!(r.last_index, 6);
+        let c = r.compacted.unwrap();
+        assert_eq!((c.records, c.end.map(|e| e.round)), (2, Some(2)));
+        assert_eq!(r.snapshot.map(|s| s.index), Some(4));
+    }
+
+    #[test]
+    fn entries_against_the_snapshot_and_a_damaged_state_are_errors_naming_the_index() {
+        let good = || state_after(&[end(1)]);
+        let cases = [
+            (
+                vec![snapshot(4, 2, good()), state(2, 4), entry(2, 4, None)],
+                "Raft entry 4: at or before the snapshot at 4",
+            ),
+            (
+                vec![snapshot(4, 2, good()), state(2, 4), entry(2, 6, None)],
+                "Raft entry 6: skips indices (expected 5)",
+            ),
+            (
+                vec![snapshot(4, 2, good()), state(2, 4), entry(1, 5, None)],
+                "Raft entry 5: term 1 after term 2 at 4",
+            ),
+            (
+                vec![snapshot(4, 2, good()), state(2, 3)],
+                "Raft entry 4: commit index 3 below the snapshot",
+            ),
+            (
+                vec![snapshot(4, 2, vec![0xff; 3]), state(2, 4)],
+                "Raft entry 4: undecodable record: snapshot state",
+            ),
+        ];
+        for (mut tail, want) in cases {
+            let mut log = vec![header()];
+            log.append(&mut tail);
+            let e = resolve(Path::new("d"), log).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("d: {want}")), "{e}");
+        }
+    }
 }

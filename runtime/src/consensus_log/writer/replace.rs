@@ -109,3 +109,82 @@ pub(super) fn finish_replace(disk: &impl Disk, dir: &Path, syncing: bool) -> Res
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::consensus_log::reader::read_log;
+    use crate::consensus_log::record::{EndReason, EndRecord, RunHeader};
+    use crate::consensus_log::writer::WriterOptions;
+    use crate::consensus_log::FORMAT_VERSION;
+
+    fn header() -> Record {
+        Record::Header(RunHeader {
+            version: FORMAT_VERSION,
+            scenario_hash: 1,
+            seed: 2,
+            clock: "lockstep".into(),
+            width: 4,
+            height: 4,
+            agents: Vec::new(),
+        })
+    }
+
+    fn end(round: u64) -> Record {
+        Record::End(EndRecord {
+            round,
+            at_goal: 0,
+            reason: EndReason::Stopped,
+        })
+    }
+
+    /// A log of many small segments: header and `n` records.
+    fn log(dir: &Path, n: u64) -> LogWriter {
+        let options = WriterOptions {
+            segment_bytes: 64,
+            ..WriterOptions::new(FsyncPolicy::EveryRecord)
+        };
+        let (mut w, _) = LogWriter::open_with(dir, options).unwrap();
+        w.append(&header()).unwrap();
+        (1..=n).for_each(|r| _ = w.append(&end(r)).unwrap());
+        w
+    }
+
+    #[test]
+    fn a_replaced_log_is_the_new_records_in_one_segment_and_appends_go_on_after_them() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut w = log(dir.path(), 40);
+        assert!(list_segments(dir.path()).unwrap().len() > 3);
+        w.replace(&[header(), end(39), end(40)]).unwrap();
+        w.append(&end(41)).unwrap();
+        drop(w);
+        assert_eq!(list_segments(dir.path()).unwrap().len(), 1);
+        let records = read_log(dir.path()).unwrap().records;
+        assert_eq!(records, vec![header(), end(39), end(40), end(41)]);
+    }
+
+    #[test]
+    fn a_replacement_cut_short_by_a_crash_is_finished_if_decided_and_dropped_if_not() {
+        let dir = tempfile::tempdir().unwrap();
+        drop(log(dir.path(), 40));
+        let mut new = MAGIC.to_vec();
+        for r in [header(), end(40)] {
+            encode_frame(&r, &mut new).unwrap();
+        }
+        // Written but not decided: the old log stays.
+        std::fs::write(dir.path().join(REPLACE_TMP), &new).unwrap();
+        let (_, recovered) = LogWriter::open(dir.path(), FsyncPolicy::EveryRecord).unwrap();
+        assert_eq!(recovered.records.len(), 41);
+        assert!(!dir.path().join(REPLACE_TMP).exists());
+        // Decided, the crash after two old segments were removed: the open finishes it.
+        std::fs::write(dir.path().join(REPLACE_READY), &new).unwrap();
+        let segments = list_segments(dir.path()).unwrap();
+        for seg in segments.iter().rev().take(2) {
+            std::fs::remove_file(seg).unwrap();
+        }
+        let (_, recovered) = LogWriter::open(dir.path(), FsyncPolicy::EveryRecord).unwrap();
+        assert_eq!(recovered.records, vec![header(), end(40)]);
+        assert_eq!(list_segments(dir.path()).unwrap().len(), 1);
+        assert!(!dir.path().join(REPLACE_READY).exists());
+    }
+}
