@@ -245,8 +245,10 @@ impl<D: Disk> Journal<D> {
 
 /// A stored snapshot as Raft's.
 pub fn raft_snapshot(s: &SnapshotRecord) -> Snapshot {
-    let mut snap = Snapshot::default();
-    snap.data = s.state.clone().into();
+    let mut snap = Snapshot {
+        data: s.state.clone().into(),
+        ..Snapshot::default()
+    };
     let meta = snap.mut_metadata();
     meta.index = s.index;
     meta.term = s.term;

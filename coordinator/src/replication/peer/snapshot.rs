@@ -15,7 +15,11 @@ impl<D: Disk> Replica<D> {
     /// Installs the snapshot a leader sent (this replica lacked the entries it stands for):
     /// durable in the journal first, then Raft's storage; the committed entries not yet taken
     /// are superseded by its state.
-    pub(super) fn install(&mut self, store: &Store, snapshot: Snapshot) -> Result<(), ReplicaError> {
+    pub(super) fn install(
+        &mut self,
+        store: &Store,
+        snapshot: Snapshot,
+    ) -> Result<(), ReplicaError> {
         let state = decode_state(&snapshot)?;
         let mut hs = store.mem().rl().hard_state().clone();
         let meta = snapshot.get_metadata();
@@ -62,8 +66,10 @@ impl<D: Disk> Replica<D> {
         }
         let last = store.last_index()?;
         let tail = store.entries(applied + 1, last + 1, None, ctx())?;
-        let mut snapshot = Snapshot::default();
-        snapshot.data = state.encode().into();
+        let mut snapshot = Snapshot {
+            data: state.encode().into(),
+            ..Snapshot::default()
+        };
         let meta = snapshot.mut_metadata();
         meta.index = applied;
         meta.term = store.term(applied)?;
