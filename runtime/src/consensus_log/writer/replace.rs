@@ -27,9 +27,11 @@ pub const REPLACE_TMP: &str = "replace.tmp";
 pub const REPLACE_READY: &str = "replace.ready";
 
 impl<D: Disk> LogWriter<D> {
-    /// Replaces the whole log with `records` (a header first), atomically across a crash
-    /// (see [the module](self)); they are durable when it returns, unless the policy is
-    /// `None`. The writer then appends after them, in segment 0. A failure after the
+    /// Replaces the whole log with `records` (a header first), atomically across a crash:
+    /// written to [`REPLACE_TMP`] and synced, renamed to [`REPLACE_READY`] (decided), the old
+    /// segments removed (the last first), the ready file made segment 0; an open finishes a
+    /// decided replacement and drops an undecided one. They are durable when it returns,
+    /// unless the policy is `None`. The writer then appends after them, in segment 0. A failure after the
     /// replacement was decided poisons the writer: the next open finishes it.
     pub fn replace(&mut self, records: &[Record]) -> Result<(), LogError> {
         self.check_usable()?;
