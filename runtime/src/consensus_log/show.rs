@@ -80,7 +80,8 @@ pub fn describe(record: &Record, width: u32) -> String {
             let _ = write!(s, "lifecycle round {}  ", l.round);
             match Role::from_u8(l.role) {
                 Some(Role::Agent) => _ = write!(s, "{} {}", Role::Agent.name(), l.index),
-                Some(r) => s.push_str(r.name()),
+                // A replica by its id (`coordinator-2`); a single coordinator, the sim by name.
+                Some(r) => s.push_str(&r.node_name(l.index)),
                 None => _ = write!(s, "role{} {}", l.role, l.index),
             }
             let event = match LifecycleEvent::from_u8(l.event) {

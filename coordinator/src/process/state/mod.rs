@@ -196,10 +196,10 @@ impl State {
             }
             Record::End(e) => self.watch.ended(e.reason),
             Record::Lifecycle(l) => {
-                if let (Some(Role::Agent), Some(ev)) =
-                    (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
-                {
-                    self.roster.event(l.index, ev, l.restarts);
+                match (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event)) {
+                    (Some(Role::Agent), Some(ev)) => self.roster.event(l.index, ev, l.restarts),
+                    (Some(role), Some(ev)) => self.heard.logged(role, l.index, ev, l.restarts),
+                    _ => {}
                 }
             }
             Record::Unreachable(u) => self.watch.logged_unreachable(u.agent),
@@ -330,8 +330,11 @@ impl State {
         Ok(())
     }
 
-    /// Flushes the log to disk.
+    /// Flushes the log to disk at the process's end.
     pub(super) fn sync(&mut self) -> Result<(), CoordinatorError> {
+        if let Some(raft) = self.log.raft() {
+            raft.report();
+        }
         self.log.sync()
     }
 
@@ -397,9 +400,7 @@ impl State {
             return Ok(false);
         }
         if first {
-            for (i, state, restarts) in self.heard.take() {
-                self.reconcile(i, state, restarts)?;
-            }
+            self.log_overheard()?;
         }
         Ok(true)
     }
