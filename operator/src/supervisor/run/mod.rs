@@ -281,7 +281,12 @@ fn summarize(
     }
     let log = dir.join("log");
     let cell_m = scenario.robot.cell_size_m;
-    let mut summary = RunSummary::from_log(run.as_str(), &log, truth, cell_m, ended.elapsed_s)?;
+    let lifelong = scenario
+        .tasks
+        .as_ref()
+        .map(|_| scenario.sim.control_period_s());
+    let mut summary =
+        RunSummary::from_log(run.as_str(), &log, truth, cell_m, ended.elapsed_s, lifelong)?;
     summary.mark_lost(&ended.lost);
     summary.rules = scenario.coordinator.rules.name().to_string();
     summary.restarts = ended.restarts;
