@@ -75,7 +75,8 @@ pub struct RunSummary {
     pub rounds: u64,
     /// Wall time of the run in seconds.
     pub wall_time_s: f64,
-    /// How the run ended: `all-at-goal`, `time-limit`, `stopped`, or `incomplete`.
+    /// How the run ended: `all-at-goal`, `time-limit`, `stopped`, or `incomplete` (the log
+    /// has no end record; `time-limit` when the supervisor ended the run at its time limit).
     pub end: String,
     /// The consensus log directory.
     pub log: PathBuf,

@@ -269,3 +269,129 @@ impl TaskStream {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::test_support::{parse, BASE};
+
+    fn with(tasks: &str) -> Result<crate::scenario::Scenario, ScenarioError> {
+        parse(&format!("{BASE}[tasks]\n{tasks}"))
+    }
+
+    /// Line 16 is `[tasks]`, the section's first key is on line 17.
+    fn error(tasks: &str) -> String {
+        with(tasks).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn a_list_cycles_through_the_goals_and_a_robot_without_one_keeps_its_goal() {
+        let s = with("stream = \"list\"\n[[tasks.goals]]\nagent = 1\ncells = [[2, 0], [4, 2]]\n")
+            .unwrap();
+        let spec = s.tasks.clone().unwrap();
+        assert_eq!(spec.cycles[0], [Cell::new(5, 3)]);
+        assert_eq!(
+            spec.cycles[1],
+            [Cell::new(0, 3), Cell::new(2, 0), Cell::new(4, 2)]
+        );
+        let mut t = TaskStream::new(&spec, &s.agents, &s.map.grid, s.map.corner_cutting);
+        assert_eq!(t.next(0), None);
+        let got: Vec<(u64, Cell)> = (0..4).filter_map(|_| t.next(1)).collect();
+        assert_eq!(
+            got,
+            [
+                (1, Cell::new(2, 0)),
+                (2, Cell::new(4, 2)),
+                (3, Cell::new(0, 3)),
+                (4, Cell::new(2, 0))
+            ]
+        );
+        assert_ne!(s.scenario_hash(), parse(BASE).unwrap().scenario_hash());
+    }
+
+    #[test]
+    fn the_seeded_stream_repeats_itself_and_avoids_taken_cells() {
+        let s = with("stream = \"seeded\"\nseed = 9\n").unwrap();
+        let spec = s.tasks.clone().unwrap();
+        assert_eq!(spec.seed, 9);
+        let stream = || TaskStream::new(&spec, &s.agents, &s.map.grid, s.map.corner_cutting);
+        let (mut a, mut b) = (stream(), stream());
+        for k in 1..200 {
+            let here = a.goal(0).unwrap();
+            let other = a.goal(1).unwrap();
+            let (task, g) = a.next(0).unwrap();
+            assert_eq!((task, g), b.next(0).unwrap());
+            assert_eq!(task, k);
+            assert!(g != here && g != other && !s.map.grid.is_blocked(g), "{g:?}");
+        }
+        // A replayed assignment puts a fresh stream where the first one is.
+        let mut c = stream();
+        c.assigned(0, a.given(0), a.goal(0).unwrap());
+        assert_eq!(c.next(0), a.next(0));
+        // Without a seed, the sim's.
+        let s = with("stream = \"seeded\"\n").unwrap();
+        assert_eq!(s.tasks.unwrap().seed, s.sim.seed);
+    }
+
+    #[test]
+    fn bad_tasks_name_their_line_and_what_is_wrong() {
+        assert_eq!(
+            error("stream = \"list\"\n[[tasks.goals]]\nagent = 0\ncells = [[9, 0]]\n"),
+            "t.toml:20: tasks.goals.cells (9, 0) is outside the 6x4 map"
+        );
+        assert_eq!(
+            error("stream = \"list\"\n[[tasks.goals]]\nagent = 0\ncells = [[0, 0],\n [1, 1]]\n"),
+            "t.toml:21: tasks.goals.cells (1, 1) is on an obstacle"
+        );
+        assert_eq!(
+            error("stream = \"list\"\n[[tasks.goals]]\nagent = 0\ncells = [[5, 3]]\n"),
+            "t.toml:20: tasks.goals.cells (5, 3) repeats the goal before it"
+        );
+        assert_eq!(
+            error("stream = \"list\"\n[[tasks.goals]]\nagent = 2\ncells = [[0, 0]]\n"),
+            "t.toml:19: tasks.goals.agent names agent 2; the scenario has agents 0 to 1"
+        );
+        assert_eq!(
+            error("stream = \"list\"\n[[tasks.goals]]\nagent = 0\ncells = [[1, 0]]\n[[tasks.goals]]\nagent = 0\ncells = [[2, 0]]\n"),
+            "t.toml:22: tasks.goals.agent agent 0 has a [[tasks.goals]] entry already"
+        );
+        assert_eq!(
+            error("stream = \"seeded\"\n[[tasks.goals]]\nagent = 0\ncells = [[1, 0]]\n"),
+            "t.toml:18: tasks.goals are for `stream = \"list\"`; the seeded stream draws the goals"
+        );
+        assert_eq!(
+            error("stream = \"list\"\nseed = 3\n"),
+            "t.toml:18: tasks.seed is for `stream = \"seeded\"`; a list has no seed"
+        );
+        assert_eq!(
+            error("stream = \"list\"\n[[tasks.goals]]\nagent = 0\ncells = []\n"),
+            "t.toml:20: tasks.goals.cells is empty; give at least one [x, y]"
+        );
+        assert_eq!(
+            error("stream = \"list\"\n[[tasks.goals]]\nagent = 0\ncells = [[1, 0, 2]]\n"),
+            "t.toml:20: tasks.goals.cells a goal must be [x, y], got 3 numbers"
+        );
+        let e = error("stream = \"sometimes\"\n");
+        assert!(e.starts_with("t.toml:17: "), "{e}");
+        let e = error("seed = 1\n");
+        assert!(e.starts_with("t.toml:") && e.contains("`stream`"), "{e}");
+    }
+
+    #[test]
+    fn a_goal_cut_off_from_the_start_and_a_robot_with_nothing_to_draw_are_refused() {
+        let walled = "name = \"w\"\n[map]\nrows = [\".@.\"]\n[[agents]]\nstart = [0, 0]\ngoal = [0, 0]\n";
+        // start == goal is allowed for an agent; the seeded stream then has no other cell.
+        let e = parse(&format!("{walled}[tasks]\nstream = \"seeded\"\n"));
+        assert_eq!(
+            e.unwrap_err().to_string(),
+            "t.toml:7: tasks.stream agent 0 has no free cell to draw a next goal from"
+        );
+        let e = parse(&format!(
+            "{walled}[tasks]\nstream = \"list\"\n[[tasks.goals]]\nagent = 0\ncells = [[2, 0]]\n"
+        ));
+        assert_eq!(
+            e.unwrap_err().to_string(),
+            "t.toml:11: tasks.goals.cells (2, 0) cannot be reached from agent 0's start"
+        );
+    }
+}

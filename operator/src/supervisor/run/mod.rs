@@ -73,6 +73,7 @@ use super::summary::RunSummary;
 use crate::invocation::Invocation;
 use error::io;
 use hang::HangWatch;
+use hnav_runtime::consensus_log::EndReason;
 use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::msg::{Lifecycle, Role, StopReason};
 use hnav_runtime::scenario::Scenario;
@@ -290,6 +291,11 @@ fn summarize(
     summary.mark_lost(&ended.lost);
     summary.rules = scenario.coordinator.rules.name().to_string();
     summary.restarts = ended.restarts;
+    // Replicas stop together at the supervisor's time limit, before the leader's end record
+    // is committed: the log then has no end, but the supervisor knows why the run ended.
+    if summary.end == "incomplete" && matches!(ended.end, End::TimeLimit) {
+        summary.end = EndReason::TimeLimit.name().to_string();
+    }
     if let End::CannotGoOn(why) = ended.end {
         summary.cannot_go_on = Some(why);
     }
