@@ -60,8 +60,8 @@ goal = [0, 0]
 
 fn run(tag: &str, scenario: &Path, dir: &Path, registry: &Path, extra: &[&str]) -> SwarmRun {
     let mut test_run = TestRun::new(tag);
-    let mut swarm = SwarmRun::start(&mut test_run, scenario, dir, registry, extra)
-        .expect("hnav run starts");
+    let mut swarm =
+        SwarmRun::start(&mut test_run, scenario, dir, registry, extra).expect("hnav run starts");
     let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
     assert!(
         status.success(),
@@ -101,7 +101,10 @@ fn a_lockstep_lifelong_run_keeps_giving_tasks_ends_by_time_and_repeats_byte_for_
     let p99 = t["task_time_p99_s"].as_f64().unwrap();
     assert!(0.0 < p50 && p50 <= p99 && p99 <= 90.0, "{t}");
     let per_hour = t["throughput_per_hour"].as_f64().unwrap();
-    assert!((per_hour - t["tasks_done"].as_f64().unwrap() * 40.0).abs() < 1e-6, "{t}");
+    assert!(
+        (per_hour - t["tasks_done"].as_f64().unwrap() * 40.0).abs() < 1e-6,
+        "{t}"
+    );
     assert_eq!(t["per_window"], serde_json::json!([t["tasks_done"]]), "{t}");
     let (ok, report) = verify_log(&first.dir.join("log"));
     assert!(ok && report.contains(" task"), "{report}");
@@ -150,10 +153,20 @@ fn a_bad_tasks_section_is_refused_at_its_line_and_nothing_starts() {
     );
     let path = tmp.path().join("bad.toml");
     std::fs::write(&path, bad).unwrap();
-    let line = 1 + good.lines().position(|l| l == "stream = \"seeded\"").unwrap() + 3;
+    let line = 1
+        + good
+            .lines()
+            .position(|l| l == "stream = \"seeded\"")
+            .unwrap()
+        + 3;
     let out = tmp.path().join("out");
     let o = std::process::Command::new(workspace_bin("hnav"))
-        .args(["run", path.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .args([
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
         .env("HNAV_RUNS_DIR", tmp.path().join("runs"))
         .output()
         .unwrap();

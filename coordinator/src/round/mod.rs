@@ -27,7 +27,7 @@
 //! is not moved this round is given its next goal: a `task` decision, and a task record the
 //! coordinator logs before the round's. The rules head for the new goal from the next round.
 
-use hnav_runtime::consensus_log::{LoggedDecision, ReplanRecord, RoundRecord, TaskRecord, Tally};
+use hnav_runtime::consensus_log::{LoggedDecision, ReplanRecord, RoundRecord, Tally, TaskRecord};
 use hnav_runtime::grid::{Cell, Direction, Grid};
 use hnav_runtime::msg::{Candidate, CandidateFlags, Decision, Verdict, NO_CELL};
 use hnav_runtime::rejected::Rejected;
@@ -118,9 +118,10 @@ impl Arbiter {
             ),
             lazy: LazyTheta::new(config.clone()),
             astar: AStar::new(config),
-            tasks: scenario.tasks.as_ref().map(|t| {
-                TaskStream::new(t, &scenario.agents, &grid, scenario.map.corner_cutting)
-            }),
+            tasks: scenario
+                .tasks
+                .as_ref()
+                .map(|t| TaskStream::new(t, &scenario.agents, &grid, scenario.map.corner_cutting)),
             assigned: Vec::new(),
             grid,
         }

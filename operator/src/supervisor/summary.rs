@@ -16,9 +16,9 @@ use serde::Serialize;
 use hnav_runtime::consensus_log::{read_decided, LogError, Record, Tally};
 
 mod tasks;
-pub use tasks::TaskSummary;
 use hnav_runtime::msg::{LifecycleEvent, Role, Truth};
 use hnav_runtime::rejected::Rejections;
+pub use tasks::TaskSummary;
 
 /// One agent's line of the summary.
 #[derive(Clone, Debug, PartialEq, Serialize)]

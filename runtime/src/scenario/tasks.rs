@@ -105,9 +105,11 @@ pub(super) fn build_tasks(
         (StreamKind::Seeded, _, None) => {
             for (i, a) in agents.iter().enumerate() {
                 let part = label[grid.index(a.start)];
-                if !label.iter().enumerate().any(|(c, &l)| {
-                    l == part && c != grid.index(a.goal) && c != grid.index(a.start)
-                }) {
+                if !label
+                    .iter()
+                    .enumerate()
+                    .any(|(c, &l)| l == part && c != grid.index(a.goal) && c != grid.index(a.start))
+                {
                     let p = format!("agent {i} has no free cell to draw a next goal from");
                     return Err(bad(section, "tasks.stream", p));
                 }
@@ -124,7 +126,10 @@ pub(super) fn build_tasks(
         let at = lines.at(&e.agent);
         let i = *e.agent.get_ref();
         let Some(a) = usize::try_from(i).ok().and_then(|k| agents.get(k)) else {
-            let p = format!("names agent {i}; the scenario has agents 0 to {}", agents.len() - 1);
+            let p = format!(
+                "names agent {i}; the scenario has agents 0 to {}",
+                agents.len() - 1
+            );
             return Err(bad(at, "tasks.goals.agent", p));
         };
         let k = i as usize;
@@ -138,9 +143,13 @@ pub(super) fn build_tasks(
         }
         for c in e.cells.get_ref() {
             let at = lines.at(c);
-            let cell = goal_cell(c.get_ref(), grid).map_err(|p| bad(at.clone(), "tasks.goals.cells", p))?;
+            let cell = goal_cell(c.get_ref(), grid)
+                .map_err(|p| bad(at.clone(), "tasks.goals.cells", p))?;
             if label[grid.index(cell)] != label[grid.index(a.start)] {
-                let p = format!("({}, {}) cannot be reached from agent {k}'s start", cell.x, cell.y);
+                let p = format!(
+                    "({}, {}) cannot be reached from agent {k}'s start",
+                    cell.x, cell.y
+                );
                 return Err(bad(at, "tasks.goals.cells", p));
             }
             if cycles[k].last() == Some(&cell) {
@@ -197,7 +206,12 @@ pub struct TaskStream {
 
 impl TaskStream {
     /// The stream of a scenario with `[tasks]`, every agent on its first goal.
-    pub fn new(spec: &TasksSpec, agents: &[AgentSpec], grid: &Grid, corners: CornerCutting) -> Self {
+    pub fn new(
+        spec: &TasksSpec,
+        agents: &[AgentSpec],
+        grid: &Grid,
+        corners: CornerCutting,
+    ) -> Self {
         let mut pool = Vec::new();
         if spec.stream == StreamKind::Seeded {
             let label = components(grid, corners);
@@ -322,7 +336,10 @@ mod tests {
             let (task, g) = a.next(0).unwrap();
             assert_eq!((task, g), b.next(0).unwrap());
             assert_eq!(task, k);
-            assert!(g != here && g != other && !s.map.grid.is_blocked(g), "{g:?}");
+            assert!(
+                g != here && g != other && !s.map.grid.is_blocked(g),
+                "{g:?}"
+            );
         }
         // A replayed assignment puts a fresh stream where the first one is.
         let mut c = stream();
@@ -379,7 +396,8 @@ mod tests {
 
     #[test]
     fn a_goal_cut_off_from_the_start_and_a_robot_with_nothing_to_draw_are_refused() {
-        let walled = "name = \"w\"\n[map]\nrows = [\".@.\"]\n[[agents]]\nstart = [0, 0]\ngoal = [0, 0]\n";
+        let walled =
+            "name = \"w\"\n[map]\nrows = [\".@.\"]\n[[agents]]\nstart = [0, 0]\ngoal = [0, 0]\n";
         // start == goal is allowed for an agent; the seeded stream then has no other cell.
         let e = parse(&format!("{walled}[tasks]\nstream = \"seeded\"\n"));
         assert_eq!(

@@ -82,7 +82,11 @@ impl TaskSummary {
     /// The fewest tasks done in a full window (all windows when none is full).
     pub fn fewest_per_full_window(&self) -> u64 {
         let full = (self.sim_time_s / WINDOW_S).floor() as usize;
-        let n = if full == 0 { self.per_window.len() } else { full };
+        let n = if full == 0 {
+            self.per_window.len()
+        } else {
+            full
+        };
         self.per_window.iter().take(n).copied().min().unwrap_or(0)
     }
 

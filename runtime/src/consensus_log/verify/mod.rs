@@ -56,7 +56,13 @@ pub struct KindCounts {
 impl KindCounts {
     /// All records.
     pub fn total(&self) -> u64 {
-        self.header + self.round + self.lifecycle + self.replan + self.end + self.unreachable + self.task
+        self.header
+            + self.round
+            + self.lifecycle
+            + self.replan
+            + self.end
+            + self.unreachable
+            + self.task
     }
 }
 
