@@ -346,6 +346,7 @@ mod tests {
             Verdict::Block,
             Verdict::Hold,
             Verdict::Replan,
+            Verdict::Task,
         ] {
             assert_eq!(Verdict::from_u8(v as u8), Some(v));
         }
@@ -353,7 +354,7 @@ mod tests {
             assert_eq!(ConflictKind::from_u8(k).map(|k| k as u8), Some(k));
         }
         assert_eq!(ConflictKind::from_u8(10), None);
-        for bad in [0u8, 5, 200, 255] {
+        for bad in [0u8, 6, 200, 255] {
             assert_eq!(Verdict::from_u8(bad), None);
         }
     }
