@@ -108,6 +108,21 @@ fn a_lockstep_lifelong_run_keeps_giving_tasks_ends_by_time_and_repeats_byte_for_
     assert_eq!(t["per_window"], serde_json::json!([t["tasks_done"]]), "{t}");
     let (ok, report) = verify_log(&first.dir.join("log"));
     assert!(ok && report.contains(" task"), "{report}");
+    // `hnav log replay` decides every round, the tasks included, as logged.
+    let replay_run = TestRun::new("lifereplay");
+    let replay = std::process::Command::new(workspace_bin("hnav"))
+        .args(["log", "replay", first.dir.to_str().unwrap()])
+        .args(["--run", replay_run.run.as_str()])
+        .env("HNAV_RUNS_DIR", &registry)
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&replay.stdout);
+    assert!(
+        replay.status.success() && said.contains("identical"),
+        "{said}\n{}",
+        String::from_utf8_lossy(&replay.stderr)
+    );
+    drop(replay_run);
 
     let second = run("life2", &scenario, &tmp.path().join("b"), &registry, &extra);
     let seg = "log/seg-00000000.hlog";
