@@ -11,7 +11,7 @@ use super::record::{RaftEntryRecord, Record};
 use crate::msg::Role;
 
 /// The kinds a filter can name, as [`Record::kind`] spells them.
-pub const KINDS: [&str; 8] = [
+pub const KINDS: [&str; 9] = [
     "header",
     "round",
     "lifecycle",
@@ -20,6 +20,7 @@ pub const KINDS: [&str; 8] = [
     "end",
     "raft-entry",
     "raft-state",
+    "task",
 ];
 
 /// What to keep of a log. The empty filter keeps everything; each part given narrows it.
@@ -29,7 +30,7 @@ pub struct RecordFilter {
     /// states, are left out).
     pub rounds: Option<RangeInclusive<u64>>,
     /// Only what concerns this agent: its decisions (a round without one is left out), its
-    /// lifecycle events, replans and unreachable reports.
+    /// lifecycle events, replans, unreachable reports and tasks.
     pub agent: Option<u32>,
     /// Only records of these kinds (names of [`KINDS`]); empty: every kind.
     pub kinds: Vec<String>,
@@ -100,6 +101,7 @@ impl RecordFilter {
             }
             Record::Replan(r) => (r.agent == agent).then(|| record.clone()),
             Record::Unreachable(u) => (u.agent == agent).then(|| record.clone()),
+            Record::Task(t) => (t.agent == agent).then(|| record.clone()),
             _ => None,
         }
     }

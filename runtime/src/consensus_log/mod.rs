@@ -63,7 +63,7 @@ pub use frame::{
 pub use reader::{read_log, LogContents, LogReader, RecordPos, TornTail};
 pub use record::{
     candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision,
-    RaftEntryRecord, RaftStateRecord, Record, ReplanRecord, RoundRecord, RunHeader,
+    RaftEntryRecord, RaftStateRecord, Record, ReplanRecord, RoundRecord, RunHeader, TaskRecord,
     UnreachableRecord,
 };
 pub use replicated::{

@@ -30,11 +30,14 @@ pub enum Record {
     Raft(RaftEntryRecord),
     /// A replica's Raft hard state (term, vote, commit index) from this point of its log on.
     RaftState(RaftStateRecord),
+    /// A lifelong run (`[tasks]`) gave an agent standing on its goal its next goal (after the
+    /// kinds above so that their encoding is unchanged).
+    Task(TaskRecord),
 }
 
 impl Record {
     /// Lower-case name of the record's kind (`header`, `round`, `lifecycle`, `replan`, `end`,
-    /// `unreachable`).
+    /// `unreachable`, `raft-entry`, `raft-state`, `task`).
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Header(_) => "header",
@@ -45,6 +48,7 @@ impl Record {
             Self::Unreachable(_) => "unreachable",
             Self::Raft(_) => "raft-entry",
             Self::RaftState(_) => "raft-state",
+            Self::Task(_) => "task",
         }
     }
 
@@ -57,6 +61,7 @@ impl Record {
             Self::Replan(r) => Some(r.round),
             Self::End(r) => Some(r.round),
             Self::Unreachable(r) => Some(r.round),
+            Self::Task(r) => Some(r.round),
             Self::Raft(_) | Self::RaftState(_) => None,
         }
     }
@@ -246,6 +251,23 @@ pub struct UnreachableRecord {
     pub agent: u32,
     /// The robot's cell (row-major index).
     pub cell: u32,
+}
+
+/// An agent of a lifelong run stood on its goal in `round` and was given its next one: task
+/// `task` (counted from 1; task 0 is its `[[agents]] goal`, given at the start). Written like
+/// a replan, just before the record of the round whose commit tells the agent (a `task`
+/// decision with the goal as its waypoint). The time from one task record of an agent to its
+/// next is the time the task took, from its assignment to the robot's arrival.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct TaskRecord {
+    /// The round the agent stood on its goal in.
+    pub round: u64,
+    /// Agent index.
+    pub agent: u32,
+    /// The task's number for this agent, from 1.
+    pub task: u64,
+    /// The new goal (row-major index).
+    pub goal: u32,
 }
 
 /// A global replan for one agent.

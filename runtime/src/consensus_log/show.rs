@@ -110,6 +110,16 @@ pub fn describe(record: &Record, width: u32) -> String {
                 cell(u.cell, width)
             );
         }
+        Record::Task(t) => {
+            let _ = write!(
+                s,
+                "task round {}  a{} task {} goal {}",
+                t.round,
+                t.agent,
+                t.task,
+                cell(t.goal, width)
+            );
+        }
         Record::End(e) => {
             let _ = write!(
                 s,
@@ -179,6 +189,9 @@ fn decision(s: &mut String, d: &LoggedDecision, width: u32) {
             }
             let _ = write!(s, " via {}", cell(d.waypoint, width));
         }
+        Some(Verdict::Task) => {
+            let _ = write!(s, "task a{}->{}", d.agent, cell(d.waypoint, width));
+        }
         None => _ = write!(s, "verdict{} a{}", d.verdict, d.agent),
     }
 }
@@ -244,6 +257,12 @@ pub fn to_json(pos: &RecordPos, record: &Record, width: u32) -> Value {
             "round": u.round,
             "agent": u.agent,
             "cell": cell(u.cell),
+        }),
+        Record::Task(t) => json!({
+            "round": t.round,
+            "agent": t.agent,
+            "task": t.task,
+            "goal": cell(t.goal),
         }),
         Record::Raft(e) => json!({
             "term": e.term,

@@ -203,6 +203,7 @@ impl State {
                 }
             }
             Record::Unreachable(u) => self.watch.logged_unreachable(u.agent),
+            Record::Task(t) => self.arbiter.replay_task(t),
             Record::Header(_) | Record::Replan(_) | Record::Raft(_) | Record::RaftState(_) => {}
         }
     }
@@ -290,6 +291,10 @@ impl State {
             self.log.append(&Record::Replan(r.clone()))?;
         }
         let rec = self.open.record(round, decisions, self.last_record.take());
+        // A lifelong run's new tasks, like replans, just before the round that tells them.
+        for t in self.arbiter.assigned() {
+            self.log.append(&Record::Task(*t))?;
+        }
         let record = Record::Round(rec);
         self.log.append(&record)?;
         let Record::Round(rec) = record else {

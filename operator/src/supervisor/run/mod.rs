@@ -76,6 +76,7 @@ use super::summary::RunSummary;
 use crate::invocation::Invocation;
 use error::io;
 use hang::HangWatch;
+use hnav_runtime::consensus_log::EndReason;
 use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::msg::{Lifecycle, Role, StopReason};
 use hnav_runtime::scenario::Scenario;
@@ -284,10 +285,20 @@ fn summarize(
     }
     let log = dir.join("log");
     let cell_m = scenario.robot.cell_size_m;
-    let mut summary = RunSummary::from_log(run.as_str(), &log, truth, cell_m, ended.elapsed_s)?;
+    let lifelong = scenario
+        .tasks
+        .as_ref()
+        .map(|_| scenario.sim.control_period_s());
+    let mut summary =
+        RunSummary::from_log(run.as_str(), &log, truth, cell_m, ended.elapsed_s, lifelong)?;
     summary.mark_lost(&ended.lost);
     summary.rules = scenario.coordinator.rules.name().to_string();
     summary.restarts = ended.restarts;
+    // Replicas stop together at the supervisor's time limit, before the leader's end record
+    // is committed: the log then has no end, but the supervisor knows why the run ended.
+    if summary.end == "incomplete" && matches!(ended.end, End::TimeLimit) {
+        summary.end = EndReason::TimeLimit.name().to_string();
+    }
     if let End::CannotGoOn(why) = ended.end {
         summary.cannot_go_on = Some(why);
     }

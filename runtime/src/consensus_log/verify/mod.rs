@@ -49,12 +49,20 @@ pub struct KindCounts {
     pub end: u64,
     /// Unreachable records.
     pub unreachable: u64,
+    /// Task records (a lifelong run's assignments).
+    pub task: u64,
 }
 
 impl KindCounts {
     /// All records.
     pub fn total(&self) -> u64 {
-        self.header + self.round + self.lifecycle + self.replan + self.end + self.unreachable
+        self.header
+            + self.round
+            + self.lifecycle
+            + self.replan
+            + self.end
+            + self.unreachable
+            + self.task
     }
 }
 
@@ -152,6 +160,10 @@ impl VerifyReport {
         if c.unreachable > 0 {
             s.pop();
             let _ = writeln!(s, ", {} unreachable", c.unreachable);
+        }
+        if c.task > 0 {
+            s.pop();
+            let _ = writeln!(s, ", {} task", c.task);
         }
         if let Some(r) = &self.raft {
             let st = &r.state;
