@@ -38,7 +38,7 @@ def cell(width: int, index: int) -> str:
 
 def describe(d, width: int) -> str:
     """One decision: `a3 accept [4,5]`, `a1 block head-on`, `a2 replan via [7,1]`,
-    `a4 task goal [9,2]` (a lifelong run's next goal).""""
+    `a4 task goal [9,2]` (a lifelong run's next goal)."""
     verdict = msg.Verdict.NAMES.get(d.verdict, f"verdict-{d.verdict}")
     text = f"a{d.agent} {verdict}"
     if d.verdict == msg.Verdict.ACCEPT:
