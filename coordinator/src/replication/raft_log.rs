@@ -190,9 +190,8 @@ impl RaftLog {
         if let Some((dead, due)) = self.campaign {
             if now >= due {
                 self.campaign = None;
-                if self.replica.leader().is_none_or(|l| l == dead)
-                    && self.replica.leader_died(dead)?
-                {
+                // A leader elected meanwhile makes this a no-op (`leader_died` checks).
+                if self.replica.leader_died(dead)? {
                     tracing::info!(
                         dead,
                         term = self.replica.term(),

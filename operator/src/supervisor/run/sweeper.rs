@@ -111,18 +111,11 @@ impl Drop for Sweeper {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hnav_runtime::transport::{purge_run, RunId};
-
-    struct Run(RunId);
-    impl Drop for Run {
-        fn drop(&mut self) {
-            let _ = purge_run(&self.0);
-        }
-    }
+    use hnav_runtime::transport::{PurgeOnDrop, RunId};
 
     #[test]
     fn every_sweep_asked_for_is_done_before_settle_returns() {
-        let run = Run(RunId::unique("sweep"));
+        let run = PurgeOnDrop(RunId::unique("sweep"));
         let transport = Transport::builder(&run.0)
             .handle_signals(false)
             .create()
