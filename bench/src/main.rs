@@ -203,7 +203,8 @@ struct ChaosCli {
     /// The campaign the test runs: 59 runs.
     #[arg(long)]
     quick: bool,
-    /// Run only plan N of the campaign (numbered from 0, as the failures name them).
+    /// Run only plan N of the campaign (numbered from 0, as the failures name them); its run
+    /// directory is kept, passed or not.
     #[arg(long, value_name = "N")]
     only: Option<usize>,
     /// Only runs of one class: kill-agents, kill-coordinator, freeze-agent, kill-sim,

@@ -149,7 +149,9 @@ fn run(seed: u64, options: Options, rounds: usize) -> Result<(), TestCaseError> 
                 }
                 Verdict::Block => {}
                 Verdict::Accept => prop_assert_eq!((o.refused, o.kind), (0, ConflictKind::None)),
-                Verdict::Replan => prop_assert!(false, "the resolver never replans"),
+                Verdict::Replan | Verdict::Task => {
+                    prop_assert!(false, "the resolver never replans nor gives tasks")
+                }
             }
             if o.verdict == Verdict::Block {
                 prop_assert!(o.kind != ConflictKind::None);

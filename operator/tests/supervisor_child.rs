@@ -17,7 +17,7 @@ use hnav_operator::supervisor::restart::{GiveUpReason, RestartDecision, RestartT
 use hnav_operator::supervisor::stop::{stop_all, StopHow};
 use hnav_runtime::msg::Role;
 use hnav_runtime::scenario::{RestartPolicy, RestartRule};
-use hnav_runtime::transport::{purge_run, RunId, Transport};
+use hnav_runtime::transport::{PurgeOnDrop, RunId, Transport};
 
 fn sh(dir: &Path, name: &str, script: &str) -> ChildSpec {
     ChildSpec::new(Role::Agent, 0, "/bin/sh", dir.join(format!("{name}.log")))
@@ -155,15 +155,6 @@ fn reaping_kills_leftovers_in_the_group() {
         .parse()
         .unwrap();
     assert!(gone_soon(grandchild), "grandchild {grandchild} survived");
-}
-
-/// A run's shared memory, purged even when the test fails.
-struct PurgeOnDrop(RunId);
-
-impl Drop for PurgeOnDrop {
-    fn drop(&mut self) {
-        let _ = purge_run(&self.0);
-    }
 }
 
 fn waitset_wake_latency(mode: WatchMode) -> Duration {

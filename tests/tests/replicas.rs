@@ -9,6 +9,7 @@ use std::time::Duration;
 use hnav_runtime::consensus_log::{
     read_decided, read_log, AppliedState, EndReason, Record, FORMAT_VERSION,
 };
+use hnav_runtime::msg::{LifecycleEvent, Role};
 use hnav_tests::swarm::{records_digest, repo_root, verify_log, SwarmRun};
 use hnav_tests::TestRun;
 
@@ -253,4 +254,51 @@ fn a_replica_left_far_behind_catches_up_from_a_snapshot() {
         states.push(state);
     }
     assert!(states.iter().all(|s| *s == states[0]), "{states:#?}");
+}
+
+/// The leader's own `down` is heard only by the followers: it dies, so it cannot log it,
+/// and no one leads while the supervisor publishes it. The replica elected next logged the
+/// old leader's `restarted` but never its `down`, so the log said a process came back that
+/// never went away. Now what a follower heard of a process other than an agent (a replica,
+/// the sim) and no leader logged is logged by the next leader, in the order heard.
+#[test]
+fn a_killed_leaders_down_is_logged_by_the_next_leader() {
+    let tmp = tempfile::tempdir().unwrap();
+    let registry = tmp.path().join("runs");
+    let dir = tmp.path().join("out");
+    let scenario = repo_root().join("scenarios/demo.toml");
+    let args = ["--replicas", "3", "--kill", "coordinator@round:300"];
+    run("rdown", &scenario, &dir, &registry, &args);
+    let log = dir.join("log").join("1");
+    let (ok, report) = verify_log(&log);
+    assert!(ok, "replica 1's log does not verify:\n{report}");
+    let events: Vec<(LifecycleEvent, u32, u32)> = read_decided(&log)
+        .unwrap()
+        .records
+        .iter()
+        .filter_map(|r| match r {
+            Record::Lifecycle(l) if Role::from_u8(l.role) == Some(Role::Coordinator) => {
+                Some((LifecycleEvent::from_u8(l.event)?, l.index, l.restarts))
+            }
+            _ => None,
+        })
+        .collect();
+    let restarted: Vec<_> = events
+        .iter()
+        .filter(|e| e.0 == LifecycleEvent::Restarted)
+        .collect();
+    assert_eq!(
+        restarted.len(),
+        1,
+        "one leader killed, one restart: {events:?}"
+    );
+    let (_, killed, restarts) = *restarted[0];
+    assert_eq!(
+        events,
+        [
+            (LifecycleEvent::Down, killed, restarts - 1),
+            (LifecycleEvent::Restarted, killed, restarts)
+        ],
+        "the killed leader's events as logged"
+    );
 }

@@ -27,6 +27,8 @@
 //! - **Hold**: wait and ask again.
 //! - **Replan**: the coordinator's global planner answered with a waypoint; the map is rebuilt
 //!   toward it, and toward the goal again once it is reached (hybrid mode).
+//! - **Task** (lifelong runs, `[tasks]`): the waypoint is the agent's next goal. The robots it
+//!   learned as obstacles are forgotten (they have moved on) and the map is rebuilt toward it.
 //!
 //! A step that does not climb (every neighbour lower, e.g. the visited cells the path
 //! constructor negates) is a local extremum: the agent says so in its candidate and stands,
@@ -110,6 +112,8 @@ pub struct Navigator {
     unreachable: bool,
     /// The route changed while proposing (a follower off its route): a snapshot is due.
     replanned: bool,
+    /// The cells learned as obstacles (standing robots), forgotten at a new task.
+    learned: Vec<Cell>,
 }
 
 impl Navigator {
@@ -142,6 +146,7 @@ impl Navigator {
             flags: 0,
             unreachable,
             replanned: false,
+            learned: Vec::new(),
         })
     }
 
@@ -344,6 +349,15 @@ impl Navigator {
                     applied.map_rebuilt = true;
                 }
             }
+            Some(Verdict::Task) => {
+                let goal = (d.waypoint != NO_CELL)
+                    .then(|| self.grid.cell_at(d.waypoint as usize))
+                    .flatten();
+                if let Some(goal) = goal.filter(|&g| g != self.task.goal) {
+                    self.new_goal(goal)?;
+                    applied.map_rebuilt = true;
+                }
+            }
             Some(Verdict::Hold) | None => {}
         }
         Ok(applied)
@@ -357,6 +371,7 @@ impl Navigator {
             return Ok(false);
         }
         self.grid.set_blocked(c, true);
+        self.learned.push(c);
         match &mut self.guide {
             Guide::Climb(climb) => climb.learn_obstacle(c, self.target)?,
             Guide::Follow(f) if f.crosses(c) => {
@@ -365,6 +380,19 @@ impl Navigator {
             Guide::Follow(_) => return Ok(false),
         }
         Ok(true)
+    }
+
+    /// A lifelong run's next task: `goal` is the goal from now on. The robots the agent
+    /// learned as obstacles on the way to the last one have moved on since: its grid is the
+    /// walls again, and the guide is rebuilt toward the new goal.
+    fn new_goal(&mut self, goal: Cell) -> Result<(), Error> {
+        self.task.goal = goal;
+        self.unreachable = false;
+        let walls: Vec<Cell> = self.learned.drain(..).collect();
+        for c in walls {
+            self.grid.set_blocked(c, false);
+        }
+        self.retarget(goal)
     }
 
     /// Points the guide at `target` from `next`: a new map and climb, or a new route.

@@ -76,7 +76,7 @@ pub struct CampaignReport {
     pub figures: Figures,
     /// The campaign's wall time.
     pub elapsed: Duration,
-    /// The directory failed runs were kept in, if any failed.
+    /// The directory failed runs were kept in, if any failed (every run, with `--only`).
     pub kept: Option<PathBuf>,
 }
 
@@ -119,6 +119,9 @@ impl CampaignReport {
             self.elapsed.as_secs_f64(),
             self.outcomes.len() - ran
         );
+        if let Some(dir) = &self.kept {
+            out += &format!("run directories kept in {}\n", dir.display());
+        }
         out
     }
 }
@@ -162,6 +165,7 @@ pub fn run_campaign(
         base_scenario: CHAOS_SCENARIO,
         agents: CHAOS_SPACE.agents as usize,
         root: root.path(),
+        keep: config.only.is_some(),
     };
     let plans: Vec<Plan> = plan::generate(config.seed, config.runs, &CHAOS_SPACE, config.class)
         .into_iter()
@@ -183,7 +187,7 @@ pub fn run_campaign(
         outcomes.push(outcome);
     }
     let any_failed = outcomes.iter().any(|o| !o.failures.is_empty());
-    let kept = any_failed.then(|| root.keep());
+    let kept = (any_failed || config.only.is_some()).then(|| root.keep());
     Ok(CampaignReport {
         outcomes,
         figures,

@@ -30,6 +30,8 @@ pub struct RunSetup<'a> {
     pub agents: usize,
     /// The campaign's directory; the run gets `run-NNN/` in it.
     pub root: &'a Path,
+    /// Keep a run's directory even when it passed (`--only N`: a plan looked at closely).
+    pub keep: bool,
 }
 
 /// What one run showed.
@@ -112,7 +114,7 @@ pub fn run_plan(setup: &RunSetup<'_>, plan: &Plan) -> RunOutcome {
     if !run_files(&run).is_empty() {
         let _ = purge_run(&run);
     }
-    if outcome.failures.is_empty() {
+    if outcome.failures.is_empty() && !setup.keep {
         let _ = std::fs::remove_dir_all(&dir);
     }
     outcome

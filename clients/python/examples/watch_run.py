@@ -37,7 +37,8 @@ def cell(width: int, index: int) -> str:
 
 
 def describe(d, width: int) -> str:
-    """One decision: `a3 accept [4,5]`, `a1 block head-on`, `a2 replan via [7,1]`."""
+    """One decision: `a3 accept [4,5]`, `a1 block head-on`, `a2 replan via [7,1]`,
+    `a4 task goal [9,2]` (a lifelong run's next goal)."""
     verdict = msg.Verdict.NAMES.get(d.verdict, f"verdict-{d.verdict}")
     text = f"a{d.agent} {verdict}"
     if d.verdict == msg.Verdict.ACCEPT:
@@ -46,6 +47,8 @@ def describe(d, width: int) -> str:
         text += f" {msg.ConflictKind.NAMES.get(d.kind, d.kind)}"
     elif d.verdict == msg.Verdict.REPLAN:
         text += f" via {cell(width, d.waypoint)}"
+    elif d.verdict == msg.Verdict.TASK:
+        text += f" goal {cell(width, d.waypoint)}"
     return text
 
 

@@ -58,7 +58,8 @@ class Verdict:
     BLOCK = 2
     HOLD = 3
     REPLAN = 4
-    NAMES = {1: "accept", 2: "block", 3: "hold", 4: "replan"}
+    TASK = 5
+    NAMES = {1: "accept", 2: "block", 3: "hold", 4: "replan", 5: "task"}
 
 
 class ConflictKind:

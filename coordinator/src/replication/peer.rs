@@ -308,6 +308,27 @@ impl<D: Disk> Replica<D> {
         self.process()
     }
 
+    /// The leader this replica follows, replica `dead`, is known to have died (its
+    /// supervisor saw the process exit): it stands for election now, as Raft's leadership
+    /// transfer does (no pre-vote; the other followers grant their vote within the leader's
+    /// lease), instead of after a whole election timeout of silence. `false`, and nothing
+    /// done, if it does not follow `dead`. Safety does not rest on the news being right:
+    /// any election is safe in Raft; a wrong one costs a term.
+    pub fn leader_died(&mut self, dead: u64) -> Result<bool, ReplicaError> {
+        if self.role() != Role::Follower || self.leader().is_some_and(|l| l != dead) {
+            return Ok(false);
+        }
+        // What Raft's leader sends the transferee; `from` only names it in Raft's log.
+        let mut m = Message::default();
+        m.set_msg_type(MessageType::MsgTimeoutNow);
+        m.from = dead;
+        m.to = self.id();
+        m.term = self.term();
+        self.node.step(m)?;
+        self.process()?;
+        Ok(true)
+    }
+
     /// Proposes `data` (a round record) for the cluster to commit; only the leader may.
     pub fn propose(&mut self, data: &[u8]) -> Result<(), ReplicaError> {
         if self.role() != Role::Leader {

@@ -34,6 +34,15 @@ pub struct RaftLog {
     lead: Lead,
     tick: Duration,
     next_tick: Instant,
+    /// Every voter's id.
+    voters: Vec<u64>,
+    /// The leader `.0` is known dead: this replica stands for election at `.1` unless a new
+    /// leader has come by then ([`RaftLog::replica_down`]).
+    campaign: Option<(u64, Instant)>,
+    /// While following: when the leader was last heard, and the longest it was silent, the
+    /// measure election timeouts are chosen from (logged at the end).
+    heard_leader: Option<Instant>,
+    longest_silence: Duration,
     /// Records committed by other leaders, in log order, for the coordinator to apply.
     applied: Vec<Record>,
     /// A snapshot's state the coordinator must start from before `applied`.
@@ -75,6 +84,10 @@ impl RaftLog {
             lead: Lead::new(),
             tick,
             next_tick: Instant::now() + tick,
+            voters: config.voters.clone(),
+            campaign: None,
+            heard_leader: None,
+            longest_silence: Duration::ZERO,
             applied: Vec::new(),
             installed: None,
             dir,
@@ -105,9 +118,28 @@ impl RaftLog {
         self.replica.role()
     }
 
-    /// When the next tick is due: the latest a wait may last.
+    /// When the next tick (or a campaign) is due: the latest a wait may last.
     pub fn deadline(&self) -> Instant {
-        self.next_tick
+        match self.campaign {
+            Some((_, due)) => due.min(self.next_tick),
+            None => self.next_tick,
+        }
+    }
+
+    /// The supervisor says replica `dead` went down. If it led this replica, the surviving
+    /// replicas stand for election in turn, lowest id first, one heartbeat apart: the first
+    /// is usually elected within a round trip; the next stands only if no leader has come
+    /// by its turn (the first's log was behind, or it died too). Without this, a follower
+    /// waits out its election timeout, `[election_ms, 2 * election_ms)` of silence, before
+    /// it notices; with it, a crashed leader costs a round trip, and the timeout is left to
+    /// what no supervisor sees (a frozen leader, a cut network, a lost host).
+    pub fn replica_down(&mut self, dead: u64) {
+        if self.replica.role() != Role::Follower || self.replica.leader() != Some(dead) {
+            return;
+        }
+        let id = self.replica.id();
+        let rank = self.voters.iter().filter(|&&v| v != dead && v < id).count() as u32;
+        self.campaign = Some((dead, Instant::now() + self.tick * rank));
     }
 
     /// Whether it may start to decide: it leads and every earlier leader's committed entry is
@@ -138,7 +170,14 @@ impl RaftLog {
     pub fn pump(&mut self) -> Result<(), ReplicaError> {
         let replica = &mut self.replica;
         let mut failed = None;
+        let (heard, longest) = (&mut self.heard_leader, &mut self.longest_silence);
         self.link.receive(|m| {
+            if replica.role() == Role::Follower && replica.leader() == Some(m.from) {
+                let now = Instant::now();
+                if let Some(before) = heard.replace(now) {
+                    *longest = (*longest).max(now - before);
+                }
+            }
             if let Err(e) = replica.step(m) {
                 // A message of another term or a stale one is Raft's to refuse; only a storage
                 // failure must stop the replica.
@@ -152,6 +191,19 @@ impl RaftLog {
             return Err(e);
         }
         let now = Instant::now();
+        if let Some((dead, due)) = self.campaign {
+            if now >= due {
+                self.campaign = None;
+                // A leader elected meanwhile makes this a no-op (`leader_died` checks).
+                if self.replica.leader_died(dead)? {
+                    tracing::info!(
+                        dead,
+                        term = self.replica.term(),
+                        "the leader died: stands for election"
+                    );
+                }
+            }
+        }
         if now >= self.next_tick {
             self.replica.tick()?;
             // From now: a replica that was late ticks once, not in a burst.
@@ -182,6 +234,16 @@ impl RaftLog {
     /// Makes everything its journal holds durable now.
     pub fn sync(&mut self) -> Result<(), ReplicaError> {
         self.replica.sync()
+    }
+
+    /// Says (at the process's end) how long the leader it followed was silent at most: set
+    /// against `election_ms`, how near the run came to an election no one needed.
+    pub fn report(&self) {
+        tracing::info!(
+            longest_leader_silence_ms = self.longest_silence.as_secs_f64() * 1e3,
+            term = self.replica.term(),
+            "replica's end"
+        );
     }
 
     /// The records other leaders committed that the coordinator has not applied yet, in log

@@ -22,12 +22,16 @@
 //! when the agent moves. PIBT needs no replanning (its priorities rise until an agent gets
 //! through), so none is made in that mode. [`Lacam`] (`lacam`) plans every robot's moves at
 //! once and executes the plan, deciding like `pibt` (no replanning either).
+//!
+//! **Tasks** (`tasks.rs`). In a lifelong run (`[tasks]`) an agent that stands on its goal and
+//! is not moved this round is given its next goal: a `task` decision, and a task record the
+//! coordinator logs before the round's. The rules head for the new goal from the next round.
 
-use hnav_runtime::consensus_log::{LoggedDecision, ReplanRecord, RoundRecord, Tally};
+use hnav_runtime::consensus_log::{LoggedDecision, ReplanRecord, RoundRecord, Tally, TaskRecord};
 use hnav_runtime::grid::{Cell, Direction, Grid};
 use hnav_runtime::msg::{Candidate, CandidateFlags, Decision, Verdict, NO_CELL};
 use hnav_runtime::rejected::Rejected;
-use hnav_runtime::scenario::{Rules, Scenario};
+use hnav_runtime::scenario::{Rules, Scenario, TaskStream};
 
 use crate::conflict::{AgentMode, AgentRow, Lacam, Options, Outcome, Pibt, Resolver};
 use crate::planner::{AStar, LazyTheta, Planner, PlannerConfig};
@@ -61,6 +65,10 @@ pub struct Arbiter {
     tally: Tally,
     lazy: LazyTheta,
     astar: AStar,
+    /// A lifelong run's goals (`[tasks]`), `None` otherwise.
+    tasks: Option<TaskStream>,
+    /// The tasks given in the last round decided.
+    assigned: Vec<TaskRecord>,
 }
 
 impl Arbiter {
@@ -110,6 +118,11 @@ impl Arbiter {
             ),
             lazy: LazyTheta::new(config.clone()),
             astar: AStar::new(config),
+            tasks: scenario
+                .tasks
+                .as_ref()
+                .map(|t| TaskStream::new(t, &scenario.agents, &grid, scenario.map.corner_cutting)),
+            assigned: Vec::new(),
             grid,
         }
     }
@@ -188,10 +201,12 @@ impl Arbiter {
     ) -> (&[Decision], &[ReplanRecord]) {
         self.decisions.clear();
         self.replans.clear();
+        self.assigned.clear();
         self.read(candidates);
         let replanning = self.resolve(tick);
         for i in 0..self.rows.len() {
-            if let Some(d) = self.answer(round, i, replanning) {
+            let answer = self.answer(round, i, replanning);
+            if let Some(d) = self.give_task(round, i, answer) {
                 // The tally counts what is published (and logged), so that a replay of the
                 // log after a restart and the run summary arrive at the same numbers.
                 self.tally.fold(&LoggedDecision::from(&d));
@@ -368,5 +383,6 @@ impl Arbiter {
     }
 }
 
+mod tasks;
 #[cfg(test)]
 mod tests;

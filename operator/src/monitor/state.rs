@@ -122,6 +122,7 @@ impl AgentView {
             Some((Verdict::Hold, _)) => AgentState::Held,
             Some((Verdict::Block, _)) => AgentState::Blocked,
             Some((Verdict::Replan, _)) => AgentState::Replanning,
+            Some((Verdict::Task, _)) => AgentState::Waiting,
         }
     }
 
@@ -134,7 +135,7 @@ impl AgentView {
         match (verdict, kind) {
             (Verdict::Accept, _) => self.pending = Some(cell),
             // Asked for nothing: still driving to what was accepted, if anything.
-            (Verdict::Hold, ConflictKind::None) => {}
+            (Verdict::Hold, ConflictKind::None) | (Verdict::Task, _) => {}
             _ => self.pending = None,
         }
         self.last = Some((verdict, kind));
@@ -364,6 +365,10 @@ impl ViewState {
         let Some(agent) = self.agents.get_mut(d.agent as usize) else {
             return;
         };
+        if verdict == Verdict::Task {
+            // A lifelong run's next goal: the robot heads for it from where it stands.
+            agent.goal = d.waypoint;
+        }
         agent.decide(verdict, kind, d.cell);
         if !(verdict == Verdict::Hold && kind == ConflictKind::None) {
             self.push_recent(RecentLine {

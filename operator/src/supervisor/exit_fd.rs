@@ -210,20 +210,11 @@ pub(crate) fn poll_readable(fds: &[RawFd], timeout: Option<Duration>) -> io::Res
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hnav_runtime::transport::{purge_run, RunId, Transport, Wake};
-
-    /// A run of one test, purged even when the test fails.
-    struct Run(RunId);
-
-    impl Drop for Run {
-        fn drop(&mut self) {
-            let _ = purge_run(&self.0);
-        }
-    }
+    use hnav_runtime::transport::{PurgeOnDrop, RunId, Transport, Wake};
 
     #[test]
     fn a_child_exit_descriptor_wakes_the_waiter() {
-        let run = Run(RunId::unique("waitfd"));
+        let run = PurgeOnDrop(RunId::unique("waitfd"));
         let t = Transport::builder(&run.0)
             .handle_signals(false)
             .create()

@@ -14,8 +14,11 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use hnav_runtime::consensus_log::{read_decided, LogError, Record, Tally};
+
+mod tasks;
 use hnav_runtime::msg::{LifecycleEvent, Role, Truth};
 use hnav_runtime::rejected::Rejections;
+pub use tasks::TaskSummary;
 
 /// One agent's line of the summary.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -72,7 +75,8 @@ pub struct RunSummary {
     pub rounds: u64,
     /// Wall time of the run in seconds.
     pub wall_time_s: f64,
-    /// How the run ended: `all-at-goal`, `time-limit`, `stopped`, or `incomplete`.
+    /// How the run ended: `all-at-goal`, `time-limit`, `stopped`, or `incomplete` (the log
+    /// has no end record; `time-limit` when the supervisor ended the run at its time limit).
     pub end: String,
     /// The consensus log directory.
     pub log: PathBuf,
@@ -99,6 +103,9 @@ pub struct RunSummary {
     /// known); the table prints `-` for them and says where they are.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub counts_on_host: Option<String>,
+    /// A lifelong run's tasks (`[tasks]`); absent for a run without.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tasks: Option<TaskSummary>,
 }
 
 impl RunSummary {
@@ -118,22 +125,27 @@ impl RunSummary {
         }
     }
 
-    /// Whether every robot reached its goal without a collision.
+    /// Whether every robot reached its goal without a collision; for a lifelong run, whether
+    /// it ran to its time limit without a collision and got tasks done.
     pub fn success(&self) -> bool {
-        self.cannot_go_on.is_none()
-            && self.collisions == 0
-            && self.agents.iter().all(|a| a.reached_goal)
+        let goals = match &self.tasks {
+            Some(t) => self.end == "time-limit" && t.tasks_done > 0,
+            None => self.agents.iter().all(|a| a.reached_goal),
+        };
+        self.cannot_go_on.is_none() && self.collisions == 0 && goals
     }
 
     /// Builds the summary from the log in `log_dir` and the last ground truth (poses in
     /// metres, cells `cell_size_m` wide), with the coordinator's counts of dropped candidates
-    /// from the run directory holding `log_dir`.
+    /// from the run directory holding `log_dir`. `lifelong` is the control period in seconds
+    /// of a run with `[tasks]` (its rounds' length), for the [`TaskSummary`].
     pub fn from_log(
         run_id: &str,
         log_dir: &Path,
         truth: Option<&Truth>,
         cell_size_m: f64,
         wall_time_s: f64,
+        lifelong: Option<f64>,
     ) -> Result<RunSummary, LogError> {
         let contents = read_decided(log_dir)?;
         let mut header = None;
@@ -142,10 +154,12 @@ impl RunSummary {
         let mut end = "incomplete".to_string();
         let mut unreachable = Vec::new();
         let mut lost = Vec::new();
+        let mut tasks = Vec::new();
         // A compacted replica's log: the records its snapshot stands for add up to its state.
         let compacted = contents.compacted.as_ref();
         if let Some(c) = compacted {
             rounds = c.round;
+            tasks.extend_from_slice(&c.tasks);
             if let Some(e) = c.end {
                 end = e.reason.name().to_string();
             }
@@ -169,6 +183,7 @@ impl RunSummary {
                 }
                 Record::End(e) => end = e.reason.name().to_string(),
                 Record::Unreachable(u) => unreachable.push(u.agent),
+                Record::Task(t) => tasks.push(*t),
                 Record::Lifecycle(l)
                     if l.role == Role::Agent as u8 && l.event == LifecycleEvent::Lost as u8 =>
                 {
@@ -221,6 +236,7 @@ impl RunSummary {
             recording: None,
             report_error: None,
             counts_on_host: None,
+            tasks: lifelong.map(|period| TaskSummary::new(&tasks, rounds, period)),
         })
     }
 
@@ -286,6 +302,7 @@ impl RunSummary {
             recording: None,
             report_error: None,
             counts_on_host: None,
+            tasks: None,
         }
     }
 
@@ -346,6 +363,9 @@ impl RunSummary {
             self.mode,
             self.end
         );
+        if let Some(t) = &self.tasks {
+            s += &t.render();
+        }
         if !self.restarts.is_empty() {
             let each: Vec<String> = self
                 .restarts

@@ -38,7 +38,7 @@ fn the_summary_is_the_tally_of_the_log_and_the_truth_of_the_goals() {
     records.push(Record::Round(fifth));
     write_log(tmp.path(), &records, ONE_SEGMENT);
 
-    let summary = RunSummary::from_log("t", tmp.path(), None, 1.0, 0.5).unwrap();
+    let summary = RunSummary::from_log("t", tmp.path(), None, 1.0, 0.5, None).unwrap();
     assert_eq!(
         (summary.mode.as_str(), summary.end.as_str()),
         ("lockstep", "incomplete")
@@ -81,7 +81,7 @@ fn the_summary_is_the_tally_of_the_log_and_the_truth_of_the_goals() {
         }))
         .unwrap();
     }
-    let summary = RunSummary::from_log("t", tmp.path(), Some(&truth), 1.0, 0.5).unwrap();
+    let summary = RunSummary::from_log("t", tmp.path(), Some(&truth), 1.0, 0.5, None).unwrap();
     let goals: Vec<bool> = summary.agents.iter().map(|a| a.reached_goal).collect();
     assert_eq!(goals, [true, false]);
     assert_eq!(

@@ -11,7 +11,7 @@ use super::record::{RaftEntryRecord, Record};
 use crate::msg::Role;
 
 /// The kinds a filter can name, as [`Record::kind`] spells them.
-pub const KINDS: [&str; 9] = [
+pub const KINDS: [&str; 10] = [
     "header",
     "round",
     "lifecycle",
@@ -20,6 +20,7 @@ pub const KINDS: [&str; 9] = [
     "end",
     "raft-entry",
     "raft-state",
+    "task",
     "snapshot",
 ];
 
@@ -30,7 +31,7 @@ pub struct RecordFilter {
     /// states, are left out).
     pub rounds: Option<RangeInclusive<u64>>,
     /// Only what concerns this agent: its decisions (a round without one is left out), its
-    /// lifecycle events, replans and unreachable reports.
+    /// lifecycle events, replans, unreachable reports and tasks.
     pub agent: Option<u32>,
     /// Only records of these kinds (names of [`KINDS`]); empty: every kind.
     pub kinds: Vec<String>,
@@ -101,6 +102,7 @@ impl RecordFilter {
             }
             Record::Replan(r) => (r.agent == agent).then(|| record.clone()),
             Record::Unreachable(u) => (u.agent == agent).then(|| record.clone()),
+            Record::Task(t) => (t.agent == agent).then(|| record.clone()),
             _ => None,
         }
     }

@@ -168,8 +168,8 @@ mod tests {
         assert_eq!(detail(&[4]), "the payload ends 1 byte early");
         assert_eq!(detail(&[1, 0xFF]), "a malformed integer");
         assert_eq!(
-            detail(&[9]),
-            "invalid value: integer `9`, expected variant index 0 <= i < 9"
+            detail(&[10]),
+            "invalid value: integer `10`, expected variant index 0 <= i < 10"
         );
     }
 

@@ -66,6 +66,7 @@ pub use reader::{read_log, LogContents, LogReader, RecordPos, TornTail};
 pub use record::{
     candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision,
     RaftEntryRecord, RaftStateRecord, Record, ReplanRecord, RoundRecord, RunHeader, SnapshotRecord,
+    TaskRecord,
     UnreachableRecord,
 };
 pub use replicated::{

@@ -30,6 +30,9 @@ pub enum Record {
     Raft(RaftEntryRecord),
     /// A replica's Raft hard state (term, vote, commit index) from this point of its log on.
     RaftState(RaftStateRecord),
+    /// A lifelong run (`[tasks]`) gave an agent standing on its goal its next goal (after the
+    /// kinds above so that their encoding is unchanged).
+    Task(TaskRecord),
     /// A replica's snapshot: the applied state of the Raft entries it replaced, which are
     /// gone from its log ([`snapshot`](super::snapshot)).
     Snapshot(SnapshotRecord),
@@ -37,7 +40,7 @@ pub enum Record {
 
 impl Record {
     /// Lower-case name of the record's kind (`header`, `round`, `lifecycle`, `replan`, `end`,
-    /// `unreachable`).
+    /// `unreachable`, `raft-entry`, `raft-state`, `task`).
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Header(_) => "header",
@@ -48,6 +51,7 @@ impl Record {
             Self::Unreachable(_) => "unreachable",
             Self::Raft(_) => "raft-entry",
             Self::RaftState(_) => "raft-state",
+            Self::Task(_) => "task",
             Self::Snapshot(_) => "snapshot",
         }
     }
@@ -61,6 +65,7 @@ impl Record {
             Self::Replan(r) => Some(r.round),
             Self::End(r) => Some(r.round),
             Self::Unreachable(r) => Some(r.round),
+            Self::Task(r) => Some(r.round),
             Self::Raft(_) | Self::RaftState(_) | Self::Snapshot(_) => None,
         }
     }
@@ -266,6 +271,23 @@ pub struct UnreachableRecord {
     pub agent: u32,
     /// The robot's cell (row-major index).
     pub cell: u32,
+}
+
+/// An agent of a lifelong run stood on its goal in `round` and was given its next one: task
+/// `task` (counted from 1; task 0 is its `[[agents]] goal`, given at the start). Written like
+/// a replan, just before the record of the round whose commit tells the agent (a `task`
+/// decision with the goal as its waypoint). The time from one task record of an agent to its
+/// next is the time the task took, from its assignment to the robot's arrival.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct TaskRecord {
+    /// The round the agent stood on its goal in.
+    pub round: u64,
+    /// Agent index.
+    pub agent: u32,
+    /// The task's number for this agent, from 1.
+    pub task: u64,
+    /// The new goal (row-major index).
+    pub goal: u32,
 }
 
 /// A global replan for one agent.

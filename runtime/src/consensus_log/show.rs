@@ -80,7 +80,8 @@ pub fn describe(record: &Record, width: u32) -> String {
             let _ = write!(s, "lifecycle round {}  ", l.round);
             match Role::from_u8(l.role) {
                 Some(Role::Agent) => _ = write!(s, "{} {}", Role::Agent.name(), l.index),
-                Some(r) => s.push_str(r.name()),
+                // A replica by its id (`coordinator-2`); a single coordinator, the sim by name.
+                Some(r) => s.push_str(&r.node_name(l.index)),
                 None => _ = write!(s, "role{} {}", l.role, l.index),
             }
             let event = match LifecycleEvent::from_u8(l.event) {
@@ -107,6 +108,16 @@ pub fn describe(record: &Record, width: u32) -> String {
                 u.round,
                 u.agent,
                 cell(u.cell, width)
+            );
+        }
+        Record::Task(t) => {
+            let _ = write!(
+                s,
+                "task round {}  a{} task {} goal {}",
+                t.round,
+                t.agent,
+                t.task,
+                cell(t.goal, width)
             );
         }
         Record::End(e) => {
@@ -198,6 +209,9 @@ fn decision(s: &mut String, d: &LoggedDecision, width: u32) {
             }
             let _ = write!(s, " via {}", cell(d.waypoint, width));
         }
+        Some(Verdict::Task) => {
+            let _ = write!(s, "task a{}->{}", d.agent, cell(d.waypoint, width));
+        }
         None => _ = write!(s, "verdict{} a{}", d.verdict, d.agent),
     }
 }
@@ -263,6 +277,12 @@ pub fn to_json(pos: &RecordPos, record: &Record, width: u32) -> Value {
             "round": u.round,
             "agent": u.agent,
             "cell": cell(u.cell),
+        }),
+        Record::Task(t) => json!({
+            "round": t.round,
+            "agent": t.agent,
+            "task": t.task,
+            "goal": cell(t.goal),
         }),
         Record::Raft(e) => json!({
             "term": e.term,

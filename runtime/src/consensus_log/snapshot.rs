@@ -15,7 +15,10 @@
 use serde::{Deserialize, Serialize};
 
 use super::error::FrameProblem;
-use super::record::{EndRecord, Record, RoundRecord, RunHeader, SnapshotRecord, UnreachableRecord};
+use super::record::{
+    EndRecord, LifecycleRecord, Record, RoundRecord, RunHeader, SnapshotRecord, TaskRecord,
+    UnreachableRecord,
+};
 use super::tally::Tally;
 use crate::msg::{LifecycleEvent, Role};
 
@@ -72,6 +75,15 @@ pub struct AppliedState {
     pub unreachable: Vec<UnreachableRecord>,
     /// The end of the run, once logged.
     pub end: Option<EndRecord>,
+    /// The lifecycle of the processes other than agents (replicas, the sim): per process
+    /// and event, the record with the most restarts, so that a replica that comes to lead
+    /// knows which of the events it overheard the log already holds. Bounded by the
+    /// processes times the event kinds.
+    pub processes: Vec<LifecycleRecord>,
+    /// A lifelong run's task records, in log order: the coordinator restores each agent's
+    /// current goal from them and the summary its task times. This is the one part that
+    /// grows with the run, by one record (about 10 bytes encoded) per task done.
+    pub tasks: Vec<TaskRecord>,
 }
 
 impl AppliedState {
@@ -85,6 +97,8 @@ impl AppliedState {
             agents: vec![AgentLife::default(); header.agents.len()],
             unreachable: Vec::new(),
             end: None,
+            processes: Vec::new(),
+            tasks: Vec::new(),
         }
     }
 
@@ -97,23 +111,36 @@ impl AppliedState {
                 self.last_round = Some(rec.clone());
             }
             Record::End(e) => self.end = Some(*e),
-            Record::Lifecycle(l) => {
-                let agent = self.agents.get_mut(l.index as usize);
-                if let (Some(Role::Agent), Some(ev), Some(a)) = (
-                    Role::from_u8(l.role),
-                    LifecycleEvent::from_u8(l.event),
-                    agent,
-                ) {
-                    a.event(ev, l.restarts);
-                }
-            }
+            Record::Lifecycle(l) => self.fold_lifecycle(l),
             Record::Unreachable(u) => self.unreachable.push(*u),
+            Record::Task(t) => self.tasks.push(*t),
             Record::Replan(_) => {}
             Record::Header(_) | Record::Raft(_) | Record::RaftState(_) | Record::Snapshot(_) => {
                 return
             }
         }
         self.records += 1;
+    }
+
+    fn fold_lifecycle(&mut self, l: &LifecycleRecord) {
+        match (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event)) {
+            (Some(Role::Agent), Some(ev)) => {
+                if let Some(a) = self.agents.get_mut(l.index as usize) {
+                    a.event(ev, l.restarts);
+                }
+            }
+            (Some(_), Some(_)) => {
+                let same = |p: &&mut LifecycleRecord| {
+                    (p.role, p.index, p.event) == (l.role, l.index, l.event)
+                };
+                match self.processes.iter_mut().find(same) {
+                    Some(p) if p.restarts < l.restarts => *p = *l,
+                    Some(_) => {}
+                    None => self.processes.push(*l),
+                }
+            }
+            _ => {}
+        }
     }
 
     /// The state as the bytes of a [`SnapshotRecord`].

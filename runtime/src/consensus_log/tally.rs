@@ -126,6 +126,8 @@ impl Tally {
                 a.replans = a.replans.saturating_add(1);
                 Counted::Replan
             }
+            // A new goal is no move and no conflict: the task records count the tasks.
+            Verdict::Task => Counted::Nothing,
         }
     }
 

@@ -77,6 +77,9 @@ pub enum Verdict {
     Hold = 3,
     /// A global replan was made; [`Decision::waypoint`] is the next intermediate target.
     Replan = 4,
+    /// A lifelong run's next task (`[tasks]`): [`Decision::waypoint`] is the agent's new
+    /// goal. Given to an agent that stands on its goal and was not moved this round.
+    Task = 5,
 }
 
 impl Verdict {
@@ -87,17 +90,19 @@ impl Verdict {
             2 => Some(Self::Block),
             3 => Some(Self::Hold),
             4 => Some(Self::Replan),
+            5 => Some(Self::Task),
             _ => None,
         }
     }
 
-    /// Lower-case name (`accept`, `block`, `hold`, `replan`), as in `hnav log show`.
+    /// Lower-case name (`accept`, `block`, `hold`, `replan`, `task`), as in `hnav log show`.
     pub fn name(self) -> &'static str {
         match self {
             Self::Accept => "accept",
             Self::Block => "block",
             Self::Hold => "hold",
             Self::Replan => "replan",
+            Self::Task => "task",
         }
     }
 }
@@ -341,6 +346,7 @@ mod tests {
             Verdict::Block,
             Verdict::Hold,
             Verdict::Replan,
+            Verdict::Task,
         ] {
             assert_eq!(Verdict::from_u8(v as u8), Some(v));
         }
@@ -348,7 +354,7 @@ mod tests {
             assert_eq!(ConflictKind::from_u8(k).map(|k| k as u8), Some(k));
         }
         assert_eq!(ConflictKind::from_u8(10), None);
-        for bad in [0u8, 5, 200, 255] {
+        for bad in [0u8, 6, 200, 255] {
             assert_eq!(Verdict::from_u8(bad), None);
         }
     }

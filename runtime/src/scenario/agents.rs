@@ -36,6 +36,10 @@ pub(super) fn with_agent_count(
         });
     }
     let mut out = s.clone();
+    if let Some(t) = out.tasks.as_mut().filter(|t| !t.cycles.is_empty()) {
+        // A list's added agents keep their one goal; dropped agents drop their lists.
+        t.cycles.truncate(n);
+    }
     if n <= s.agents.len() {
         out.agents.truncate(n);
         for (i, f) in out.faults.iter().enumerate() {
@@ -92,6 +96,9 @@ pub(super) fn with_agent_count(
                 start_heading_deg: 0.0,
                 planner: Planner::Hnav,
             });
+            if let Some(t) = out.tasks.as_mut().filter(|t| !t.cycles.is_empty()) {
+                t.cycles.push(vec![goal]);
+            }
             placed = true;
             break;
         }

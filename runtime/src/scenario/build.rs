@@ -60,6 +60,13 @@ pub(super) fn parse(
     for (i, f) in raw.faults.iter().enumerate() {
         faults.push(build_fault(i, f, agents.len(), &lines)?);
     }
+    let tasks = super::tasks::build_tasks(
+        raw.tasks,
+        sim.seed,
+        &agents,
+        (&map.grid, map.corner_cutting),
+        &lines,
+    )?;
     Ok(Scenario {
         name: raw.name.into_inner(),
         source_name: source_name.into(),
@@ -74,6 +81,7 @@ pub(super) fn parse(
         agents,
         faults,
         allow_unreachable,
+        tasks,
     })
 }
 

@@ -15,7 +15,8 @@
 //!
 //! * `allow_unreachable`, only when it is `true` (appended last), so that the hash of every
 //!   scenario without the key, and every log written before it existed, stays the same;
-//!   likewise `[restart] on_give_up`, only when it is `"stop"`.
+//!   likewise `[restart] on_give_up`, only when it is `"stop"`, and `[tasks]`, only when
+//!   the section is there (the tag `tasks`, the stream's code and seed, each agent's cycle).
 //!
 //! It does **not** cover the scenario `name`, the source file name, or the map file's path
 //! (only the map's content), so renaming or moving files keeps the hash.
@@ -27,6 +28,7 @@
 use super::params::{
     ClockMode, FsyncPolicy, GiveUpAction, Planner, RestartPolicy, RestartRule, Rules,
 };
+use super::tasks::StreamKind;
 use super::{FaultAction, FaultSignal, FaultSpec, FaultTarget, FaultTime, Scenario};
 use crate::grid::{CornerCutting, TerrainKind};
 use crate::hash::Fnv1a64;
@@ -188,6 +190,20 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
     }
     if s.restart.on_give_up == GiveUpAction::Stop {
         h.bytes(b"on_give_up=stop");
+    }
+    if let Some(t) = &s.tasks {
+        h.bytes(b"tasks");
+        match t.stream {
+            StreamKind::Seeded => h.u64(0).u64(t.seed),
+            StreamKind::List => h.u64(1),
+        };
+        h.u64(t.cycles.len() as u64);
+        for c in &t.cycles {
+            h.u64(c.len() as u64);
+            for g in c {
+                h.u64(g.x.into()).u64(g.y.into());
+            }
+        }
     }
     h.finish()
 }

@@ -96,6 +96,13 @@
 //!                                      # "coordinator", a replica, 1 to replicas
 //! signal = "KILL"                      # kill only: or "TERM"; default "KILL"
 //! # for_s = 0.3                        # freeze only: seconds stopped; omitted = never continued
+//!
+//! [tasks]                              # optional: goals that keep coming (lifelong; [`tasks`]);
+//! stream = "seeded"                    # the run then ends by time_limit_s. Or "list":
+//! seed = 7                             # seeded only; default the [sim] seed
+//! # [[tasks.goals]]                    # list only (`goals`): a robot's goals after its goal,
+//! # agent = 0                          # cycled; a robot without an entry keeps its one goal
+//! # cells = [[5, 3], [0, 0]]
 //! ```
 //!
 //! Unknown keys are errors (a typo must not silently fall back to a default). Every semantic
@@ -148,6 +155,7 @@ pub mod params;
 mod raw;
 pub mod record;
 pub mod report;
+pub mod tasks;
 mod validate;
 
 use std::path::{Path, PathBuf};
@@ -164,6 +172,7 @@ pub use params::{
 pub use raw::KEYS;
 pub use record::RecordParams;
 pub use report::{default_out_dir, ScenarioReport};
+pub use tasks::{StreamKind, TaskStream, TasksSpec};
 
 use crate::grid::{Cell, CornerCutting, Grid};
 
@@ -320,6 +329,9 @@ pub struct Scenario {
     /// Whether a goal that cannot be reached from its start is accepted (the agent then
     /// reports it in the run) instead of refused ([`ScenarioError::UnreachableGoal`]).
     pub allow_unreachable: bool,
+    /// Goals that keep coming (`[tasks]`): a lifelong run, ended by time; `None` for a run
+    /// that ends once every robot stands on its goal.
+    pub tasks: Option<TasksSpec>,
 }
 
 impl Scenario {

@@ -12,8 +12,8 @@ use toml::Spanned;
 use super::params::{ClockMode, FsyncPolicy, GiveUpAction, Planner, RestartPolicy, Rules};
 
 /// Every key of the format, table by table as the structs below (and `health`'s and
-/// `record`'s) take them: `""` is the top level, `restart.ROLE` each role's rule, `agents`
-/// and `faults` one entry of the arrays of tables. The docs that describe the format are
+/// `record`'s) take them: `""` is the top level, `restart.ROLE` each role's rule, `agents`,
+/// `faults` and `tasks.goals` one entry of the arrays of tables. The docs that describe the format are
 /// checked against it, and a test checks it against what the parser accepts.
 pub const KEYS: &[(&str, &[&str])] = &[
     (
@@ -31,6 +31,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
             "record",
             "agents",
             "faults",
+            "tasks",
         ],
     ),
     ("map", &["file", "rows", "corner_cutting"]),
@@ -106,6 +107,8 @@ pub const KEYS: &[(&str, &[&str])] = &[
             "at_round", "at_s", "action", "role", "index", "signal", "for_s",
         ],
     ),
+    ("tasks", &["stream", "seed", "goals"]),
+    ("tasks.goals", &["agent", "cells"]),
 ];
 
 /// Top level.
@@ -126,6 +129,7 @@ pub(super) struct RawScenario {
     pub agents: Vec<Spanned<RawAgent>>,
     #[serde(default)]
     pub faults: Vec<Spanned<RawFault>>,
+    pub tasks: Option<Spanned<super::tasks::RawTasks>>,
 }
 
 /// `[map]`.

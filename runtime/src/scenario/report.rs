@@ -76,6 +76,9 @@ pub struct ScenarioReport {
     pub restart: RestartConfig,
     /// Things that are legal but probably unintended (e.g. an unreachable goal).
     pub warnings: Vec<String>,
+    /// A lifelong run's `[tasks]` in words; absent without the section.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tasks: Option<String>,
 }
 
 impl ScenarioReport {
@@ -114,7 +117,18 @@ impl ScenarioReport {
         // As the command line writes them (`--kill agent:3@round:40`), one spelling for
         // both sources of a fault plan.
         let faults = s.faults.iter().map(ToString::to_string).collect();
+        let tasks = s.tasks.as_ref().map(|t| {
+            let stream = match t.stream {
+                super::StreamKind::Seeded => format!("seeded stream, seed {}", t.seed),
+                super::StreamKind::List => {
+                    let lists = t.cycles.iter().filter(|c| c.len() > 1).count();
+                    format!("lists of goals for {lists} of the agents, cycled")
+                }
+            };
+            format!("{stream}; a lifelong run, ended by the time limit")
+        });
         ScenarioReport {
+            tasks,
             name: s.name.clone(),
             source: s.source_name.clone(),
             scenario_hash: format!("{:016x}", s.scenario_hash()),
@@ -195,6 +209,9 @@ impl ScenarioReport {
         }
         if !self.faults.is_empty() {
             let _ = writeln!(o, "faults    {}", self.faults.join("; "));
+        }
+        if let Some(t) = &self.tasks {
+            let _ = writeln!(o, "tasks     {t}");
         }
         for w in &self.warnings {
             let _ = writeln!(o, "warning: {w}");

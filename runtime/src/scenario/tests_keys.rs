@@ -12,6 +12,9 @@ fn accepted(table: &str) -> Vec<String> {
         "agents" => BASE.replacen("[[agents]]\n", "[[agents]]\nzz_unknown = 1\n", 1),
         "faults" => format!("{BASE}[[faults]]\nzz_unknown = 1\n"),
         "restart.ROLE" => format!("{BASE}[restart]\nagent = {{ zz_unknown = 1 }}\n"),
+        "tasks.goals" => {
+            format!("{BASE}[tasks]\nstream = \"list\"\n[[tasks.goals]]\nzz_unknown = 1\n")
+        }
         t => format!("{BASE}[{t}]\nzz_unknown = 1\n"),
     };
     match parse(&text) {

@@ -281,14 +281,8 @@ mod tests {
     /// has no data event) and a plain receiver by its datagram; both get the sample.
     #[test]
     fn a_ringing_send_sends_datagrams_only_to_plain_listeners() {
-        use crate::transport::{purge_run, Qos, RunId, Transport};
-        struct Run(RunId);
-        impl Drop for Run {
-            fn drop(&mut self) {
-                let _ = purge_run(&self.0);
-            }
-        }
-        let run = Run(RunId::unique("bellsend"));
+        use crate::transport::{PurgeOnDrop, Qos, RunId, Transport};
+        let run = PurgeOnDrop(RunId::unique("bellsend"));
         let t = Transport::builder(&run.0)
             .handle_signals(false)
             .create()

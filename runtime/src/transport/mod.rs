@@ -55,8 +55,8 @@ pub use node::{Transport, TransportBuilder};
 pub use nodes::{CleanupReport, NodeInfo, NodeLiveness};
 pub use qos::{Delivery, Qos};
 pub use run::{
-    ipc_root, is_domain_name, purge_run, run_config, run_iceoryx2_files, run_shm_files, RunId,
-    DOMAIN_ENV, IPC_ROOT_ENV,
+    ipc_root, is_domain_name, purge_run, run_config, run_iceoryx2_files, run_shm_files,
+    PurgeOnDrop, RunId, DOMAIN_ENV, IPC_ROOT_ENV,
 };
 pub use slice::{SliceLoan, SliceReceiver, SliceSender};
 pub use waiter::{stop_requested, Attachment, AttachmentId, Waiter, Wake};

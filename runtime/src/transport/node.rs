@@ -181,6 +181,12 @@ impl Transport {
         cleanup_dead_nodes_in(&self.config)
     }
 
+    /// [`Transport::cleanup_dead_nodes`] from another thread, which holds a copy of
+    /// [`Transport::config`] (a node stays on the thread that made it).
+    pub fn cleanup_dead_nodes_with(config: &Config) -> Result<CleanupReport, TransportError> {
+        cleanup_dead_nodes_in(config)
+    }
+
     /// Like [`Transport::cleanup_dead_nodes`], but waits up to `timeout` for another cleaner.
     pub fn blocking_cleanup_dead_nodes(&self, timeout: Duration) -> u64 {
         self.node.blocking_cleanup_dead_nodes(timeout).cleanups

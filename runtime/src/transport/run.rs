@@ -330,6 +330,16 @@ pub fn run_iceoryx2_files(run: &RunId) -> Vec<PathBuf> {
     files
 }
 
+/// A throwaway run (a test's, say) whose leftovers are purged ([`purge_run`]) when it is
+/// dropped, even when the code that made it panics.
+pub struct PurgeOnDrop(pub RunId);
+
+impl Drop for PurgeOnDrop {
+    fn drop(&mut self) {
+        let _ = purge_run(&self.0);
+    }
+}
+
 /// Removes what a finished run left behind: stale resources of dead nodes, then the run's
 /// global management segment, then any file of the run still in `/dev/shm` or under
 /// iceoryx2's root directory ([`run_iceoryx2_files`]; a node directory left empty goes too).

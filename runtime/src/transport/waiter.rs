@@ -398,22 +398,13 @@ impl Waiter {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::transport::{purge_run, RunId, Transport};
-
-    /// A run of one test, purged even when the test fails.
-    struct Run(RunId);
-
-    impl Drop for Run {
-        fn drop(&mut self) {
-            let _ = purge_run(&self.0);
-        }
-    }
+    use crate::transport::{PurgeOnDrop, RunId, Transport};
 
     #[test]
     fn wait_with_names_the_receiver_that_was_signalled() {
         use crate::msg::{Lifecycle, Role};
         use crate::transport::Qos;
-        let run = Run(RunId::unique("waitwith"));
+        let run = PurgeOnDrop(RunId::unique("waitwith"));
         let t = Transport::builder(&run.0)
             .handle_signals(false)
             .create()
@@ -444,7 +435,7 @@ mod tests {
     #[test]
     fn a_bell_ring_wakes_the_waiter_once() {
         use crate::transport::Bell;
-        let run = Run(RunId::unique("waitbell"));
+        let run = PurgeOnDrop(RunId::unique("waitbell"));
         let t = Transport::builder(&run.0)
             .handle_signals(false)
             .create()
@@ -472,7 +463,7 @@ mod tests {
 
     #[test]
     fn a_dropped_interval_no_longer_counts_as_a_tick() {
-        let run = Run(RunId::unique("waittick"));
+        let run = PurgeOnDrop(RunId::unique("waittick"));
         let t = Transport::builder(&run.0)
             .handle_signals(false)
             .create()

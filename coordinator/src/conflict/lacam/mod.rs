@@ -109,6 +109,19 @@ impl Lacam {
         }
     }
 
+    /// Agent `agent` heads for `goal` from now on (a lifelong run's next task, on the `grid`
+    /// these rounds were made for). The plan being followed led to the old goals: it is
+    /// dropped, and the robots settle and are planned for again.
+    pub fn set_goal(&mut self, grid: &Grid, agent: usize, goal: Cell) {
+        if let Some(g) = self.goals.get_mut(agent) {
+            *g = grid.index(goal) as u32;
+        }
+        self.pibt.set_goal(grid, agent, goal);
+        if self.schedule.take().is_some() {
+            self.phase = Phase::Settling;
+        }
+    }
+
     /// Sets the search budget.
     pub fn set_budget(&mut self, budget: Budget) {
         self.budget = budget;

@@ -49,6 +49,41 @@ pub fn can_step(
     Some(to)
 }
 
+/// One goal's table: the distance from every cell of `grid` to `goal` under `rule`
+/// (Dijkstra from the goal; the steps are symmetric). `table` reads [`UNREACHABLE`]
+/// everywhere before.
+fn fill(table: &mut [u32], grid: &Grid, rule: CornerCutting, goal: Cell) {
+    let Some(g) = grid.checked_index(goal).filter(|&g| !grid.blocked()[g]) else {
+        return;
+    };
+    let mut heap = BinaryHeap::new();
+    table[g] = 0;
+    heap.push(Reverse((0u32, g as u32)));
+    while let Some(Reverse((dist, u))) = heap.pop() {
+        if dist > table[u as usize] {
+            continue;
+        }
+        let Some(from) = grid.cell_at(u as usize) else {
+            continue;
+        };
+        for dir in Direction::ALL {
+            let step = can_step(grid.blocked(), grid.width(), grid.height(), rule, from, dir);
+            let Some(to) = step else { continue };
+            let v = grid.index(to);
+            let nd = dist
+                + if dir.is_diagonal() {
+                    DIAGONAL
+                } else {
+                    STRAIGHT
+                };
+            if nd < table[v] {
+                table[v] = nd;
+                heap.push(Reverse((nd, v as u32)));
+            }
+        }
+    }
+}
+
 /// Distances to each agent's goal; see the [module docs](self).
 #[derive(Clone, Debug)]
 pub struct Distances {
@@ -74,40 +109,24 @@ impl Distances {
             return d;
         }
         d.table = vec![UNREACHABLE; goals.len() * cells];
-        let mut heap = BinaryHeap::new();
         for (i, &goal) in goals.iter().enumerate() {
-            let table = &mut d.table[i * cells..(i + 1) * cells];
-            let Some(g) = grid.checked_index(goal).filter(|&g| !grid.blocked()[g]) else {
-                continue;
-            };
-            table[g] = 0;
-            heap.push(Reverse((0u32, g as u32)));
-            while let Some(Reverse((dist, u))) = heap.pop() {
-                if dist > table[u as usize] {
-                    continue;
-                }
-                let Some(from) = grid.cell_at(u as usize) else {
-                    continue;
-                };
-                for dir in Direction::ALL {
-                    let step =
-                        can_step(grid.blocked(), grid.width(), grid.height(), rule, from, dir);
-                    let Some(to) = step else { continue };
-                    let v = grid.index(to);
-                    let nd = dist
-                        + if dir.is_diagonal() {
-                            DIAGONAL
-                        } else {
-                            STRAIGHT
-                        };
-                    if nd < table[v] {
-                        table[v] = nd;
-                        heap.push(Reverse((nd, v as u32)));
-                    }
-                }
-            }
+            fill(&mut d.table[i * cells..(i + 1) * cells], grid, rule, goal);
         }
         d
+    }
+
+    /// Agent `agent` heads for `goal` from now on (a lifelong run's next task): its table is
+    /// computed again on `grid` under `rule`, one Dijkstra.
+    pub fn set_goal(&mut self, grid: &Grid, rule: CornerCutting, agent: usize, goal: Cell) {
+        let Some(g) = self.goals.get_mut(agent) else {
+            return;
+        };
+        *g = goal;
+        let cells = self.cells;
+        if let Some(table) = self.table.get_mut(agent * cells..(agent + 1) * cells) {
+            table.fill(UNREACHABLE);
+            fill(table, grid, rule, goal);
+        }
     }
 
     /// Whether the exact tables were built (else the octile heuristic answers).

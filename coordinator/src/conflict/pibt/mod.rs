@@ -216,6 +216,13 @@ impl Pibt {
         self.distances.exact()
     }
 
+    /// Agent `agent` heads for `goal` from now on (a lifelong run's next task, on the `grid`
+    /// these rounds were made for).
+    pub fn set_goal(&mut self, grid: &Grid, agent: usize, goal: Cell) {
+        self.distances
+            .set_goal(grid, self.options.corner_cutting, agent, goal);
+    }
+
     /// Agent `agent`'s dynamic priority: rounds since it was last on its goal.
     pub fn waited(&self, agent: usize) -> u32 {
         self.waited.get(agent).copied().unwrap_or(0)

@@ -1,5 +1,6 @@
 //! When the run is over ([`EndWatch`]): every agent at its goal, or settled (at its goal,
-//! confirmed unable to reach it, or lost), or in lockstep the round of the time limit.
+//! confirmed unable to reach it, or lost), or in lockstep the round of the time limit. A
+//! lifelong run (`[tasks]`) ends only by the time limit.
 
 use hnav_runtime::consensus_log::EndReason;
 use hnav_runtime::grid::{reachable_from, Cell, CornerCutting, Grid};
@@ -22,6 +23,8 @@ pub(super) struct EndWatch {
     walls: Grid,
     corners: CornerCutting,
     goals: Vec<Cell>,
+    /// A lifelong run (`[tasks]`): only time ends it.
+    lifelong: bool,
 }
 
 impl EndWatch {
@@ -35,6 +38,7 @@ impl EndWatch {
             walls: scenario.map.grid.clone(),
             corners: scenario.map.corner_cutting,
             goals: scenario.agents.iter().map(|a| a.goal).collect(),
+            lifelong: scenario.tasks.is_some(),
         }
     }
 
@@ -77,6 +81,13 @@ impl EndWatch {
     pub(super) fn due(&self, round: u64, arbiter: &Arbiter, roster: &Roster) -> Option<EndReason> {
         if self.end.is_some() || round == 0 {
             return None;
+        }
+        if self.lifelong {
+            // Goals keep coming: all at goal is a moment, not the end.
+            return self
+                .round_limit
+                .is_some_and(|limit| round >= limit)
+                .then_some(EndReason::TimeLimit);
         }
         let settled = || {
             (0..arbiter.agents()).all(|i| {

@@ -196,13 +196,14 @@ impl State {
             }
             Record::End(e) => self.watch.ended(e.reason),
             Record::Lifecycle(l) => {
-                if let (Some(Role::Agent), Some(ev)) =
-                    (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
-                {
-                    self.roster.event(l.index, ev, l.restarts);
+                match (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event)) {
+                    (Some(Role::Agent), Some(ev)) => self.roster.event(l.index, ev, l.restarts),
+                    (Some(role), Some(ev)) => self.heard.logged(role, l.index, ev, l.restarts),
+                    _ => {}
                 }
             }
             Record::Unreachable(u) => self.watch.logged_unreachable(u.agent),
+            Record::Task(t) => self.arbiter.replay_task(t),
             Record::Header(_)
             | Record::Replan(_)
             | Record::Raft(_)
@@ -223,6 +224,14 @@ impl State {
         }
         for u in &s.unreachable {
             self.watch.logged_unreachable(u.agent);
+        }
+        for l in &s.processes {
+            if let (Some(role), Some(ev)) = (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event)) {
+                self.heard.logged(role, l.index, ev, l.restarts);
+            }
+        }
+        for t in &s.tasks {
+            self.arbiter.replay_task(t);
         }
     }
 
@@ -309,6 +318,10 @@ impl State {
             self.log.append(&Record::Replan(r.clone()))?;
         }
         let rec = self.open.record(round, decisions, self.last_record.take());
+        // A lifelong run's new tasks, like replans, just before the round that tells them.
+        for t in self.arbiter.assigned() {
+            self.log.append(&Record::Task(*t))?;
+        }
         let record = Record::Round(rec);
         self.log.append(&record)?;
         let Record::Round(rec) = record else {
@@ -349,8 +362,11 @@ impl State {
         Ok(())
     }
 
-    /// Flushes the log to disk.
+    /// Flushes the log to disk at the process's end.
     pub(super) fn sync(&mut self) -> Result<(), CoordinatorError> {
+        if let Some(raft) = self.log.raft() {
+            raft.report();
+        }
         self.log.sync()
     }
 
@@ -420,9 +436,7 @@ impl State {
             return Ok(false);
         }
         if first {
-            for (i, state, restarts) in self.heard.take() {
-                self.reconcile(i, state, restarts)?;
-            }
+            self.log_overheard()?;
         }
         Ok(true)
     }

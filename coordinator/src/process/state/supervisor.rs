@@ -123,13 +123,33 @@ impl State {
         Ok(())
     }
 
+    /// This replica comes to lead: what it heard while following and no leader logged is
+    /// logged now. The other processes' events first, in the order heard (the leader it
+    /// replaces died unlogged: its `Down` reached only the followers), then each agent's
+    /// state, reconciled with the log.
+    pub(super) fn log_overheard(&mut self) -> Result<(), CoordinatorError> {
+        for (role, index, ev, restarts) in self.heard.take_others() {
+            self.log_event(role, index, ev, restarts)?;
+        }
+        for (i, state, restarts) in self.heard.take() {
+            self.reconcile(i, state, restarts)?;
+        }
+        Ok(())
+    }
+
     /// A following replica takes in the supervisor's events: liveness is remembered for when
     /// it comes to lead (the leader logs it meanwhile); returns how the run ends on a `Stop`.
     pub(in crate::process) fn overhear(
         &mut self,
         life: &LifecyclePorts,
     ) -> Result<Option<EndReason>, CoordinatorError> {
-        Ok(self.heard.hear(life)?.map(stopped))
+        let stop = self.heard.hear(life)?.map(stopped);
+        if let Some(raft) = self.log.raft() {
+            for dead in self.heard.take_replicas_down() {
+                raft.replica_down(u64::from(dead));
+            }
+        }
+        Ok(stop)
     }
 }
 

@@ -30,6 +30,9 @@ pub enum RunError {
         /// The error.
         source: std::io::Error,
     },
+    /// The thread that removes dead nodes' resources could not be started.
+    #[error("cannot start the dead-node sweeper thread: {0}")]
+    Sweeper(std::io::Error),
     /// The options name no run directory.
     #[error("start-up failed: no run directory")]
     NoRunDir,

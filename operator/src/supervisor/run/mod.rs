@@ -11,8 +11,9 @@
 //!    [`super::startup`]).
 //! 3. Watch (module `watch`): block in a `Waiter` on the children's exit descriptors (a
 //!    child's death wakes it at once) with a short tick for the progress bar and the fault
-//!    schedule. A dead child is reaped, its stale iceoryx2 resources removed (which wakes its
-//!    peers with a "peer dead" event), the others told on the lifecycle topic, and it is
+//!    schedule. A dead child is reaped, the others told on the lifecycle topic, its stale
+//!    iceoryx2 resources removed on the sweeper's thread (which wakes its peers with a "peer
+//!    dead" event), and it is
 //!    restarted under its role's policy with `--resume` (module `slots`). The progress bar
 //!    (`progress`) follows the coordinator's progress topic; the scenario's planned faults
 //!    (`faults`) too in realtime, and the sim's `Hold` at each fault's round in lockstep.
@@ -42,6 +43,7 @@
 // | `hang` | the hang deadlines of the processes that are up, and the kill of a silent one |
 // | `progress` | the progress bar (or line) |
 // | `slots` | the run's processes: spawn, reap, restart under their policy, `Up`s announced |
+// | `sweeper` | dead nodes' shared memory removed on a thread of its own, so that it never delays a reap |
 // | `host` | this host's part of a run across hosts; the list of a run's processes |
 // | `action` | what the watch's parts want done: signals, journal lines, lifecycle messages, respawns |
 // | `error` | [`RunError`] |
@@ -52,6 +54,7 @@ mod hang;
 mod progress;
 
 mod slots;
+mod sweeper;
 
 mod host;
 
@@ -73,6 +76,7 @@ use super::summary::RunSummary;
 use crate::invocation::Invocation;
 use error::io;
 use hang::HangWatch;
+use hnav_runtime::consensus_log::EndReason;
 use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::msg::{Lifecycle, Role, StopReason};
 use hnav_runtime::scenario::Scenario;
@@ -281,10 +285,20 @@ fn summarize(
     }
     let log = dir.join("log");
     let cell_m = scenario.robot.cell_size_m;
-    let mut summary = RunSummary::from_log(run.as_str(), &log, truth, cell_m, ended.elapsed_s)?;
+    let lifelong = scenario
+        .tasks
+        .as_ref()
+        .map(|_| scenario.sim.control_period_s());
+    let mut summary =
+        RunSummary::from_log(run.as_str(), &log, truth, cell_m, ended.elapsed_s, lifelong)?;
     summary.mark_lost(&ended.lost);
     summary.rules = scenario.coordinator.rules.name().to_string();
     summary.restarts = ended.restarts;
+    // Replicas stop together at the supervisor's time limit, before the leader's end record
+    // is committed: the log then has no end, but the supervisor knows why the run ended.
+    if summary.end == "incomplete" && matches!(ended.end, End::TimeLimit) {
+        summary.end = EndReason::TimeLimit.name().to_string();
+    }
     if let End::CannotGoOn(why) = ended.end {
         summary.cannot_go_on = Some(why);
     }

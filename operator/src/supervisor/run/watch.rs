@@ -16,6 +16,7 @@ use super::faults::FaultSchedule;
 use super::hang::HangWatch;
 use super::progress::ProgressView;
 use super::slots::Slots;
+use super::sweeper::Sweeper;
 use crate::supervisor::events::{RunEvent, RunEvents};
 use crate::supervisor::registry::RunRecord;
 use crate::supervisor::startup::SupervisorPorts;
@@ -26,6 +27,10 @@ use hnav_runtime::transport::{Receiver, RunId, Transport, Wake};
 
 /// Refresh period of the progress bar and the fault schedule.
 const TICK: Duration = Duration::from_millis(50);
+
+/// The longest a respawn waits for the dead-node clean-up in flight (it took 300 ms in a
+/// debug build on a loaded machine).
+const SWEEP_SETTLE: Duration = Duration::from_secs(5);
 
 /// How the watched part of a run ended.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -40,6 +45,8 @@ pub(super) enum End {
 /// The supervisor's node on the run's transport and its ports (dropped in this order: the
 /// ports, then the node).
 pub(super) struct Ports {
+    /// Removes dead nodes' resources off the watch's thread.
+    sweeper: Sweeper,
     pub(super) life: SupervisorPorts,
     pub(super) progress: Receiver<Progress>,
     pub(super) truth: Receiver<Truth>,
@@ -54,7 +61,9 @@ impl Ports {
             .node_name("supervisor")
             .handle_signals(true)
             .create()?;
+        let sweeper = Sweeper::start(transport.config().clone()).map_err(RunError::Sweeper)?;
         Ok(Self {
+            sweeper,
             life: SupervisorPorts::open(&transport, agents)?,
             progress: transport.receiver(topics::PROGRESS, topics::progress_qos())?,
             truth: transport.receiver(topics::TRUTH, topics::truth_qos())?,
@@ -294,12 +303,13 @@ impl<'s> Watch<'s> {
                 }
                 Action::Journal(event) => self.journal.record(event),
                 Action::Publish(message) => self.ports.life.publish(message)?,
-                Action::CleanUpDead => {
-                    if let Err(e) = self.ports.transport.cleanup_dead_nodes() {
-                        tracing::warn!("dead-node clean-up failed: {e}");
-                    }
-                }
+                Action::CleanUpDead => self.ports.sweeper.sweep(),
                 Action::Respawn { role, index } => {
+                    // A respawned process should find its predecessor's ports gone (it
+                    // would clean up itself as it starts, later).
+                    if !self.ports.sweeper.settle(SWEEP_SETTLE) {
+                        tracing::warn!("dead-node clean-up still running at a respawn");
+                    }
                     if let Some(spawned) = slots.respawn(role, index)? {
                         self.journal.record(spawned);
                     }

@@ -53,12 +53,20 @@ pub struct KindCounts {
     pub end: u64,
     /// Unreachable records.
     pub unreachable: u64,
+    /// Task records (a lifelong run's assignments).
+    pub task: u64,
 }
 
 impl KindCounts {
     /// All records.
     pub fn total(&self) -> u64 {
-        self.header + self.round + self.lifecycle + self.replan + self.end + self.unreachable
+        self.header
+            + self.round
+            + self.lifecycle
+            + self.replan
+            + self.end
+            + self.unreachable
+            + self.task
     }
 }
 
@@ -161,6 +169,10 @@ impl VerifyReport {
         if c.unreachable > 0 {
             s.pop();
             let _ = writeln!(s, ", {} unreachable", c.unreachable);
+        }
+        if c.task > 0 {
+            s.pop();
+            let _ = writeln!(s, ", {} task", c.task);
         }
         if let Some((index, term)) = self.raft.and_then(|r| r.snapshot) {
             let _ = writeln!(

@@ -4,7 +4,7 @@
 //!
 //! The coordinator (`coordinator::process::state`) writes a replan record for round `n + 1`
 //! just before the round record `n + 1`, and a lifecycle or end record at the last round it
-//! logged (`n`, 0 before the first round); an unreachable record is written like a replan. A restarted coordinator resumes from the last
+//! logged (`n`, 0 before the first round); an unreachable or task record is written like a replan. A restarted coordinator resumes from the last
 //! round record, so a round decided twice (replans logged, then a crash before the round
 //! record) repeats only its replan records. These rules are what lets a lost record show: a
 //! round record removed from the middle of a segment leaves a gap, and records lost at the
@@ -125,6 +125,11 @@ impl OrderCheck {
             Record::Unreachable(u) => {
                 report.counts.unreachable += 1;
                 self.agent(report, pos, u.agent);
+                self.at_round(report, pos, record, last + 1);
+            }
+            Record::Task(t) => {
+                report.counts.task += 1;
+                self.agent(report, pos, t.agent);
                 self.at_round(report, pos, record, last + 1);
             }
             Record::End(e) => {
