@@ -101,9 +101,12 @@ pub struct Replica<D: Disk = RealDisk> {
     early: Option<EarlyOut>,
     outbox: Vec<Message>,
     committed: VecDeque<Committed>,
-    /// The state of a snapshot the owner has not taken yet: the journal's on a restart, or
-    /// one the leader sent ([`take_installed`](Replica::take_installed)).
-    installed: Option<AppliedState>,
+    /// A snapshot's index and state the owner has not taken yet: the journal's on a
+    /// restart, or one the leader sent ([`take_installed`](Replica::take_installed)). The
+    /// index is kept beside the state because the replica may compact again before the owner
+    /// takes it (a restart applies the journal's committed entries and can reach the next
+    /// snapshot at once): its current snapshot index is then a later one.
+    installed: Option<(u64, AppliedState)>,
     snapshot_entries: u64,
     /// Snapshots installed from a leader since the start.
     installs: u64,
@@ -133,8 +136,9 @@ impl Replica {
     pub fn restart(config: &ReplicaConfig, storage: Store) -> Result<Self, ReplicaError> {
         let snapshot = storage.last_snapshot();
         let mut replica = Self::over(config, storage)?;
-        if snapshot.get_metadata().index > 0 {
-            replica.installed = Some(decode_state(&snapshot)?);
+        let index = snapshot.get_metadata().index;
+        if index > 0 {
+            replica.installed = Some((index, decode_state(&snapshot)?));
         }
         Ok(replica)
     }
@@ -164,9 +168,10 @@ impl<D: Disk> Replica<D> {
     ) -> Result<Self, ReplicaError> {
         let (journal, storage, compacted) =
             Journal::open_on(disk, dir, header, options, &config.voters)?;
+        let index = storage.snapshot_index();
         let mut replica = Self::over(config, storage)?;
         replica.journal = Some(journal);
-        replica.installed = compacted;
+        replica.installed = compacted.map(|state| (index, state));
         // The committed entries of the journal are ready at once.
         replica.process()?;
         Ok(replica)
@@ -281,10 +286,10 @@ impl<D: Disk> Replica<D> {
     }
 
     /// The state its owner must start from before the next committed entries, if it is not
-    /// the state it has applied so far: that of the snapshot its journal starts with (after a
-    /// restart) or of one its leader sent (it was too far behind). Take it before
-    /// [`take_committed`](Self::take_committed).
-    pub fn take_installed(&mut self) -> Option<AppliedState> {
+    /// the state it has applied so far, with the index it stands for: that of the snapshot
+    /// its journal starts with (after a restart) or of one its leader sent (it was too far
+    /// behind). Take it before [`take_committed`](Self::take_committed).
+    pub fn take_installed(&mut self) -> Option<(u64, AppliedState)> {
         self.installed.take()
     }
 

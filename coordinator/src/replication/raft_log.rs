@@ -293,7 +293,7 @@ impl RaftLog {
 
     /// Moves the committed records this replica did not decide itself into `applied`.
     fn take_committed(&mut self) -> Result<(), ReplicaError> {
-        if let Some(state) = self.replica.take_installed() {
+        if let Some((_, state)) = self.replica.take_installed() {
             // The records not yet applied are in the snapshot's state.
             self.applied.clear();
             self.installed = Some(state);

@@ -99,7 +99,7 @@ impl Cluster {
             let mut mail = Vec::new();
             for (i, r) in self.replicas.iter_mut().enumerate() {
                 if let Some(r) = r {
-                    if let Some(state) = r.take_installed() {
+                    if let Some((_, state)) = r.take_installed() {
                         // The entries handed out before are in the snapshot's state.
                         self.committed[i].clear();
                         self.installed[i] = Some(state);

@@ -23,6 +23,7 @@ impl<D: Disk> Replica<D> {
         let state = decode_state(&snapshot)?;
         let mut hs = store.mem().rl().hard_state().clone();
         let meta = snapshot.get_metadata();
+        let index = meta.index;
         hs.term = hs.term.max(meta.term);
         hs.commit = hs.commit.max(meta.index);
         if let Some(j) = &mut self.journal {
@@ -35,7 +36,7 @@ impl<D: Disk> Replica<D> {
         );
         store.compact_to(snapshot, &[], hs)?;
         self.committed.clear();
-        self.installed = Some(state);
+        self.installed = Some((index, state));
         self.installs += 1;
         Ok(())
     }

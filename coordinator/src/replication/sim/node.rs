@@ -182,10 +182,7 @@ impl Node {
         let from_leader = p.replica.installs() > installs;
         let mut messages: Vec<Message> = p.early.borrow_mut().drain(..).collect();
         messages.extend(p.replica.take_messages());
-        let installed = p
-            .replica
-            .take_installed()
-            .map(|s| (p.replica.snapshot_index(), s));
+        let installed = p.replica.take_installed();
         let committed = p.replica.take_committed().collect();
         let now = (p.replica.term(), p.replica.role());
         let campaigned = messages.iter().any(|m| {
