@@ -66,8 +66,7 @@ pub use reader::{read_log, LogContents, LogReader, RecordPos, TornTail};
 pub use record::{
     candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision,
     RaftEntryRecord, RaftStateRecord, Record, ReplanRecord, RoundRecord, RunHeader, SnapshotRecord,
-    TaskRecord,
-    UnreachableRecord,
+    TaskRecord, UnreachableRecord,
 };
 pub use replicated::{
     is_replicated, read_decided, replica_dirs, resolve, Decided, ReplicaRole, Resolved, ROLE_FILE,

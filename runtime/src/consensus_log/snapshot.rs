@@ -180,3 +180,76 @@ impl SnapshotRecord {
         AppliedState::decode(&self.state)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn header() -> RunHeader {
+        RunHeader {
+            version: 1,
+            scenario_hash: 1,
+            seed: 2,
+            clock: "lockstep".into(),
+            width: 4,
+            height: 4,
+            agents: Vec::new(),
+        }
+    }
+
+    fn life(role: Role, index: u32, event: LifecycleEvent, restarts: u32) -> Record {
+        Record::Lifecycle(LifecycleRecord {
+            round: 7,
+            role: role as u8,
+            index,
+            event: event as u8,
+            restarts,
+        })
+    }
+
+    #[test]
+    fn the_state_keeps_each_processes_latest_events_and_every_task() {
+        let mut s = AppliedState::new(&header());
+        let task = |task, goal| {
+            Record::Task(TaskRecord {
+                round: 9,
+                agent: 0,
+                task,
+                goal,
+            })
+        };
+        for r in [
+            life(Role::Coordinator, 3, LifecycleEvent::Down, 0),
+            life(Role::Coordinator, 3, LifecycleEvent::Restarted, 1),
+            life(Role::Coordinator, 3, LifecycleEvent::Down, 1),
+            // Logged late by a new leader: an older event of the same kind is not kept.
+            life(Role::Coordinator, 3, LifecycleEvent::Down, 0),
+            life(Role::Sim, 0, LifecycleEvent::Down, 0),
+            task(1, 5),
+            task(2, 11),
+        ] {
+            s.fold(&r);
+        }
+        let kept: Vec<(u8, u32, u8, u32)> = s
+            .processes
+            .iter()
+            .map(|p| (p.role, p.index, p.event, p.restarts))
+            .collect();
+        let (c, down, up) = (
+            Role::Coordinator as u8,
+            LifecycleEvent::Down as u8,
+            LifecycleEvent::Restarted as u8,
+        );
+        assert_eq!(
+            kept,
+            [
+                (c, 3, down, 1),
+                (c, 3, up, 1),
+                (Role::Sim as u8, 0, down, 0)
+            ]
+        );
+        assert_eq!(s.tasks.iter().map(|t| t.goal).collect::<Vec<_>>(), [5, 11]);
+        assert_eq!(s.records, 7);
+        assert_eq!(AppliedState::decode(&s.encode()).unwrap(), s);
+    }
+}

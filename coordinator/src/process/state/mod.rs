@@ -226,7 +226,9 @@ impl State {
             self.watch.logged_unreachable(u.agent);
         }
         for l in &s.processes {
-            if let (Some(role), Some(ev)) = (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event)) {
+            if let (Some(role), Some(ev)) =
+                (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
+            {
                 self.heard.logged(role, l.index, ev, l.restarts);
             }
         }
