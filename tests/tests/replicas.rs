@@ -6,7 +6,9 @@
 use std::path::Path;
 use std::time::Duration;
 
-use hnav_runtime::consensus_log::{read_decided, read_log, EndReason, Record, FORMAT_VERSION};
+use hnav_runtime::consensus_log::{
+    read_decided, read_log, AppliedState, EndReason, Record, FORMAT_VERSION,
+};
 use hnav_runtime::msg::{LifecycleEvent, Role};
 use hnav_tests::swarm::{records_digest, repo_root, verify_log, SwarmRun};
 use hnav_tests::TestRun;
@@ -17,8 +19,13 @@ const RUN_TIMEOUT: Duration = Duration::from_secs(600);
 /// Runs `scenario` in lockstep with `extra` arguments into `dir`; every robot must reach its
 /// goal without a collision.
 fn run(tag: &str, scenario: &Path, dir: &Path, registry: &Path, extra: &[&str]) {
+    run_in("lockstep", tag, scenario, dir, registry, extra);
+}
+
+/// [`run`] in clock mode `mode`.
+fn run_in(mode: &str, tag: &str, scenario: &Path, dir: &Path, registry: &Path, extra: &[&str]) {
     let mut run = TestRun::new(tag);
-    let mut args = vec!["--mode", "lockstep"];
+    let mut args = vec!["--mode", mode];
     args.extend_from_slice(extra);
     let mut swarm =
         SwarmRun::start(&mut run, scenario, dir, registry, &args).expect("hnav run starts");
@@ -184,6 +191,69 @@ fn a_leader_stopped_by_sigterm_leaves_the_run_to_the_others() {
     // The one that led at the end logged it (the other may have stopped before it heard the
     // commit).
     assert!(ended >= 1, "no replica logged the run's end");
+}
+
+/// A replica killed while the others decide far past the snapshot threshold comes back
+/// behind their snapshots: it installs its leader's snapshot (the entries it missed are
+/// compacted away), and every replica's log, each compacted, verifies and adds up to the
+/// same state.
+///
+/// Realtime, because a lockstep run holds its rounds while a killed process is away (that
+/// is what keeps it reproducible), so no replica ever falls behind a snapshot there.
+#[test]
+fn a_replica_left_far_behind_catches_up_from_a_snapshot() {
+    let tmp = tempfile::tempdir().unwrap();
+    let registry = tmp.path().join("runs");
+    let dir = tmp.path().join("out");
+    let demo = std::fs::read_to_string(repo_root().join("scenarios/demo.toml")).unwrap();
+    let scenario = tmp.path().join("demo-snapshots.toml");
+    let compacting = demo.replacen(
+        "[coordinator]\n",
+        "[coordinator]\nsnapshot_entries = 10\n",
+        1,
+    );
+    assert_ne!(compacting, demo, "the demo has a [coordinator] table");
+    // Restarted 2 s after its kill: the others (a new leader elected meanwhile if it led)
+    // decide about a hundred rounds without it, ten snapshots' worth.
+    let compacting = format!("{compacting}\n[restart.coordinator]\nbackoff_ms = 2000\n");
+    std::fs::write(&scenario, compacting).unwrap();
+    let args = ["--replicas", "3", "--kill", "coordinator:2@round:40"];
+    run_in("realtime", "rsnap", &scenario, &dir, &registry, &args);
+    let logs = std::fs::read_dir(dir.join("logs")).unwrap();
+    let installed = logs.flatten().any(|e| {
+        std::fs::read_to_string(e.path())
+            .is_ok_and(|t| t.contains("installed the leader's snapshot"))
+    });
+    assert!(
+        installed,
+        "no replica installed a snapshot\n{}",
+        hnav_tests::swarm::log_tails(&dir)
+    );
+    let mut states = Vec::new();
+    for id in 1..=3 {
+        let log = dir.join("log").join(id.to_string());
+        let (ok, report) = verify_log(&log);
+        assert!(ok, "replica {id}'s log does not verify:\n{report}");
+        assert!(
+            report.contains("snapshot   index"),
+            "replica {id} never compacted:\n{report}"
+        );
+        let d = read_decided(&log).unwrap();
+        let Some(Record::Header(h)) = d.records.first() else {
+            panic!("replica {id}'s log has no header");
+        };
+        let mut state = d.compacted.clone().unwrap_or_else(|| AppliedState::new(h));
+        for r in &d.records[1..] {
+            state.fold(r);
+        }
+        assert_eq!(
+            state.end.map(|e| e.reason),
+            Some(EndReason::AllAtGoal),
+            "replica {id}"
+        );
+        states.push(state);
+    }
+    assert!(states.iter().all(|s| *s == states[0]), "{states:#?}");
 }
 
 /// The leader's own `down` is heard only by the followers: it dies, so it cannot log it,

@@ -72,6 +72,10 @@ pub struct Figures {
     /// SIGKILL (`signalled`) → the observer's receipt of that process's `Down`: when the
     /// coordinator and every other process are told.
     pub kill_to_down: Figure,
+    /// SIGKILL (`signalled`) → the supervisor reaped that process (`exited`): the kernel's
+    /// teardown of the killed process, the floor under `kill_to_down` for any supervisor
+    /// that learns of a death from the kernel (its `Down` cannot be sent earlier).
+    pub kill_to_exit: Figure,
     /// SIGSTOP (`signalled`) → `hung` declared for that process.
     pub freeze_to_hung: Figure,
     /// How long each hung process had been silent when it was declared (`silent_ms`): the
@@ -91,6 +95,7 @@ impl Default for Figures {
     fn default() -> Self {
         Figures {
             kill_to_down: Figure::new("SIGKILL -> Down received", "p99 <= 10 ms"),
+            kill_to_exit: Figure::new("SIGKILL -> exit reaped (the floor)", "the kernel's"),
             freeze_to_hung: Figure::new("SIGSTOP -> hang declared", "beside the deadline"),
             hang_silence: Figure::new("silence when declared hung", "the deadline"),
             agent_back: Figure::new("agent spawned -> first candidate", "<= 300 ms"),
@@ -147,6 +152,11 @@ impl Figures {
                         })
                         .map(|l| l.t_ns);
                     self.kill_to_down.add_ns(e.t_ns, down, what);
+                    let exited = events
+                        .iter()
+                        .find(|x| x.event == "exited" && x.node == e.node && x.t_ns >= e.t_ns)
+                        .map(|x| x.t_ns);
+                    self.kill_to_exit.add_ns(e.t_ns, exited, what);
                     if role == Role::Coordinator && index > 0 && e.fault.is_some() {
                         let first = first_new_round(seen, e.t_ns);
                         self.failover.add_ns(e.t_ns, first, what);
@@ -197,9 +207,10 @@ impl Figures {
     }
 
     /// Every figure, in table order.
-    pub fn all(&self) -> [&Figure; 7] {
+    pub fn all(&self) -> [&Figure; 8] {
         [
             &self.kill_to_down,
+            &self.kill_to_exit,
             &self.freeze_to_hung,
             &self.hang_silence,
             &self.agent_back,
@@ -301,6 +312,9 @@ mod tests {
         assert!(near(f.kill_to_down.quantile_ms(0.5), 2.0));
         // The coordinator's Down never arrived.
         assert_eq!(f.kill_to_down.unmatched, 1);
+        // Agent 2 was reaped 0.5 ms after its SIGKILL; the coordinator's exit is missing.
+        assert!(near(f.kill_to_exit.quantile_ms(0.5), 0.5));
+        assert_eq!(f.kill_to_exit.unmatched, 1);
         assert!(near(f.agent_back.quantile_ms(0.5), 20.0));
         // The resend of round 40 at 310 ms is skipped: round 41 at 350 ms is its first.
         assert!(near(f.coordinator_back.quantile_ms(0.5), 50.0));

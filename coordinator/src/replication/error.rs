@@ -44,8 +44,4 @@ pub enum ReplicaError {
         /// What differs.
         what: String,
     },
-    /// Raft asked to install a snapshot; replicas catch up by log replay only (entries are
-    /// never compacted away).
-    #[error("raft sent a snapshot; replicas catch up from the log and never compact it")]
-    Snapshot,
 }

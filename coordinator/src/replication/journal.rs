@@ -10,9 +10,14 @@
 //! commit index it lost from the leader.
 //!
 //! On open the log is read whole, overwritten entries are dropped, and the `MemStorage` a
-//! restarted replica runs on is rebuilt from what is left: its entries, term, vote and commit
-//! index. Raft then hands the committed entries out again, so the coordinator's state is
-//! rebuilt by applying them, exactly as a follower applies the leader's.
+//! restarted replica runs on is rebuilt from what is left: its snapshot, entries, term, vote
+//! and commit index. Raft then hands the committed entries after the snapshot out again, so
+//! the coordinator's state is rebuilt from the snapshot's state and then by applying them,
+//! exactly as a follower applies the leader's.
+//!
+//! A replica that compacts ([`Journal::compact`]) writes its log anew: header, snapshot, hard
+//! state and the entries after the snapshot, replacing the old segments whole or not at all
+//! ([`LogWriter::replace`]).
 //!
 //! The journal writes on a [`Disk`]: the machine's ([`RealDisk`]) in the coordinator, a
 //! simulated one that fails writes and fsyncs and loses power in the simulation
@@ -21,15 +26,19 @@
 use std::path::Path;
 
 use hnav_runtime::consensus_log::{
-    resolve, LogWriter, RaftEntryRecord, RaftStateRecord, Record, RunHeader, WriterOptions,
-    REPLICATED_VERSION,
+    resolve, AppliedState, LogWriter, RaftEntryRecord, RaftStateRecord, Record, RunHeader,
+    SnapshotRecord, WriterOptions, REPLICATED_VERSION,
 };
 use hnav_runtime::durable::{Disk, RealDisk};
 use hnav_runtime::scenario::FsyncPolicy;
-use raft::eraftpb::{ConfState, Entry, HardState};
-use raft::storage::MemStorage;
+use raft::eraftpb::{ConfState, Entry, HardState, Snapshot};
 
 use super::error::ReplicaError;
+use super::store::Store;
+
+/// What a journal held when it was opened: Raft's storage, and the state of the snapshot
+/// the log starts with (none if it was never compacted).
+pub type Opened<D> = (Journal<D>, Store, Option<AppliedState>);
 
 /// A replica's durable Raft log, written on the disk `D`.
 pub struct Journal<D: Disk = RealDisk> {
@@ -40,6 +49,10 @@ pub struct Journal<D: Disk = RealDisk> {
     /// new term or a vote), rather than only a newer commit index.
     must_sync: bool,
     last: HardState,
+    /// The log's header, the first record of every rewrite.
+    header: RunHeader,
+    /// The applied state at the snapshot the log starts with (of nothing, before the first).
+    base: AppliedState,
 }
 
 impl Journal {
@@ -51,7 +64,7 @@ impl Journal {
         header: RunHeader,
         fsync: FsyncPolicy,
         voters: &[u64],
-    ) -> Result<(Journal, MemStorage), ReplicaError> {
+    ) -> Result<Opened<RealDisk>, ReplicaError> {
         Journal::open_on(RealDisk, dir, header, WriterOptions::new(fsync), voters)
     }
 }
@@ -64,7 +77,7 @@ impl<D: Disk> Journal<D> {
         mut header: RunHeader,
         options: WriterOptions,
         voters: &[u64],
-    ) -> Result<(Journal<D>, MemStorage), ReplicaError> {
+    ) -> Result<Opened<D>, ReplicaError> {
         header.version = REPLICATED_VERSION;
         let (mut log, recovered) = LogWriter::open_on(disk, dir, options)?;
         if recovered.truncated_bytes > 0 {
@@ -76,7 +89,7 @@ impl<D: Disk> Journal<D> {
         }
         match recovered.records.first() {
             None => {
-                log.append(&Record::Header(header))?;
+                log.append(&Record::Header(header.clone()))?;
             }
             Some(Record::Header(h)) if *h == header => {}
             Some(other) => {
@@ -91,7 +104,10 @@ impl<D: Disk> Journal<D> {
             }
         }
         let resolved = resolve(dir, recovered.records)?;
-        let storage = MemStorage::new_with_conf_state(ConfState::from((voters.to_vec(), vec![])));
+        let storage = Store::new(voters);
+        if let Some(s) = &resolved.snapshot {
+            storage.compact_to(raft_snapshot(s), &[], HardState::default())?;
+        }
         let entries: Vec<Entry> = resolved.raft.into_iter().map(entry).collect();
         let state = resolved.state;
         let mut hs = HardState::default();
@@ -101,17 +117,72 @@ impl<D: Disk> Journal<D> {
         // took them): it learns the rest from the leader.
         hs.set_commit(state.commit.min(resolved.last_index));
         {
-            let mut w = storage.wl();
+            let mut w = storage.mem().wl();
             w.append(&entries)?;
             w.set_hardstate(hs.clone());
         }
+        let compacted = resolved.compacted;
         let journal = Journal {
             log,
             pending: Vec::new(),
             must_sync: false,
             last: hs,
+            base: compacted
+                .clone()
+                .unwrap_or_else(|| AppliedState::new(&header)),
+            header,
         };
-        Ok((journal, storage))
+        Ok((journal, storage, compacted))
+    }
+
+    /// The applied state of the snapshot the log starts with.
+    pub fn base(&self) -> &AppliedState {
+        &self.base
+    }
+
+    /// Writes the log anew, whole or not at all, as `snapshot` (its state `state`), the hard
+    /// state `hs` and the entries after the snapshot (`tail`): the compaction of a replica
+    /// that took a snapshot, or the log of one that installed its leader's (no tail). Durable
+    /// when it returns; what was queued is in `hs`.
+    pub fn compact(
+        &mut self,
+        snapshot: &Snapshot,
+        state: AppliedState,
+        hs: &HardState,
+        tail: &[Entry],
+    ) -> Result<(), ReplicaError> {
+        let meta = snapshot.get_metadata();
+        let mut records = Vec::with_capacity(tail.len() + 3);
+        records.push(Record::Header(self.header.clone()));
+        records.push(Record::Snapshot(SnapshotRecord {
+            index: meta.index,
+            term: meta.term,
+            voters: meta.get_conf_state().voters.clone(),
+            state: snapshot.data.to_vec(),
+        }));
+        records.push(Record::RaftState(RaftStateRecord {
+            term: hs.term,
+            vote: hs.vote,
+            commit: hs.commit,
+        }));
+        records.extend(tail.iter().map(|e| {
+            Record::Raft(RaftEntryRecord {
+                term: e.term,
+                index: e.index,
+                data: e.data.to_vec(),
+            })
+        }));
+        self.log.replace(&records)?;
+        self.pending.clear();
+        self.must_sync = false;
+        self.last = hs.clone();
+        self.base = state;
+        Ok(())
+    }
+
+    /// Records in its log on disk now.
+    pub fn records(&self) -> u64 {
+        self.log.records()
     }
 
     /// Queues Raft's new entries (the suffix from their first index on replaces what the log
@@ -170,6 +241,19 @@ impl<D: Disk> Journal<D> {
         self.must_sync = false;
         Ok(())
     }
+}
+
+/// A stored snapshot as Raft's.
+pub fn raft_snapshot(s: &SnapshotRecord) -> Snapshot {
+    let mut snap = Snapshot {
+        data: s.state.clone().into(),
+        ..Snapshot::default()
+    };
+    let meta = snap.mut_metadata();
+    meta.index = s.index;
+    meta.term = s.term;
+    meta.set_conf_state(ConfState::from((s.voters.clone(), Vec::new())));
+    snap
 }
 
 /// A stored entry as Raft's.

@@ -40,7 +40,8 @@
 //! | `overheard` | [`Overheard`]: the supervisor's liveness events a following replica keeps |
 //! | `lead` | [`Lead`]: when a replica may decide, and when its decision is final |
 //! | `peer` | [`Replica`], [`ReplicaConfig`], [`Role`], [`Committed`]: one voter and its `Ready` cycle |
-//! | `journal` | [`Journal`]: the Raft log on disk, in the consensus-log segments |
+//! | `journal` | [`Journal`]: the Raft log on disk, in the consensus-log segments, compacted behind a snapshot |
+//! | `store` | [`Store`]: Raft's storage in memory and the last snapshot |
 //! | `link` | [`RaftLink`]: the `raft/<i>` topics between replicas |
 //! | `wire` | [`encode`], [`decode`]: a Raft message as bytes |
 //! | `log_bridge` | Raft's `slog` lines into `tracing` |
@@ -57,6 +58,7 @@ mod overheard;
 mod peer;
 mod raft_log;
 pub mod sim;
+mod store;
 #[cfg(test)]
 mod tests;
 mod wire;
@@ -68,4 +70,5 @@ pub use link::{topic, Inbox, RaftLink, MAX_ENTRIES_BYTES, MAX_MESSAGE_BYTES};
 pub use overheard::Overheard;
 pub use peer::{Committed, Replica, ReplicaConfig, Role};
 pub use raft_log::RaftLog;
+pub use store::Store;
 pub use wire::{decode, encode};

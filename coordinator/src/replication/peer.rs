@@ -4,17 +4,20 @@
 
 use std::collections::VecDeque;
 
-use raft::eraftpb::{ConfState, Entry, EntryType, Message, MessageType};
-use raft::storage::MemStorage;
-use raft::{Config, RawNode, StateRole};
+use raft::eraftpb::{Entry, EntryType, Message, MessageType};
+use raft::{Config, RawNode, SnapshotStatus, StateRole};
 
-use hnav_runtime::consensus_log::WriterOptions;
+use hnav_runtime::consensus_log::{AppliedState, WriterOptions};
 use hnav_runtime::durable::{Disk, RealDisk};
 
 use super::error::ReplicaError;
 use super::journal::Journal;
 use super::link::{RaftLink, MAX_ENTRIES_BYTES};
 use super::log_bridge;
+use super::store::Store;
+use snapshot::decode_state;
+
+mod snapshot;
 
 /// A replica's timing and identity.
 #[derive(Debug, Clone)]
@@ -28,6 +31,9 @@ pub struct ReplicaConfig {
     pub election_ticks: usize,
     /// Ticks between the leader's heartbeats; well below `election_ticks`.
     pub heartbeat_ticks: usize,
+    /// Committed entries after which a durable replica takes a snapshot and compacts its
+    /// journal; 0 never.
+    pub snapshot_entries: u64,
 }
 
 impl ReplicaConfig {
@@ -39,6 +45,7 @@ impl ReplicaConfig {
             voters: (1..=n).collect(),
             election_ticks: 10,
             heartbeat_ticks: 1,
+            snapshot_entries: 0,
         }
     }
 }
@@ -85,7 +92,7 @@ type EarlyOut = Box<dyn FnMut(&Message)>;
 /// One voter of a Raft cluster, driven by its owner's loop; its journal is written on the
 /// disk `D`.
 pub struct Replica<D: Disk = RealDisk> {
-    node: RawNode<MemStorage>,
+    node: RawNode<Store>,
     /// Where entries and hard states are made durable; `None` keeps them in memory only (the
     /// in-process tests).
     journal: Option<Journal<D>>,
@@ -94,14 +101,21 @@ pub struct Replica<D: Disk = RealDisk> {
     early: Option<EarlyOut>,
     outbox: Vec<Message>,
     committed: VecDeque<Committed>,
+    /// A snapshot's index and state the owner has not taken yet: the journal's on a
+    /// restart, or one the leader sent ([`take_installed`](Replica::take_installed)). The
+    /// index is kept beside the state because the replica may compact again before the owner
+    /// takes it (a restart applies the journal's committed entries and can reach the next
+    /// snapshot at once): its current snapshot index is then a later one.
+    installed: Option<(u64, AppliedState)>,
+    snapshot_entries: u64,
+    /// Snapshots installed from a leader since the start.
+    installs: u64,
 }
 
 impl Replica {
     /// A replica of a new cluster: empty storage that knows the voters.
     pub fn new(config: &ReplicaConfig) -> Result<Self, ReplicaError> {
-        let storage =
-            MemStorage::new_with_conf_state(ConfState::from((config.voters.clone(), Vec::new())));
-        Self::restart(config, storage)
+        Self::restart(config, Store::new(&config.voters))
     }
 
     /// A replica whose Raft log is the journal in `dir` (created with `header` if new,
@@ -117,9 +131,16 @@ impl Replica {
     }
 
     /// A replica over storage that survived it: its term, vote and entries come back; what it
-    /// had applied is applied again from the start (its owner's state machine starts empty).
-    pub fn restart(config: &ReplicaConfig, storage: MemStorage) -> Result<Self, ReplicaError> {
-        Self::over(config, storage)
+    /// had applied is applied again from the start (its owner's state machine starts empty),
+    /// or from its last snapshot ([`take_installed`](Replica::take_installed)).
+    pub fn restart(config: &ReplicaConfig, storage: Store) -> Result<Self, ReplicaError> {
+        let snapshot = storage.last_snapshot();
+        let mut replica = Self::over(config, storage)?;
+        let index = snapshot.get_metadata().index;
+        if index > 0 {
+            replica.installed = Some((index, decode_state(&snapshot)?));
+        }
+        Ok(replica)
     }
 
     /// Sends the messages Raft lets leave before the storage (a leader's appends and
@@ -145,9 +166,12 @@ impl<D: Disk> Replica<D> {
         header: hnav_runtime::consensus_log::RunHeader,
         options: WriterOptions,
     ) -> Result<Self, ReplicaError> {
-        let (journal, storage) = Journal::open_on(disk, dir, header, options, &config.voters)?;
+        let (journal, storage, compacted) =
+            Journal::open_on(disk, dir, header, options, &config.voters)?;
+        let index = storage.snapshot_index();
         let mut replica = Self::over(config, storage)?;
         replica.journal = Some(journal);
+        replica.installed = compacted.map(|state| (index, state));
         // The committed entries of the journal are ready at once.
         replica.process()?;
         Ok(replica)
@@ -162,7 +186,7 @@ impl<D: Disk> Replica<D> {
         }
     }
 
-    fn over(config: &ReplicaConfig, storage: MemStorage) -> Result<Self, ReplicaError> {
+    fn over(config: &ReplicaConfig, storage: Store) -> Result<Self, ReplicaError> {
         if config.id == 0 || !config.voters.contains(&config.id) {
             return Err(ReplicaError::NotAVoter {
                 id: config.id,
@@ -191,6 +215,9 @@ impl<D: Disk> Replica<D> {
             early: None,
             outbox: Vec::new(),
             committed: VecDeque::new(),
+            installed: None,
+            snapshot_entries: config.snapshot_entries,
+            installs: 0,
         })
     }
 
@@ -238,8 +265,32 @@ impl<D: Disk> Replica<D> {
     }
 
     /// The storage, to keep for a restart ([`Replica::restart`]).
-    pub fn storage(&self) -> &MemStorage {
+    pub fn storage(&self) -> &Store {
         self.node.store()
+    }
+
+    /// The index of its last snapshot (0 before the first): every entry up to it is
+    /// compacted away.
+    pub fn snapshot_index(&self) -> u64 {
+        self.node.store().snapshot_index()
+    }
+
+    /// Snapshots it installed from a leader (this process).
+    pub fn installs(&self) -> u64 {
+        self.installs
+    }
+
+    /// Records in its journal now (0 for a replica in memory).
+    pub fn journal_records(&self) -> u64 {
+        self.journal.as_ref().map_or(0, Journal::records)
+    }
+
+    /// The state its owner must start from before the next committed entries, if it is not
+    /// the state it has applied so far, with the index it stands for: that of the snapshot
+    /// its journal starts with (after a restart) or of one its leader sent (it was too far
+    /// behind). Take it before [`take_committed`](Self::take_committed).
+    pub fn take_installed(&mut self) -> Option<(u64, AppliedState)> {
+        self.installed.take()
     }
 
     /// Advances its logical clock by one tick (elections, heartbeats).
@@ -342,18 +393,23 @@ impl<D: Disk> Replica<D> {
             // Messages of a leader may leave before its own append (Raft's leader writes in
             // parallel with its followers); the rest wait for the storage below.
             let early = ready.take_messages();
+            let snapshots: Vec<u64> = early
+                .iter()
+                .filter(|m| m.get_msg_type() == MessageType::MsgSnapshot)
+                .map(|m| m.to)
+                .collect();
             match &mut self.early {
                 Some(out) => early.iter().for_each(out),
                 None => self.outbox.extend(early),
             }
             let store = self.node.store().clone();
             if !ready.snapshot().is_empty() {
-                return Err(ReplicaError::Snapshot);
+                self.install(&store, ready.snapshot().clone())?;
             }
             self.collect(ready.take_committed_entries());
-            store.wl().append(ready.entries())?;
+            store.mem().wl().append(ready.entries())?;
             if let Some(hs) = ready.hs() {
-                store.wl().set_hardstate(hs.clone());
+                store.mem().wl().set_hardstate(hs.clone());
             }
             if let Some(j) = &mut self.journal {
                 j.entries(ready.entries());
@@ -366,7 +422,7 @@ impl<D: Disk> Replica<D> {
             self.outbox.extend(ready.take_persisted_messages());
             let mut light = self.node.advance(ready);
             if let Some(commit) = light.commit_index() {
-                store.wl().mut_hard_state().set_commit(commit);
+                store.mem().wl().mut_hard_state().set_commit(commit);
                 if let Some(j) = &mut self.journal {
                     j.commit(commit);
                 }
@@ -374,13 +430,22 @@ impl<D: Disk> Replica<D> {
             self.outbox.extend(light.take_messages());
             self.collect(light.take_committed_entries());
             self.node.advance_apply();
+            // A snapshot is reported sent as it leaves, so that the leader probes the
+            // follower again: one lost on the way is found out like a lost append (the
+            // follower refuses the next one) and sent again, instead of being waited for.
+            for to in snapshots {
+                self.node.report_snapshot(to, SnapshotStatus::Finish);
+            }
         }
-        Ok(())
+        self.compact_if_due()
     }
 
     fn collect(&mut self, entries: Vec<Entry>) {
+        // Entries up to an installed snapshot are in its state.
+        let floor = self.node.store().snapshot_index();
         for e in entries {
-            if e.get_entry_type() == EntryType::EntryNormal && !e.data.is_empty() {
+            if e.get_entry_type() == EntryType::EntryNormal && !e.data.is_empty() && e.index > floor
+            {
                 self.committed.push_back(Committed {
                     index: e.index,
                     term: e.term,

@@ -12,7 +12,7 @@ use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 use hnav_runtime::consensus_log::{
-    decode_record, encode_record, Record, ReplicaRole, RunHeader, ROLE_FILE,
+    decode_record, encode_record, AppliedState, Record, ReplicaRole, RunHeader, ROLE_FILE,
 };
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::transport::Transport;
@@ -45,6 +45,8 @@ pub struct RaftLog {
     longest_silence: Duration,
     /// Records committed by other leaders, in log order, for the coordinator to apply.
     applied: Vec<Record>,
+    /// A snapshot's state the coordinator must start from before `applied`.
+    installed: Option<AppliedState>,
     /// The replica's log directory, where its role file is kept for `hnav ps`.
     dir: PathBuf,
     /// The role and term the role file says.
@@ -65,6 +67,7 @@ impl RaftLog {
         let config = ReplicaConfig {
             election_ticks: c.election_ticks(),
             heartbeat_ticks: 1,
+            snapshot_entries: c.snapshot_entries,
             ..ReplicaConfig::cluster(id, u64::from(c.replicas))
         };
         let dir = run_dir.join("log").join(id.to_string());
@@ -86,6 +89,7 @@ impl RaftLog {
             heard_leader: None,
             longest_silence: Duration::ZERO,
             applied: Vec::new(),
+            installed: None,
             dir,
             shown: None,
         };
@@ -178,7 +182,7 @@ impl RaftLog {
                 // A message of another term or a stale one is Raft's to refuse; only a storage
                 // failure must stop the replica.
                 match e {
-                    ReplicaError::Log(_) | ReplicaError::Snapshot => failed = Some(e),
+                    ReplicaError::Log(_) | ReplicaError::Decode(_) => failed = Some(e),
                     other => tracing::debug!("raft message refused: {other}"),
                 }
             }
@@ -249,6 +253,13 @@ impl RaftLog {
         std::mem::take(&mut self.applied)
     }
 
+    /// The state of a snapshot the coordinator must start from before the records of
+    /// [`take_applied`](Self::take_applied): its journal's, after a restart over a compacted
+    /// log, or the leader's, when this replica was too far behind for the entries.
+    pub fn take_installed(&mut self) -> Option<AppliedState> {
+        self.installed.take()
+    }
+
     /// Takes back the buffer [`RaftLog::take_applied`] lent, emptied.
     pub fn recycle(&mut self, mut records: Vec<Record>) {
         records.clear();
@@ -282,6 +293,11 @@ impl RaftLog {
 
     /// Moves the committed records this replica did not decide itself into `applied`.
     fn take_committed(&mut self) -> Result<(), ReplicaError> {
+        if let Some((_, state)) = self.replica.take_installed() {
+            // The records not yet applied are in the snapshot's state.
+            self.applied.clear();
+            self.installed = Some(state);
+        }
         for c in self.replica.take_committed() {
             if self.lead.decided_here(&c) {
                 continue;

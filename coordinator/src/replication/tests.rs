@@ -5,18 +5,21 @@
 use super::*;
 use hnav_runtime::consensus_log::{encode_record, read_decided, Record, RoundRecord, RunHeader};
 use hnav_runtime::scenario::FsyncPolicy;
-use raft::storage::MemStorage;
 
 /// Replicas 1..=n, each `None` while lost, with the storages kept for restarts and every
 /// entry each has committed so far.
 struct Cluster {
     replicas: Vec<Option<Replica>>,
-    storages: Vec<MemStorage>,
+    storages: Vec<Store>,
     /// The replicas' journals (`<dir>/<id>/`), for a durable cluster.
     journals: Option<tempfile::TempDir>,
     committed: Vec<Vec<Committed>>,
     /// Pairs (from, to) whose messages are dropped: a partition.
     cut: Vec<(u64, u64)>,
+    /// Per replica: the snapshot's state it started from in this incarnation, if any.
+    installed: Vec<Option<hnav_runtime::consensus_log::AppliedState>>,
+    /// Entries after which a durable replica compacts (0 never).
+    snapshot_entries: u64,
 }
 
 impl Cluster {
@@ -34,14 +37,21 @@ impl Cluster {
             journals: None,
             committed: vec![Vec::new(); n as usize],
             cut: Vec::new(),
+            installed: vec![None; n as usize],
+            snapshot_entries: 0,
         }
     }
 
     /// A cluster whose replicas keep their Raft logs in journals on disk.
     fn durable(n: u64) -> Self {
+        Self::compacting(n, 0)
+    }
+
+    /// A durable cluster whose replicas compact their journals every `snapshot_entries`.
+    fn compacting(n: u64, snapshot_entries: u64) -> Self {
         let dir = tempfile::tempdir().unwrap();
         let replicas: Vec<_> = (1..=n)
-            .map(|id| Some(durable_replica(dir.path(), id, n)))
+            .map(|id| Some(durable_replica(dir.path(), id, n, snapshot_entries)))
             .collect();
         Cluster {
             replicas,
@@ -49,6 +59,8 @@ impl Cluster {
             journals: Some(dir),
             committed: vec![Vec::new(); n as usize],
             cut: Vec::new(),
+            installed: vec![None; n as usize],
+            snapshot_entries,
         }
     }
 
@@ -74,10 +86,11 @@ impl Cluster {
         // The old process is gone first: its journal's lock goes with it.
         self.replicas[i] = None;
         self.replicas[i] = Some(match &self.journals {
-            Some(dir) => durable_replica(dir.path(), id, self.n()),
+            Some(dir) => durable_replica(dir.path(), id, self.n(), self.snapshot_entries),
             None => Replica::restart(&config, self.storages[i].clone()).unwrap(),
         });
         self.committed[i].clear();
+        self.installed[i] = None;
     }
 
     /// Delivers messages until none is in flight; collects what each replica committed.
@@ -86,6 +99,11 @@ impl Cluster {
             let mut mail = Vec::new();
             for (i, r) in self.replicas.iter_mut().enumerate() {
                 if let Some(r) = r {
+                    if let Some((_, state)) = r.take_installed() {
+                        // The entries handed out before are in the snapshot's state.
+                        self.committed[i].clear();
+                        self.installed[i] = Some(state);
+                    }
                     self.committed[i].extend(r.take_committed());
                     mail.extend(r.take_messages());
                 }
@@ -180,8 +198,11 @@ fn header() -> RunHeader {
     }
 }
 
-fn durable_replica(dir: &std::path::Path, id: u64, n: u64) -> Replica {
-    let config = ReplicaConfig::cluster(id, n);
+fn durable_replica(dir: &std::path::Path, id: u64, n: u64, snapshot_entries: u64) -> Replica {
+    let config = ReplicaConfig {
+        snapshot_entries,
+        ..ReplicaConfig::cluster(id, n)
+    };
     Replica::durable(
         &config,
         &dir.join(id.to_string()),
@@ -190,6 +211,8 @@ fn durable_replica(dir: &std::path::Path, id: u64, n: u64) -> Replica {
     )
     .unwrap()
 }
+
+mod snapshot;
 
 #[test]
 fn three_replicas_commit_the_same_records_in_the_same_order() {
@@ -388,7 +411,7 @@ fn every_replica_restarted_from_its_journal_comes_back_with_the_log() {
 #[test]
 fn a_journal_of_another_run_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    drop(durable_replica(dir.path(), 1, 3));
+    drop(durable_replica(dir.path(), 1, 3, 0));
     let other = RunHeader {
         seed: 2,
         ..header()

@@ -371,6 +371,11 @@ impl Arbiter {
         &self.tally
     }
 
+    /// Takes `tally` as that of every decision so far (a replica that starts from a snapshot).
+    pub fn restore_tally(&mut self, tally: Tally) {
+        self.tally = tally;
+    }
+
     /// Adds a logged round's decisions to the tally, as if this arbiter had made them (after
     /// a coordinator restart).
     pub fn replay(&mut self, round: &RoundRecord) {

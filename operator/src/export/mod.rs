@@ -101,12 +101,20 @@ struct RunInfo {
 /// to the MCAP file `out`.
 pub fn export_mcap(run_dir: &Path, out: &Path) -> Result<ExportReport, ExportError> {
     let log_dir = run_dir.join("log");
-    let records = read_decided(&log_dir)?.records;
+    let decided = read_decided(&log_dir)?;
+    let records = decided.records;
     let header = match records.first() {
         Some(Record::Header(h)) => h.clone(),
         _ => return Err(ExportError::NoHeader { dir: log_dir }),
     };
     let mut report = ExportReport::default();
+    if let Some(c) = &decided.compacted {
+        report.notes.push(format!(
+            "{}: compacted behind a snapshot; the decisions start after round {}",
+            decided.dir.display(),
+            c.round
+        ));
+    }
     let info = run_info(run_dir, header, &mut report.notes);
     let write_err = |e: &dyn std::fmt::Display| ExportError::Write {
         path: out.to_path_buf(),

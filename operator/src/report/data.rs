@@ -168,6 +168,19 @@ impl RunData {
         };
         let mut at = data.starts.clone();
         let mut tally = Tally::from_header(header);
+        if let Some(c) = &contents.compacted {
+            // The map draws what the log still holds; the totals count the snapshot's too.
+            data.notes.push(format!(
+                "{}: compacted, the first {} decided records (through round {}) are in its \
+                 snapshot: the paths start there",
+                contents.dir.display(),
+                c.records,
+                c.round
+            ));
+            tally = c.tally.clone();
+            data.rounds = c.round;
+            at = tally.cells().iter().map(|&c| xy(c)).collect();
+        }
         for r in &contents.records {
             match r {
                 Record::Round(round) => data.fold_round(round, &mut tally, &mut at, xy),

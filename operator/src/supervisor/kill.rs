@@ -256,13 +256,7 @@ fn coordinator_index(run: &str, record: &RunRecord) -> Result<u32, KillError> {
 /// (0 if it has none or cannot be read: the signal is sent either way, and the journal's
 /// stamp says when).
 fn last_round(dir: &Path) -> u64 {
-    read_decided(dir).map_or(0, |d| {
-        d.records
-            .iter()
-            .filter_map(|r| r.round())
-            .max()
-            .unwrap_or(0)
-    })
+    read_decided(dir).map_or(0, |d| d.last_round())
 }
 
 #[cfg(test)]

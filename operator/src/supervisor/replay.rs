@@ -17,14 +17,16 @@
 //! decided the most, the lowest id among equals. In lockstep every replica decides the very
 //! records a single coordinator decides (`tests/tests/replicas.rs`), so which replica led
 //! when does not matter; only how far each had learned of the commits when the run ended
-//! does, and the one that decided the most knew all of them.
+//! does, and the one that decided the most knew all of them. A replica's log compacted behind
+//! a snapshot holds only the records after it: the two logs are compared from the first
+//! record both still hold.
 
 use std::path::{Path, PathBuf};
 
 use super::run::{run, RunError, RunOptions};
 use crate::invocation::{Invocation, InvocationError, FILE as INVOCATION};
 use hnav_runtime::consensus_log::{
-    compare, read_decided, replica_dirs, Comparison, LogError, Record, RunHeader,
+    compare, read_decided, replica_dirs, Comparison, Decided, LogError, Record, RunHeader,
     REPLICATED_VERSION,
 };
 use hnav_runtime::launch::ProcessArgs;
@@ -125,8 +127,8 @@ pub fn run_dir_of(dir: &Path) -> PathBuf {
 pub fn replay(opts: &ReplayOptions) -> Result<Replayed, ReplayError> {
     let dir = run_dir_of(&opts.dir);
     let log_dir = dir.join("log");
-    let logged = read_decided(&log_dir)?.records;
-    let header = match logged.first() {
+    let logged = read_decided(&log_dir)?;
+    let header = match logged.records.first() {
         Some(Record::Header(h)) => h.clone(),
         _ => return Err(ReplayError::NoHeader { dir: log_dir }),
     };
@@ -162,11 +164,28 @@ pub fn replay(opts: &ReplayOptions) -> Result<Replayed, ReplayError> {
         record: false,
         host: None,
     })?;
-    let replayed = read_decided(tmp.0.join("log"))?.records;
+    let replayed = read_decided(tmp.0.join("log"))?;
+    // Compacted logs (replicas' snapshots) are compared from where both hold their records.
+    let skip = [&logged, &replayed]
+        .iter()
+        .filter_map(|d| d.compacted.as_ref().map(|c| c.records))
+        .max()
+        .unwrap_or(0);
+    let (logged, replayed) = (after(logged, skip), after(replayed, skip));
     Ok(Replayed {
         comparison: compare(&logged, &replayed, header.width),
         header,
     })
+}
+
+/// The header and the decided records after the first `skip`, of which `d` may hold only
+/// those after its snapshot.
+fn after(d: Decided, skip: u64) -> Vec<Record> {
+    let held = skip.saturating_sub(d.compacted.map_or(0, |c| c.records)) as usize;
+    let mut records = d.records;
+    let drop = held.min(records.len().saturating_sub(1));
+    records.drain(1..1 + drop);
+    records
 }
 
 /// An `invocation.json` written before it recorded `--replicas` leaves the replicas to the

@@ -155,10 +155,26 @@ impl RunSummary {
         let mut unreachable = Vec::new();
         let mut lost = Vec::new();
         let mut tasks = Vec::new();
+        // A compacted replica's log: the records its snapshot stands for add up to its state.
+        let compacted = contents.compacted.as_ref();
+        if let Some(c) = compacted {
+            rounds = c.round;
+            tasks.extend_from_slice(&c.tasks);
+            if let Some(e) = c.end {
+                end = e.reason.name().to_string();
+            }
+            unreachable.extend(c.unreachable.iter().map(|u| u.agent));
+            lost.extend(
+                (0u32..)
+                    .zip(&c.agents)
+                    .filter(|(_, a)| a.lost)
+                    .map(|(i, _)| i),
+            );
+        }
         for r in &contents.records {
             match r {
                 Record::Header(h) => {
-                    tally = Tally::from_header(h);
+                    tally = compacted.map_or_else(|| Tally::from_header(h), |c| c.tally.clone());
                     header = Some(h);
                 }
                 Record::Round(rec) => {
@@ -176,7 +192,8 @@ impl RunSummary {
                 Record::Lifecycle(_)
                 | Record::Replan(_)
                 | Record::Raft(_)
-                | Record::RaftState(_) => {}
+                | Record::RaftState(_)
+                | Record::Snapshot(_) => {}
             }
         }
         let mut agents: Vec<AgentSummary> = (0u32..)

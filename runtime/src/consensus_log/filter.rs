@@ -11,7 +11,7 @@ use super::record::{RaftEntryRecord, Record};
 use crate::msg::Role;
 
 /// The kinds a filter can name, as [`Record::kind`] spells them.
-pub const KINDS: [&str; 9] = [
+pub const KINDS: [&str; 10] = [
     "header",
     "round",
     "lifecycle",
@@ -21,6 +21,7 @@ pub const KINDS: [&str; 9] = [
     "raft-entry",
     "raft-state",
     "task",
+    "snapshot",
 ];
 
 /// What to keep of a log. The empty filter keeps everything; each part given narrows it.

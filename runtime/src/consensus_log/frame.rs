@@ -169,7 +169,7 @@ mod tests {
         assert_eq!(detail(&[1, 0xFF]), "a malformed integer");
         assert_eq!(
             detail(&[10]),
-            "invalid value: integer `10`, expected variant index 0 <= i < 9"
+            "invalid value: integer `10`, expected variant index 0 <= i < 10"
         );
     }
 

@@ -37,6 +37,7 @@
 //! | [`show`] | one-line text and JSON renderings of records |
 //! | [`filter`] | [`RecordFilter`]: which records `hnav log show` prints, by round, agent and kind |
 //! | [`tally`] | [`Tally`]: per-agent steps, octile length, conflicts, rounds waited for the plan and replans of the decisions |
+//! | [`snapshot`] | [`SnapshotRecord`], [`AppliedState`]: what a replica's compacted prefix adds up to |
 //! | [`replicated`] | a replica's log (version [`REPLICATED_VERSION`]): Raft entries and hard state in the same frames; [`resolve`], [`read_decided`] |
 //! | [`compare`](mod@compare) | [`compare()`]: two logs record by record, the first [`Divergence`] in words (`hnav log replay`) |
 //! | [`error`] | [`LogError`], [`FrameProblem`] |
@@ -50,6 +51,7 @@ pub mod record;
 pub mod replicated;
 pub mod segment;
 pub mod show;
+pub mod snapshot;
 pub mod tally;
 pub mod verify;
 pub mod writer;
@@ -63,16 +65,20 @@ pub use frame::{
 pub use reader::{read_log, LogContents, LogReader, RecordPos, TornTail};
 pub use record::{
     candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision,
-    RaftEntryRecord, RaftStateRecord, Record, ReplanRecord, RoundRecord, RunHeader, TaskRecord,
-    UnreachableRecord,
+    RaftEntryRecord, RaftStateRecord, Record, ReplanRecord, RoundRecord, RunHeader, SnapshotRecord,
+    TaskRecord, UnreachableRecord,
 };
 pub use replicated::{
     is_replicated, read_decided, replica_dirs, resolve, Decided, ReplicaRole, Resolved, ROLE_FILE,
 };
 pub use segment::{list_segments, segment_name, segment_path, DEFAULT_SEGMENT_BYTES};
+pub use snapshot::{AgentLife, AppliedState};
 pub use tally::{AgentTally, Counted, Tally};
 pub use verify::{verify, KindCounts, VerifyReport, VerifyStatus};
-pub use writer::{LogWriter, Recovered, WriterOptions, BATCH_INTERVAL, BATCH_RECORDS, WRITER_LOCK};
+pub use writer::{
+    LogWriter, Recovered, WriterOptions, BATCH_INTERVAL, BATCH_RECORDS, REPLACE_READY, REPLACE_TMP,
+    WRITER_LOCK,
+};
 
 /// The format version of a single coordinator's log, in its [`RunHeader::version`].
 pub const FORMAT_VERSION: u32 = 1;

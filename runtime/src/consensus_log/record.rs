@@ -33,6 +33,9 @@ pub enum Record {
     /// A lifelong run (`[tasks]`) gave an agent standing on its goal its next goal (after the
     /// kinds above so that their encoding is unchanged).
     Task(TaskRecord),
+    /// A replica's snapshot: the applied state of the Raft entries it replaced, which are
+    /// gone from its log ([`snapshot`](super::snapshot)).
+    Snapshot(SnapshotRecord),
 }
 
 impl Record {
@@ -49,6 +52,7 @@ impl Record {
             Self::Raft(_) => "raft-entry",
             Self::RaftState(_) => "raft-state",
             Self::Task(_) => "task",
+            Self::Snapshot(_) => "snapshot",
         }
     }
 
@@ -62,7 +66,7 @@ impl Record {
             Self::End(r) => Some(r.round),
             Self::Unreachable(r) => Some(r.round),
             Self::Task(r) => Some(r.round),
-            Self::Raft(_) | Self::RaftState(_) => None,
+            Self::Raft(_) | Self::RaftState(_) | Self::Snapshot(_) => None,
         }
     }
 }
@@ -79,6 +83,22 @@ pub struct RaftEntryRecord {
     /// The decided [`Record`] in the log's own payload encoding, or empty for the empty entry
     /// a new leader appends.
     pub data: Vec<u8>,
+}
+
+/// A replica's snapshot: the applied state of every Raft entry up to `index`, which it
+/// replaces in the log. The first record after the header of a compacted log; see
+/// [`snapshot`](super::snapshot).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SnapshotRecord {
+    /// The last Raft index it covers (every entry up to it is committed).
+    pub index: u64,
+    /// That entry's term.
+    pub term: u64,
+    /// The cluster's voters.
+    pub voters: Vec<u64>,
+    /// The [`AppliedState`](super::snapshot::AppliedState), encoded: the bytes Raft sends to a
+    /// replica that needs the snapshot.
+    pub state: Vec<u8>,
 }
 
 /// A replica's Raft hard state, as of this point in its log.

@@ -21,8 +21,9 @@ use std::path::{Path, PathBuf};
 use super::error::LogError;
 use super::frame::decode_record;
 use super::reader::read_log;
-use super::record::{RaftEntryRecord, RaftStateRecord, Record};
+use super::record::{RaftEntryRecord, RaftStateRecord, Record, SnapshotRecord};
 use super::segment::list_segments;
+use super::snapshot::AppliedState;
 use super::REPLICATED_VERSION;
 
 /// A replica's log, read and resolved.
@@ -36,9 +37,13 @@ pub struct Resolved {
     pub state: RaftStateRecord,
     /// The last entry's index, committed or not.
     pub last_index: u64,
-    /// The log's current Raft entries (overwritten ones dropped), for a restarted replica's
-    /// storage.
+    /// The log's current Raft entries (overwritten ones dropped, and those the snapshot
+    /// stands for), for a restarted replica's storage.
     pub raft: Vec<RaftEntryRecord>,
+    /// The log's snapshot, if it was compacted: it stands for every entry up to its index.
+    pub snapshot: Option<SnapshotRecord>,
+    /// The snapshot's state, decoded: what `records` come after.
+    pub compacted: Option<AppliedState>,
 }
 
 impl Resolved {
@@ -66,6 +71,8 @@ pub fn resolve(dir: &Path, records: Vec<Record>) -> Result<Resolved, LogError> {
             state: RaftStateRecord::default(),
             last_index: 0,
             raft: Vec::new(),
+            snapshot: None,
+            compacted: None,
         });
     }
     let bad = |index: u64, what: String| LogError::Raft {
@@ -75,31 +82,52 @@ pub fn resolve(dir: &Path, records: Vec<Record>) -> Result<Resolved, LogError> {
     };
     let mut raft: Vec<RaftEntryRecord> = Vec::new();
     let mut state = RaftStateRecord::default();
+    let mut snapshot: Option<(SnapshotRecord, AppliedState)> = None;
     let mut it = records.into_iter();
     let header = it.next().expect("is_replicated saw a header");
     for r in it {
+        let base = snapshot.as_ref().map_or((0, 0), |(s, _)| (s.index, s.term));
         match r {
             Record::Raft(e) => {
-                // Entries are never compacted away: a replica's log starts at index 1.
-                let next = raft.last().map_or(1, |l| l.index + 1);
-                if e.index == 0 || e.index > next {
+                let next = raft.last().map_or(base.0 + 1, |l| l.index + 1);
+                if e.index <= base.0 {
+                    let what = format!("at or before the snapshot at {}", base.0);
+                    return Err(bad(e.index, what));
+                }
+                if e.index > next {
                     return Err(bad(e.index, format!("skips indices (expected {next})")));
                 }
                 // An entry at an index already written replaces it and all after it.
-                raft.truncate((e.index - 1) as usize);
-                if let Some(prev) = raft.last().filter(|p| p.term > e.term) {
-                    let what =
-                        format!("term {} after term {} at {}", e.term, prev.term, prev.index);
+                raft.truncate((e.index - base.0 - 1) as usize);
+                let prev = raft.last().map_or(base, |p| (p.index, p.term));
+                if prev.1 > e.term {
+                    let what = format!("term {} after term {} at {}", e.term, prev.1, prev.0);
                     return Err(bad(e.index, what));
                 }
                 raft.push(e);
             }
             Record::RaftState(s) => state = s,
+            Record::Snapshot(s) => {
+                if s.index < base.0 || (s.index == base.0 && s.term < base.1) {
+                    let what = format!("snapshot after the snapshot at {}", base.0);
+                    return Err(bad(s.index, what));
+                }
+                let applied = s.applied().map_err(|p| bad(s.index, p.to_string()))?;
+                // It stands for every entry up to its index; later ones stay (a compacted
+                // log rewrites them after it).
+                let keep = raft.iter().position(|e| e.index > s.index);
+                raft.drain(..keep.unwrap_or(raft.len()));
+                snapshot = Some((s, applied));
+            }
             other => {
                 let what = format!("a {} record outside a Raft entry", other.kind());
                 return Err(bad(raft.last().map_or(0, |l| l.index), what));
             }
         }
+    }
+    if let Some((s, _)) = snapshot.as_ref().filter(|(s, _)| state.commit < s.index) {
+        let what = format!("commit index {} below the snapshot", state.commit);
+        return Err(bad(s.index, what));
     }
     let mut decided = vec![header];
     let mut entries = Vec::new();
@@ -110,7 +138,7 @@ pub fn resolve(dir: &Path, records: Vec<Record>) -> Result<Resolved, LogError> {
         let record = decode_record(&e.data).map_err(|p| bad(e.index, p.to_string()))?;
         if matches!(
             record,
-            Record::Header(_) | Record::Raft(_) | Record::RaftState(_)
+            Record::Header(_) | Record::Raft(_) | Record::RaftState(_) | Record::Snapshot(_)
         ) {
             let what = format!("holds a {} record, not a decision", record.kind());
             return Err(bad(e.index, what));
@@ -118,12 +146,18 @@ pub fn resolve(dir: &Path, records: Vec<Record>) -> Result<Resolved, LogError> {
         decided.push(record);
         entries.push((e.term, e.index));
     }
+    let last_index = raft
+        .last()
+        .map_or(snapshot.as_ref().map_or(0, |(s, _)| s.index), |l| l.index);
+    let (snapshot, compacted) = snapshot.map_or((None, None), |(s, a)| (Some(s), Some(a)));
     Ok(Resolved {
         records: decided,
         entries,
         state,
-        last_index: raft.last().map_or(0, |l| l.index),
+        last_index,
         raft,
+        snapshot,
+        compacted,
     })
 }
 
@@ -136,6 +170,25 @@ pub struct Decided {
     pub dir: PathBuf,
     /// The replica's id, for a run with replicas.
     pub replica: Option<u64>,
+    /// What the records a compacted log no longer holds add up to (its snapshot's state):
+    /// `records` are those after it.
+    pub compacted: Option<AppliedState>,
+}
+
+impl Decided {
+    /// Decided records in all, those the snapshot stands for included (the header not
+    /// counted).
+    pub fn decided(&self) -> u64 {
+        let before = self.compacted.as_ref().map_or(0, |c| c.records);
+        before + self.records.len().saturating_sub(1) as u64
+    }
+
+    /// The last round decided, whether its record is here or compacted.
+    pub fn last_round(&self) -> u64 {
+        let here = self.records.iter().filter_map(Record::round).max();
+        let before = self.compacted.as_ref().map_or(0, |c| c.round);
+        here.unwrap_or(0).max(before)
+    }
 }
 
 /// The replicas' log directories under `dir` (`DIR/log/<id>/`), by id; empty for a single
@@ -171,10 +224,7 @@ pub fn read_decided(dir: impl AsRef<Path>) -> Result<Decided, LogError> {
     let mut best: Option<Decided> = None;
     for (id, sub) in replicas {
         let d = read_one(&sub, Some(id))?;
-        if best
-            .as_ref()
-            .is_none_or(|b| d.records.len() > b.records.len())
-        {
+        if best.as_ref().is_none_or(|b| d.decided() > b.decided()) {
             best = Some(d);
         }
     }
@@ -187,6 +237,7 @@ fn read_one(dir: &Path, replica: Option<u64>) -> Result<Decided, LogError> {
         records: resolved.records,
         dir: dir.to_path_buf(),
         replica,
+        compacted: resolved.compacted,
     })
 }
 
@@ -312,6 +363,76 @@ mod tests {
             (
                 vec![entry(1, 1, Some(&header())), state(1, 1)],
                 "Raft entry 1: holds a header record",
+            ),
+        ];
+        for (mut tail, want) in cases {
+            let mut log = vec![header()];
+            log.append(&mut tail);
+            let e = resolve(Path::new("d"), log).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("d: {want}")), "{e}");
+        }
+    }
+
+    fn snapshot(index: u64, term: u64, state: Vec<u8>) -> Record {
+        Record::Snapshot(SnapshotRecord {
+            index,
+            term,
+            voters: vec![1, 2, 3],
+            state,
+        })
+    }
+
+    fn state_after(records: &[Record]) -> Vec<u8> {
+        let Record::Header(h) = header() else {
+            unreachable!()
+        };
+        let mut s = AppliedState::new(&h);
+        records.iter().for_each(|r| s.fold(r));
+        s.encode()
+    }
+
+    #[test]
+    fn a_snapshot_stands_for_the_entries_up_to_its_index() {
+        let log = vec![
+            header(),
+            snapshot(4, 2, state_after(&[end(1), end(2)])),
+            state(2, 4),
+            entry(2, 5, Some(&end(3))),
+            entry(3, 6, Some(&end(4))),
+            state(3, 5),
+        ];
+        let r = resolve(Path::new("d"), log).unwrap();
+        assert_eq!(r.records, vec![header(), end(3)]);
+        assert_eq!(r.entries, vec![(2, 5)]);
+        assert_eq!(r.last_index, 6);
+        let c = r.compacted.unwrap();
+        assert_eq!((c.records, c.end.map(|e| e.round)), (2, Some(2)));
+        assert_eq!(r.snapshot.map(|s| s.index), Some(4));
+    }
+
+    #[test]
+    fn entries_against_the_snapshot_and_a_damaged_state_are_errors_naming_the_index() {
+        let good = || state_after(&[end(1)]);
+        let cases = [
+            (
+                vec![snapshot(4, 2, good()), state(2, 4), entry(2, 4, None)],
+                "Raft entry 4: at or before the snapshot at 4",
+            ),
+            (
+                vec![snapshot(4, 2, good()), state(2, 4), entry(2, 6, None)],
+                "Raft entry 6: skips indices (expected 5)",
+            ),
+            (
+                vec![snapshot(4, 2, good()), state(2, 4), entry(1, 5, None)],
+                "Raft entry 5: term 1 after term 2 at 4",
+            ),
+            (
+                vec![snapshot(4, 2, good()), state(2, 3)],
+                "Raft entry 4: commit index 3 below the snapshot",
+            ),
+            (
+                vec![snapshot(4, 2, vec![0xff; 3]), state(2, 4)],
+                "Raft entry 4: undecodable record: snapshot state",
             ),
         ];
         for (mut tail, want) in cases {

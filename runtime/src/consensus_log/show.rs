@@ -144,6 +144,26 @@ pub fn describe(record: &Record, width: u32) -> String {
                 st.term, st.vote, st.commit
             );
         }
+        Record::Snapshot(snap) => {
+            let _ = write!(s, "snapshot {}.{}  ", snap.term, snap.index);
+            match snap.applied() {
+                Ok(a) => {
+                    let _ = write!(
+                        s,
+                        "{} records through round {}  conflicts {}  replans {}  lost {}",
+                        a.records,
+                        a.round,
+                        a.tally.conflicts(),
+                        a.tally.replans(),
+                        a.agents.iter().filter(|l| l.lost).count()
+                    );
+                    if let Some(e) = a.end {
+                        let _ = write!(s, "  ended {}", e.reason.name());
+                    }
+                }
+                Err(p) => _ = write!(s, "undecodable: {p}"),
+            }
+        }
     }
     s
 }
@@ -277,6 +297,21 @@ pub fn to_json(pos: &RecordPos, record: &Record, width: u32) -> Value {
             "term": st.term,
             "vote": st.vote,
             "commit": st.commit,
+        }),
+        Record::Snapshot(snap) => json!({
+            "term": snap.term,
+            "index": snap.index,
+            "voters": snap.voters,
+            "state": match snap.applied() {
+                Ok(a) => json!({
+                    "records": a.records,
+                    "round": a.round,
+                    "conflicts": a.tally.conflicts(),
+                    "replans": a.tally.replans(),
+                    "end": a.end.map(|e| e.reason.name()),
+                }),
+                Err(p) => json!({ "undecodable": p.to_string() }),
+            },
         }),
     };
     let mut object = Map::new();

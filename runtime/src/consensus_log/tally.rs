@@ -27,7 +27,7 @@ use super::record::{LoggedDecision, RoundRecord, RunHeader};
 use crate::msg::{ConflictKind, Verdict};
 
 /// One agent's share of a [`Tally`].
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AgentTally {
     /// Accepted moves.
     pub steps: u32,
@@ -63,7 +63,7 @@ pub enum Counted {
 /// It keeps each agent's cell (its start, then the cell of its last accepted move) to measure
 /// the next move, and its last decision to tell a new request from one still waiting.
 /// Folding allocates nothing.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Tally {
     agents: Vec<AgentTally>,
     cells: Vec<u32>,
@@ -136,6 +136,11 @@ impl Tally {
         for d in &round.decisions {
             self.fold(d);
         }
+    }
+
+    /// Per agent, the cell it stands on: its start, then that of its last accepted move.
+    pub fn cells(&self) -> &[u32] {
+        &self.cells
     }
 
     /// Per agent, index = agent number.

@@ -20,6 +20,9 @@
 //! the reader cannot tell from corruption; under `EveryRecord` only the record in flight can
 //! be torn, and reopening cuts exactly that.
 //!
+//! A Raft replica compacting its log replaces it whole ([`LogWriter::replace`], in
+//! `replace`).
+//!
 //! ```no_run
 //! use hnav_runtime::consensus_log::{LogWriter, Record, RunHeader, FORMAT_VERSION};
 //! use hnav_runtime::scenario::FsyncPolicy;
@@ -39,6 +42,10 @@
 //! # Ok(())
 //! # }
 //! ```
+
+mod replace;
+
+pub use replace::{REPLACE_READY, REPLACE_TMP};
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -152,6 +159,7 @@ impl<D: Disk> LogWriter<D> {
             }
         }
         let lock = lock_log(&dir)?;
+        replace::finish_replace(&disk, &dir, syncing)?;
         let segments = list_segments(&dir)?;
         if segments.is_empty() {
             let path = segment_path(&dir, 0);

@@ -212,6 +212,10 @@ pub(super) fn build_coordinator(
             "coordinator.election_ms",
             lines,
         )?,
+        snapshot_entries: c
+            .snapshot_entries
+            .as_ref()
+            .map_or(d.snapshot_entries, |s| *s.get_ref()),
     })
     .and_then(|p| election_after_heartbeats(p, &c, lines))
 }

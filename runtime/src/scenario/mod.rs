@@ -50,6 +50,7 @@
 //! replicas = 1                         # 1, 3 or 5 coordinator replicas agreeing by Raft; not in the hash
 //! raft_heartbeat_ms = 50               # the replicas' tick
 //! election_ms = 500                    # at least 3 heartbeats; Raft randomises it up to twice that
+//! snapshot_entries = 10000             # a replica compacts its log after this many entries; 0 never
 //!
 //! [restart]                            # per role; default for each role as shown
 //! agent = { policy = "on-failure", max_restarts = 3, backoff_ms = 100 }

@@ -272,6 +272,10 @@ pub struct CoordinatorParams {
     /// Time without a leader's heartbeat after which a follower stands for election (Raft
     /// randomises it in `[election_ms, 2 * election_ms)`); a multiple of the heartbeat.
     pub election_ms: u32,
+    /// Committed Raft entries after which a replica takes a snapshot of the applied state
+    /// and compacts its log behind it; 0 never. Not in the scenario hash: it changes what a
+    /// replica keeps on disk, not what is decided.
+    pub snapshot_entries: u64,
 }
 
 impl CoordinatorParams {
@@ -298,6 +302,8 @@ impl Default for CoordinatorParams {
             // stalled by a busy 2-core machine for less than 0.5 s deposes nobody.
             raft_heartbeat_ms: 50,
             election_ms: 500,
+            // About 100 s of rounds at the default 10 ms period: a short run never compacts.
+            snapshot_entries: 10_000,
         }
     }
 }

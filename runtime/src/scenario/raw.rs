@@ -74,6 +74,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
             "replicas",
             "raft_heartbeat_ms",
             "election_ms",
+            "snapshot_entries",
         ],
     ),
     ("run", &["startup_timeout_s"]),
@@ -182,6 +183,7 @@ pub(super) struct RawCoordinator {
     pub replicas: Option<Spanned<u32>>,
     pub raft_heartbeat_ms: Option<Spanned<u32>>,
     pub election_ms: Option<Spanned<u32>>,
+    pub snapshot_entries: Option<Spanned<u64>>,
 }
 
 /// `[run]`.

@@ -22,8 +22,8 @@ mod supervisor;
 use std::path::Path;
 
 use hnav_runtime::consensus_log::{
-    AgentEntry, EndReason, EndRecord, LogWriter, Record, RoundRecord, RunHeader, UnreachableRecord,
-    FORMAT_VERSION,
+    AgentEntry, AppliedState, EndReason, EndRecord, LogWriter, Record, RoundRecord, RunHeader,
+    UnreachableRecord, FORMAT_VERSION,
 };
 use hnav_runtime::msg::{CandidateFlags, Lifecycle, LifecycleEvent, Progress, Role};
 use hnav_runtime::rejected::Rejected;
@@ -204,7 +204,36 @@ impl State {
             }
             Record::Unreachable(u) => self.watch.logged_unreachable(u.agent),
             Record::Task(t) => self.arbiter.replay_task(t),
-            Record::Header(_) | Record::Replan(_) | Record::Raft(_) | Record::RaftState(_) => {}
+            Record::Header(_)
+            | Record::Replan(_)
+            | Record::Raft(_)
+            | Record::RaftState(_)
+            | Record::Snapshot(_) => {}
+        }
+    }
+
+    /// Starts from a snapshot's state, as if its records had been replayed (a replica over a
+    /// compacted journal, or one its leader sent a snapshot).
+    fn restore(&mut self, s: &AppliedState) {
+        self.round = self.round.max(s.round);
+        self.arbiter.restore_tally(s.tally.clone());
+        self.last_record.clone_from(&s.last_round);
+        self.roster.restore(&s.agents);
+        if let Some(e) = s.end {
+            self.watch.ended(e.reason);
+        }
+        for u in &s.unreachable {
+            self.watch.logged_unreachable(u.agent);
+        }
+        for l in &s.processes {
+            if let (Some(role), Some(ev)) =
+                (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
+            {
+                self.heard.logged(role, l.index, ev, l.restarts);
+            }
+        }
+        for t in &s.tasks {
+            self.arbiter.replay_task(t);
         }
     }
 
@@ -382,6 +411,10 @@ impl State {
     /// Applies the records other leaders committed, as a restarted coordinator replays its
     /// log.
     fn apply_committed(&mut self) {
+        let Some(raft) = self.log.raft() else { return };
+        if let Some(state) = raft.take_installed() {
+            self.restore(&state);
+        }
         let Some(raft) = self.log.raft() else { return };
         let records = raft.take_applied();
         for r in &records {

@@ -1,6 +1,7 @@
 //! Who the coordinator waits for ([`Roster`]): per agent, live or down, lost for good, and its
 //! restarts as the supervisor counts them; the same whether heard or replayed from the log.
 
+use hnav_runtime::consensus_log::AgentLife;
 use hnav_runtime::msg::{LifecycleEvent, RosterState};
 
 use crate::round::Arbiter;
@@ -30,7 +31,8 @@ impl Roster {
     }
 
     /// What an agent's lifecycle event (heard or replayed) says of who is live: a `Down`
-    /// agent is not waited for until it is back, a `Lost` one never again.
+    /// agent is not waited for until it is back, a `Lost` one never again ([`AgentLife`]'s
+    /// rule, which a snapshot's state follows too).
     pub(super) fn event(&mut self, index: u32, ev: LifecycleEvent, restarts: u32) {
         let i = index as usize;
         let (Some(live), Some(lost), Some(r)) = (
@@ -40,12 +42,19 @@ impl Roster {
         ) else {
             return;
         };
-        *r = (*r).max(restarts);
-        match ev {
-            LifecycleEvent::Down => *live = false,
-            LifecycleEvent::Restarted => *live = !*lost,
-            LifecycleEvent::Lost => (*live, *lost) = (false, true),
-            _ => {}
+        let mut life = AgentLife {
+            live: *live,
+            lost: *lost,
+            restarts: *r,
+        };
+        life.event(ev, restarts);
+        (*live, *lost, *r) = (life.live, life.lost, life.restarts);
+    }
+
+    /// Every agent as a snapshot's state says (a replica that starts from one).
+    pub(super) fn restore(&mut self, agents: &[AgentLife]) {
+        for (i, a) in agents.iter().enumerate().take(self.live.len()) {
+            (self.live[i], self.lost[i], self.restarts[i]) = (a.live, a.lost, a.restarts);
         }
     }
 

@@ -21,6 +21,8 @@ use std::fmt;
 
 use raft::eraftpb::{HardState, Message, MessageType};
 
+use hnav_runtime::consensus_log::{decode_record, AppliedState};
+
 use super::super::peer::{Committed, Role};
 use super::clock::Time;
 
@@ -233,19 +235,24 @@ impl Checker {
     /// every committed entry up to the highest index a leader of an earlier term committed:
     /// Raft's leader completeness speaks of leaders of later terms, and a leader of an earlier
     /// term may win its election after a later term has committed more.
+    /// Indices up to `compacted` are in the leader's snapshot, which stands for committed
+    /// entries only.
     pub fn complete(
         &mut self,
         at: Time,
-        id: u64,
-        term: u64,
+        (id, term): (u64, u64),
+        compacted: u64,
         log_term: impl Fn(u64) -> Option<u64>,
     ) {
         let Some(&upto) = self.leader_commits.range(..term).map(|(_, i)| i).max() else {
             return;
         };
+        if upto <= compacted {
+            return;
+        }
         let missing = self
             .committed
-            .range(..=upto)
+            .range(compacted + 1..=upto)
             .find(|(&index, (t, _))| log_term(index) != Some(*t));
         if let Some((index, (t, _))) = missing {
             let held = log_term(*index).map_or("nothing".to_string(), |h| format!("term {h}"));
@@ -290,6 +297,41 @@ impl Checker {
         }
     }
 
+    /// Replica `id` started from a snapshot standing for the entries up to `index`, its state
+    /// `state`: that must be what the committed records up to `index` add up to (folded
+    /// from `fresh`, the state of nothing); from there on the replica is as one that handed
+    /// them out and applied them.
+    pub fn installed(
+        &mut self,
+        at: Time,
+        id: u64,
+        (index, state): &(u64, AppliedState),
+        mut fresh: AppliedState,
+    ) {
+        let i = id as usize - 1;
+        let prefix: Vec<Vec<u8>> = self
+            .committed
+            .range(..=*index)
+            .map(|(_, (_, d))| d.clone())
+            .collect();
+        for d in &prefix {
+            if let Ok(r) = decode_record(d) {
+                fresh.fold(&r);
+            }
+        }
+        if fresh != *state {
+            let detail = format!(
+                "replica {id}'s snapshot at index {index} holds {} records through round {}, \
+                 the committed entries up to it {} through round {}",
+                state.records, state.round, fresh.records, fresh.round
+            );
+            self.fail(at, Property::SameRecordAtIndex, detail);
+        }
+        self.handed[i] = self.handed[i].max(*index);
+        self.applied_set[i] = prefix.iter().cloned().collect();
+        self.applied[i] = prefix;
+    }
+
     /// Replica `id`'s coordinator applied `record`.
     pub fn applied(&mut self, at: Time, id: u64, record: &[u8]) {
         let i = id as usize - 1;
@@ -310,20 +352,23 @@ impl Checker {
         self.acked.insert(index, record.to_vec());
     }
 
-    /// The logs of the running replicas, compared pairwise.
-    pub fn logs(&mut self, at: Time, logs: &[(u64, Vec<LogEntry>)]) {
-        for (a, (ia, la)) in logs.iter().enumerate() {
-            for (ib, lb) in logs[a + 1..].iter() {
-                let common = la.len().min(lb.len());
-                let Some(top) = (0..common).rev().find(|&k| la[k].0 == lb[k].0) else {
+    /// The logs of the running replicas, compared pairwise: each is the index its snapshot
+    /// stands for and the entries after it; the indices both hold are compared (a snapshot
+    /// stands for committed entries only, checked as they are handed out).
+    pub fn logs(&mut self, at: Time, logs: &[(u64, (u64, Vec<LogEntry>))]) {
+        for (a, (ia, (oa, la))) in logs.iter().enumerate() {
+            for (ib, (ob, lb)) in logs[a + 1..].iter() {
+                let first = oa.max(ob) + 1;
+                let end = (oa + la.len() as u64).min(ob + lb.len() as u64);
+                let ea = |index: u64| &la[(index - oa - 1) as usize];
+                let eb = |index: u64| &lb[(index - ob - 1) as usize];
+                let Some(top) = (first..=end).rev().find(|&k| ea(k).0 == eb(k).0) else {
                     continue;
                 };
-                if let Some(k) = (0..top).find(|&k| la[k] != lb[k]) {
+                if let Some(k) = (first..top).find(|&k| ea(k) != eb(k)) {
                     let detail = format!(
-                        "replicas {ia} and {ib} agree on index {} (term {}) but not on index {}",
-                        top + 1,
-                        la[top].0,
-                        k + 1
+                        "replicas {ia} and {ib} agree on index {top} (term {}) but not on index {k}",
+                        ea(top).0,
                     );
                     self.fail(at, Property::LogMatching, detail);
                     return;

@@ -15,7 +15,7 @@ use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::rc::Rc;
 
-use hnav_runtime::consensus_log::{RunHeader, WriterOptions};
+use hnav_runtime::consensus_log::{AppliedState, RunHeader, WriterOptions};
 use hnav_runtime::scenario::FsyncPolicy;
 use raft::eraftpb::{HardState, Message, MessageType};
 use raft::Storage;
@@ -57,6 +57,11 @@ pub struct Called {
     pub messages: Vec<Message>,
     /// What it handed out as committed.
     pub committed: Vec<Committed>,
+    /// A snapshot it started from before `committed` (its journal's after a restart, or its
+    /// leader's), with the index it stands for.
+    pub installed: Option<(u64, AppliedState)>,
+    /// Whether `installed` came from the leader (not from the journal).
+    pub from_leader: bool,
     /// The call's result.
     pub result: Result<(), ReplicaError>,
 }
@@ -135,7 +140,7 @@ impl Node {
         let early = Rc::new(RefCell::new(Vec::new()));
         let out = Rc::clone(&early);
         replica.send_early_to(move |m| out.borrow_mut().push(m.clone()));
-        let hs = replica.storage().rl().hard_state().clone();
+        let hs = replica.storage().mem().rl().hard_state().clone();
         let seen = (replica.term(), replica.role());
         self.process = Some(Process {
             replica,
@@ -172,9 +177,12 @@ impl Node {
             return None;
         }
         let p = self.process.as_mut()?;
+        let installs = p.replica.installs();
         let result = f(&mut p.replica);
+        let from_leader = p.replica.installs() > installs;
         let mut messages: Vec<Message> = p.early.borrow_mut().drain(..).collect();
         messages.extend(p.replica.take_messages());
+        let installed = p.replica.take_installed();
         let committed = p.replica.take_committed().collect();
         let now = (p.replica.term(), p.replica.role());
         let campaigned = messages.iter().any(|m| {
@@ -193,6 +201,8 @@ impl Node {
         Some(Called {
             messages,
             committed,
+            installed,
+            from_leader,
             result,
         })
     }
@@ -227,22 +237,29 @@ impl Node {
         Some((p.replica.role(), p.replica.term()))
     }
 
-    /// The replica's log: (term, data) per index from 1.
-    pub fn log(&self) -> Option<Vec<LogEntry>> {
+    /// The replica's log: the index its snapshot stands for (0 if none), and (term, data)
+    /// per index after it.
+    pub fn log(&self) -> Option<(u64, Vec<LogEntry>)> {
         let p = self.process.as_ref()?;
         let s = p.replica.storage();
-        let last = s.last_index().ok()?;
-        if last == 0 {
-            return Some(Vec::new());
+        let (first, last) = (s.first_index().ok()?, s.last_index().ok()?);
+        if last < first {
+            return Some((first - 1, Vec::new()));
         }
         let ctx = raft::GetEntriesContext::empty(false);
-        let entries = s.entries(1, last + 1, None, ctx).ok()?;
-        Some(
-            entries
-                .into_iter()
-                .map(|e| (e.term, e.data.to_vec()))
-                .collect(),
-        )
+        let entries = s.entries(first, last + 1, None, ctx).ok()?;
+        let entries = entries
+            .into_iter()
+            .map(|e| (e.term, e.data.to_vec()))
+            .collect();
+        Some((first - 1, entries))
+    }
+
+    /// The index its snapshot stands for (0 if none, or while down).
+    pub fn compacted(&self) -> u64 {
+        self.process
+            .as_ref()
+            .map_or(0, |p| p.replica.snapshot_index())
     }
 
     /// The highest index the replica knows committed (0 while down).
@@ -264,7 +281,7 @@ impl Node {
 }
 
 /// The journal's header: the same for every replica and run.
-fn header() -> RunHeader {
+pub fn header() -> RunHeader {
     RunHeader {
         version: 0,
         scenario_hash: 0x5157,

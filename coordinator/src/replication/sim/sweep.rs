@@ -43,6 +43,8 @@ pub struct Row {
     pub crashes: u64,
     /// Records acknowledged, over all runs.
     pub commits: u64,
+    /// Snapshots installed from a leader, over all runs.
+    pub installs: u64,
     /// Runs that broke a property.
     pub violations: u64,
     /// The slowest recovery after the heal, in microseconds.
@@ -133,6 +135,7 @@ pub fn sweep(
                     row.elections += outcome.elections;
                     row.crashes += outcome.crashes;
                     row.commits += outcome.commits;
+                    row.installs += outcome.installs;
                     row.violations += u64::from(outcome.violation.is_some());
                     row.slowest_recovery = row
                         .slowest_recovery
@@ -206,12 +209,13 @@ pub fn shrunk(outcome: Outcome, scratch: &Path) -> std::io::Result<Failure> {
 fn row(out: &mut String, name: &str, r: &Row) {
     let _ = writeln!(
         out,
-        "| {name} | {} | {} | {} | {} | {} | {} | {:.2} s |",
+        "| {name} | {} | {} | {} | {} | {} | {} | {} | {:.2} s |",
         r.runs,
         r.faults,
         r.elections,
         r.crashes,
         r.commits,
+        r.installs,
         r.violations,
         r.slowest_recovery as f64 / 1e6
     );
@@ -221,8 +225,8 @@ impl Report {
     /// The table, in markdown.
     pub fn table(&self) -> String {
         let mut out = String::from(
-            "| nemesis | runs | faults injected | leaders elected | processes crashed | commits | violations | slowest recovery after the heal |\n\
-             |---|---:|---:|---:|---:|---:|---:|---:|\n",
+            "| nemesis | runs | faults injected | leaders elected | processes crashed | commits | snapshots installed | violations | slowest recovery after the heal |\n\
+             |---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         );
         let mut total = Row::default();
         for (n, r) in &self.rows {
@@ -232,6 +236,7 @@ impl Report {
             total.elections += r.elections;
             total.crashes += r.crashes;
             total.commits += r.commits;
+            total.installs += r.installs;
             total.violations += r.violations;
             total.slowest_recovery = total.slowest_recovery.max(r.slowest_recovery);
         }

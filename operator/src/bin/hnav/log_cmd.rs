@@ -54,7 +54,7 @@ pub enum LogCommand {
         #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = crate::arg_values::agent_index)]
         agent: Option<u32>,
         /// Only records of these kinds (comma-separated or repeated): header, round,
-        /// lifecycle, replan, unreachable, end, raft-entry, raft-state.
+        /// lifecycle, replan, unreachable, end, raft-entry, raft-state, snapshot.
         #[arg(long, value_name = "KIND", value_delimiter = ',', value_parser = parse_kind)]
         kind: Vec<String>,
     },

@@ -14,7 +14,10 @@
 //! A replica's log (version [`REPLICATED_VERSION`](super::REPLICATED_VERSION)) must also make
 //! a Raft log ([`resolve`]: no skipped index, no falling term, nothing but
 //! entries and hard states after the header), and the rules above apply to its decided
-//! records (the committed entries), each placed at the entry it came from.
+//! records (the committed entries), each placed at the entry it came from. A compacted
+//! replica's log starts with a snapshot (after the header): its state must decode, the entries
+//! after it go on from its index and term, the commit index is not below it, and the rules
+//! above go on from its last round.
 //!
 //! A log without an end record is intact but *not closed* ([`VerifyReport::is_closed`]): the
 //! run was cut short (a crash of the whole run, a kill of the supervisor) or is still going.
@@ -23,6 +26,7 @@
 mod order;
 mod segments;
 
+use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -75,6 +79,8 @@ pub struct RaftSummary {
     pub last_index: u64,
     /// The last hard state written.
     pub state: RaftStateRecord,
+    /// The snapshot's index and term, for a compacted log.
+    pub snapshot: Option<(u64, u64)>,
 }
 
 /// The verdict of [`verify`].
@@ -107,6 +113,9 @@ pub struct VerifyReport {
     pub end: Option<EndRecord>,
     /// For a replica's log: its Raft entries and last hard state.
     pub raft: Option<RaftSummary>,
+    /// Decided records a compacted replica's log no longer holds, its snapshot stands for
+    /// them (0 for any other log).
+    pub compacted: u64,
     /// The torn tail, if any.
     pub torn: Option<TornTail>,
     /// The error that stopped reading (corruption, header, version, gap, I/O), if any.
@@ -164,6 +173,13 @@ impl VerifyReport {
         if c.task > 0 {
             s.pop();
             let _ = writeln!(s, ", {} task", c.task);
+        }
+        if let Some((index, term)) = self.raft.and_then(|r| r.snapshot) {
+            let _ = writeln!(
+                s,
+                "snapshot   index {index}, term {term}: {} decided records compacted",
+                self.compacted
+            );
         }
         if let Some(r) = &self.raft {
             let st = &r.state;
@@ -233,6 +249,7 @@ pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
         last_round: None,
         end: None,
         raft: None,
+        compacted: 0,
         torn: None,
         error: None,
         problems: Vec::new(),
@@ -249,8 +266,9 @@ pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
     let mut order = OrderCheck::default();
     let mut spans = SegmentCheck::default();
     let mut last_segment = None;
-    // A replica's log is checked once resolved: its stored records, and where each entry is.
-    let mut replica: Option<(Vec<Record>, Vec<RecordPos>)> = None;
+    // A replica's log is checked once resolved: its stored records, and where each entry
+    // is (the last written at each index, as resolving takes it).
+    let mut replica: Option<(Vec<Record>, HashMap<u64, RecordPos>)> = None;
     loop {
         match reader.next_record() {
             Ok(Some((pos, record))) => {
@@ -261,13 +279,12 @@ pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
                 report.bytes += pos.len;
                 spans.record(pos);
                 if replica.is_none() && is_replicated(std::slice::from_ref(&record)) {
-                    replica = Some((Vec::new(), Vec::new()));
+                    replica = Some((Vec::new(), HashMap::new()));
                 }
                 match &mut replica {
                     Some((records, at)) if !matches!(record, Record::Header(_)) => {
                         if let Record::Raft(e) = &record {
-                            at.truncate(e.index.saturating_sub(1) as usize);
-                            at.push(pos);
+                            at.insert(e.index, pos);
                         }
                         records.push(record);
                     }
@@ -315,7 +332,7 @@ pub fn verify(dir: impl AsRef<Path>) -> VerifyReport {
 fn check_replica(
     dir: &Path,
     records: Vec<Record>,
-    at: &[RecordPos],
+    at: &HashMap<u64, RecordPos>,
     order: &mut OrderCheck,
     report: &mut VerifyReport,
 ) {
@@ -329,10 +346,18 @@ fn check_replica(
                 written,
                 last_index: r.last_index,
                 state: r.state,
+                snapshot: r.snapshot.as_ref().map(|s| (s.index, s.term)),
             });
+            // The decided records go on from where the snapshot's state left off.
+            if let Some(c) = &r.compacted {
+                report.compacted = c.records;
+                report.last_round = Some(c.round).filter(|&n| n > 0);
+                report.end = c.end;
+                order.ended(c.end.is_some());
+            }
             // The header was checked as it was read.
             for (record, &(_, index)) in r.records.iter().skip(1).zip(&r.entries) {
-                if let Some(&pos) = at.get((index - 1) as usize) {
+                if let Some(&pos) = at.get(&index) {
                     order.check(report, pos, record);
                 }
             }

@@ -68,6 +68,11 @@ impl OrderCheck {
         self.problem(report, pos, what);
     }
 
+    /// Says whether the run ended before the records to come (a compacted log's snapshot).
+    pub(super) fn ended(&mut self, ended: bool) {
+        self.end_seen = ended;
+    }
+
     /// Applies the rules to the next record and counts it.
     pub(super) fn check(&mut self, report: &mut VerifyReport, pos: RecordPos, record: &Record) {
         if self.end_seen && !matches!(record, Record::End(_)) {
@@ -139,7 +144,7 @@ impl OrderCheck {
             }
             // Raft's records are resolved before these rules see a replica's log; in any
             // other log they are out of place.
-            Record::Raft(_) | Record::RaftState(_) => {
+            Record::Raft(_) | Record::RaftState(_) | Record::Snapshot(_) => {
                 let what = format!("a {} record in a single coordinator's log", record.kind());
                 self.problem(report, pos, what);
             }

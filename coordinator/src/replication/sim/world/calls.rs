@@ -4,7 +4,7 @@
 //! acknowledges it, and one that may decide proposes the next record. A call that fails on
 //! the journal is the process exiting; its supervisor restarts it.
 
-use hnav_runtime::consensus_log::{encode_record, Record, RoundRecord};
+use hnav_runtime::consensus_log::{encode_record, AppliedState, Record, RoundRecord};
 use protobuf::Message as _;
 use raft::eraftpb::Message;
 
@@ -13,7 +13,7 @@ use super::super::super::lead::Lead;
 use super::super::super::link::MAX_MESSAGE_BYTES;
 use super::super::super::peer::Role;
 use super::super::disk::Fired;
-use super::super::node::Called;
+use super::super::node::{header, Called};
 use super::{Ev, Sabotage, World, HEAL};
 
 /// How long a supervisor waits before it restarts a process that exited: from 20 to 300 ms.
@@ -34,7 +34,7 @@ impl World {
     /// Raft's business; a journal that fails is the process's end.
     pub(super) fn step(&mut self, i: usize, m: Message) {
         let called = self.nodes[i].call(|r| match r.step(m) {
-            Err(e @ (ReplicaError::Log(_) | ReplicaError::Snapshot)) => Err(e),
+            Err(e @ (ReplicaError::Log(_) | ReplicaError::Decode(_))) => Err(e),
             _ => Ok(()),
         });
         if let Some(called) = called {
@@ -106,6 +106,14 @@ impl World {
                 self.crash(i, fired, &why);
                 return;
             }
+            if let Some(installed) = &called.installed {
+                let fresh = AppliedState::new(&header());
+                self.checker.installed(self.now, id, installed, fresh);
+                if called.from_leader {
+                    self.installs += 1;
+                    self.note(|| format!("n{id} installed the snapshot at {}", installed.0));
+                }
+            }
             self.checker.committed(self.now, id, &called.committed);
             if let Some(p) = &self.nodes[i].process {
                 for c in called.committed.iter().filter(|c| !p.lead.decided_here(c)) {
@@ -116,8 +124,9 @@ impl World {
                 if self.checker.role(self.now, id, role, term) {
                     self.note(|| format!("n{id} leads term {term}"));
                     let node = &self.nodes[i];
+                    let compacted = node.compacted();
                     self.checker
-                        .complete(self.now, id, term, |index| node.term_at(index));
+                        .complete(self.now, (id, term), compacted, |index| node.term_at(index));
                     self.check_logs();
                 }
                 if role == Role::Leader {

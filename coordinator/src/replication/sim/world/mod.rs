@@ -37,6 +37,11 @@ pub const TICK_US: u64 = 50_000;
 /// Ticks to an election: the coordinator's default `election_ms` over `raft_heartbeat_ms`.
 pub const ELECTION_TICKS: usize = 10;
 
+/// Committed entries after which a replica snapshots and compacts its journal: small, so
+/// that compaction, and a leader's snapshot sent to a replica left behind, happen under the
+/// nemeses of every run.
+pub const SNAPSHOT_ENTRIES: u64 = 8;
+
 /// When every fault ends.
 pub const HEAL: Time = Time::ms(6_000);
 
@@ -150,6 +155,8 @@ pub struct Outcome {
     /// Processes that exited or died (killed, deposed, a failed write or fsync, a power
     /// loss).
     pub crashes: u64,
+    /// Snapshots a replica installed from its leader (it was too far behind for entries).
+    pub installs: u64,
     /// The first violation.
     pub violation: Option<Violation>,
     /// From the heal to the first commit of a record proposed after it, in microseconds.
@@ -222,6 +229,7 @@ struct World {
     rng: Rng,
     faults: u64,
     crashes: u64,
+    installs: u64,
     sabotage: Sabotage,
     next_record: u64,
     healed: bool,
@@ -250,6 +258,7 @@ fn run_quietly(config: &Config, scratch: &Path) -> std::io::Result<Outcome> {
             let rc = ReplicaConfig {
                 election_ticks: ELECTION_TICKS,
                 heartbeat_ticks: 1,
+                snapshot_entries: SNAPSHOT_ENTRIES,
                 ..ReplicaConfig::cluster(id, n)
             };
             let lying = config.sabotage == Sabotage::LyingFsync;
@@ -272,6 +281,7 @@ fn run_quietly(config: &Config, scratch: &Path) -> std::io::Result<Outcome> {
         rng: Rng::new(config.seed, 4),
         faults: 0,
         crashes: 0,
+        installs: 0,
         sabotage: config.sabotage,
         next_record: 0,
         healed: false,
@@ -287,6 +297,7 @@ fn run_quietly(config: &Config, scratch: &Path) -> std::io::Result<Outcome> {
         commits: w.checker.acknowledged(),
         elections: w.checker.elections(),
         crashes: w.crashes,
+        installs: w.installs,
         violation: w.checker.violation().cloned(),
         recovered_after: w.recovered.map(|(t, _)| t.0 - HEAL.0),
         end: w.now,
