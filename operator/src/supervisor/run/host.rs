@@ -36,7 +36,8 @@ pub struct HostPart {
 impl HostPart {
     /// Host `name` of the placement in `file`, checked for a run of `scenario`.
     pub fn load(file: &Path, name: &str, scenario: &Scenario) -> Result<Self, PlacementError> {
-        let placement = Placement::load(file, scenario.agents.len())?;
+        let placement =
+            Placement::load(file, scenario.agents.len(), scenario.coordinator.replicas)?;
         let index = placement.index_of(name)?;
         Ok(Self {
             file: file.to_path_buf(),
@@ -65,12 +66,13 @@ impl HostPart {
         }
     }
 
-    /// The host that runs the coordinator (or its replicas): the one with the log.
+    /// The host that runs the coordinator, or the first that runs one of its replicas: one
+    /// with a log (with replicas apart, each replica's host has its replica's).
     pub fn coordinator_host(&self) -> &str {
         let hosts = self.placement.hosts();
         hosts
             .iter()
-            .find(|h| h.coordinator)
+            .find(|h| !h.coordinator.is_empty())
             .unwrap_or(&hosts[self.index])
             .name
             .as_str()
@@ -85,6 +87,8 @@ impl HostPart {
             .arg(run)
             .arg("--agents")
             .arg(scenario.agents.len().to_string())
+            .arg("--replicas")
+            .arg(scenario.coordinator.replicas.to_string())
             .arg("--hosts")
             .arg(&self.file)
             .arg("--host")

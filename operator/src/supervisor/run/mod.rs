@@ -275,7 +275,7 @@ fn summarize(
     ended: Ended,
 ) -> Result<RunSummary, RunError> {
     let (truth, progress) = (ended.seen.truth.as_ref(), ended.seen.progress.as_ref());
-    if let Some(h) = host.filter(|h| !h.this().coordinator) {
+    if let Some(h) = host.filter(|h| h.this().coordinator.is_empty()) {
         let mut summary =
             RunSummary::from_truth(run.as_str(), scenario, truth, progress, ended.elapsed_s);
         summary.counts_on_host = Some(h.coordinator_host().to_string());

@@ -388,7 +388,8 @@ impl Slots {
     }
 
     /// Whether more than half of the coordinator replicas are not lost for good (running, or
-    /// to be restarted): Raft can still commit. True for a single coordinator.
+    /// to be restarted): Raft can still commit. True for a single coordinator. A replica of
+    /// another host counts as left: its own supervisor judges it.
     fn replica_majority_left(&self) -> bool {
         let replicas = self
             .slots
@@ -397,6 +398,10 @@ impl Slots {
         let (total, left) = replicas.fold((0, 0), |(t, l), s| {
             (t + 1, l + usize::from(s.lost.is_none()))
         });
+        let remote = (self.host.iter().flat_map(HostPart::remote))
+            .filter(|&(role, index, _)| role == Role::Coordinator && index > 0)
+            .count();
+        let (total, left) = (total + remote, left + remote);
         total == 0 || 2 * left > total
     }
 
