@@ -9,14 +9,15 @@
 //!   (nftables) on every link, every robot still gets home without a collision.
 //! - A robot host cut off for 2 s stands (the sim's watchdog brakes its robots, the
 //!   coordinator logs them down) and rejoins when the link is back.
-//! - Three coordinator replicas on three hosts of their own (`replicas`): the rounds go on
+//! - Three coordinator replicas on three hosts of their own (`replicas_apart`): the rounds go on
 //!   with one replica host cut off, stop with the leader's cut off too, and resume when both
 //!   are back; the replicas' logs agree.
 //!
 //! Where namespaces cannot be created (no root, a locked-down kernel) each test says so and
 //! skips, unless `HNAV_REQUIRE_NETNS=1` (set by `.ci/run` where its probe could make one).
 
-mod replicas;
+#[path = "multi_host/replicas_apart.rs"]
+mod replicas_apart;
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
