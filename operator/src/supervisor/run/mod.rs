@@ -61,6 +61,9 @@ mod host;
 mod action;
 mod error;
 
+#[cfg(test)]
+mod across_tests;
+
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 

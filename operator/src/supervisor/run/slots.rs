@@ -407,7 +407,10 @@ impl Slots {
 
     /// Restarted processes that announced themselves up (`ups`: role and index as they came
     /// in on `ready`): each journalled `Up` and announced `Restarted`, and after a sim's or a
-    /// coordinator's, the agents' roster that it missed.
+    /// coordinator's, the agents' roster that it missed. In a run across hosts the `Up` of a
+    /// sim or a coordinator of another host (its start-up `Up`s were taken by the handshake,
+    /// so this one is a restart's) is answered with this host's agents' roster: each host
+    /// tells the restarted process about the agents it runs, and together they name them all.
     pub(super) fn on_up(&mut self, ups: &[(u8, u32)]) -> Vec<Action> {
         let mut todo = Vec::new();
         for &(role, index) in ups {
@@ -416,6 +419,9 @@ impl Slots {
                 .iter_mut()
                 .find(|s| s.announce && s.spec.role as u8 == role && s.spec.index == index);
             let Some(s) = announced else {
+                if self.runs_elsewhere(role, index) {
+                    todo.extend(self.roster());
+                }
                 continue;
             };
             s.announce = false;
@@ -431,6 +437,18 @@ impl Slots {
             }
         }
         todo
+    }
+}
+
+impl Slots {
+    /// Whether `role` (as on the wire) / `index` is a sim or a coordinator that another host
+    /// of a run across hosts runs.
+    fn runs_elsewhere(&self, role: u8, index: u32) -> bool {
+        let Some(role) = Role::from_u8(role).filter(|r| matches!(r, Role::Sim | Role::Coordinator))
+        else {
+            return false;
+        };
+        (self.host.iter().flat_map(HostPart::remote)).any(|(r, i, _)| r == role && i == index)
     }
 }
 
