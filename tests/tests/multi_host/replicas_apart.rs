@@ -118,22 +118,32 @@ fn replicas_on_three_hosts_decide_with_a_majority_stop_without_and_resume_when_h
     let Some(net) = across::net_or_skip("rep", HOSTS.len()) else {
         return;
     };
-    let tmp = tempfile::tempdir().unwrap();
-    let scenario = realtime_demo(tmp.path());
-    let hosts = placement(tmp.path());
+    let tmp = tempfile::tempdir().unwrap().keep();
+    eprintln!("DEBUGDIR {}", tmp.display());
+    let scenario = realtime_demo(tmp.as_path());
+    let hosts = placement(tmp.as_path());
     let mut run = TestRun::new("rep");
     let _purge = DomainPurge {
         run: run.run.clone(),
         hosts: HOSTS.iter().map(|h| h.to_string()).collect(),
     };
-    let extra = ["--mode", "realtime", "--replicas", "3"];
+    // A fault for a process of another host than the hub's: every host reads the plan,
+    // host `rep-2` carries it out (replica 2 is killed and restarted, and catches up).
+    let extra = [
+        "--mode",
+        "realtime",
+        "--replicas",
+        "3",
+        "--kill",
+        "coordinator:2@round:150",
+    ];
     let mut across = Across::start(
         &mut run,
         &net,
         &HOSTS,
         &hosts,
         &scenario,
-        tmp.path(),
+        tmp.as_path(),
         &extra,
         &[],
     );
@@ -175,6 +185,27 @@ fn replicas_on_three_hosts_decide_with_a_majority_stop_without_and_resume_when_h
     );
     across.finish();
     every_replica_holds_the_same_rounds_once(&across);
+    only_its_host_carried_out_the_fault(&across);
+}
+
+/// `rep-2`'s journal has the kill of replica 2; no other host signalled anything.
+fn only_its_host_carried_out_the_fault(across: &Across) {
+    for (i, dir) in across.dirs.iter().enumerate() {
+        let journal = std::fs::read_to_string(dir.join("events.jsonl")).unwrap_or_default();
+        let kills: Vec<&str> = (journal.lines())
+            .filter(|l| l.contains(r#""event":"signalled""#))
+            .collect();
+        match i {
+            2 => {
+                assert!(
+                    kills.len() == 1 && kills[0].contains("coordinator-2"),
+                    "rep-2's journal:\n{journal}"
+                );
+                println!("rep-2: {}", kills[0]);
+            }
+            _ => assert!(kills.is_empty(), "{} signalled: {kills:?}", HOSTS[i]),
+        }
+    }
 }
 
 /// Every replica's log verifies; the shorter committed records are a prefix of the longer;
