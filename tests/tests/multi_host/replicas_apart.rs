@@ -30,6 +30,9 @@ const ROUNDS_WITH_MAJORITY: u64 = 20;
 /// before the cut may still reach the log), then how long no round may be committed.
 const SETTLE: Duration = Duration::from_millis(1500);
 const WITHOUT_MAJORITY: Duration = Duration::from_secs(2);
+/// How far apart the hosts' supervisors may end (they start within a second of each other,
+/// and end on the first host's `Stop`).
+const MAX_END_SPREAD_S: f64 = 10.0;
 
 /// The placement: sim and agents on the hub, replica `i` alone on host `i`.
 fn placement(dir: &Path) -> PathBuf {
@@ -118,10 +121,9 @@ fn replicas_on_three_hosts_decide_with_a_majority_stop_without_and_resume_when_h
     let Some(net) = across::net_or_skip("rep", HOSTS.len()) else {
         return;
     };
-    let tmp = tempfile::tempdir().unwrap().keep();
-    eprintln!("DEBUGDIR {}", tmp.display());
-    let scenario = realtime_demo(tmp.as_path());
-    let hosts = placement(tmp.as_path());
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = realtime_demo(tmp.path());
+    let hosts = placement(tmp.path());
     let mut run = TestRun::new("rep");
     let _purge = DomainPurge {
         run: run.run.clone(),
@@ -143,7 +145,7 @@ fn replicas_on_three_hosts_decide_with_a_majority_stop_without_and_resume_when_h
         &HOSTS,
         &hosts,
         &scenario,
-        tmp.as_path(),
+        tmp.path(),
         &extra,
         &[],
     );
@@ -184,6 +186,7 @@ fn replicas_on_three_hosts_decide_with_a_majority_stop_without_and_resume_when_h
         took.as_secs_f64()
     );
     across.finish();
+    the_hosts_ended_together(&across);
     every_replica_holds_the_same_rounds_once(&across);
     only_its_host_carried_out_the_fault(&across);
 }
@@ -206,6 +209,23 @@ fn only_its_host_carried_out_the_fault(across: &Across) {
             _ => assert!(kills.is_empty(), "{} signalled: {kills:?}", HOSTS[i]),
         }
     }
+}
+
+/// Every host's supervisor ended with the run, none at its own time limit: a host that
+/// missed the coordinator's last progress (a realtime bridge may drop it) ends on another
+/// host's `Stop` (before, one host of three runs went on to the 120 s limit).
+fn the_hosts_ended_together(across: &Across) {
+    let walls: Vec<f64> = (across.dirs.iter())
+        .map(|d| across::summary(d)["wall_time_s"].as_f64().unwrap())
+        .collect();
+    let (first, last) = walls
+        .iter()
+        .fold((f64::MAX, 0.0f64), |(lo, hi), &w| (lo.min(w), hi.max(w)));
+    println!("the hosts ended {first:.1} to {last:.1} s after their start");
+    assert!(
+        last - first < MAX_END_SPREAD_S,
+        "the hosts' wall times {walls:?}"
+    );
 }
 
 /// Every replica's log verifies; the shorter committed records are a prefix of the longer;
