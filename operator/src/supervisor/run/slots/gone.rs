@@ -23,7 +23,13 @@ pub(super) struct Gone {
 impl Gone {
     /// Notes that `role`/`index` `ended` and is not restarted (`on_give_up`: what an agent
     /// gone for good does to the run); returns what that means to the run, for the journal.
-    pub(super) fn note(&mut self, role: Role, index: u32, ended: &str, on_give_up: GiveUpAction) -> String {
+    pub(super) fn note(
+        &mut self,
+        role: Role,
+        index: u32,
+        ended: &str,
+        on_give_up: GiveUpAction,
+    ) -> String {
         let replica = role == Role::Coordinator && index > 0;
         let gone = if replica {
             format!("{ended}: the cluster goes on while a majority of it is left")
