@@ -157,12 +157,14 @@ pub fn commit_qos(agents: usize) -> Qos {
     }
 }
 
-/// QoS of the `ready` and `lifecycle` topics of a swarm of `agents`.
+/// QoS of the `ready` and `lifecycle` topics of a swarm of `agents`. One subscriber more
+/// than the run's nodes: in a run across hosts the supervisor listens on `lifecycle` too, for
+/// another host's `Stop`.
 pub fn lifecycle_qos(agents: usize) -> Qos {
     let n = agents.max(1) + Qos::EXTRA_NODES;
     Qos {
         max_publishers: 2 * n,
-        max_subscribers: n,
+        max_subscribers: n + 1,
         buffer: 2 * n,
         history: 1,
         delivery: Delivery::LatestOnly,

@@ -175,6 +175,16 @@ fn sixteen_agents_across_three_hosts_log_what_one_host_logs() {
     same_log_as_one_host("r16", &scenario, &["--agents", "16"]);
 }
 
+/// A fault plan across hosts: agent 4 (on `robots-b`) killed at round 100 in lockstep. Every
+/// host reads the plan, `robots-b` kills and restarts it and resumes the sim's hold: the log
+/// is the one-host run's with the same kill, record for record. (Before, a plan was refused
+/// in a run across hosts.)
+#[test]
+fn a_lockstep_kill_on_a_robot_host_logs_what_it_logs_on_one_host() {
+    let scenario = repo_root().join("scenarios/demo.toml");
+    same_log_as_one_host("dkill", &scenario, &["--kill", "agent:4@round:100"]);
+}
+
 #[test]
 fn delay_and_loss_on_every_link_still_bring_every_robot_home() {
     let _one = one_at_a_time();
