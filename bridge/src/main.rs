@@ -1,11 +1,13 @@
-//! `hnav-bridge --run ID --agents N [--hosts FILE --host NAME] [--listen EP]... [--connect EP]...
-//! [--maps]`: forwards run ID's topics between this host's iceoryx2 domain and the other
+//! `hnav-bridge --run ID --agents N [--replicas N] [--hosts FILE --host NAME] [--listen EP]...
+//! [--connect EP]... [--maps]`: forwards run ID's topics between this host's iceoryx2 domain and the other
 //! hosts' bridges over Zenoh, until SIGTERM or SIGINT; then prints what it moved (`out=..
 //! in=.. dropped=.. overflow=.. failed=..`). See `hnav_bridge`.
 //!
 //! With `--hosts FILE --host NAME` (what `hnav run --host` starts) the endpoints come from the
 //! placement, and the bridge follows the other hosts: it announces itself `Up` on its host's
-//! `ready` once it hears all of them, and tells its host when one is cut off and back.
+//! `ready` once it hears all of them, and tells its host when one is cut off and back. Where
+//! the placement puts the coordinator's replicas on more than one host, their Raft messages
+//! cross too.
 
 use std::process::ExitCode;
 
@@ -40,6 +42,10 @@ struct Args {
     /// This host's name in the placement.
     #[arg(long, value_name = "NAME", requires = "hosts")]
     host: Option<String>,
+    /// The run's coordinator replicas (1: a single coordinator): with the replicas on more
+    /// than one host, their Raft inboxes `raft/<i>` cross too.
+    #[arg(long, default_value_t = 1)]
+    replicas: u32,
     /// Drop samples other than lifecycle events that a link cannot take instead of waiting:
     /// for realtime runs (`hnav run` passes it), never for lockstep.
     #[arg(long)]
@@ -74,8 +80,12 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         ..Endpoints::default()
     };
     let mut peers = None;
+    let mut specs = topics::run_topics(args.agents, args.maps);
     if let (Some(file), Some(name)) = (&args.hosts, &args.host) {
-        let placement = Placement::load(file, args.agents)?;
+        let placement = Placement::load(file, args.agents, args.replicas)?;
+        if placement.replicas_apart() {
+            specs.extend(topics::raft_topics(args.replicas));
+        }
         let me = placement.index_of(name)?;
         endpoints
             .listen
@@ -98,7 +108,6 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
                 .collect(),
         });
     }
-    let mut specs = topics::run_topics(args.agents, args.maps);
     if args.best_effort {
         topics::best_effort(&mut specs);
     }

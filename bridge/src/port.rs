@@ -8,6 +8,7 @@ use hnav_runtime::msg::{
     Candidate, Commit, Lifecycle, MapHeader, Odometry, Progress, Truth, WheelCommand, Wire,
     WireError,
 };
+use hnav_runtime::topics;
 use hnav_runtime::transport::{
     Attachment, PublisherId, Qos, Receiver, Sender, SliceReceiver, SliceSender, Transport,
     TransportError, Waiter,
@@ -226,6 +227,67 @@ impl Port for Map {
     }
 }
 
+/// The name a Raft message crosses under (`raft/<i>`): its bytes are Raft's protobuf, which
+/// the replica decodes and drops if it does not decode (`coordinator::replication::wire`).
+pub const RAFT_WIRE_NAME: &str = "hnav::RaftMessage";
+
+/// The port of a coordinator replica's Raft inbox (`raft/<i>`): bytes of any length up to
+/// [`topics::RAFT_MAX_BYTES`], as they are.
+struct Raft {
+    topic: String,
+    rx: SliceReceiver<u8, ()>,
+    tx: SliceSender<u8, ()>,
+    own: Vec<PublisherId>,
+}
+
+impl Port for Raft {
+    fn topic(&self) -> &str {
+        &self.topic
+    }
+
+    fn attach<'w>(&'w self, waiter: &'w Waiter) -> Result<Attachment<'w, 'w>, TransportError> {
+        waiter.attach(&self.rx)
+    }
+
+    fn skip(&mut self, id: PublisherId) {
+        self.own.push(id);
+    }
+
+    fn send_out(&self, out: &Outlet, counts: &mut Counts) -> Result<(), TransportError> {
+        self.rx.drain_pending_except(&self.own, |(), bytes| {
+            counts.put(&self.topic, out.put(bytes, RAFT_WIRE_NAME));
+        })?;
+        Ok(())
+    }
+
+    fn bring_in(
+        &self,
+        _: &Transport,
+        payload: &ZBytes,
+        type_name: Option<&str>,
+    ) -> Result<Result<(), WireError>, TransportError> {
+        if type_name != Some(RAFT_WIRE_NAME) {
+            return Ok(Err(WireError::TypeName {
+                expected: RAFT_WIRE_NAME,
+                got: type_name.unwrap_or("(none)").to_string(),
+            }));
+        }
+        let bytes = payload.to_bytes();
+        if bytes.len() > self.tx.max_len() {
+            return Ok(Err(WireError::Field {
+                type_name: RAFT_WIRE_NAME,
+                what: format!(
+                    "{} bytes, over the topic's {}",
+                    bytes.len(),
+                    self.tx.max_len()
+                ),
+            }));
+        }
+        self.tx.loan(bytes.len())?.copy_and_send(&bytes)?;
+        Ok(Ok(()))
+    }
+}
+
 /// Opens the port of `spec` on `transport`.
 pub(crate) fn open(
     transport: &Transport,
@@ -252,6 +314,16 @@ pub(crate) fn open(
         Payload::Truth => typed::<Truth>(transport, spec),
         Payload::Odometry => typed::<Odometry>(transport, spec),
         Payload::WheelCommand => typed::<WheelCommand>(transport, spec),
+        Payload::Raft => {
+            let tx =
+                transport.slice_sender::<u8, ()>(&spec.topic, topics::RAFT_MAX_BYTES, spec.qos)?;
+            Ok(Box::new(Raft {
+                topic: spec.topic.clone(),
+                own: vec![tx.id()],
+                rx: transport.slice_receiver::<u8, ()>(&spec.topic, spec.qos)?,
+                tx,
+            }))
+        }
         Payload::Map => Ok(Box::new(Map {
             topic: spec.topic.clone(),
             qos: spec.qos,

@@ -3,7 +3,8 @@
 //! (a different QoS would not open).
 //!
 //! The neural-map snapshots (`map/<i>`, up to megabytes each) only on request
-//! ([`run_topics`]'s `maps`). Left out: heartbeats and estimates (each host's supervisor
+//! ([`run_topics`]'s `maps`); the replicas' Raft inboxes (`raft/<i>`) only where the replicas
+//! are on more than one host ([`raft_topics`]). Left out: heartbeats and estimates (each host's supervisor
 //! watches its own processes).
 
 use hnav_runtime::topics;
@@ -28,6 +29,8 @@ pub enum Payload {
     WheelCommand,
     /// `map/<i>`: a neural-map snapshot (`f32` activations with a `MapHeader`).
     Map,
+    /// `raft/<i>`: a Raft message to coordinator replica `i` (bytes, Raft's protobuf).
+    Raft,
 }
 
 /// One forwarded topic.
@@ -48,7 +51,8 @@ impl TopicSpec {
     /// Whether a realtime run may lose its samples on a link that cannot take them: all but
     /// the lifecycle events. State (truth, progress, odometry, wheels, maps) is superseded
     /// by the next sample; a realtime agent resends an unanswered candidate, and the
-    /// coordinator answers a candidate for a decided round with the last commit.
+    /// coordinator answers a candidate for a decided round with the last commit; Raft
+    /// resends what a replica did not acknowledge.
     pub fn is_recoverable(&self) -> bool {
         self.payload != Payload::Lifecycle
     }
@@ -111,6 +115,21 @@ pub fn run_topics(agents: usize, maps: bool) -> Vec<TopicSpec> {
     out
 }
 
+/// The Raft inbox of every replica of a run of `replicas` (Raft ids 1 to `replicas`): for a
+/// run whose replicas are on more than one host. Each keeps the replicas' QoS (a slow
+/// reader's oldest message is overwritten: Raft resends).
+pub fn raft_topics(replicas: u32) -> Vec<TopicSpec> {
+    let voters = replicas as usize;
+    (1..=u64::from(replicas))
+        .map(|id| TopicSpec {
+            topic: topics::raft(id),
+            payload: Payload::Raft,
+            qos: topics::raft_qos(voters),
+            droppable: false,
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -130,5 +149,15 @@ mod tests {
             .map(|s| s.topic.as_str())
             .collect();
         assert_eq!(kept, ["lifecycle", "ready"]);
+    }
+
+    #[test]
+    fn three_replicas_have_three_raft_inboxes_droppable_in_realtime() {
+        let mut t = raft_topics(3);
+        let names: Vec<&str> = t.iter().map(|s| s.topic.as_str()).collect();
+        assert_eq!(names, ["raft/1", "raft/2", "raft/3"]);
+        best_effort(&mut t);
+        assert!(t.iter().all(|s| s.droppable && s.payload == Payload::Raft));
+        assert!(raft_topics(1).len() == 1);
     }
 }

@@ -7,13 +7,18 @@
 //! name = "base"
 //! listen = ["tcp/10.0.0.1:7447"]
 //! sim = true
-//! coordinator = true
+//! coordinator = true      # or some replicas by Raft id: [1], "1-2"
 //!
 //! # A robot's computer: its agent.
 //! [[host]]
 //! name = "robot-0"
 //! agents = "0"            # or a list: [0, 1], or ranges: "0-7,9"
 //! ```
+//!
+//! `coordinator = true` puts every replica of the coordinator on the host (the single
+//! coordinator of a run without replicas); a list or ranges of Raft ids (1 to the run's
+//! `replicas`) puts those replicas there, so that replicas can live on hosts of their own and
+//! their Raft messages cross the bridges. Each replica runs on exactly one host.
 //!
 //! The hosts form a star: the first host (the hub, normally the base station) listens on its
 //! `listen` endpoints as a Zenoh router, and every other host connects to it as a Zenoh
@@ -96,18 +101,20 @@ pub struct Host {
     pub listen: Vec<String>,
     /// Whether it runs the sim.
     pub sim: bool,
-    /// Whether it runs the coordinator (every replica of it).
-    pub coordinator: bool,
+    /// The coordinator processes it runs, ascending, by process index: `[0]` for the single
+    /// coordinator of a run without replicas, else replica ids (1 to the run's replicas).
+    pub coordinator: Vec<u32>,
     /// The agents it runs, ascending.
     pub agents: Vec<u32>,
 }
 
 impl Host {
-    /// Whether it runs process `role`/`index` (any replica of the coordinator).
+    /// Whether it runs process `role`/`index` (a coordinator by process index: 0 for a single
+    /// coordinator, else the replica's Raft id).
     pub fn runs(&self, role: Role, index: u32) -> bool {
         match role {
             Role::Sim => self.sim,
-            Role::Coordinator => self.coordinator,
+            Role::Coordinator => self.coordinator.binary_search(&index).is_ok(),
             Role::Agent => self.agents.binary_search(&index).is_ok(),
             Role::Bridge => false,
         }
@@ -136,30 +143,81 @@ struct RawHost {
     #[serde(default)]
     sim: bool,
     #[serde(default)]
-    coordinator: bool,
+    coordinator: Option<Spanned<RawIds>>,
     #[serde(default)]
-    agents: Option<Spanned<RawAgents>>,
+    agents: Option<Spanned<RawIds>>,
 }
 
+/// Indices as written: every one (`true`), none (`false`), a list or ranges.
 #[derive(Deserialize)]
 #[serde(untagged)]
-enum RawAgents {
+enum RawIds {
+    All(bool),
     List(Vec<u32>),
     Ranges(String),
 }
 
+/// The ids a key may name: `key` in `hosts.toml`, `noun` for one id, `first..=last` valid, a
+/// run of `count` of them.
+struct IdSpace {
+    key: &'static str,
+    noun: &'static str,
+    first: u32,
+    count: usize,
+}
+
+impl IdSpace {
+    fn agents(count: usize) -> Self {
+        Self {
+            key: "agents",
+            noun: "agent",
+            first: 0,
+            count,
+        }
+    }
+
+    /// The replicas of a run of `replicas` (Raft ids from 1).
+    fn replicas(replicas: u32) -> Self {
+        Self {
+            key: "coordinator",
+            noun: "replica",
+            first: 1,
+            count: replicas as usize,
+        }
+    }
+
+    fn last(&self) -> u32 {
+        (self.first as usize + self.count).saturating_sub(1) as u32
+    }
+
+    fn range(&self) -> String {
+        format!("{}-{}", self.first, self.last())
+    }
+
+    fn contains(&self, id: u32) -> bool {
+        id >= self.first && (id as usize) < self.first as usize + self.count
+    }
+}
+
 impl Placement {
-    /// Reads and checks `path` for a run of `agents` agents.
-    pub fn load(path: &Path, agents: usize) -> Result<Self, PlacementError> {
+    /// Reads and checks `path` for a run of `agents` agents and `replicas` coordinator
+    /// replicas (1: a single coordinator).
+    pub fn load(path: &Path, agents: usize, replicas: u32) -> Result<Self, PlacementError> {
         let text = std::fs::read_to_string(path).map_err(|e| PlacementError::Io {
             path: path.to_path_buf(),
             message: e.to_string(),
         })?;
-        Self::parse(&text, &path.display().to_string(), agents)
+        Self::parse(&text, &path.display().to_string(), agents, replicas)
     }
 
-    /// Parses and checks `text` (named `file` in errors) for a run of `agents` agents.
-    pub fn parse(text: &str, file: &str, agents: usize) -> Result<Self, PlacementError> {
+    /// Parses and checks `text` (named `file` in errors) for a run of `agents` agents and
+    /// `replicas` coordinator replicas (1: a single coordinator).
+    pub fn parse(
+        text: &str,
+        file: &str,
+        agents: usize,
+        replicas: u32,
+    ) -> Result<Self, PlacementError> {
         let lines = Lines::new(text, file);
         let at = |offset: usize| Loc::new(file, lines.line(offset));
         let raw: RawFile = toml::from_str(text).map_err(|e| PlacementError::Toml {
@@ -171,8 +229,7 @@ impl Placement {
             what,
         };
         let mut hosts: Vec<Host> = Vec::with_capacity(raw.host.len());
-        let mut agent_host: Vec<Option<usize>> = vec![None; agents];
-        let (mut sim, mut coordinator) = (None::<usize>, None::<usize>);
+        let mut claims = Claims::new(agents, replicas);
         for (i, h) in raw.host.iter().enumerate() {
             let start = h.span().start;
             let h = h.get_ref();
@@ -191,56 +248,17 @@ impl Placement {
             }
             let listen = check_listen(name, i, h.listen.as_ref())
                 .map_err(|(at, what)| invalid(at.unwrap_or(start), what))?;
-            for (flag, holder, what) in [
-                (h.sim, &mut sim, "the sim"),
-                (h.coordinator, &mut coordinator, "the coordinator"),
-            ] {
-                if let (true, Some(other)) = (flag, *holder) {
-                    let other = &hosts[other].name;
-                    return Err(invalid(
-                        start,
-                        format!("{what} is on host `{other}` already"),
-                    ));
-                }
-                if flag {
-                    *holder = Some(i);
-                }
-            }
-            let mine = match &h.agents {
-                None => Vec::new(),
-                Some(a) => parse_agents(a.get_ref(), agents)
-                    .map_err(|what| invalid(a.span().start, what))?,
-            };
-            for &a in &mine {
-                if let Some(other) = agent_host[a as usize].replace(i) {
-                    let other = &hosts.get(other).map_or(name, |o| &o.name);
-                    return Err(invalid(
-                        h.agents.as_ref().map_or(start, |s| s.span().start),
-                        format!("agent {a} is on host `{other}` already"),
-                    ));
-                }
-            }
-            hosts.push(Host {
-                name: name.clone(),
-                listen,
-                sim: h.sim,
-                coordinator: h.coordinator,
-                agents: mine,
-            });
+            let host = claims
+                .claim(i, name, h, &hosts)
+                .map_err(|(at, what)| invalid(at.unwrap_or(start), what))?;
+            hosts.push(Host { listen, ..host });
         }
-        let unplaced = |what: String| PlacementError::Unplaced {
-            file: file.to_string(),
-            what,
-        };
-        if sim.is_none() {
-            return Err(unplaced("the sim".into()));
-        }
-        if coordinator.is_none() {
-            return Err(unplaced("the coordinator".into()));
-        }
-        if let Some(a) = agent_host.iter().position(Option::is_none) {
-            return Err(unplaced(format!("agent {a} (the run has {agents} agents)")));
-        }
+        claims
+            .check_all_placed()
+            .map_err(|what| PlacementError::Unplaced {
+                file: file.to_string(),
+                what,
+            })?;
         Ok(Self {
             hosts,
             file: file.to_string(),
@@ -267,6 +285,16 @@ impl Placement {
                     .collect::<Vec<_>>()
                     .join(", "),
             })
+    }
+
+    /// Whether the coordinator's replicas are on more than one host (their Raft messages then
+    /// cross the bridges).
+    pub fn replicas_apart(&self) -> bool {
+        self.hosts
+            .iter()
+            .filter(|h| !h.coordinator.is_empty())
+            .count()
+            > 1
     }
 
     /// The host that runs `role`/`index`.
@@ -312,24 +340,131 @@ fn check_listen(
     }
 }
 
-/// The agents of `raw`, ascending and each once, all below `agents`.
-fn parse_agents(raw: &RawAgents, agents: usize) -> Result<Vec<u32>, String> {
+/// Which host holds each process so far, while the hosts are read in order.
+struct Claims {
+    agents: IdSpace,
+    replicas: IdSpace,
+    sim: Option<usize>,
+    agent_host: Vec<Option<usize>>,
+    /// By Raft id from 1 (index 0 unused).
+    replica_host: Vec<Option<usize>>,
+}
+
+impl Claims {
+    fn new(agents: usize, replicas: u32) -> Self {
+        Self {
+            agents: IdSpace::agents(agents),
+            replicas: IdSpace::replicas(replicas),
+            sim: None,
+            agent_host: vec![None; agents],
+            replica_host: vec![None; replicas as usize + 1],
+        }
+    }
+
+    /// Host number `i` (named `name`, `h` as written; `before` are the hosts read so far)
+    /// claims its processes; it comes back without its `listen`. An error is the offset of
+    /// what is wrong, if known, and what.
+    fn claim(
+        &mut self,
+        i: usize,
+        name: &str,
+        h: &RawHost,
+        before: &[Host],
+    ) -> Result<Host, (Option<usize>, String)> {
+        let host_name = |other: usize| before.get(other).map_or(name, |o| &o.name).to_string();
+        if h.sim {
+            if let Some(other) = self.sim {
+                let other = host_name(other);
+                return Err((None, format!("the sim is on host `{other}` already")));
+            }
+            self.sim = Some(i);
+        }
+        let ids = |raw: &Option<Spanned<RawIds>>, space: &IdSpace| match raw {
+            None => Ok(Vec::new()),
+            Some(r) => parse_ids(r.get_ref(), space).map_err(|what| (Some(r.span().start), what)),
+        };
+        let agents = ids(&h.agents, &self.agents)?;
+        let replicas = ids(&h.coordinator, &self.replicas)?;
+        for (mine, holders, space, raw) in [
+            (&agents, &mut self.agent_host, &self.agents, &h.agents),
+            (
+                &replicas,
+                &mut self.replica_host,
+                &self.replicas,
+                &h.coordinator,
+            ),
+        ] {
+            for &a in mine {
+                if let Some(other) = holders[a as usize].replace(i) {
+                    let other = host_name(other);
+                    let at = raw.as_ref().map(|s| s.span().start);
+                    let what = self_noun(space, a);
+                    return Err((at, format!("{what} is on host `{other}` already")));
+                }
+            }
+        }
+        // A single coordinator is process 0; replicas are their Raft ids.
+        let coordinator = match self.replicas.count {
+            1 => replicas.iter().map(|_| 0).collect(),
+            _ => replicas,
+        };
+        Ok(Host {
+            name: name.to_string(),
+            listen: Vec::new(),
+            sim: h.sim,
+            coordinator,
+            agents,
+        })
+    }
+
+    /// What no host runs, if anything: the first in the run's order.
+    fn check_all_placed(&self) -> Result<(), String> {
+        if self.sim.is_none() {
+            return Err("the sim".into());
+        }
+        if let Some(r) = (1..self.replica_host.len()).find(|&r| self.replica_host[r].is_none()) {
+            return Err(match self.replicas.count {
+                1 => "the coordinator".into(),
+                n => format!("replica {r} of the coordinator (the run has {n} replicas)"),
+            });
+        }
+        if let Some(a) = self.agent_host.iter().position(Option::is_none) {
+            let agents = self.agents.count;
+            return Err(format!("agent {a} (the run has {agents} agents)"));
+        }
+        Ok(())
+    }
+}
+
+/// One id of `space` in words (`agent 3`; `the coordinator` for a single one).
+fn self_noun(space: &IdSpace, id: u32) -> String {
+    match (space.key, space.count) {
+        ("coordinator", 1) => "the coordinator".to_string(),
+        _ => format!("{} {id}", space.noun),
+    }
+}
+
+/// The ids of `raw` in `space`, ascending and each once (`true`: all of them).
+fn parse_ids(raw: &RawIds, space: &IdSpace) -> Result<Vec<u32>, String> {
+    let (key, noun, count) = (space.key, space.noun, space.count);
     let mut out = match raw {
-        RawAgents::List(v) => v.clone(),
-        RawAgents::Ranges(s) => {
+        RawIds::All(true) => (space.first..=space.last()).take(count).collect(),
+        RawIds::All(false) => Vec::new(),
+        RawIds::List(v) => v.clone(),
+        RawIds::Ranges(s) => {
             let mut out = Vec::new();
             for part in s.split(',').map(str::trim) {
-                let bad = || format!("agents `{s}`: `{part}` is no index or range `A-B`");
+                let bad = || format!("{key} `{s}`: `{part}` is no index or range `A-B`");
                 let (a, b) = match part.split_once('-') {
                     Some((a, b)) => (a.trim(), b.trim()),
                     None => (part, part),
                 };
                 let (a, b): (u32, u32) =
                     (a.parse().map_err(|_| bad())?, b.parse().map_err(|_| bad())?);
-                if a > b || b as usize >= agents {
+                if a > b || !space.contains(a) || !space.contains(b) {
                     return Err(format!(
-                        "agents `{s}`: `{part}` is not within 0-{} (the run has {agents} agents)",
-                        agents.saturating_sub(1)
+                        "{key} `{s}`: `{part}` is not within {} (the run has {count} {noun}s)",
+                        space.range()
                     ));
                 }
                 out.extend(a..=b);
@@ -337,15 +472,15 @@ fn parse_agents(raw: &RawAgents, agents: usize) -> Result<Vec<u32>, String> {
             out
         }
     };
-    if let Some(&a) = out.iter().find(|&&a| a as usize >= agents) {
+    if let Some(&a) = out.iter().find(|&&a| !space.contains(a)) {
         return Err(format!(
-            "agent {a}: the run has {agents} agents (0-{})",
-            agents.saturating_sub(1)
+            "{noun} {a}: the run has {count} {noun}s ({})",
+            space.range()
         ));
     }
     out.sort_unstable();
     if let Some(w) = out.windows(2).find(|w| w[0] == w[1]) {
-        return Err(format!("agent {} is listed twice", w[0]));
+        return Err(format!("{noun} {} is listed twice", w[0]));
     }
     Ok(out)
 }
@@ -372,7 +507,7 @@ agents = [2, 3]
 
     #[test]
     fn a_placement_names_each_process_host_and_the_star() {
-        let p = Placement::parse(THREE, "hosts.toml", 4).unwrap();
+        let p = Placement::parse(THREE, "hosts.toml", 4, 3).unwrap();
         assert_eq!(p.hosts().len(), 3);
         assert_eq!(p.host_of(Role::Sim, 0).unwrap().name, "base");
         assert_eq!(p.host_of(Role::Coordinator, 2).unwrap().name, "base");
@@ -392,7 +527,7 @@ agents = [2, 3]
     #[test]
     fn bad_placements_name_the_file_line_and_problem() {
         let err = |text: &str, agents| {
-            Placement::parse(text, "h.toml", agents)
+            Placement::parse(text, "h.toml", agents, 1)
                 .unwrap_err()
                 .to_string()
         };
@@ -447,5 +582,86 @@ agents = [2, 3]
             e.starts_with("h.toml:15: host `robots-b` has `listen`, but only the first host"),
             "{e}"
         );
+    }
+
+    /// Three replicas on three hosts of their own, the sim and the agents on the hub.
+    const SPREAD: &str = r#"
+[[host]]
+name = "base"
+listen = ["tcp/10.0.0.1:7447"]
+sim = true
+agents = "0-3"
+
+[[host]]
+name = "r1"
+coordinator = [1]
+
+[[host]]
+name = "r2"
+coordinator = "2"
+
+[[host]]
+name = "r3"
+coordinator = "3"
+"#;
+
+    #[test]
+    fn replicas_may_each_have_a_host_of_their_own() {
+        let p = Placement::parse(SPREAD, "hosts.toml", 4, 3).unwrap();
+        for id in 1..=3 {
+            let h = p.host_of(Role::Coordinator, id).unwrap();
+            assert_eq!(h.name, format!("r{id}"));
+            assert_eq!(h.coordinator, [id]);
+        }
+        assert_eq!(p.host_of(Role::Coordinator, 0), None);
+        assert!(p.replicas_apart());
+        assert!(p.hosts()[0].coordinator.is_empty());
+        // `true` is every replica; in a run of one coordinator, `true` and `[1]` are it.
+        let all = Placement::parse(THREE, "hosts.toml", 4, 5).unwrap();
+        assert_eq!(all.hosts()[0].coordinator, [1, 2, 3, 4, 5]);
+        assert!(!all.replicas_apart());
+        let one = Placement::parse(THREE, "hosts.toml", 4, 1).unwrap();
+        assert_eq!(one.host_of(Role::Coordinator, 0).unwrap().name, "base");
+        let text = THREE.replace("coordinator = true", "coordinator = [1]");
+        let one = Placement::parse(&text, "hosts.toml", 4, 1).unwrap();
+        assert_eq!(one.hosts()[0].coordinator, [0]);
+    }
+
+    #[test]
+    fn a_replica_unplaced_placed_twice_or_out_of_range_is_named_with_its_line() {
+        let err = |text: &str, replicas| {
+            Placement::parse(text, "h.toml", 4, replicas)
+                .unwrap_err()
+                .to_string()
+        };
+        // Nobody runs replica 3.
+        let e = err(&SPREAD.replace("coordinator = \"3\"", ""), 3);
+        assert_eq!(
+            e,
+            "h.toml: no host runs replica 3 of the coordinator (the run has 3 replicas)"
+        );
+        // Replica 2 on two hosts (line 18: r3's `coordinator`).
+        let e = err(
+            &SPREAD.replace("coordinator = \"3\"", "coordinator = \"2-3\""),
+            3,
+        );
+        assert_eq!(e, "h.toml:18: replica 2 is on host `r2` already");
+        // Replica 4 of a run of 3 (line 10: r1's list; line 14: r2's ranges).
+        let e = err(&SPREAD.replace("[1]", "[1, 4]"), 3);
+        assert_eq!(e, "h.toml:10: replica 4: the run has 3 replicas (1-3)");
+        let e = err(&SPREAD.replace("\"2\"", "\"2-4\""), 3);
+        assert_eq!(
+            e,
+            "h.toml:14: coordinator `2-4`: `2-4` is not within 1-3 (the run has 3 replicas)"
+        );
+        // No coordinator at all in a run without replicas.
+        let e = err(&THREE.replace("coordinator = true", ""), 1);
+        assert_eq!(e, "h.toml: no host runs the coordinator");
+        // A single coordinator on two hosts.
+        let e = err(
+            &THREE.replace("agents = [2, 3]", "agents = [2, 3]\ncoordinator = true"),
+            1,
+        );
+        assert_eq!(e, "h.toml:15: the coordinator is on host `base` already");
     }
 }

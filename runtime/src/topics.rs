@@ -14,6 +14,7 @@
 //! | `ready` | [`Lifecycle`](crate::msg::Lifecycle) (`Up`; the sim's `Hold`) | every process -> supervisor | latest, deep buffer |
 //! | `lifecycle` | [`Lifecycle`](crate::msg::Lifecycle) | supervisor -> every process | latest, deep buffer |
 //! | `heartbeat` | [`Heartbeat`](crate::msg::Heartbeat) | every process -> supervisor | latest, depth 1, not notified |
+//! | `raft/<i>` | `[u8]`: a Raft message | every other coordinator replica -> replica i | latest ([`raft_qos`]) |
 //!
 //! Why "latest" (overwrite the oldest) for commits and lifecycle events, where every sample
 //! counts: with backpressure a dead subscriber whose buffer is full would stall the publisher
@@ -72,6 +73,29 @@ pub const ESTIMATE: &str = "estimate";
 
 /// Every process's heartbeat ([`heartbeat_qos`]).
 pub const HEARTBEAT: &str = "heartbeat";
+
+/// The Raft inbox of coordinator replica `id`: every other replica writes its messages to
+/// it there (`coordinator::replication::link`), and a bridge carries them to another host.
+pub fn raft(id: u64) -> String {
+    format!("raft/{id}")
+}
+
+/// The largest Raft message a `raft/<i>` sample carries.
+pub const RAFT_MAX_BYTES: usize = 64 * 1024;
+
+/// QoS of the `raft/<i>` topics of `voters` replicas: Raft resends what is lost and a leader
+/// must never wait for a dead follower, so a slow reader's oldest message is overwritten.
+/// Publishers: every other replica, an observer and a bridge; subscribers: the replica, an
+/// observer and a bridge.
+pub fn raft_qos(voters: usize) -> Qos {
+    Qos {
+        max_publishers: voters + 2,
+        max_subscribers: 3,
+        buffer: 32,
+        history: 0,
+        delivery: Delivery::LatestOnly,
+    }
+}
 
 /// QoS of the per-robot topics and of truth and progress: superseding state.
 pub fn state_qos() -> Qos {
@@ -133,12 +157,14 @@ pub fn commit_qos(agents: usize) -> Qos {
     }
 }
 
-/// QoS of the `ready` and `lifecycle` topics of a swarm of `agents`.
+/// QoS of the `ready` and `lifecycle` topics of a swarm of `agents`. One subscriber more
+/// than the run's nodes: in a run across hosts the supervisor listens on `lifecycle` too, for
+/// another host's `Stop`.
 pub fn lifecycle_qos(agents: usize) -> Qos {
     let n = agents.max(1) + Qos::EXTRA_NODES;
     Qos {
         max_publishers: 2 * n,
-        max_subscribers: n,
+        max_subscribers: n + 1,
         buffer: 2 * n,
         history: 1,
         delivery: Delivery::LatestOnly,

@@ -13,7 +13,7 @@
 //! - [`lost_wakeup`]: both halves of the lost-wake-up reproducer (`tests/lost_wakeup.rs`);
 //! - [`tmux`]: a terminal of a test's own for full-screen programs (`hnav top`, playback);
 //! - [`netns`]: hosts on one machine (network namespaces, a switch, loss, partitions) for the
-//!   multi-host tests (`tests/multi_host.rs`);
+//!   multi-host tests (`tests/multi_host.rs`), and [`across`]: one run across those hosts;
 //! - [`docs`]: what `tests/docs.rs` checks in the markdown (commands, links, paths).
 //!
 //! **Must not depend on**: `hnav-bench` or `hnav-fuzz` outside its test binaries (the chaos
@@ -27,6 +27,7 @@
 //! |---|---|
 //! | [`house`] | the workspace's import rules checked over its sources: rings of files, imports back up a `lib.rs` table |
 //! | [`docs`] | what `tests/docs.rs` checks in the markdown: commands against `--help`, links, paths |
+//! | [`across`] | one run across hosts in network namespaces: a supervisor per host, their domains purged |
 //! | [`swarm`] | one `hnav run` of a test: its scenario, its run directory, its log's digest |
 //! | [`rogue`] | the hostile candidates `hnav-rogue` forges |
 //! | [`lost_wakeup`] | both halves of the lost-wake-up reproducer |
@@ -37,6 +38,7 @@
 //! Tests that SIGKILL processes live in their own test binaries (`tests/*_kill.rs`).
 //! Tests that send other signals do too (`tests/waiter_signals.rs`).
 
+pub mod across;
 pub mod docs;
 pub mod house;
 pub mod lost_wakeup;

@@ -9,24 +9,29 @@
 //!   (nftables) on every link, every robot still gets home without a collision.
 //! - A robot host cut off for 2 s stands (the sim's watchdog brakes its robots, the
 //!   coordinator logs them down) and rejoins when the link is back.
+//! - Three coordinator replicas on three hosts of their own (`replicas_apart`): the rounds go on
+//!   with one replica host cut off, stop with the leader's cut off too, and resume when both
+//!   are back; the replicas' logs agree.
 //!
 //! Where namespaces cannot be created (no root, a locked-down kernel) each test says so and
 //! skips, unless `HNAV_REQUIRE_NETNS=1` (set by `.ci/run` where its probe could make one).
+
+#[path = "multi_host/replicas_apart.rs"]
+mod replicas_apart;
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use hnav_runtime::consensus_log::{read_log, Record};
 use hnav_runtime::msg::{LifecycleEvent, Role};
-use hnav_runtime::transport::{purge_run, RunId};
-use hnav_tests::netns::Net;
-use hnav_tests::swarm::{
-    hnav_output, lifecycle_records, log_tails, records_digest, repo_root, workspace_bin, SwarmRun,
+use hnav_runtime::transport::RunId;
+use hnav_tests::across::{
+    self, one_at_a_time, required, summary, Across, DomainPurge, RUN_TIMEOUT,
 };
-use hnav_tests::{Peer, TestRun};
+use hnav_tests::netns::Net;
+use hnav_tests::swarm::{hnav_output, lifecycle_records, records_digest, repo_root, SwarmRun};
+use hnav_tests::TestRun;
 
-/// Generous: debug builds of up to 20 processes and three bridges on a 2-core machine.
-const RUN_TIMEOUT: Duration = Duration::from_secs(600);
 /// Rounds the coordinator must decide while a robot host is cut off (see the cut test).
 const MIN_ROUNDS_WHILE_CUT: u64 = 5;
 /// Rounds the coordinator logs before the cut test cuts a host off.
@@ -34,49 +39,16 @@ const CUT_AFTER_ROUNDS: u64 = 300;
 /// The hosts' names: the base station, then two robot computers.
 const HOSTS: [&str; 3] = ["base", "robots-a", "robots-b"];
 
-/// The tests of this binary run one at a time: each starts about 20 processes and three
-/// bridges, and side by side on 2 cores they starved each other (a verdict about a cut
-/// host must not depend on what the binary's other tests are doing).
-fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
-    static ONE: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    // A test that failed holding it poisons it; the next one still runs.
-    ONE.lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner)
-}
-
-/// Whether CI requires these tests to run (`HNAV_REQUIRE_NETNS=1`, set by `.ci/run` where its
-/// probe made a namespace and nftables is installed): a skip is then a failure.
-fn required() -> bool {
-    std::env::var_os("HNAV_REQUIRE_NETNS").is_some_and(|v| v == "1")
-}
-
-/// The namespaces for test `tag`, or `None` (said on stderr) where they cannot be made.
+/// The namespaces of the three hosts for test `tag`, or `None` where they cannot be made.
 fn net_or_skip(tag: &str) -> Option<Net> {
-    match Net::create(tag, HOSTS.len()) {
-        Ok(net) => Some(net),
-        Err(e) if required() => {
-            panic!("HNAV_REQUIRE_NETNS=1 but no network namespace could be made: {e}")
-        }
-        Err(e) => {
-            eprintln!("skipped: no network namespaces here ({e})");
-            None
-        }
-    }
+    across::net_or_skip(tag, HOSTS.len())
 }
 
-/// Removes what the run left in each host's iceoryx2 domain, after its processes are gone
-/// (declared before the [`TestRun`], so dropped after it kills them).
-struct DomainPurge(RunId);
-
-impl Drop for DomainPurge {
-    fn drop(&mut self) {
-        for h in HOSTS {
-            if let Ok(run) = self.0.clone().in_domain(h) {
-                if let Err(e) = purge_run(&run) {
-                    eprintln!("cleanup of run {run} in domain {h} failed: {e}");
-                }
-            }
-        }
+/// The purge of every host's domain for `run`.
+fn purge(run: &RunId) -> DomainPurge {
+    DomainPurge {
+        run: run.clone(),
+        hosts: HOSTS.iter().map(|h| h.to_string()).collect(),
     }
 }
 
@@ -116,115 +88,33 @@ fn realtime_demo(dir: &Path) -> PathBuf {
     file
 }
 
-/// One run across the three hosts.
-struct Across {
-    supervisors: Vec<Peer>,
-    dirs: Vec<PathBuf>,
+/// Starts `hnav run SCENARIO --host H` on each of the three hosts, placed by [`placement`]
+/// for the `--agents` of `extra` (6 without).
+fn start(
+    run: &mut TestRun,
+    net: &Net,
+    scenario: &Path,
+    tmp: &Path,
+    extra: &[&str],
+    env: &[(&str, &Path)],
+) -> Across {
+    let agents = extra
+        .windows(2)
+        .find(|w| w[0] == "--agents")
+        .map_or(6, |w| w[1].parse().unwrap());
+    let hosts = placement(tmp, agents);
+    Across::start(run, net, &HOSTS, &hosts, scenario, tmp, extra, env)
 }
 
-impl Across {
-    /// Starts `hnav run SCENARIO --host H` in each host's namespace, with `extra` arguments
-    /// and `env` on top of each host's domain and registry.
-    fn start(
-        run: &mut TestRun,
-        net: &Net,
-        scenario: &Path,
-        tmp: &Path,
-        extra: &[&str],
-        env: &[(&str, &Path)],
-    ) -> Across {
-        let agents = extra
-            .windows(2)
-            .find(|w| w[0] == "--agents")
-            .map_or(6, |w| w[1].parse().unwrap());
-        let hosts = placement(tmp, agents);
-        let hnav = workspace_bin("hnav").display().to_string();
-        let mut across = Across {
-            supervisors: Vec::new(),
-            dirs: Vec::new(),
-        };
-        for (i, name) in HOSTS.iter().enumerate() {
-            let dir = tmp.join(name);
-            let mut args: Vec<String> = ["netns", "exec", net.ns(i), &hnav, "run"]
-                .iter()
-                .map(|s| s.to_string())
-                .collect();
-            args.push(scenario.display().to_string());
-            for a in ["--run", run.run.as_str(), "--host", name, "--no-record"] {
-                args.push(a.to_string());
-            }
-            args.extend(["--hosts".into(), hosts.display().to_string()]);
-            args.extend(["--out".into(), dir.display().to_string()]);
-            args.extend(extra.iter().map(|s| s.to_string()));
-            let registry = tmp.join(format!("runs-{name}"));
-            let domain = PathBuf::from(name);
-            let mut all: Vec<(&str, &Path)> =
-                vec![("HNAV_DOMAIN", &domain), ("HNAV_RUNS_DIR", &registry)];
-            all.extend_from_slice(env);
-            let peer = run
-                .spawn_exact_env("ip", &args, &all)
-                .expect("ip netns exec");
-            across.supervisors.push(peer);
-            across.dirs.push(dir);
-        }
-        across
-    }
-
-    /// [`Across::start`] in realtime.
-    fn realtime(
-        run: &mut TestRun,
-        net: &Net,
-        scenario: &Path,
-        tmp: &Path,
-        env: &[(&str, &Path)],
-    ) -> Across {
-        Self::start(run, net, scenario, tmp, &["--mode", "realtime"], env)
-    }
-
-    /// Waits for every supervisor; each must exit 0 (every robot home, no collision).
-    fn finish(&mut self) {
-        let deadline = Instant::now() + RUN_TIMEOUT;
-        for (i, p) in self.supervisors.iter_mut().enumerate() {
-            let left = deadline.saturating_duration_since(Instant::now());
-            let status = p
-                .wait_exit(left)
-                .unwrap_or_else(|e| panic!("{}: {e}", HOSTS[i]));
-            assert!(
-                status.success(),
-                "host {} exited {status}\n{}",
-                HOSTS[i],
-                self.tails()
-            );
-        }
-        for d in &self.dirs {
-            let s = summary(d);
-            assert_eq!(s["end"], "all-at-goal", "{}: {s}", d.display());
-            assert_eq!(s["collisions"], 0, "{}: {s}", d.display());
-        }
-    }
-
-    fn tails(&self) -> String {
-        self.dirs.iter().map(|d| log_tails(d)).collect()
-    }
-}
-
-/// A supervisor still running when the test ends (it failed) is asked to stop, so that it
-/// stops its children (a SIGKILL would orphan them) before the run's memory is purged.
-impl Drop for Across {
-    fn drop(&mut self) {
-        for p in &mut self.supervisors {
-            let running = p.wait_exit(Duration::ZERO).is_err();
-            if running && p.signal(nix::sys::signal::Signal::SIGTERM).is_ok() {
-                let _ = p.wait_exit(Duration::from_secs(20));
-            }
-        }
-    }
-}
-
-fn summary(dir: &Path) -> serde_json::Value {
-    let p = dir.join("summary.json");
-    let text = std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-    serde_json::from_str(&text).unwrap()
+/// [`start`] in realtime.
+fn realtime(
+    run: &mut TestRun,
+    net: &Net,
+    scenario: &Path,
+    tmp: &Path,
+    env: &[(&str, &Path)],
+) -> Across {
+    start(run, net, scenario, tmp, &["--mode", "realtime"], env)
 }
 
 /// A one-host run of `scenario` with `extra` arguments into `dir`; returns its wall time.
@@ -254,8 +144,8 @@ fn same_log_as_one_host(tag: &str, scenario: &Path, extra: &[&str]) {
     assert!(reference.len() > 10, "a suspiciously short log");
 
     let mut run = TestRun::new(tag);
-    let _purge = DomainPurge(run.run.clone());
-    let mut across = Across::start(&mut run, &net, scenario, tmp.path(), &args, &[]);
+    let _purge = purge(&run.run);
+    let mut across = start(&mut run, &net, scenario, tmp.path(), &args, &[]);
     across.finish();
     let got = read_log(across.dirs[0].join("log")).unwrap().records;
     assert_eq!(
@@ -285,6 +175,16 @@ fn sixteen_agents_across_three_hosts_log_what_one_host_logs() {
     same_log_as_one_host("r16", &scenario, &["--agents", "16"]);
 }
 
+/// A fault plan across hosts: agent 4 (on `robots-b`) killed at round 100 in lockstep. Every
+/// host reads the plan, `robots-b` kills and restarts it and resumes the sim's hold: the log
+/// is the one-host run's with the same kill, record for record. (Before, a plan was refused
+/// in a run across hosts.)
+#[test]
+fn a_lockstep_kill_on_a_robot_host_logs_what_it_logs_on_one_host() {
+    let scenario = repo_root().join("scenarios/demo.toml");
+    same_log_as_one_host("dkill", &scenario, &["--kill", "agent:4@round:100"]);
+}
+
 #[test]
 fn delay_and_loss_on_every_link_still_bring_every_robot_home() {
     let _one = one_at_a_time();
@@ -308,10 +208,10 @@ fn delay_and_loss_on_every_link_still_bring_every_robot_home() {
     let one_rounds = summary(&one)["rounds"].as_u64().unwrap();
 
     let mut run = TestRun::new("lossy");
-    let _purge = DomainPurge(run.run.clone());
+    let _purge = purge(&run.run);
     let delay = PathBuf::from("5:2");
     let env = [("HNAV_BRIDGE_DELAY_MS", delay.as_path())];
-    let mut across = Across::realtime(&mut run, &net, &scenario, tmp.path(), &env);
+    let mut across = realtime(&mut run, &net, &scenario, tmp.path(), &env);
     across.finish();
     let s = summary(&across.dirs[0]);
     let rounds = s["rounds"].as_u64().unwrap();
@@ -381,8 +281,8 @@ fn a_robot_host_cut_off_for_two_seconds_stands_and_rejoins() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = realtime_demo(tmp.path());
     let mut run = TestRun::new("cut");
-    let _purge = DomainPurge(run.run.clone());
-    let mut across = Across::realtime(&mut run, &net, &scenario, tmp.path(), &[]);
+    let _purge = purge(&run.run);
+    let mut across = realtime(&mut run, &net, &scenario, tmp.path(), &[]);
     // Early in the run: once the coordinator has logged CUT_AFTER_ROUNDS rounds (3 s in on a
     // quiet machine, about 10 s on one loaded 10-fold; the robots need 30 to 45 s to get
     // home). A run that ends first fails at once, not at the timeout.

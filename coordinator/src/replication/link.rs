@@ -7,34 +7,30 @@
 //!
 //! Raft tolerates lost messages (it resends), but a leader must never wait for a dead
 //! follower, so the topics overwrite the oldest unread message of a slow reader instead of
-//! holding the writer ([`Delivery::LatestOnly`]).
+//! holding the writer ([`topics::raft_qos`]).
 //!
 //! A sample has no user header: the message names its sender and addressee itself.
 
 use protobuf::{CodedOutputStream, Message as _};
 use raft::eraftpb::Message;
 
-use hnav_runtime::transport::{
-    Delivery, Qos, SliceReceiver, SliceSender, Transport, TransportError,
-};
+use hnav_runtime::topics;
+use hnav_runtime::transport::{SliceReceiver, SliceSender, Transport, TransportError};
 
 use super::error::ReplicaError;
 use super::wire::decode;
 
 /// The largest encoded message a topic carries. [`MAX_ENTRIES_BYTES`] keeps Raft's appends
 /// well below it; a round record is a few KiB at 256 agents.
-pub const MAX_MESSAGE_BYTES: usize = 64 * 1024;
+pub const MAX_MESSAGE_BYTES: usize = topics::RAFT_MAX_BYTES;
 
 /// What Raft may put into one append message (`Config::max_size_per_msg`); Raft always sends
 /// at least one entry, so a single record must stay below [`MAX_MESSAGE_BYTES`].
 pub const MAX_ENTRIES_BYTES: u64 = 16 * 1024;
 
-/// Messages buffered per reader before the oldest is overwritten.
-const BUFFER: usize = 32;
-
 /// The topic replica `id` reads.
 pub fn topic(id: u64) -> String {
-    format!("raft/{id}")
+    topics::raft(id)
 }
 
 /// One replica's end of the Raft topics.
@@ -48,14 +44,7 @@ pub struct RaftLink {
 impl RaftLink {
     /// Opens replica `id`'s inbox and a sender to every other voter.
     pub fn open(transport: &Transport, id: u64, voters: &[u64]) -> Result<Self, ReplicaError> {
-        let qos = Qos {
-            // Every other replica writes to a replica's inbox, and an observer may.
-            max_publishers: voters.len() + 1,
-            max_subscribers: 2,
-            buffer: BUFFER,
-            history: 0,
-            delivery: Delivery::LatestOnly,
-        };
+        let qos = topics::raft_qos(voters.len());
         let inbox = transport.slice_receiver(&topic(id), qos)?;
         let peers = voters
             .iter()

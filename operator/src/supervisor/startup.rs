@@ -102,6 +102,11 @@ impl SupervisorPorts {
         &self.ready
     }
 
+    /// The publisher of this supervisor's `lifecycle` events, as its samples name it.
+    pub fn events_id(&self) -> hnav_runtime::transport::PublisherId {
+        self.events.id()
+    }
+
     /// Publishes `event` on `lifecycle`. A process that already died has no subscriber left;
     /// the send still succeeds.
     pub fn publish(&self, event: Lifecycle) -> Result<(), TransportError> {

@@ -170,9 +170,8 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
                     dir.join(hnav_runtime::placement::DEFAULT_FILE)
                 });
                 let part = HostPart::load(&file, name, &s).map_err(|e| e.to_string())?;
-                if !faults.is_empty() || !s.faults.is_empty() {
-                    return Err("faults (--kill, --term, --freeze, [[faults]]) are not supported in a run across hosts yet".to_string());
-                }
+                let all: Vec<_> = s.faults.iter().chain(&faults).cloned().collect();
+                part.check_faults(&all, &s)?;
                 Some(part)
             }
         };

@@ -17,6 +17,11 @@
 //! incarnation that was stopped: one that died meanwhile (hang detection kills a process
 //! frozen for too long) or was replaced gets nothing.
 //!
+//! In a run across hosts every host's supervisor reads the same plan and carries out the
+//! faults whose target it runs ([`HostPart::runs_target`]); the others it passes over. In
+//! lockstep only the host that runs a round's targets resumes the sim's hold at it (the plan
+//! is checked so that one host does: [`HostPart::check_faults`]).
+//!
 //! The schedule only decides: it reads the slots and returns the signals to send
 //! ([`Action::Signal`]); the watch sends them and tells it where each fault's landed
 //! ([`FaultSchedule::landed`]), which is what a hold waits for and what a freeze ends.
@@ -24,11 +29,12 @@
 use std::time::{Duration, Instant};
 
 use super::action::{Action, Incarnation, Landed, Shot, Why};
+use super::host::HostPart;
 use super::slots::Slots;
 use crate::supervisor::child::Signal;
 use hnav_runtime::msg::{Lifecycle, Role};
 use hnav_runtime::scenario::{
-    FaultAction, FaultSignal, FaultSpec, FaultTarget, FaultTime, SimParams,
+    ClockMode, FaultAction, FaultSignal, FaultSpec, FaultTarget, FaultTime, Scenario,
 };
 
 /// The plan's faults, which have fired, the hold in progress and the freezes to end.
@@ -37,6 +43,8 @@ pub(super) struct FaultSchedule<'s> {
     /// When each fault is due.
     due: Vec<Due>,
     done: Vec<bool>,
+    /// Whether this host runs each fault's target (always, on one host).
+    mine: Vec<bool>,
     lockstep: bool,
     /// Realtime: the last round the coordinator reported committed.
     round: u64,
@@ -71,8 +79,11 @@ struct Thaw {
 }
 
 impl<'s> FaultSchedule<'s> {
-    /// None of `faults` fired yet; `sim` turns their seconds into rounds in `lockstep`.
-    pub(super) fn new(faults: &'s [FaultSpec], lockstep: bool, sim: &SimParams) -> Self {
+    /// None of `scenario`'s faults fired yet (seconds become rounds in lockstep); in a run
+    /// across hosts (`host`), only those whose target this host runs are carried out here.
+    pub(super) fn new(scenario: &'s Scenario, host: Option<&HostPart>) -> Self {
+        let (faults, sim) = (&scenario.faults[..], &scenario.sim);
+        let lockstep = sim.clock == ClockMode::Lockstep;
         let due = faults
             .iter()
             .map(|f| match f.at {
@@ -85,10 +96,15 @@ impl<'s> FaultSchedule<'s> {
                 }
             })
             .collect();
+        let mine = faults
+            .iter()
+            .map(|f| host.is_none_or(|h| h.runs_target(&f.target)))
+            .collect();
         Self {
             faults,
             due,
             done: vec![false; faults.len()],
+            mine,
             lockstep,
             round: 0,
             leader: 0,
@@ -167,8 +183,17 @@ impl<'s> FaultSchedule<'s> {
 
     /// Lockstep: the sim holds before `period`; the signals of the faults of that round
     /// (each once: a restarted sim holding again at a round already done is resumed at once).
+    /// In a run across hosts, only the host that runs the round's targets holds (and so
+    /// resumes): another host's `Resume` would end the hold before the faults landed.
     pub(super) fn on_hold(&mut self, slots: &Slots, period: u64) -> Vec<Action> {
         self.round = period;
+        let at_hold = |i: usize| matches!(self.due[i], Due::Round(r) if r == period);
+        if !(0..self.faults.len()).any(|i| at_hold(i) && self.mine[i]) {
+            for i in (0..self.faults.len()).filter(|&i| at_hold(i)) {
+                self.done[i] = true;
+            }
+            return Vec::new();
+        }
         self.held = Some(Held {
             period,
             hit: Vec::new(),
@@ -201,6 +226,9 @@ impl<'s> FaultSchedule<'s> {
     /// `wait_stop`, a freeze is waited for until its target is stopped.
     fn fire(&mut self, i: usize, slots: &Slots, round: u64, wait_stop: bool) -> Option<Action> {
         self.done[i] = true;
+        if !self.mine[i] {
+            return None;
+        }
         let f = &self.faults[i];
         let (role, index) = match f.target {
             FaultTarget::Agent(i) => (Role::Agent, i as u32),

@@ -20,7 +20,7 @@ use crate::supervisor::child::ChildSpec;
 use crate::supervisor::startup::Roll;
 use hnav_runtime::msg::Role;
 use hnav_runtime::placement::{Host, Placement, PlacementError};
-use hnav_runtime::scenario::{ClockMode, Scenario};
+use hnav_runtime::scenario::{ClockMode, FaultSpec, FaultTarget, Scenario};
 use hnav_runtime::transport::{RunId, TransportError};
 
 /// This host's part of a run across hosts.
@@ -36,7 +36,8 @@ pub struct HostPart {
 impl HostPart {
     /// Host `name` of the placement in `file`, checked for a run of `scenario`.
     pub fn load(file: &Path, name: &str, scenario: &Scenario) -> Result<Self, PlacementError> {
-        let placement = Placement::load(file, scenario.agents.len())?;
+        let placement =
+            Placement::load(file, scenario.agents.len(), scenario.coordinator.replicas)?;
         let index = placement.index_of(name)?;
         Ok(Self {
             file: file.to_path_buf(),
@@ -65,12 +66,13 @@ impl HostPart {
         }
     }
 
-    /// The host that runs the coordinator (or its replicas): the one with the log.
+    /// The host that runs the coordinator, or the first that runs one of its replicas: one
+    /// with a log (with replicas apart, each replica's host has its replica's).
     pub fn coordinator_host(&self) -> &str {
         let hosts = self.placement.hosts();
         hosts
             .iter()
-            .find(|h| h.coordinator)
+            .find(|h| !h.coordinator.is_empty())
             .unwrap_or(&hosts[self.index])
             .name
             .as_str()
@@ -85,6 +87,8 @@ impl HostPart {
             .arg(run)
             .arg("--agents")
             .arg(scenario.agents.len().to_string())
+            .arg("--replicas")
+            .arg(scenario.coordinator.replicas.to_string())
             .arg("--hosts")
             .arg(&self.file)
             .arg("--host")
@@ -93,6 +97,64 @@ impl HostPart {
             ClockMode::Realtime => spec.arg("--best-effort"),
             ClockMode::Lockstep => spec,
         }
+    }
+
+    /// Whether this host runs the target of a planned fault: it carries the fault out (every
+    /// host reads the same plan). `coordinator` (the leader when the fault fires) is any
+    /// host with a replica; the one that runs the leader then finds it among its processes.
+    pub fn runs_target(&self, target: &FaultTarget) -> bool {
+        let me = self.this();
+        match *target {
+            FaultTarget::Agent(i) => me.runs(Role::Agent, i as u32),
+            FaultTarget::Sim => me.sim,
+            FaultTarget::Coordinator => !me.coordinator.is_empty(),
+            FaultTarget::Replica(id) => me.runs(Role::Coordinator, id),
+        }
+    }
+
+    /// Checks that every fault of `faults` (the scenario's and the command line's) can be
+    /// carried out across hosts. In realtime any can: each host fires those it runs the
+    /// target of. In lockstep the sim holds at a fault's round until `Resume`, which the host
+    /// that runs the round's targets sends once they are done: so the faults of one round
+    /// must target one host's processes, and `coordinator` (whichever replica leads then)
+    /// must not be spread over several hosts.
+    pub fn check_faults(&self, faults: &[FaultSpec], scenario: &Scenario) -> Result<(), String> {
+        if scenario.sim.clock != ClockMode::Lockstep {
+            return Ok(());
+        }
+        let host_of = |t: &FaultTarget| -> Vec<&str> {
+            let hosts = self.placement.hosts().iter();
+            let part = |h: &&Host| match *t {
+                FaultTarget::Agent(i) => h.runs(Role::Agent, i as u32),
+                FaultTarget::Sim => h.sim,
+                FaultTarget::Coordinator => !h.coordinator.is_empty(),
+                FaultTarget::Replica(id) => h.runs(Role::Coordinator, id),
+            };
+            hosts.filter(part).map(|h| h.name.as_str()).collect()
+        };
+        let mut rounds: Vec<(u64, &str)> = Vec::new();
+        for f in faults {
+            let hosts = host_of(&f.target);
+            if hosts.len() > 1 {
+                return Err(format!(
+                    "a lockstep fault at `coordinator` (the leader) with the replicas on hosts {}: name the replica (coordinator:ID) so that one host holds the run for it",
+                    hosts.join(", ")
+                ));
+            }
+            let (Some(host), round) = (hosts.first(), f.lockstep_round(&scenario.sim)) else {
+                continue;
+            };
+            match rounds.iter().find(|(r, _)| *r == round) {
+                Some((_, other)) if other != host => {
+                    return Err(format!(
+                        "lockstep faults at round {round} target processes of hosts {other} and {host}: the faults of one round must be one host's (it holds the run until they are done)"
+                    ))
+                }
+                Some(_) => {}
+                None => rounds.push((round, host)),
+            }
+        }
+        Ok(())
     }
 
     /// Every process of the run that another host runs: role, index and that host.

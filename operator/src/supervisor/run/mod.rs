@@ -61,6 +61,9 @@ mod host;
 mod action;
 mod error;
 
+#[cfg(test)]
+mod across_tests;
+
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -75,6 +78,7 @@ use super::stop::stop_all;
 use super::summary::RunSummary;
 use crate::invocation::Invocation;
 use error::io;
+use faults::FaultSchedule;
 use hang::HangWatch;
 use hnav_runtime::consensus_log::EndReason;
 use hnav_runtime::launch::ProcessArgs;
@@ -152,7 +156,7 @@ fn run_owned(
     Invocation::new(&opts.args, &scenario)
         .write(&dir)
         .map_err(io(&dir))?;
-    let ports = Ports::open(&run, scenario.agents.len())?;
+    let ports = Ports::open(&run, scenario.agents.len(), opts.host.is_some())?;
     // Started before any process, so the recording begins with the first truth message.
     let recorder = start_recorder(opts, &run, &scenario, &dir);
     let mut record = registry.new_record(&run, &dir);
@@ -275,7 +279,7 @@ fn summarize(
     ended: Ended,
 ) -> Result<RunSummary, RunError> {
     let (truth, progress) = (ended.seen.truth.as_ref(), ended.seen.progress.as_ref());
-    if let Some(h) = host.filter(|h| !h.this().coordinator) {
+    if let Some(h) = host.filter(|h| h.this().coordinator.is_empty()) {
         let mut summary =
             RunSummary::from_truth(run.as_str(), scenario, truth, progress, ended.elapsed_s);
         summary.counts_on_host = Some(h.coordinator_host().to_string());
@@ -298,6 +302,13 @@ fn summarize(
     // is committed: the log then has no end, but the supervisor knows why the run ended.
     if summary.end == "incomplete" && matches!(ended.end, End::TimeLimit) {
         summary.end = EndReason::TimeLimit.name().to_string();
+    }
+    // A replica on a host of its own may hear the run's `Stop` before the leader's end
+    // record reaches it: the end is then what crossed the bridge (ground truth, progress).
+    if summary.end == "incomplete" && host.is_some() && matches!(ended.end, End::AllAtGoal) {
+        let crossed =
+            RunSummary::from_truth(run.as_str(), scenario, truth, progress, ended.elapsed_s);
+        summary.end = crossed.end;
     }
     if let End::CannotGoOn(why) = ended.end {
         summary.cannot_go_on = Some(why);
@@ -341,7 +352,9 @@ fn supervise(
     if start_up(ports, scenario, slots, record)? == Startup::Interrupted {
         return Ok(End::Signalled);
     }
-    Watch::start(ports, scenario, journal, hang, show_progress, seen).until_end(slots, record)
+    let faults = FaultSchedule::new(scenario, slots.host());
+    Watch::start(ports, scenario, faults, journal, hang, show_progress, seen)
+        .until_end(slots, record)
 }
 
 /// Spawns the processes and runs the start-up handshake, up to `Start`. In a run across

@@ -7,6 +7,10 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+mod gone;
+
+use gone::{not_restarted, role_writes, Gone};
+
 use super::action::Action;
 use super::error::RunError;
 use super::host::{processes_of, HostPart};
@@ -388,7 +392,8 @@ impl Slots {
     }
 
     /// Whether more than half of the coordinator replicas are not lost for good (running, or
-    /// to be restarted): Raft can still commit. True for a single coordinator.
+    /// to be restarted): Raft can still commit. True for a single coordinator. A replica of
+    /// another host counts as left: its own supervisor judges it.
     fn replica_majority_left(&self) -> bool {
         let replicas = self
             .slots
@@ -397,12 +402,19 @@ impl Slots {
         let (total, left) = replicas.fold((0, 0), |(t, l), s| {
             (t + 1, l + usize::from(s.lost.is_none()))
         });
+        let remote = (self.host.iter().flat_map(HostPart::remote))
+            .filter(|&(role, index, _)| role == Role::Coordinator && index > 0)
+            .count();
+        let (total, left) = (total + remote, left + remote);
         total == 0 || 2 * left > total
     }
 
     /// Restarted processes that announced themselves up (`ups`: role and index as they came
     /// in on `ready`): each journalled `Up` and announced `Restarted`, and after a sim's or a
-    /// coordinator's, the agents' roster that it missed.
+    /// coordinator's, the agents' roster that it missed. In a run across hosts the `Up` of a
+    /// sim or a coordinator of another host (its start-up `Up`s were taken by the handshake,
+    /// so this one is a restart's) is answered with this host's agents' roster: each host
+    /// tells the restarted process about the agents it runs, and together they name them all.
     pub(super) fn on_up(&mut self, ups: &[(u8, u32)]) -> Vec<Action> {
         let mut todo = Vec::new();
         for &(role, index) in ups {
@@ -411,6 +423,9 @@ impl Slots {
                 .iter_mut()
                 .find(|s| s.announce && s.spec.role as u8 == role && s.spec.index == index);
             let Some(s) = announced else {
+                if self.runs_elsewhere(role, index) {
+                    todo.extend(self.roster());
+                }
                 continue;
             };
             s.announce = false;
@@ -429,81 +444,22 @@ impl Slots {
     }
 }
 
+impl Slots {
+    /// Whether `role` (as on the wire) / `index` is a sim or a coordinator that another host
+    /// of a run across hosts runs.
+    fn runs_elsewhere(&self, role: u8, index: u32) -> bool {
+        let Some(role) = Role::from_u8(role).filter(|r| matches!(r, Role::Sim | Role::Coordinator))
+        else {
+            return false;
+        };
+        (self.host.iter().flat_map(HostPart::remote)).any(|(r, i, _)| r == role && i == index)
+    }
+}
+
 /// What one reaping found.
 pub(super) struct Reaped {
     /// What to do about it, in this order.
     pub(super) todo: Vec<Action>,
     /// `Ok(Some(why))`: the run cannot go on; `Err`: a process stopped on a full disk.
     pub(super) verdict: Result<Option<String>, RunError>,
-}
-
-/// The processes given up on in one reaping, for the verdict on the run.
-#[derive(Default)]
-struct Gone {
-    /// The sim, the coordinator or a bridge (or an agent under `on_give_up = "stop"`): the
-    /// run ends.
-    core: Option<String>,
-    /// A coordinator replica: the run ends once no majority is left.
-    replica: Option<String>,
-    /// An agent: the run ends if it was the last one.
-    agent: Option<String>,
-}
-
-impl Gone {
-    /// Notes that `role`/`index` `ended` and is not restarted (`on_give_up`: what an agent
-    /// gone for good does to the run); returns what that means to the run, for the journal.
-    fn note(&mut self, role: Role, index: u32, ended: &str, on_give_up: GiveUpAction) -> String {
-        let replica = role == Role::Coordinator && index > 0;
-        let gone = if replica {
-            format!("{ended}: the cluster goes on while a majority of it is left")
-        } else {
-            format!("{ended}: the run cannot go on")
-        };
-        match role {
-            Role::Agent if on_give_up == GiveUpAction::Stop => {
-                self.core = Some(format!(
-                    "{ended}, and [restart] on_give_up = \"stop\" ends the run"
-                ));
-            }
-            Role::Agent => self.agent = Some(gone.clone()),
-            Role::Coordinator if replica => self.replica = Some(ended.to_string()),
-            Role::Sim | Role::Coordinator | Role::Bridge => self.core = Some(gone.clone()),
-        }
-        gone
-    }
-}
-
-/// That `role`/`index` ended with `exit` and is not restarted for `why`, in words.
-fn not_restarted(role: Role, index: u32, exit: &ExitInfo, why: GiveUpReason) -> String {
-    let who = match role {
-        Role::Agent => format!("hnav-agent {index}"),
-        other => format!("hnav-{}", other.name()),
-    };
-    format!("{who} ended ({exit}) and is not restarted ({why})")
-}
-
-/// What a process of `role` writes in the run directory `dir`, for the message of a run that
-/// ended on a full disk.
-fn role_writes(role: Role, index: u32, dir: &Path) -> String {
-    let log = dir
-        .join("logs")
-        .join(format!("{}.log", role.node_name(index)));
-    match role {
-        Role::Coordinator if index > 0 => format!(
-            "its replica's consensus log in {}",
-            dir.join("log").join(index.to_string()).display()
-        ),
-        Role::Coordinator => format!("the consensus log in {}", dir.join("log").display()),
-        Role::Agent => format!(
-            "its checkpoint {} or its log {}",
-            dir.join("agents").join(format!("{index}.ckpt")).display(),
-            log.display()
-        ),
-        Role::Sim => format!(
-            "its checkpoint {} or its log {}",
-            dir.join("sim.ckpt.{0,1}").display(),
-            log.display()
-        ),
-        Role::Bridge => format!("its log {}", log.display()),
-    }
 }

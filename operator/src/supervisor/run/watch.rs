@@ -20,7 +20,7 @@ use super::sweeper::Sweeper;
 use crate::supervisor::events::{RunEvent, RunEvents};
 use crate::supervisor::registry::RunRecord;
 use crate::supervisor::startup::SupervisorPorts;
-use hnav_runtime::msg::{LifecycleEvent, Progress, Truth};
+use hnav_runtime::msg::{Lifecycle, LifecycleEvent, Progress, StopReason, Truth};
 use hnav_runtime::scenario::{ClockMode, Scenario};
 use hnav_runtime::topics;
 use hnav_runtime::transport::{Receiver, RunId, Transport, Wake};
@@ -50,13 +50,17 @@ pub(super) struct Ports {
     pub(super) life: SupervisorPorts,
     pub(super) progress: Receiver<Progress>,
     pub(super) truth: Receiver<Truth>,
+    /// In a run across hosts, the `lifecycle` topic, where another host's supervisor that
+    /// saw the run end first says `Stop` (the coordinator's last progress may not cross: a
+    /// realtime bridge drops what a busy link cannot take).
+    others_stop: Option<Receiver<Lifecycle>>,
     pub(super) transport: Transport,
 }
 
 impl Ports {
     /// The supervisor's node in `run` (it handles SIGINT and SIGTERM) and its ports, for a
-    /// run of `agents` agents.
-    pub(super) fn open(run: &RunId, agents: usize) -> Result<Self, RunError> {
+    /// run of `agents` agents (`across` hosts: one more, for the other hosts' `Stop`).
+    pub(super) fn open(run: &RunId, agents: usize, across: bool) -> Result<Self, RunError> {
         let transport = Transport::builder(run)
             .node_name("supervisor")
             .handle_signals(true)
@@ -67,6 +71,9 @@ impl Ports {
             life: SupervisorPorts::open(&transport, agents)?,
             progress: transport.receiver(topics::PROGRESS, topics::progress_qos())?,
             truth: transport.receiver(topics::TRUTH, topics::truth_qos())?,
+            others_stop: across
+                .then(|| transport.receiver(topics::LIFECYCLE, topics::lifecycle_qos(agents)))
+                .transpose()?,
             transport,
         })
     }
@@ -112,6 +119,7 @@ impl<'s> Watch<'s> {
     pub(super) fn start(
         ports: &'s Ports,
         scenario: &'s Scenario,
+        faults: FaultSchedule<'s>,
         journal: RunEvents,
         hang: HangWatch,
         show_progress: bool,
@@ -123,7 +131,7 @@ impl<'s> Watch<'s> {
             journal,
             view: ProgressView::new(show_progress, scenario.agents.len()),
             seen,
-            faults: FaultSchedule::new(&scenario.faults, lockstep, &scenario.sim),
+            faults,
             hang,
             round: 0,
             t0: Instant::now(),
@@ -245,6 +253,9 @@ impl<'s> Watch<'s> {
         self.ports.truth.drain_pending(|t| seen.truth = Some(*t))?;
         let mut last = None;
         self.ports.progress.drain_pending(|p| last = Some(*p))?;
+        if let Some(end) = self.other_host_stopped()? {
+            return Ok(Some(end));
+        }
         let Some(p) = last else {
             return Ok(None);
         };
@@ -260,6 +271,25 @@ impl<'s> Watch<'s> {
             Progress::TIME_LIMIT => Some(End::TimeLimit),
             _ => None,
         })
+    }
+
+    /// In a run across hosts, how the run ended if another host's supervisor said `Stop`:
+    /// at the time limit, or (all robots home, or stopped there) over.
+    fn other_host_stopped(&mut self) -> Result<Option<End>, RunError> {
+        let Some(rx) = &self.ports.others_stop else {
+            return Ok(None);
+        };
+        let mut stop = None;
+        let own = [self.ports.life.events_id()];
+        rx.drain_pending_except(&own, |l| {
+            if l.event == LifecycleEvent::Stop as u8 {
+                stop = Some(l.reason);
+            }
+        })?;
+        Ok(stop.map(|reason| match StopReason::from_u8(reason) {
+            Some(StopReason::TimeLimit) => End::TimeLimit,
+            _ => End::AllAtGoal,
+        }))
     }
 
     /// Takes what came in on `ready`: a restarted process that is up is announced
