@@ -131,6 +131,23 @@ pub struct RunHeader {
     pub agents: Vec<AgentEntry>,
 }
 
+#[cfg(test)]
+impl RunHeader {
+    /// The header of a 4 x 4 run without agents, written by format `version`: the fixture
+    /// of the log's unit tests.
+    pub(crate) fn tiny(version: u32) -> Self {
+        RunHeader {
+            version,
+            scenario_hash: 1,
+            seed: 2,
+            clock: "lockstep".into(),
+            width: 4,
+            height: 4,
+            agents: Vec::new(),
+        }
+    }
+}
+
 /// One agent of the run.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AgentEntry {

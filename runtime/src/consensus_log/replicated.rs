@@ -275,15 +275,7 @@ mod tests {
     use crate::consensus_log::{EndReason, EndRecord, RunHeader};
 
     fn header() -> Record {
-        Record::Header(RunHeader {
-            version: REPLICATED_VERSION,
-            scenario_hash: 1,
-            seed: 2,
-            clock: "lockstep".into(),
-            width: 4,
-            height: 4,
-            agents: Vec::new(),
-        })
+        Record::Header(RunHeader::tiny(REPLICATED_VERSION))
     }
 
     fn end(round: u64) -> Record {

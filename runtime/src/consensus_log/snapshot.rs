@@ -186,15 +186,7 @@ mod tests {
     use super::*;
 
     fn header() -> RunHeader {
-        RunHeader {
-            version: 1,
-            scenario_hash: 1,
-            seed: 2,
-            clock: "lockstep".into(),
-            width: 4,
-            height: 4,
-            agents: Vec::new(),
-        }
+        RunHeader::tiny(1)
     }
 
     fn life(role: Role, index: u32, event: LifecycleEvent, restarts: u32) -> Record {

@@ -225,15 +225,12 @@ impl State {
         for u in &s.unreachable {
             self.watch.logged_unreachable(u.agent);
         }
+        // The other processes' events and the tasks are kept as records: replayed as such.
         for l in &s.processes {
-            if let (Some(role), Some(ev)) =
-                (Role::from_u8(l.role), LifecycleEvent::from_u8(l.event))
-            {
-                self.heard.logged(role, l.index, ev, l.restarts);
-            }
+            self.replay(&Record::Lifecycle(*l));
         }
         for t in &s.tasks {
-            self.arbiter.replay_task(t);
+            self.replay(&Record::Task(*t));
         }
     }
 

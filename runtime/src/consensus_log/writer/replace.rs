@@ -121,15 +121,7 @@ mod tests {
     use crate::consensus_log::FORMAT_VERSION;
 
     fn header() -> Record {
-        Record::Header(RunHeader {
-            version: FORMAT_VERSION,
-            scenario_hash: 1,
-            seed: 2,
-            clock: "lockstep".into(),
-            width: 4,
-            height: 4,
-            agents: Vec::new(),
-        })
+        Record::Header(RunHeader::tiny(FORMAT_VERSION))
     }
 
     fn end(round: u64) -> Record {
