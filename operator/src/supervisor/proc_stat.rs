@@ -50,6 +50,37 @@ pub fn process_cpu_ticks(pid: u32) -> Option<u64> {
     Some(user + system)
 }
 
+/// The kernel's flag of a task in `do_exit` (`PF_EXITING`, `include/linux/sched.h`): set
+/// before the task gives up its memory, and never cleared; a task with it runs no more user
+/// code.
+const PF_EXITING: u64 = 0x4;
+
+/// Whether every thread of `pid` has entered the kernel's exit (`PF_EXITING` in field 9 of
+/// its `/proc/<pid>/task/<tid>/stat`, a zombie, or gone), so that the process will never run
+/// another instruction of its own, although the kernel may take tens of milliseconds more to
+/// tear it down before its parent can reap it. False when `/proc` cannot tell (no `/proc`,
+/// the process not ours to read, or a thread still running).
+///
+/// A supervisor that sent SIGKILL can say the process is down at this point instead of at
+/// the reap: see `run/dying.rs`.
+pub fn exiting(pid: u32) -> bool {
+    let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
+        return false;
+    };
+    tasks.flatten().all(|task| {
+        let Ok(stat) = std::fs::read_to_string(task.path().join("stat")) else {
+            // The thread is gone between the listing and the read: it has exited.
+            return true;
+        };
+        let Some(mut fields) = fields_after_name(&stat) else {
+            return false;
+        };
+        let state = fields.next();
+        let flags = fields.nth(5).and_then(|f| f.parse::<u64>().ok());
+        matches!(state, Some("Z" | "X")) || flags.is_some_and(|f| f & PF_EXITING != 0)
+    })
+}
+
 /// Field `n` (1-based, as `proc(5)` numbers them; `n >= 3`) of `/proc/<pid>/stat`.
 fn stat_field(pid: u32, n: usize) -> Option<u64> {
     let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
@@ -82,6 +113,27 @@ mod tests {
         assert!(process_alive(me, Some(ticks)));
         assert!(process_alive(me, None));
         assert!(!process_alive(me, Some(ticks + 1)), "a reused pid");
+    }
+
+    #[test]
+    fn a_running_process_is_not_exiting_and_a_killed_one_soon_is() {
+        let mut child = std::process::Command::new("sleep")
+            .arg("30")
+            .spawn()
+            .expect("sleep runs");
+        let pid = child.id();
+        assert!(!exiting(pid), "a sleeping process is not exiting");
+        assert!(!exiting(std::process::id()), "this test is not exiting");
+        child.kill().expect("SIGKILL is sent");
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+        while !exiting(pid) && std::time::Instant::now() < deadline {
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        assert!(
+            exiting(pid),
+            "a SIGKILLed process is seen exiting within 10 s"
+        );
+        child.wait().expect("reaped");
     }
 
     #[test]

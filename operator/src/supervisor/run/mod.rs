@@ -18,8 +18,10 @@
 //!    (`progress`) follows the coordinator's progress topic; the scenario's planned faults
 //!    (`faults`) too in realtime, and the sim's `Hold` at each fault's round in lockstep.
 //!    Every process that is up has a hang deadline (`hang`): one silent past it is SIGKILLed
-//!    and takes the same path. The fault schedule, the hang watch and the slots only decide,
-//!    and return actions (`action`); the watch alone carries them out.
+//!    and takes the same path. A process the supervisor SIGKILLed itself is told `Down` as
+//!    soon as every thread of it has entered the kernel's exit (`dying`), not at the reap.
+//!    The fault schedule, the hang watch and the slots only decide, and return actions
+//!    (`action`); the watch alone carries them out.
 //! 4. End when the coordinator reports every agent at its goal, or (lockstep) the last round
 //!    of the time limit committed; when the time limit passes on the wall clock (realtime);
 //!    when the run cannot go on (the sim or the coordinator down and not restarted, or no
@@ -42,6 +44,7 @@
 // | `faults` | the planned faults: when each is due, its signal, the lockstep hold, the end of a freeze |
 // | `hang` | the hang deadlines of the processes that are up, and the kill of a silent one |
 // | `progress` | the progress bar (or line) |
+// | `dying` | processes the supervisor SIGKILLed, told `Down` once they can no longer act, before the kernel has torn them down |
 // | `slots` | the run's processes: spawn, reap, restart under their policy, `Up`s announced |
 // | `sweeper` | dead nodes' shared memory removed on a thread of its own, so that it never delays a reap |
 // | `host` | this host's part of a run across hosts; the list of a run's processes |
@@ -52,6 +55,8 @@ mod watch;
 mod faults;
 mod hang;
 mod progress;
+
+mod dying;
 
 mod slots;
 mod sweeper;

@@ -11,7 +11,7 @@ mod gone;
 
 use gone::{not_restarted, role_writes, Gone};
 
-use super::action::Action;
+use super::action::{Action, Incarnation};
 use super::error::RunError;
 use super::host::{processes_of, HostPart};
 use crate::supervisor::child::{Child, ChildError, ChildSpec, ExitInfo};
@@ -35,6 +35,8 @@ struct Slot {
     announce: bool,
     /// Gone for good (not restarted): why, in words.
     lost: Option<String>,
+    /// The pid of the incarnation already told `Down` before its reap (see `dying`).
+    down_told: Option<u32>,
 }
 
 /// Every process of the run: the sim, the coordinator (or its replicas, index = Raft id) and
@@ -106,6 +108,7 @@ impl Slots {
                 restart_at: None,
                 announce: false,
                 lost: None,
+                down_told: None,
             });
         };
         let bridge = host.map(|h| (Role::Bridge, h.index() as u32));
@@ -173,6 +176,40 @@ impl Slots {
             .and_then(|s| s.child.as_ref())
     }
 
+    /// Whether `target` is the running, unreaped incarnation of its slot, not yet told
+    /// `Down`.
+    pub(super) fn may_tell_down(&self, target: Incarnation) -> bool {
+        self.slot_of(target)
+            .is_some_and(|s| s.down_told != Some(target.pid))
+    }
+
+    /// `target`, which the supervisor SIGKILLed, can no longer act: its `Down`, told now
+    /// rather than at its reap (which then does not tell it again). None if `target` is not
+    /// the slot's running incarnation or was told already.
+    pub(super) fn told_down(&mut self, target: Incarnation) -> Option<Action> {
+        if !self.may_tell_down(target) {
+            return None;
+        }
+        let s = (self.slots.iter_mut())
+            .find(|s| s.spec.role == target.role && s.spec.index == target.index)?;
+        s.down_told = Some(target.pid);
+        let (role, index) = (s.spec.role, s.spec.index);
+        Some(Action::Publish(Lifecycle::down(
+            role,
+            index,
+            s.tracker.restarts(),
+        )))
+    }
+
+    /// The slot whose running, unreaped incarnation is `target`.
+    fn slot_of(&self, target: Incarnation) -> Option<&Slot> {
+        self.slots.iter().find(|s| {
+            s.spec.role == target.role
+                && s.spec.index == target.index
+                && (s.child.as_ref()).is_some_and(|c| c.pid() == target.pid && c.exit().is_none())
+        })
+    }
+
     /// Whether the incarnation `pid` of `role`/`index` is over for good or replaced: it was
     /// reaped, and it is either not restarted or its successor is up and announced.
     pub(super) fn settled(&self, role: Role, index: u32, pid: u32) -> bool {
@@ -218,6 +255,8 @@ impl Slots {
             let restarts = s.tracker.restarts();
             let (state, restarts) = match (&s.child, s.lost.is_some()) {
                 (_, true) => (RosterState::Lost, restarts),
+                // Told `Down` and not reaped yet: its restart is not counted yet.
+                (Some(c), false) if s.down_told == Some(c.pid()) => (RosterState::Down, restarts),
                 (Some(_), false) if !s.announce => (RosterState::Up, restarts),
                 // Dead, waiting for its restart, or restarted and not up yet: the restart
                 // already counted is still to be announced.
@@ -303,11 +342,13 @@ impl Slots {
             pid,
             how: exit.to_string(),
         }));
-        todo.push(Action::Publish(Lifecycle::down(
-            role,
-            index,
-            s.tracker.restarts(),
-        )));
+        if s.down_told.take() != Some(pid) {
+            todo.push(Action::Publish(Lifecycle::down(
+                role,
+                index,
+                s.tracker.restarts(),
+            )));
+        }
         let why = match s.tracker.on_exit(&exit) {
             RestartDecision::Restart { after } => {
                 s.restart_at = Some(Instant::now() + after);

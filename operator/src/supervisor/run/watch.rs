@@ -11,12 +11,14 @@
 use std::time::{Duration, Instant};
 
 use super::action::{Action, Landed, Shot, Why};
+use super::dying::Dying;
 use super::error::RunError;
 use super::faults::FaultSchedule;
 use super::hang::HangWatch;
 use super::progress::ProgressView;
 use super::slots::Slots;
 use super::sweeper::Sweeper;
+use crate::supervisor::child::Signal;
 use crate::supervisor::events::{RunEvent, RunEvents};
 use crate::supervisor::registry::RunRecord;
 use crate::supervisor::startup::SupervisorPorts;
@@ -106,6 +108,8 @@ pub(super) struct Watch<'s> {
     seen: &'s mut Seen,
     faults: FaultSchedule<'s>,
     hang: HangWatch,
+    /// The processes SIGKILLed here, until they are told `Down`.
+    dying: Dying,
     /// The last committed round the coordinator reported.
     round: u64,
     t0: Instant,
@@ -133,6 +137,7 @@ impl<'s> Watch<'s> {
             seen,
             faults,
             hang,
+            dying: Dying::default(),
             round: 0,
             t0: Instant::now(),
             // In lockstep the coordinator counts the limit in rounds and says when it is
@@ -215,6 +220,8 @@ impl<'s> Watch<'s> {
         if let Some(end) = self.on_progress(slots)? {
             return Ok(Look::End(end));
         }
+        let told = self.dying.check(slots);
+        self.apply(told, slots)?;
         self.on_ready(slots)?;
         let due = self.faults.resume_due(slots);
         self.apply(due, slots)?;
@@ -235,10 +242,15 @@ impl<'s> Watch<'s> {
             return Ok(Look::RestartDue);
         }
         // The next tick of the progress bar and the fault schedule, sooner if a restart, a
-        // hang deadline, a fault in seconds or the end of a freeze is due, never past the
-        // time limit.
+        // hang deadline, a fault in seconds, the end of a freeze or a killed process's next
+        // look is due, never past the time limit.
         let mut until = now + left.map_or(TICK, |l| TICK.min(l));
-        let timed = [restart_due, hung_due, self.faults.next_deadline(self.t0)];
+        let timed = [
+            restart_due,
+            hung_due,
+            self.faults.next_deadline(self.t0),
+            self.dying.next_look(now),
+        ];
         for d in timed.into_iter().flatten() {
             until = until.min(d);
         }
@@ -327,6 +339,9 @@ impl<'s> Watch<'s> {
             match action {
                 Action::Signal(shot) => {
                     let landed = self.shoot(&shot, slots);
+                    if landed != Landed::Missed && shot.signal == Signal::SIGKILL {
+                        self.dying.killed(shot.target);
+                    }
                     if let Why::Fault(i) = shot.why {
                         self.faults.landed(i, shot.target, landed);
                     }
