@@ -56,17 +56,7 @@ fn decision(agent: u32, verdict: Verdict, cell: u32) -> LoggedDecision {
 fn run_dir(dir: &Path) {
     let scenario_path = dir.join("fixture.toml");
     std::fs::write(&scenario_path, SCENARIO).unwrap();
-    let args = ProcessArgs {
-        run: "fixture".into(),
-        scenario: scenario_path,
-        agents: None,
-        seed: None,
-        mode: None,
-        replicas: None,
-        dir: None,
-        resume: false,
-        faults: Vec::new(),
-    };
+    let args = ProcessArgs::new("fixture", scenario_path);
     let scenario = args.scenario().unwrap();
     Invocation::new(&args, &scenario).write(dir).unwrap();
     let (mut log, _) = LogWriter::open(dir.join("log"), FsyncPolicy::None).unwrap();

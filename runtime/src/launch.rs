@@ -76,6 +76,21 @@ pub struct ProcessArgs {
 }
 
 impl ProcessArgs {
+    /// The arguments of run `run` of `scenario` with no override: the scenario as written.
+    pub fn new(run: impl Into<String>, scenario: impl Into<PathBuf>) -> Self {
+        ProcessArgs {
+            run: run.into(),
+            scenario: scenario.into(),
+            agents: None,
+            seed: None,
+            mode: None,
+            replicas: None,
+            dir: None,
+            resume: false,
+            faults: Vec::new(),
+        }
+    }
+
     /// The scenario with the overrides applied: `--seed` replaces `sim.seed`, `--agents`
     /// takes the first N agents or adds seeded random ones, `--mode` replaces `sim.clock`,
     /// `--replicas` replaces `coordinator.replicas`, and the command line's faults follow the

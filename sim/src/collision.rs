@@ -14,8 +14,11 @@ use nalgebra::Point2;
 pub enum Hit {
     /// Another robot (index).
     Robot(u32),
-    /// A blocked cell `(x, y)` (column, row; may lie outside the grid).
+    /// A blocked cell `(x, y)` (column, row; may lie outside the grid): a wall, or a cell an
+    /// event closed.
     Cell(i64, i64),
+    /// A moving obstacle of the scenario's events (its number, in the order they appeared).
+    Mover(u32),
 }
 
 /// One recorded collision: when it began, who was involved and where they were.
@@ -75,6 +78,12 @@ fn blocked(grid: &Grid, x: i64, y: i64) -> bool {
     grid.cell_checked(x, y).is_none_or(|c| grid.is_blocked(c))
 }
 
+/// Whether cell `c` and its 8 neighbours are free and inside the grid.
+fn open_around(grid: &Grid, c: hnav_runtime::grid::Cell) -> bool {
+    let (x, y) = (i64::from(c.x), i64::from(c.y));
+    (-1..=1).all(|dy| (-1..=1).all(|dx| !blocked(grid, x + dx, y + dy)))
+}
+
 /// The first blocked cell a disc of radius `r` overlaps, if any. Only cells meeting the
 /// disc's bounding box are examined (one to four when the disc is no wider than a cell).
 pub fn wall_contact(grid: &Grid, p: &Point2<f64>, r: f64, cell: f64) -> Option<(i64, i64)> {
@@ -114,13 +123,7 @@ impl Detector {
     /// A detector for `n` robots of body radius `radius` (at most `cell / 2`) on `grid`, whose
     /// cells have edge `cell` (m).
     pub fn new(n: usize, grid: &Grid, cell: f64, radius: f64) -> Detector {
-        let open = grid
-            .cells()
-            .map(|c| {
-                let (x, y) = (i64::from(c.x), i64::from(c.y));
-                (-1..=1).all(|dy| (-1..=1).all(|dx| !blocked(grid, x + dx, y + dy)))
-            })
-            .collect();
+        let open = grid.cells().map(|c| open_around(grid, c)).collect();
         Detector {
             open,
             open_w: grid.width(),
@@ -174,6 +177,13 @@ impl Detector {
                 .open
                 .get((cy.saturating_mul(w).saturating_add(cx)) as usize)
                 == Some(&true)
+    }
+
+    /// Rebuilds the table of open cells after cells of `grid` closed or opened.
+    pub(crate) fn refresh_open(&mut self, grid: &Grid) {
+        for (open, c) in self.open.iter_mut().zip(grid.cells()) {
+            *open = open_around(grid, c);
+        }
     }
 
     /// Checks all contacts of the robot centres `centres` and appends the contacts that
@@ -330,7 +340,7 @@ mod tests {
                 .iter()
                 .filter_map(|c| match c.hit {
                     Hit::Robot(j) => Some((c.robot, j)),
-                    Hit::Cell(..) => None,
+                    Hit::Cell(..) | Hit::Mover(_) => None,
                 })
                 .collect();
             got.sort_unstable();

@@ -26,7 +26,10 @@ use hnav_runtime::scenario::params::{RobotParams, SimParams};
 use hnav_runtime::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Translation2};
 
+mod changes;
 mod snapshot;
+
+use changes::Changes;
 
 pub use snapshot::SnapshotError;
 
@@ -68,6 +71,8 @@ pub struct World {
     slip_on: bool,
     detector: Detector,
     collisions: Vec<Collision>,
+    /// The scenario's `[[events]]`: cells that close or open, movers.
+    changes: Changes,
 }
 
 impl World {
@@ -128,6 +133,7 @@ impl World {
             slip_on: sim.slip_std > 0.0,
             detector: Detector::new(n, &grid, model.cell_size_m, model.body_radius_m),
             collisions: Vec::new(),
+            changes: Changes::default(),
             model,
             grid,
         })
@@ -142,12 +148,28 @@ impl World {
             .iter()
             .map(|a| cell_centre_pose(cs, a.start, a.start_heading_rad()))
             .collect();
-        World::new(
+        let mut world = World::new(
             &scenario.robot,
             &scenario.sim,
             scenario.map.grid.clone(),
             &starts,
-        )
+        )?;
+        world.changes = Changes::new(scenario.events.clone());
+        world.apply_changes();
+        Ok(world)
+    }
+
+    /// Applies the events due by now; the movers are moved by the next step.
+    fn apply_changes(&mut self) {
+        let t_s = self.time_ns() as f64 * 1e-9;
+        if self.changes.apply_due(t_s, &mut self.grid, self.pos.len()) {
+            self.detector.refresh_open(&self.grid);
+        }
+    }
+
+    /// The moving obstacles under way: name and centre (m).
+    pub fn movers(&self) -> impl Iterator<Item = (&str, Point2<f64>)> {
+        self.changes.movers()
     }
 
     /// Number of robots.
@@ -301,8 +323,23 @@ impl World {
         }
         self.steps += 1;
         let t = self.time_ns();
-        self.detector
-            .check(&self.grid, &self.pos, t, &mut self.collisions)
+        if self.changes.is_empty() {
+            return self
+                .detector
+                .check(&self.grid, &self.pos, t, &mut self.collisions);
+        }
+        self.apply_changes();
+        let (r, cell) = (self.model.body_radius_m, self.model.cell_size_m);
+        let movers = self.changes.mover_contacts(
+            t as f64 * 1e-9,
+            t,
+            (&self.pos, r, cell),
+            &mut self.collisions,
+        );
+        movers
+            + self
+                .detector
+                .check(&self.grid, &self.pos, t, &mut self.collisions)
     }
 
     /// Robot `agent`'s ground-truth pose.

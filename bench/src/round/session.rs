@@ -194,15 +194,8 @@ fn session<T>(
     // Every agent port exists before the coordinator starts, as after a real start-up.
     let mut swarm = Swarm::open(run, layout, bell)?;
     let args = ProcessArgs {
-        run: run.as_str().to_string(),
-        scenario,
-        agents: None,
-        seed: None,
-        mode: None,
-        replicas: None,
         dir: Some(dir.to_path_buf()),
-        resume: false,
-        faults: Vec::new(),
+        ..ProcessArgs::new(run.as_str(), scenario)
     };
     // As the supervisor numbers them: index 0 for one coordinator, Raft ids 1..=n for
     // replicas (each told its id with `--replica`).

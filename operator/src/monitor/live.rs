@@ -275,15 +275,8 @@ mod tests {
     fn register(registry: &RunRegistry, id: &str, dir: &Path) {
         let mut record = registry.new_record(&RunId::new(id).unwrap(), dir);
         record.set_process_args(&ProcessArgs {
-            run: id.into(),
-            scenario: "demo.toml".into(),
-            agents: None,
-            seed: None,
-            mode: None,
-            replicas: None,
             dir: Some(dir.to_path_buf()),
-            resume: false,
-            faults: Vec::new(),
+            ..ProcessArgs::new(id, "demo.toml")
         });
         record.write().unwrap();
     }

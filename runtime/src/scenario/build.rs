@@ -67,6 +67,7 @@ pub(super) fn parse(
         (&map.grid, map.corner_cutting),
         &lines,
     )?;
+    let events = super::events::build_events(raw.events, &map.grid, &agents, &sim, &lines)?;
     Ok(Scenario {
         name: raw.name.into_inner(),
         source_name: source_name.into(),
@@ -82,6 +83,7 @@ pub(super) fn parse(
         faults,
         allow_unreachable,
         tasks,
+        events,
     })
 }
 

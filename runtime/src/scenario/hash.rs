@@ -16,7 +16,9 @@
 //! * `allow_unreachable`, only when it is `true` (appended last), so that the hash of every
 //!   scenario without the key, and every log written before it existed, stays the same;
 //!   likewise `[restart] on_give_up`, only when it is `"stop"`, and `[tasks]`, only when
-//!   the section is there (the tag `tasks`, the stream's code and seed, each agent's cycle).
+//!   the section is there (the tag `tasks`, the stream's code and seed, each agent's cycle),
+//!   and `[[events]]`, only when there are some (the tag `events`, then each event's time and
+//!   change: a code, its cells, a mover's name, speed and repeat).
 //!
 //! It does **not** cover the scenario `name`, the source file name, or the map file's path
 //! (only the map's content), so renaming or moving files keeps the hash.
@@ -29,6 +31,7 @@ use super::params::{
     ClockMode, FsyncPolicy, GiveUpAction, Planner, RestartPolicy, RestartRule, Rules,
 };
 use super::tasks::StreamKind;
+use super::{EventSpec, WorldChange};
 use super::{FaultAction, FaultSignal, FaultSpec, FaultTarget, FaultTime, Scenario};
 use crate::grid::{CornerCutting, TerrainKind};
 use crate::hash::Fnv1a64;
@@ -205,5 +208,37 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
             }
         }
     }
+    if !s.events.is_empty() {
+        h.bytes(b"events");
+        h.u64(s.events.len() as u64);
+        for e in &s.events {
+            event(&mut h, e);
+        }
+    }
     h.finish()
+}
+
+fn event(h: &mut Fnv1a64, e: &EventSpec) {
+    h.f64(e.at_s);
+    let cells = match &e.change {
+        WorldChange::Close(c) => {
+            h.u64(0);
+            c
+        }
+        WorldChange::Open(c) => {
+            h.u64(1);
+            c
+        }
+        WorldChange::Mover(m) => {
+            h.u64(2)
+                .bytes(m.name.as_bytes())
+                .f64(m.speed)
+                .u64(m.repeat.into());
+            &m.cells
+        }
+    };
+    h.u64(cells.len() as u64);
+    for c in cells {
+        h.u64(c.x.into()).u64(c.y.into());
+    }
 }

@@ -103,6 +103,17 @@
 //! # [[tasks.goals]]                    # list only (`goals`): a robot's goals after its goal,
 //! # agent = 0                          # cycled; a robot without an entry keeps its one goal
 //! # cells = [[5, 3], [0, 0]]
+//!
+//! [[events]]                           # optional: the world changes ([`events`]); one
+//! at_round = 120                       # change each, at a round or at_s
+//! close = [[5, 3]]                     # cells become obstacles; or one of:
+//! # close_rect = [[4, 2], [5, 3]]      # a rectangle, corners included
+//! # open = [[5, 3]]                    # free again (or a wall of the map opened);
+//! # open_rect = [[4, 2], [5, 3]]       # open_rect likewise
+//! # mover = "forklift"                 # a moving obstacle (a person, a forklift) along
+//! # path = [[1, 1], [1, 8]]            # legs along rows or columns, speed in cells/s,
+//! # speed = 0.5                        # back and forth with repeat = true
+//! # repeat = true
 //! ```
 //!
 //! Unknown keys are errors (a typo must not silently fall back to a default). Every semantic
@@ -147,6 +158,7 @@ mod agents;
 mod build;
 mod build_params;
 pub mod error;
+pub mod events;
 pub mod fault_arg;
 mod hash;
 pub mod health;
@@ -163,6 +175,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 pub use error::{Loc, ScenarioError};
+pub use events::{EventSpec, MoverSpec, WorldChange};
 pub use health::HealthParams;
 pub use params::{
     default_startup_timeout_s, ClockMode, ClockModeError, CoordinatorParams, FsyncPolicy,
@@ -332,6 +345,8 @@ pub struct Scenario {
     /// Goals that keep coming (`[tasks]`): a lifelong run, ended by time; `None` for a run
     /// that ends once every robot stands on its goal.
     pub tasks: Option<TasksSpec>,
+    /// How the world changes during the run (`[[events]]`), in time order.
+    pub events: Vec<EventSpec>,
 }
 
 impl Scenario {
@@ -417,6 +432,8 @@ impl Scenario {
 mod test_support;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_events;
 #[cfg(test)]
 mod tests_faults;
 #[cfg(test)]

@@ -13,7 +13,7 @@ use super::params::{ClockMode, FsyncPolicy, GiveUpAction, Planner, RestartPolicy
 
 /// Every key of the format, table by table as the structs below (and `health`'s and
 /// `record`'s) take them: `""` is the top level, `restart.ROLE` each role's rule, `agents`,
-/// `faults` and `tasks.goals` one entry of the arrays of tables. The docs that describe the format are
+/// `faults`, `tasks.goals` and `events` one entry of the arrays of tables. The docs that describe the format are
 /// checked against it, and a test checks it against what the parser accepts.
 pub const KEYS: &[(&str, &[&str])] = &[
     (
@@ -32,6 +32,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
             "agents",
             "faults",
             "tasks",
+            "events",
         ],
     ),
     ("map", &["file", "rows", "corner_cutting"]),
@@ -109,6 +110,21 @@ pub const KEYS: &[(&str, &[&str])] = &[
     ),
     ("tasks", &["stream", "seed", "goals"]),
     ("tasks.goals", &["agent", "cells"]),
+    (
+        "events",
+        &[
+            "at_round",
+            "at_s",
+            "close",
+            "close_rect",
+            "open",
+            "open_rect",
+            "mover",
+            "path",
+            "speed",
+            "repeat",
+        ],
+    ),
 ];
 
 /// Top level.
@@ -130,6 +146,8 @@ pub(super) struct RawScenario {
     #[serde(default)]
     pub faults: Vec<Spanned<RawFault>>,
     pub tasks: Option<Spanned<super::tasks::RawTasks>>,
+    #[serde(default)]
+    pub events: Vec<Spanned<super::events::RawEvent>>,
 }
 
 /// `[map]`.

@@ -79,6 +79,9 @@ pub struct ScenarioReport {
     /// A lifelong run's `[tasks]` in words; absent without the section.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tasks: Option<String>,
+    /// How the world changes (`[[events]]`), one line each; absent without events.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub events: Vec<String>,
 }
 
 impl ScenarioReport {
@@ -127,8 +130,10 @@ impl ScenarioReport {
             };
             format!("{stream}; a lifelong run, ended by the time limit")
         });
+        let events = s.events.iter().map(event_line).collect();
         ScenarioReport {
             tasks,
+            events,
             name: s.name.clone(),
             source: s.source_name.clone(),
             scenario_hash: format!("{:016x}", s.scenario_hash()),
@@ -210,6 +215,9 @@ impl ScenarioReport {
         if !self.faults.is_empty() {
             let _ = writeln!(o, "faults    {}", self.faults.join("; "));
         }
+        for e in &self.events {
+            let _ = writeln!(o, "event     {e}");
+        }
         if let Some(t) = &self.tasks {
             let _ = writeln!(o, "tasks     {t}");
         }
@@ -277,6 +285,28 @@ pub fn default_out_dir(name: &str) -> PathBuf {
         safe = format!("_{safe}");
     }
     Path::new("target").join("hnav-out").join(safe)
+}
+
+/// One event in words: `at 1.20 s: close (5, 3), (5, 4)`.
+fn event_line(e: &super::EventSpec) -> String {
+    let cells = |c: &[crate::grid::Cell]| {
+        let all: Vec<String> = c.iter().map(|c| format!("({}, {})", c.x, c.y)).collect();
+        all.join(", ")
+    };
+    let what = match &e.change {
+        super::WorldChange::Close(c) => format!("close {}", cells(c)),
+        super::WorldChange::Open(c) => format!("open {}", cells(c)),
+        super::WorldChange::Mover(m) => format!(
+            "mover `{}` at {} cells/s{} from ({}, {}) over {} cells",
+            m.name,
+            m.speed,
+            if m.repeat { ", back and forth" } else { "" },
+            m.cells[0].x,
+            m.cells[0].y,
+            m.cells.len()
+        ),
+    };
+    format!("at {:.2} s: {what}", e.at_s)
 }
 
 #[cfg(test)]

@@ -172,20 +172,9 @@ pub(super) fn build_tasks(
 
 /// `[x, y]` as a free cell of `grid`, or what is wrong with it.
 fn goal_cell(xy: &[i64], grid: &Grid) -> Result<Cell, String> {
-    let [x, y] = xy else {
-        return Err(format!("a goal must be [x, y], got {} numbers", xy.len()));
-    };
-    let inside = |v: i64, n: u32| u32::try_from(v).ok().filter(|&v| v < n);
-    let (Some(cx), Some(cy)) = (inside(*x, grid.width()), inside(*y, grid.height())) else {
-        return Err(format!(
-            "({x}, {y}) is outside the {}x{} map",
-            grid.width(),
-            grid.height()
-        ));
-    };
-    let cell = Cell::new(cx, cy);
+    let cell = super::events::on_map(xy, grid)?;
     if grid.is_blocked(cell) {
-        return Err(format!("({x}, {y}) is on an obstacle"));
+        return Err(format!("({}, {}) is on an obstacle", cell.x, cell.y));
     }
     Ok(cell)
 }
@@ -386,7 +375,7 @@ mod tests {
         );
         assert_eq!(
             error("stream = \"list\"\n[[tasks.goals]]\nagent = 0\ncells = [[1, 0, 2]]\n"),
-            "t.toml:20: tasks.goals.cells a goal must be [x, y], got 3 numbers"
+            "t.toml:20: tasks.goals.cells a cell must be [x, y], got 3 numbers"
         );
         let e = error("stream = \"sometimes\"\n");
         assert!(e.starts_with("t.toml:17: "), "{e}");

@@ -11,6 +11,7 @@ fn accepted(table: &str) -> Vec<String> {
         "map" => BASE.replace("[map]\n", "[map]\nzz_unknown = 1\n"),
         "agents" => BASE.replacen("[[agents]]\n", "[[agents]]\nzz_unknown = 1\n", 1),
         "faults" => format!("{BASE}[[faults]]\nzz_unknown = 1\n"),
+        "events" => format!("{BASE}[[events]]\nzz_unknown = 1\n"),
         "restart.ROLE" => format!("{BASE}[restart]\nagent = {{ zz_unknown = 1 }}\n"),
         "tasks.goals" => {
             format!("{BASE}[tasks]\nstream = \"list\"\n[[tasks.goals]]\nzz_unknown = 1\n")

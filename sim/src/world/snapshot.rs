@@ -125,6 +125,7 @@ impl World {
             let (kind, x, y) = match c.hit {
                 Hit::Robot(j) => (0, i64::from(j), 0),
                 Hit::Cell(x, y) => (1, x, y),
+                Hit::Mover(k) => (2, i64::from(k), 0),
             };
             for w in [c.time_ns, u64::from(c.robot), kind, x as u64, y as u64] {
                 put(out, w);
@@ -184,6 +185,7 @@ impl World {
                 (w.next()?, w.next()?, w.next()?, w.next()?, w.next()?);
             let hit = match kind {
                 0 => Hit::Robot(x as u32),
+                2 => Hit::Mover(x as u32),
                 _ => Hit::Cell(x as i64, y as i64),
             };
             next.collisions.push(Collision {
@@ -197,6 +199,8 @@ impl World {
         if !w.0.is_empty() {
             return Err(SnapshotError::Length);
         }
+        // The world changes by the scenario and the time alone: catch up to the snapshot's.
+        next.apply_changes();
         *self = next;
         Ok(())
     }

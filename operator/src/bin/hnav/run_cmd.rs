@@ -144,16 +144,13 @@ fn parse_faults(
 pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
     hnav_runtime::logging::init();
     let written = cli_faults(&a, matches);
+    let run_id = a.run.unwrap_or_else(|| new_run_id().as_str().to_string());
     let mut args = ProcessArgs {
-        run: a.run.unwrap_or_else(|| new_run_id().as_str().to_string()),
-        scenario: a.scenario,
         agents: a.agents,
         seed: a.seed,
         mode: a.mode,
         replicas: a.replicas,
-        dir: None,
-        resume: false,
-        faults: Vec::new(),
+        ..ProcessArgs::new(run_id, a.scenario)
     };
     // The scenario as the processes will see it (--agents applied), so that a fault's agent
     // is checked against the run's agents before anything is spawned.

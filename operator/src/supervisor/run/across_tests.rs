@@ -34,17 +34,7 @@ fn demo() -> PathBuf {
 fn slots_of(tmp: &Path, placement: &str, name: &str) -> Slots {
     let file = tmp.join("hosts.toml");
     std::fs::write(&file, placement).unwrap();
-    let args = ProcessArgs {
-        run: "across".into(),
-        scenario: demo(),
-        agents: None,
-        seed: None,
-        mode: None,
-        replicas: None,
-        dir: None,
-        resume: false,
-        faults: Vec::new(),
-    };
+    let args = ProcessArgs::new("across", demo());
     let scenario = Scenario::load(demo()).unwrap();
     let part = HostPart::load(&file, name, &scenario).unwrap();
     Slots::new(&args, tmp, &scenario, tmp, None, Some(&part), None)

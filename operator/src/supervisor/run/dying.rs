@@ -89,17 +89,7 @@ mod tests {
             std::fs::set_permissions(&program, std::fs::Permissions::from_mode(0o755)).unwrap();
         }
         let demo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/demo.toml");
-        let args = ProcessArgs {
-            run: "dying".into(),
-            scenario: demo.clone(),
-            agents: None,
-            seed: None,
-            mode: None,
-            replicas: None,
-            dir: None,
-            resume: false,
-            faults: Vec::new(),
-        };
+        let args = ProcessArgs::new("dying", &demo);
         let scenario = Scenario::load(demo).unwrap();
         Slots::new(&args, &bin, &scenario, tmp, None, None, None)
     }

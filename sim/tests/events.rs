@@ -1,0 +1,104 @@
+//! The world's `[[events]]` in the sim: a closed cell is a wall a robot can hit, a mover is
+//! an obstacle a robot can touch, both recorded once per contact; a restored world catches up
+//! with the events by its time.
+
+use hnav_runtime::grid::Cell;
+use hnav_runtime::scenario::Scenario;
+use hnav_sim::{Hit, World};
+
+/// A 10x5 free room, one robot at (2, 2) facing +x (towards (9, 2)), and `events`.
+fn world(events: &str) -> World {
+    let text = format!(
+        "name = \"ev\"\n[map]\nrows = [\"..........\", \"..........\", \"..........\", \
+         \"..........\", \"..........\"]\n[[agents]]\nstart = [2, 2]\ngoal = [9, 2]\n{events}"
+    );
+    let s = Scenario::from_str(&text, "ev.toml", std::path::Path::new(".")).unwrap();
+    World::from_scenario(&s).unwrap()
+}
+
+/// Drives robot 0 straight ahead for `steps` steps (commands renewed every 10).
+fn drive(w: &mut World, steps: u64) {
+    for _ in 0..steps {
+        if w.steps().is_multiple_of(10) {
+            let (now, period) = (w.time_ns(), w.steps() / 10);
+            w.apply_command(0, period, 10.0, 10.0, now).unwrap();
+        }
+        w.step();
+    }
+}
+
+#[test]
+fn a_cell_closed_ahead_is_hit_and_one_opened_again_is_not() {
+    let mut clear = world("");
+    drive(&mut clear, 3000);
+    assert!(clear
+        .collisions()
+        .iter()
+        .all(|c| !matches!(c.hit, Hit::Cell(6, 2))));
+
+    let mut closed = world("[[events]]\nat_s = 0.5\nclose = [[6, 2]]\n");
+    assert!(
+        !closed.grid().is_blocked(Cell::new(6, 2)),
+        "not before its time"
+    );
+    drive(&mut closed, 3000);
+    assert!(closed.grid().is_blocked(Cell::new(6, 2)));
+    let first = closed.collisions().first().expect("the closed cell is hit");
+    assert_eq!((first.robot, first.hit), (0, Hit::Cell(6, 2)));
+    assert!(first.time_ns >= 500_000_000);
+
+    // Closed, then open before the robot gets there: nothing to hit.
+    let mut reopened = world(
+        "[[events]]\nat_s = 0.1\nclose = [[6, 2]]\n[[events]]\nat_s = 0.2\nopen = [[6, 2]]\n",
+    );
+    drive(&mut reopened, 3000);
+    assert!(!reopened.grid().is_blocked(Cell::new(6, 2)));
+    assert!(reopened
+        .collisions()
+        .iter()
+        .all(|c| !matches!(c.hit, Hit::Cell(6, 2))));
+}
+
+#[test]
+fn a_mover_crossing_the_robots_way_is_touched_once() {
+    // Down column 7 and back at 0.5 cells/s for ever: the robot, driving along row 2,
+    // meets it there.
+    let mover = "[[events]]\nat_s = 0\nmover = \"person\"\npath = [[7, 0], [7, 4]]\nspeed = 0.5\nrepeat = true\n";
+    let mut w = world(mover);
+    drive(&mut w, 30_000);
+    let hits: Vec<_> = (w.collisions().iter())
+        .filter(|c| c.hit == Hit::Mover(0))
+        .collect();
+    assert_eq!(hits.len(), 1, "{:?}", w.collisions());
+    let d = (hits[0].position - hits[0].other_position).norm();
+    let r = hnav_runtime::scenario::params::RobotParams::default().body_radius_m;
+    assert!(
+        d < 2.0 * r && d > 2.0 * r - 0.01,
+        "{d}: a contact begins at the discs' touch"
+    );
+    eprintln!("mover contact at {} ns", hits[0].time_ns);
+    let (name, at) = w.movers().next().expect("the mover is under way");
+    assert_eq!(name, "person");
+    assert!(at.x > 0.0 && at.y > 0.0);
+}
+
+#[test]
+fn a_restored_world_catches_up_with_the_events() {
+    let events = "[[events]]\nat_s = 0\nmover = \"p\"\npath = [[7, 0], [7, 4]]\nspeed = 0.5\n\
+                  repeat = true\n[[events]]\nat_s = 0.5\nclose = [[6, 2]]\n";
+    let mut w = world(events);
+    drive(&mut w, 1000);
+    let mut bytes = Vec::new();
+    w.write_snapshot(&mut bytes);
+    let mut back = world(events);
+    assert!(!back.grid().is_blocked(Cell::new(6, 2)));
+    back.restore_snapshot(&bytes).unwrap();
+    assert!(
+        back.grid().is_blocked(Cell::new(6, 2)),
+        "closed by its time"
+    );
+    drive(&mut w, 20_000);
+    drive(&mut back, 20_000);
+    assert_eq!(w.collisions(), back.collisions());
+    assert_eq!(w.pose(0), back.pose(0));
+}
