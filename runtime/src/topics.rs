@@ -50,6 +50,11 @@ pub fn odometry(i: usize) -> String {
     format!("odom/{i}")
 }
 
+/// Robot `i`'s sensor view (the sim's [`View`](crate::msg::View)).
+pub fn view(i: usize) -> String {
+    format!("view/{i}")
+}
+
 /// Agent `i`'s neural-map snapshots.
 pub fn map(i: usize) -> String {
     format!("map/{i}")

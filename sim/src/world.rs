@@ -27,6 +27,7 @@ use hnav_runtime::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Translation2};
 
 mod changes;
+mod sensing;
 mod snapshot;
 
 use changes::Changes;

@@ -102,3 +102,49 @@ fn a_restored_world_catches_up_with_the_events() {
     assert_eq!(w.collisions(), back.collisions());
     assert_eq!(w.pose(0), back.pose(0));
 }
+
+/// The cells robot 0 sees within `range`, as (x, y, blocked).
+fn seen(w: &World, range: u32) -> Vec<(u32, u32, bool)> {
+    let mut v = hnav_runtime::msg::View::default();
+    w.fill_view(0, 0, range, &mut v);
+    v.cells().collect()
+}
+
+#[test]
+fn a_view_sees_what_is_in_range_and_in_sight_and_a_wall_hides_what_is_behind() {
+    // The robot at (2, 2); (4, 2) closed at once: seen blocked, (5, 2) behind it hidden.
+    let w = world("[[events]]\nat_s = 0\nclose = [[4, 2]]\n");
+    let cells = seen(&w, 3);
+    assert!(cells.contains(&(4, 2, true)), "{cells:?}");
+    assert!(cells.contains(&(3, 2, false)));
+    assert!(
+        !cells.iter().any(|&(x, y, _)| (x, y) == (5, 2)),
+        "hidden: {cells:?}"
+    );
+    // In range (a disc of 3 cells) and in the map only.
+    assert!(cells.iter().all(|&(x, y, _)| {
+        let (dx, dy) = (i64::from(x) - 2, i64::from(y) - 2);
+        dx * dx + dy * dy <= 9 && x < 10 && y < 5
+    }));
+    assert!(cells.contains(&(2, 2, false)), "its own cell");
+    assert!(
+        !cells.iter().any(|&(x, y, _)| (x, y) == (5, 3)),
+        "out of range"
+    );
+    // Nothing closed: (5, 2) is seen, free.
+    assert!(seen(&world(""), 3).contains(&(5, 2, false)));
+}
+
+#[test]
+fn a_mover_in_range_is_seen_as_blocked_cells() {
+    let w = world("[[events]]\nat_s = 0\nmover = \"p\"\npath = [[4, 0], [4, 4]]\nspeed = 1\n");
+    let mut w = w;
+    drive(&mut w, 2000); // 2 s: the mover near (4, 2)
+    let blocked: Vec<_> = seen(&w, 5)
+        .into_iter()
+        .filter(|c| c.2)
+        .map(|c| (c.0, c.1))
+        .collect();
+    assert!(blocked.iter().all(|&(x, _)| x == 4), "{blocked:?}");
+    assert!(blocked.contains(&(4, 2)), "{blocked:?}");
+}

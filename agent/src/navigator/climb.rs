@@ -4,11 +4,14 @@
 use hnav_runtime::grid::{Cell, CornerCutting, Direction, Grid};
 use hnav_runtime::msg::ActivationKind;
 
+use super::sense::{RepairKind, PARTIAL_SWEEPS};
 use super::Proposal;
 use crate::error::Error;
+use crate::neural_map::repair::{partial_correction, path_hits};
 use crate::neural_map::{BuildReport, NeuralDynamics, NeuralMap, Outcome, StopRule};
 use crate::path_constructor::{DirectionMask, PathConstructor, PathOptions, Walker};
 use crate::plan::{PlanOptions, PlanStop};
+use hnav_runtime::scenario::RepairRule;
 
 /// The neural map, its last build, and the walker that climbs it.
 pub(super) struct Climb {
@@ -87,6 +90,34 @@ impl Climb {
         self.map.add_obstacles(&[cell])?;
         self.report = self.map.build(target, StopRule::FullActivation)?;
         Ok(())
+    }
+
+    /// Repairs the map after `closed` cells closed (and others opened, if `opened`) in
+    /// `grid`, the robot at `from` heading for `target`, as `rule` says (`sense.rs`).
+    pub(super) fn repair(
+        &mut self,
+        grid: &Grid,
+        closed: &[Cell],
+        opened: bool,
+        (from, target): (Cell, Cell),
+        rule: RepairRule,
+    ) -> Result<RepairKind, Error> {
+        let rebuild = opened
+            || match rule {
+                RepairRule::Rebuild => true,
+                RepairRule::Partial => false,
+                RepairRule::Auto => self
+                    .constructor
+                    .trace(&self.map, from)
+                    .map_or(true, |p| path_hits(&p.cells, closed)),
+            };
+        if rebuild {
+            self.map = NeuralMap::new(grid, *self.map.options())?;
+            self.report = self.map.build(target, StopRule::FullActivation)?;
+            return Ok(RepairKind::Rebuild);
+        }
+        self.report = partial_correction(&mut self.map, closed, PARTIAL_SWEEPS)?;
+        Ok(RepairKind::Partial)
     }
 
     /// A new map of `grid` toward `target`, climbed afresh from `from`.

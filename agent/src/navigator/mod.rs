@@ -37,6 +37,7 @@
 
 mod climb;
 mod follow;
+mod sense;
 #[cfg(test)]
 mod tests;
 
@@ -50,6 +51,7 @@ use crate::neural_map::NeuralMap;
 use crate::route::RoutePlanner;
 use climb::Climb;
 use follow::Follow;
+pub use sense::{Repair, RepairKind, PARTIAL_SWEEPS};
 
 /// What the agent is told at start.
 #[derive(Clone, Copy, PartialEq, Debug)]

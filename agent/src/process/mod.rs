@@ -108,7 +108,8 @@ impl<'t> AgentProcess<'t> {
             .agents
             .get(index as usize)
             .ok_or(AgentError::NoSuchAgent { index, agents })?;
-        let ports = Ports::open(transport, &scenario.map.grid, index, agents)?;
+        let sensing = scenario.sensing.is_some();
+        let ports = Ports::open(transport, &scenario.map.grid, (index, agents), sensing)?;
         let heart = Heartbeat::open(transport, Role::Agent, index, agents, scenario.heartbeat())?;
         if !args.resume {
             // Only a first start has a supervisor waiting on a bound; a restarted agent

@@ -2,7 +2,9 @@
 
 use hnav_runtime::grid::Grid;
 use hnav_runtime::launch::LifecyclePorts;
-use hnav_runtime::msg::{Candidate, Commit, Estimate, MapHeader, Odometry, Role, WheelCommand};
+use hnav_runtime::msg::{
+    Candidate, Commit, Estimate, MapHeader, Odometry, Role, View, WheelCommand,
+};
 use hnav_runtime::topics;
 use hnav_runtime::transport::{
     Bell, BellWatch, Receiver, Sender, SliceSender, Transport, TransportError,
@@ -12,6 +14,8 @@ use hnav_runtime::transport::{
 /// candidates, neural-map snapshots and dead-reckoned poses out, and its side of the lifecycle protocol.
 pub(super) struct Ports {
     pub(super) odom: Receiver<Odometry>,
+    /// The robot's sensor view, when the scenario senses (`[sensing]`).
+    pub(super) view: Option<Receiver<View>>,
     pub(super) commit: Receiver<Commit>,
     /// The run's commit bell, watched in place of a datagram per commit (under a supervisor).
     pub(super) bell: Option<BellWatch>,
@@ -23,13 +27,14 @@ pub(super) struct Ports {
 }
 
 impl Ports {
-    /// Opens the ports of agent `index` in a swarm of `agents` on `grid`; `Up` is announced
-    /// later, by the handshake in [`AgentProcess::run`](super::AgentProcess::run).
+    /// Opens the ports of agent `index` in a swarm of `agents` on `grid` (with its view if
+    /// `sensing`); `Up` is announced later, by the handshake in
+    /// [`AgentProcess::run`](super::AgentProcess::run).
     pub(super) fn open(
         transport: &Transport,
         grid: &Grid,
-        index: u32,
-        agents: usize,
+        (index, agents): (u32, usize),
+        sensing: bool,
     ) -> Result<Self, TransportError> {
         let i = index as usize;
         // With a bell the commit listener is one the coordinator does not send datagrams to;
@@ -41,6 +46,9 @@ impl Ports {
         };
         Ok(Self {
             odom: transport.receiver(&topics::odometry(i), topics::state_qos())?,
+            view: sensing
+                .then(|| transport.receiver(&topics::view(i), topics::state_qos()))
+                .transpose()?,
             commit,
             bell: bell.map(Bell::into_watch).transpose()?,
             wheels: transport.sender(&topics::wheels(i), topics::state_qos())?,

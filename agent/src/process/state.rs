@@ -8,9 +8,10 @@ use std::time::{Duration, Instant};
 use hnav_runtime::diag::is_no_space_io;
 use hnav_runtime::grid::geometry::{cell_centre_m, cell_centre_pose, cell_index};
 use hnav_runtime::grid::Cell;
+use hnav_runtime::grid::Grid;
 use hnav_runtime::hash::SplitMix64;
-use hnav_runtime::msg::{Estimate, MapHeader, Odometry, Pose, WheelCommand};
-use hnav_runtime::scenario::{AgentSpec, ClockMode, Planner, Scenario};
+use hnav_runtime::msg::{Estimate, MapHeader, Odometry, Pose, View, WheelCommand};
+use hnav_runtime::scenario::{AgentSpec, ClockMode, Planner, RepairRule, Scenario};
 
 use super::checkpoint::{Checkpoint, CheckpointFile};
 use super::ports::Ports;
@@ -53,6 +54,8 @@ pub(super) struct Core {
     /// A candidate is due for the last odometry reading.
     candidate_due: bool,
     ticks: (i64, i64),
+    /// How the neural map is repaired when the view differs from it; none: no sensing.
+    repair: Option<RepairRule>,
 }
 
 impl Core {
@@ -66,7 +69,10 @@ impl Core {
         resumed: Option<Checkpoint>,
         restarted: bool,
     ) -> Result<Self, AgentError> {
-        let grid = &scenario.map.grid;
+        // Unmapped (`known_map = false`, seed 003): no wall is known until it is seen.
+        let unmapped = scenario.sensing.is_some_and(|s| !s.known_map);
+        let blank = unmapped.then(|| blank_like(&scenario.map.grid));
+        let grid = blank.as_ref().unwrap_or(&scenario.map.grid);
         let cs = scenario.robot.cell_size_m;
         let task = Task {
             index,
@@ -116,6 +122,7 @@ impl Core {
             last_wheels: None,
             candidate_due: false,
             ticks,
+            repair: scenario.sensing.map(|s| s.repair),
         })
     }
 
@@ -211,8 +218,28 @@ impl Core {
         Ok(())
     }
 
+    /// Folds in the newest views (they come before the odometry of their period): cells
+    /// that changed are learned and the guide repaired.
+    fn on_views(&mut self, p: &Ports) -> Result<(), AgentError> {
+        let (Some(rx), Some(rule)) = (&p.view, self.repair) else {
+            return Ok(());
+        };
+        let mut latest: Option<View> = None;
+        rx.drain_pending(|v| {
+            if v.agent == self.index && latest.is_none_or(|l| v.period >= l.period) {
+                latest = Some(*v);
+            }
+        })?;
+        // A repaired map is marked replanned: its snapshot goes out with the next candidate.
+        if let Some(v) = latest {
+            self.nav.sense(&v, rule)?;
+        }
+        Ok(())
+    }
+
     /// Folds in the newest odometry reading and opens the next round.
     fn on_odometry(&mut self, p: &Ports) -> Result<(), AgentError> {
+        self.on_views(p)?;
         let mut latest: Option<Odometry> = None;
         p.odom.drain_pending(|o| {
             if latest.is_none_or(|l| o.period >= l.period) {
@@ -418,4 +445,13 @@ fn wheel_drive(scenario: &Scenario, spec: &AgentSpec) -> WheelDrive {
             ControllerParams::new(&scenario.robot, spec.speed),
         )),
     }
+}
+
+/// A grid of `grid`'s size with no wall: what an agent knows of an unmapped world.
+fn blank_like(grid: &Grid) -> Grid {
+    let mut blank = grid.clone();
+    for c in grid.cells() {
+        blank.set_blocked(c, false);
+    }
+    blank
 }

@@ -31,6 +31,7 @@ pub(super) fn parse(
     let run = build_run(raw.run, &lines)?;
     let health = super::health::build_health(raw.health, &lines)?;
     let record = super::record::build_record(raw.record, &lines)?;
+    let sensing = super::sensing::build_sensing(raw.sensing, &lines)?;
     if raw.agents.is_empty() {
         return Err(ScenarioError::NoAgents {
             at: Loc::new(source_name, 1),
@@ -84,6 +85,7 @@ pub(super) fn parse(
         allow_unreachable,
         tasks,
         events,
+        sensing,
     })
 }
 

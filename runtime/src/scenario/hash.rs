@@ -18,7 +18,8 @@
 //!   likewise `[restart] on_give_up`, only when it is `"stop"`, and `[tasks]`, only when
 //!   the section is there (the tag `tasks`, the stream's code and seed, each agent's cycle),
 //!   and `[[events]]`, only when there are some (the tag `events`, then each event's time and
-//!   change: a code, its cells, a mover's name, speed and repeat).
+//!   change: a code, its cells, a mover's name, speed and repeat), after `[sensing]`, only
+//!   when the section is there (the tag `sensing`, range, known_map, the repair rule's code).
 //!
 //! It does **not** cover the scenario `name`, the source file name, or the map file's path
 //! (only the map's content), so renaming or moving files keeps the hash.
@@ -31,7 +32,7 @@ use super::params::{
     ClockMode, FsyncPolicy, GiveUpAction, Planner, RestartPolicy, RestartRule, Rules,
 };
 use super::tasks::StreamKind;
-use super::{EventSpec, WorldChange};
+use super::{EventSpec, RepairRule, WorldChange};
 use super::{FaultAction, FaultSignal, FaultSpec, FaultTarget, FaultTime, Scenario};
 use crate::grid::{CornerCutting, TerrainKind};
 use crate::hash::Fnv1a64;
@@ -207,6 +208,17 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
                 h.u64(g.x.into()).u64(g.y.into());
             }
         }
+    }
+    if let Some(v) = &s.sensing {
+        let repair = match v.repair {
+            RepairRule::Auto => 0,
+            RepairRule::Partial => 1,
+            RepairRule::Rebuild => 2,
+        };
+        h.bytes(b"sensing")
+            .u64(v.range.into())
+            .u64(v.known_map.into())
+            .u64(repair);
     }
     if !s.events.is_empty() {
         h.bytes(b"events");

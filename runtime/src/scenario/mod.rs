@@ -114,6 +114,11 @@
 //! # path = [[1, 1], [1, 8]]            # legs along rows or columns, speed in cells/s,
 //! # speed = 0.5                        # back and forth with repeat = true
 //! # repeat = true
+//!
+//! [sensing]                            # optional: robots sense the world ([`sensing`]);
+//! range = 5                            # cells seen in line of sight, in [1, 15]
+//! known_map = true                     # false: only the walls seen so far are known
+//! repair = "auto"                      # neural-map repair: "auto", "partial", "rebuild"
 //! ```
 //!
 //! Unknown keys are errors (a typo must not silently fall back to a default). Every semantic
@@ -167,6 +172,7 @@ pub mod params;
 mod raw;
 pub mod record;
 pub mod report;
+pub mod sensing;
 pub mod tasks;
 mod validate;
 
@@ -185,6 +191,7 @@ pub use params::{
 pub use raw::KEYS;
 pub use record::RecordParams;
 pub use report::{default_out_dir, ScenarioReport};
+pub use sensing::{RepairRule, SensingParams};
 pub use tasks::{StreamKind, TaskStream, TasksSpec};
 
 use crate::grid::{Cell, CornerCutting, Grid};
@@ -347,6 +354,9 @@ pub struct Scenario {
     pub tasks: Option<TasksSpec>,
     /// How the world changes during the run (`[[events]]`), in time order.
     pub events: Vec<EventSpec>,
+    /// What the robots sense of the world after `Start` (`[sensing]`); `None`: nothing, they
+    /// plan on the scenario's map.
+    pub sensing: Option<SensingParams>,
 }
 
 impl Scenario {

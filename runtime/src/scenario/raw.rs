@@ -33,6 +33,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
             "faults",
             "tasks",
             "events",
+            "sensing",
         ],
     ),
     ("map", &["file", "rows", "corner_cutting"]),
@@ -110,6 +111,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
     ),
     ("tasks", &["stream", "seed", "goals"]),
     ("tasks.goals", &["agent", "cells"]),
+    ("sensing", &["range", "known_map", "repair"]),
     (
         "events",
         &[
@@ -148,6 +150,7 @@ pub(super) struct RawScenario {
     pub tasks: Option<Spanned<super::tasks::RawTasks>>,
     #[serde(default)]
     pub events: Vec<Spanned<super::events::RawEvent>>,
+    pub sensing: Option<super::sensing::RawSensing>,
 }
 
 /// `[map]`.

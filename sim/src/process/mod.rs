@@ -91,7 +91,7 @@ impl<'t> SimProcess<'t> {
     /// `start_heading_deg`) and opens the ports.
     pub fn new(transport: &'t Transport, scenario: &Scenario) -> Result<Self, SimProcessError> {
         let world = World::from_scenario(scenario)?;
-        let ports = Ports::open(transport, world.robots())?;
+        let ports = Ports::open(transport, world.robots(), scenario.sensing.is_some())?;
         let heart = Heartbeat::open(
             transport,
             Role::Sim,
@@ -104,7 +104,8 @@ impl<'t> SimProcess<'t> {
         Ok(SimProcess {
             transport,
             ports,
-            state: State::new(world, scenario.sim.clock, lockstep_deadline),
+            state: State::new(world, scenario.sim.clock, lockstep_deadline)
+                .with_views(scenario.sensing.map(|s| s.range)),
             heart,
             resume: false,
             fault_rounds: scenario

@@ -1,8 +1,8 @@
 //! The topics of the `hnav-sim` process: one wheel-command receiver and one odometry sender
-//! per robot, the Truth sender and, when joined to the run's lifecycle protocol, its ports.
+//! (and, when the scenario senses, one view sender) per robot, the Truth sender and, when joined to the run's lifecycle protocol, its ports.
 
 use hnav_runtime::launch::LifecyclePorts;
-use hnav_runtime::msg::{Odometry, Truth, WheelCommand};
+use hnav_runtime::msg::{Odometry, Truth, View, WheelCommand};
 use hnav_runtime::topics;
 use hnav_runtime::transport::{Attachment, Receiver, Sender, Transport, TransportError, Waiter};
 
@@ -13,6 +13,8 @@ pub(crate) struct Ports {
     pub(crate) wheels: Vec<Receiver<WheelCommand>>,
     /// Robot `i`'s odometry.
     pub(crate) odom: Vec<Sender<Odometry>>,
+    /// Robot `i`'s sensor view (empty when the scenario senses nothing).
+    pub(crate) view: Vec<Sender<View>>,
     /// Ground truth of every robot, once per control period.
     pub(crate) truth: Sender<Truth>,
     /// The lifecycle protocol's ports, if joined.
@@ -20,8 +22,12 @@ pub(crate) struct Ports {
 }
 
 impl Ports {
-    /// Opens the topics of a world of `robots` robots.
-    pub(crate) fn open(transport: &Transport, robots: usize) -> Result<Self, TransportError> {
+    /// Opens the topics of a world of `robots` robots, with their views if `sensing`.
+    pub(crate) fn open(
+        transport: &Transport,
+        robots: usize,
+        sensing: bool,
+    ) -> Result<Self, TransportError> {
         let q = topics::state_qos();
         let wheels = (0..robots)
             .map(|i| transport.receiver(&topics::wheels(i), q))
@@ -29,9 +35,14 @@ impl Ports {
         let odom = (0..robots)
             .map(|i| transport.sender(&topics::odometry(i), q))
             .collect::<Result<Vec<_>, _>>()?;
+        let views = if sensing { robots } else { 0 };
+        let view = (0..views)
+            .map(|i| transport.sender(&topics::view(i), q))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             wheels,
             odom,
+            view,
             truth: transport.sender(topics::TRUTH, topics::truth_qos())?,
             life: None,
         })

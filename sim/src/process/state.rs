@@ -32,6 +32,8 @@ pub(crate) struct State {
     hold_sent: bool,
     /// Where each stepped period is checkpointed for a restart, if the run has a directory.
     pub(crate) checkpoint: Option<SimCheckpoint>,
+    /// The range of the robots' views, cells; none: the scenario senses nothing.
+    view_range: Option<u32>,
 }
 
 /// What a lifecycle drain found.
@@ -57,7 +59,14 @@ impl State {
             holds: VecDeque::new(),
             hold_sent: false,
             checkpoint: None,
+            view_range: None,
         }
+    }
+
+    /// Publishes each robot's view within `range` cells with its odometry (none: no views).
+    pub(crate) fn with_views(mut self, range: Option<u32>) -> Self {
+        self.view_range = range;
+        self
     }
 
     /// Holds before stepping each of `periods` until the supervisor's `Resume` for it.
@@ -256,6 +265,12 @@ impl State {
     /// Publishes every robot's odometry and the truth of the world as it stands, as the
     /// reading of `period`.
     fn publish(&self, ports: &Ports, period: u64) -> Result<(), SimProcessError> {
+        // Views first: an agent acting on its odometry has the view of the same period.
+        if let Some(range) = self.view_range {
+            for (i, tx) in ports.view.iter().enumerate() {
+                tx.send_in_place(|v| self.world.fill_view(i as u32, period, range, v))?;
+            }
+        }
         for (i, tx) in ports.odom.iter().enumerate() {
             if let Some(o) = self.world.odometry(i as u32, period) {
                 tx.send(o)?;

@@ -1,0 +1,114 @@
+//! What a robot's range sensor sees of the world (an emulated LiDAR, seed 000 §3.1.1): the
+//! cells within range and in line of sight, free or blocked, as the sim's truth has them.
+
+use iceoryx2::prelude::ZeroCopySend;
+
+/// The largest window edge a [`View`] holds, cells: a range of up to 15 cells.
+pub const VIEW_EDGE: usize = 32;
+
+/// Robot `agent`'s view at the end of control period `period`: a window of `size` x `size`
+/// cells whose top-left cell is (`x0`, `y0`), centred on the robot's cell (clipped to the
+/// map). Bit `c` of row `r` stands for cell (`x0 + c`, `y0 + r`): in `seen` if it is within
+/// range and in line of sight, in `blocked` if it is then a wall, a closed cell or a moving
+/// obstacle's. A cell not seen says nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
+#[type_name("hnav::View")]
+pub struct View {
+    /// Simulated time of the view, ns since the start of the run.
+    pub sim_time_ns: u64,
+    /// Control period the view closes.
+    pub period: u64,
+    /// Agent (robot) index.
+    pub agent: u32,
+    /// Column of the window's top-left cell.
+    pub x0: u32,
+    /// Row of the window's top-left cell.
+    pub y0: u32,
+    /// Window edge, cells (at most [`VIEW_EDGE`]).
+    pub size: u32,
+    /// Per window row, the cells seen.
+    pub seen: [u32; VIEW_EDGE],
+    /// Per window row, the cells seen blocked.
+    pub blocked: [u32; VIEW_EDGE],
+}
+
+impl Default for View {
+    fn default() -> Self {
+        bytemuck::Zeroable::zeroed()
+    }
+}
+
+impl View {
+    /// Clears the window and places it at (`x0`, `y0`) with edge `size` (at most
+    /// [`VIEW_EDGE`]).
+    pub fn reset(&mut self, x0: u32, y0: u32, size: u32) {
+        self.x0 = x0;
+        self.y0 = y0;
+        self.size = size.min(VIEW_EDGE as u32);
+        self.seen = [0; VIEW_EDGE];
+        self.blocked = [0; VIEW_EDGE];
+    }
+
+    /// Marks cell (`x`, `y`) of the map seen, blocked or not; one outside the window is
+    /// ignored.
+    pub fn mark(&mut self, x: u32, y: u32, blocked: bool) {
+        let (Some(c), Some(r)) = (x.checked_sub(self.x0), y.checked_sub(self.y0)) else {
+            return;
+        };
+        if c >= self.size || r >= self.size {
+            return;
+        }
+        self.seen[r as usize] |= 1 << c;
+        if blocked {
+            self.blocked[r as usize] |= 1 << c;
+        }
+    }
+
+    /// Every cell seen, as (`x`, `y`, blocked), row by row.
+    pub fn cells(&self) -> impl Iterator<Item = (u32, u32, bool)> + '_ {
+        let size = self.size.min(VIEW_EDGE as u32);
+        (0..size).flat_map(move |r| {
+            (0..size).filter_map(move |c| {
+                let bit = 1u32 << c;
+                (self.seen[r as usize] & bit != 0).then(|| {
+                    let blocked = self.blocked[r as usize] & bit != 0;
+                    (self.x0 + c, self.y0 + r, blocked)
+                })
+            })
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::mem::{align_of, offset_of, size_of};
+
+    #[test]
+    fn view_layout() {
+        assert_eq!(size_of::<View>(), 288);
+        assert_eq!(align_of::<View>(), 8);
+        assert_eq!(offset_of!(View, sim_time_ns), 0);
+        assert_eq!(offset_of!(View, period), 8);
+        assert_eq!(offset_of!(View, agent), 16);
+        assert_eq!(offset_of!(View, x0), 20);
+        assert_eq!(offset_of!(View, y0), 24);
+        assert_eq!(offset_of!(View, size), 28);
+        assert_eq!(offset_of!(View, seen), 32);
+        assert_eq!(offset_of!(View, blocked), 160);
+    }
+
+    #[test]
+    fn marked_cells_come_back_and_cells_off_the_window_are_ignored() {
+        let mut v = View::default();
+        v.reset(3, 4, 5);
+        v.mark(3, 4, false);
+        v.mark(7, 8, true);
+        v.mark(8, 8, true);
+        v.mark(2, 5, true);
+        assert_eq!(v.cells().collect::<Vec<_>>(), [(3, 4, false), (7, 8, true)]);
+        v.reset(0, 0, 3);
+        assert_eq!(v.cells().count(), 0);
+    }
+}
