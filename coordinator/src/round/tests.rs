@@ -254,12 +254,18 @@ fn agent_0_accepted_into_the_crossing(s: &Scenario) -> (Arbiter, Vec<RoundRecord
     let mut a = Arbiter::new(s);
     let mut records = Vec::new();
     let rounds = [
-        [cand(s, 0, (4, 2), Some((3, 2))), cand(s, 1, (2, 0), Some((2, 1)))],
+        [
+            cand(s, 0, (4, 2), Some((3, 2))),
+            cand(s, 1, (2, 0), Some((2, 1))),
+        ],
         [cand(s, 0, (3, 2), Some((2, 2))), cand(s, 1, (2, 1), None)],
     ];
     for (round, [c0, c1]) in (1..).zip(rounds) {
         let (d, _) = a.decide(round, &[Some(c0), Some(c1)]);
-        assert!(d.iter().all(|d| d.verdict == Verdict::Accept as u8), "{d:?}");
+        assert!(
+            d.iter().all(|d| d.verdict == Verdict::Accept as u8),
+            "{d:?}"
+        );
         records.push(RoundRecord::new(round, &[], d));
     }
     (a, records)
