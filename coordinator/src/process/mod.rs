@@ -10,10 +10,11 @@
 //! the default fsync policy a commit an agent sees is already durable.
 //!
 //! **Restart.** On start the log in `DIR/log` is opened; a torn tail is cut off, the complete
-//! records are replayed: the last round number, the tallies and whether the run ended. The
-//! agents still waiting for the last logged round get its commit again, rebuilt from the log
-//! (never decided twice); a round in flight when the old coordinator died is decided anew from
-//! the candidates the agents resend.
+//! records are replayed: the last round number, the tallies, the cells each robot was
+//! committed to (an agent down with the coordinator holds them until it speaks again) and
+//! whether the run ended. The agents still waiting for the last logged round get its commit
+//! again, rebuilt from the log (never decided twice); a round in flight when the old
+//! coordinator died is decided anew from the candidates the agents resend.
 //!
 //! Once every agent stands on its goal, or in lockstep once the round of the time limit
 //! (`time_limit_s` of simulated time, [`SimParams::rounds_in`]) is committed, the coordinator

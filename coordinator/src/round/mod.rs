@@ -2,9 +2,11 @@
 //! the decisions (and the global replans) out. The coordinator process wraps it in the
 //! Waiter loop, the consensus log and the commit topic.
 //!
-//! The arbiter keeps each agent's last known row. An agent missing from a round (late, dead,
-//! restarting) keeps its cells and counts as standing still: a stable position (type d) for
-//! the others, as the architecture says. Priorities come from the scenario, not from the
+//! The arbiter keeps each agent's last known row, moved on by its own decisions (`next <-`
+//! the accepted cell) and, after a coordinator restart, rebuilt from the logged decisions
+//! ([`Arbiter::replay`]). An agent missing from a round (late, dead, restarting) keeps its
+//! cells, the one it was committed to included, and counts as standing still: a stable
+//! position (type d) for the others, as the architecture says. Priorities come from the scenario, not from the
 //! candidates, so a confused agent cannot promote itself.
 //!
 //! **Hybrid mode.** An agent that asked and was refused or held for `replan_after_rounds`
@@ -213,6 +215,18 @@ impl Arbiter {
                 self.decisions.push(d);
             }
         }
+        for d in &self.decisions {
+            if d.verdict == Verdict::Accept as u8 {
+                if let (Some(row), Some(cell)) = (
+                    self.rows.get_mut(d.agent as usize),
+                    self.grid.cell_at(d.cell as usize),
+                ) {
+                    // `next <- cell`: an agent silent in the next round (late, or killed on
+                    // its way) keeps the cell it was committed to.
+                    row.next = cell;
+                }
+            }
+        }
         (&self.decisions, &self.replans)
     }
 
@@ -371,15 +385,37 @@ impl Arbiter {
         &self.tally
     }
 
-    /// Takes `tally` as that of every decision so far (a replica that starts from a snapshot).
+    /// Takes `tally` as that of every decision so far (a replica that starts from a snapshot),
+    /// and each row as standing on the cell of its agent's last accepted move: a snapshot
+    /// keeps no other cell, so one of a robot stopped half-way is not held (only the log's
+    /// rounds, [`Arbiter::replay`], give both).
     pub fn restore_tally(&mut self, tally: Tally) {
+        for (row, &c) in self.rows.iter_mut().zip(tally.cells()) {
+            if let Some(cell) = self.grid.cell_at(c as usize) {
+                (row.current, row.next) = (cell, cell);
+            }
+        }
         self.tally = tally;
     }
 
-    /// Adds a logged round's decisions to the tally, as if this arbiter had made them (after
-    /// a coordinator restart).
+    /// Adds a logged round's decisions to the tally and the rows, as if this arbiter had made
+    /// them (after a coordinator restart). The log has no candidates, so a row is what the
+    /// decisions say: an accept moves it on (`current <- next <- cell`: the robot may be
+    /// anywhere between the two, so both are held), any other decision answered a request,
+    /// which an agent makes only at rest (`current <- next`). An agent silent after the
+    /// restart (down with the coordinator) thus holds the cells it was committed to, not its
+    /// start.
     pub fn replay(&mut self, round: &RoundRecord) {
         self.tally.fold_round(round);
+        for d in &round.decisions {
+            let Some(row) = self.rows.get_mut(d.agent as usize) else {
+                continue;
+            };
+            row.current = row.next;
+            if d.verdict == Verdict::Accept as u8 {
+                row.next = self.grid.cell_at(d.cell as usize).unwrap_or(row.next);
+            }
+        }
     }
 }
 

@@ -245,3 +245,88 @@ fn pibt_moves_an_agent_that_asked_nothing_and_replans_nobody() {
     let t = a.tally().agents()[0];
     assert_eq!((t.conflicts, t.waited), (1, 4), "{t:?}");
 }
+
+/// Agent 0 drives west along row 2, agent 1 south down column 2, across its lane (the chaos
+/// campaign's robots 2 and 5). Agent 0 is accepted into (3, 2), then, at rest there, into
+/// (2, 2); agent 1 reaches (2, 1) and waits. Returns the arbiter that decided the two
+/// rounds and their records, as the consensus log holds them.
+fn agent_0_accepted_into_the_crossing(s: &Scenario) -> (Arbiter, Vec<RoundRecord>) {
+    let mut a = Arbiter::new(s);
+    let mut records = Vec::new();
+    let rounds = [
+        [
+            cand(s, 0, (4, 2), Some((3, 2))),
+            cand(s, 1, (2, 0), Some((2, 1))),
+        ],
+        [cand(s, 0, (3, 2), Some((2, 2))), cand(s, 1, (2, 1), None)],
+    ];
+    for (round, [c0, c1]) in (1..).zip(rounds) {
+        let (d, _) = a.decide(round, &[Some(c0), Some(c1)]);
+        assert!(
+            d.iter().all(|d| d.verdict == Verdict::Accept as u8),
+            "{d:?}"
+        );
+        records.push(RoundRecord::new(round, &[], d));
+    }
+    (a, records)
+}
+
+const CROSSING: &str = r#"
+    name = "t"
+    [map]
+    rows = ["......", "......", "......", "......", "......"]
+    [coordinator]
+    rules = "dissertation"
+    [[agents]]
+    start = [4, 2]
+    goal = [1, 2]
+    [[agents]]
+    start = [2, 0]
+    goal = [2, 4]
+"#;
+
+/// Agent 1 asks for (2, 2) in round 3 while agent 0, committed to it in round 2, is silent
+/// (killed on its way: its robot stands somewhere between (3, 2) and (2, 2)).
+fn agent_1_asks_for_the_crossing(s: &Scenario, a: &mut Arbiter) -> Decision {
+    let c1 = cand(s, 1, (2, 1), Some((2, 2)));
+    let (d, _) = a.decide(3, &[None, Some(c1)]);
+    assert_eq!(d.len(), 1, "{d:?}");
+    d[0]
+}
+
+#[test]
+fn a_silent_agent_keeps_the_cell_it_was_accepted_into() {
+    let s = scenario(CROSSING);
+    let (mut live, _) = agent_0_accepted_into_the_crossing(&s);
+    let d = agent_1_asks_for_the_crossing(&s, &mut live);
+    assert_eq!(d.verdict, Verdict::Block as u8, "{d:?}");
+    assert_eq!(d.kind, ConflictKind::StableCell as u8, "{d:?}");
+}
+
+/// A coordinator restarted while agent 0 is down too (plans 3 and 11 of `hnav-bench chaos
+/// --class kill-mix --seed 21`): it knows the robots only from its log, and must hold the
+/// cells the log committed agent 0 to, not its start.
+#[test]
+fn a_restarted_arbiter_holds_the_logged_cells_of_a_silent_agent() {
+    let s = scenario(CROSSING);
+    let (_, records) = agent_0_accepted_into_the_crossing(&s);
+    let mut restarted = Arbiter::new(&s);
+    for r in &records {
+        restarted.replay(r);
+    }
+    let d = agent_1_asks_for_the_crossing(&s, &mut restarted);
+    assert_eq!(d.verdict, Verdict::Block as u8, "{d:?}");
+    assert_eq!(d.kind, ConflictKind::StableCell as u8, "{d:?}");
+}
+
+/// A replica that starts from a snapshot has only the tally: a silent agent stands on the
+/// cell of its last accepted move, not on its start.
+#[test]
+fn a_restored_tally_puts_a_silent_agent_on_its_last_accepted_cell() {
+    let s = scenario(CROSSING);
+    let (live, _) = agent_0_accepted_into_the_crossing(&s);
+    let mut restored = Arbiter::new(&s);
+    restored.restore_tally(live.tally().clone());
+    let d = agent_1_asks_for_the_crossing(&s, &mut restored);
+    assert_eq!(d.verdict, Verdict::Block as u8, "{d:?}");
+}
