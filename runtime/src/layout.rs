@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use crate::msg::{
     Candidate, Commit, Decision, Estimate, Heartbeat, Lifecycle, MapHeader, Odometry, Pose,
-    Progress, Truth, WheelCommand, MAX_AGENTS,
+    Progress, Truth, View, WheelCommand, MAX_AGENTS,
 };
 use crate::topics;
 
@@ -195,6 +195,16 @@ pub fn layouts() -> Layouts {
             activation: u8,
             reserved: [u8; 3]
         }),
+        layout!(View {
+            sim_time_ns: u64,
+            period: u64,
+            agent: u32,
+            x0: u32,
+            y0: u32,
+            size: u32,
+            seen: [u32; 32],
+            blocked: [u32; 32]
+        }),
     ];
     let fixed = |topic, payload| TopicLayout {
         topic,
@@ -205,6 +215,7 @@ pub fn layouts() -> Layouts {
     let topics = vec![
         fixed("wheels/<i>", type_name_of::<WheelCommand>()),
         fixed("odom/<i>", type_name_of::<Odometry>()),
+        fixed("view/<i>", type_name_of::<View>()),
         fixed(topics::TRUTH, type_name_of::<Truth>()),
         fixed(topics::CANDIDATES, type_name_of::<Candidate>()),
         fixed(topics::COMMIT, type_name_of::<Commit>()),
@@ -294,6 +305,6 @@ mod tests {
         let map = l.topics.iter().find(|t| t.topic == "map/<i>").unwrap();
         assert_eq!((map.payload, map.user_header), ("f32", "hnav::MapHeader"));
         let json: serde_json::Value = serde_json::from_str(&l.to_json()).unwrap();
-        assert_eq!(json["types"].as_array().unwrap().len(), 12);
+        assert_eq!(json["types"].as_array().unwrap().len(), 13);
     }
 }

@@ -251,6 +251,31 @@ class MapHeader(_Payload):
     ]
 
 
+class View(_Payload):
+    """What robot `agent`'s range sensor sees: a `size` x `size` window of cells from
+    (`x0`, `y0`); bit `c` of row `r` is cell (`x0 + c`, `y0 + r`), in `seen` if it is in range
+    and in line of sight, in `blocked` if it is then a wall, a closed cell or a mover's."""
+
+    _fields_ = [
+        ("sim_time_ns", ctypes.c_uint64),
+        ("period", ctypes.c_uint64),
+        ("agent", ctypes.c_uint32),
+        ("x0", ctypes.c_uint32),
+        ("y0", ctypes.c_uint32),
+        ("size", ctypes.c_uint32),
+        ("seen", ctypes.c_uint32 * 32),
+        ("blocked", ctypes.c_uint32 * 32),
+    ]
+
+    def cells(self):
+        """Every cell seen, as (x, y, blocked), row by row."""
+        size = min(self.size, 32)
+        for r in range(size):
+            for c in range(size):
+                if self.seen[r] >> c & 1:
+                    yield (self.x0 + c, self.y0 + r, bool(self.blocked[r] >> c & 1))
+
+
 # Every payload mirror, for the layout test.
 PAYLOADS = [
     Candidate,
@@ -265,4 +290,5 @@ PAYLOADS = [
     Lifecycle,
     Heartbeat,
     MapHeader,
+    View,
 ]

@@ -31,6 +31,7 @@ DOMAIN_ENV = "HNAV_DOMAIN"
 TOPICS = {
     "wheels/<i>": (msg.WheelCommand, None),
     "odom/<i>": (msg.Odometry, None),
+    "view/<i>": (msg.View, None),
     "truth": (msg.Truth, None),
     "candidates": (msg.Candidate, None),
     "commit": (msg.Commit, None),
