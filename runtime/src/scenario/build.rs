@@ -31,6 +31,8 @@ pub(super) fn parse(
     let run = build_run(raw.run, &lines)?;
     let health = super::health::build_health(raw.health, &lines)?;
     let record = super::record::build_record(raw.record, &lines)?;
+    let localisation =
+        super::localisation::build_localisation(raw.localisation, sim.odometry_hz, &lines)?;
     if raw.agents.is_empty() {
         return Err(ScenarioError::NoAgents {
             at: Loc::new(source_name, 1),
@@ -78,6 +80,7 @@ pub(super) fn parse(
         run,
         health,
         record,
+        localisation,
         agents,
         faults,
         allow_unreachable,
