@@ -4,6 +4,12 @@
 //! Each reading's tick increments become wheel arcs `Δs = 2π·r·Δn/N`; the centre moves
 //! `Δs = (Δs_R + Δs_L)/2` while turning `Δθ = (Δs_R − Δs_L)/b`, integrated with the exact-arc
 //! update (midpoint when `|Δθ| ≤ 1e-6`).
+//!
+//! Ticks alone drift without bound: the heading is known only to within a tick pair
+//! (`2πr/N/b`, 1.8° for the default robot), so the position error is a random walk of the
+//! distance driven (in `scenarios/replicas-lifelong.toml` without fixes it passed the 22 mm
+//! between a robot at a cell's centre and the cell's edge after 2 260 s). [`Relocaliser`]
+//! bounds it with the sim's localisation fixes.
 
 use hnav_runtime::grid::geometry::wrap_angle;
 use hnav_runtime::msg::Pose;
@@ -89,6 +95,50 @@ impl DeadReckoning {
     }
 }
 
+/// When the estimate takes a localisation fix: only when it differs from the fix by more
+/// than the gate, in position (m) or heading (rad). A smaller difference is the fix's own
+/// noise (or, in heading, the tick pair's quantum that dead reckoning never exceeds without
+/// slip) rather than drift: taking it would make a good estimate worse and move the target
+/// the wheel controller steers to (see [`hnav_runtime::scenario::localisation::GATE_SIGMAS`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Relocaliser {
+    /// Largest position difference kept, m.
+    pub gate_m: f64,
+    /// Largest heading difference kept, rad.
+    pub gate_rad: f64,
+}
+
+impl Relocaliser {
+    /// The gate of the scenario's `[localisation]` section for a robot with `odo`'s wheels:
+    /// the fix's noise gate, and in heading also the tick pair's quantum.
+    pub fn new(params: &hnav_runtime::scenario::LocalisationParams, odo: &OdometryParams) -> Self {
+        let (gate_m, gate_rad) = params.gate();
+        Relocaliser {
+            gate_m,
+            gate_rad: gate_rad + odo.tick_arc_m() / odo.axle_track_m,
+        }
+    }
+
+    /// Moves `dr`'s pose to `fix` if they differ by more than the gate, and says whether it
+    /// did. A fix with a non-finite coordinate is ignored.
+    pub fn apply(&self, dr: &mut DeadReckoning, fix: Pose) -> bool {
+        if !(fix.x_m.is_finite() && fix.y_m.is_finite() && fix.theta_rad.is_finite()) {
+            return false;
+        }
+        let p = dr.pose;
+        let off = (fix.x_m - p.x_m).hypot(fix.y_m - p.y_m);
+        let turned = wrap_angle(fix.theta_rad - p.theta_rad).abs();
+        if off <= self.gate_m && turned <= self.gate_rad {
+            return false;
+        }
+        dr.pose = Pose {
+            theta_rad: wrap_angle(fix.theta_rad),
+            ..fix
+        };
+        true
+    }
+}
+
 /// The exact-arc update of §D.2 (midpoint for tiny heading changes); `theta` is wrapped to
 /// `(-π, π]`.
 pub fn arc_update(p: Pose, ds: f64, dtheta: f64) -> Pose {
@@ -141,6 +191,41 @@ mod tests {
         assert!(end.x_m.abs() < 1e-12 && end.y_m.abs() < 1e-12);
         let want = 10.0 * p.tick_arc_m() / p.axle_track_m;
         assert!((end.theta_rad - want).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_fix_is_taken_only_beyond_the_gate() {
+        let r = Relocaliser {
+            gate_m: 0.01,
+            gate_rad: 0.1,
+        };
+        let mut e = DeadReckoning::new(params(), Pose::default());
+        let near = Pose {
+            x_m: 0.006,
+            y_m: -0.006,
+            theta_rad: 0.05,
+        };
+        assert!(!r.apply(&mut e, near));
+        assert_eq!(e.pose(), Pose::default());
+        let nan = Pose {
+            x_m: f64::NAN,
+            ..near
+        };
+        assert!(!r.apply(&mut e, nan));
+        let turned = Pose {
+            theta_rad: -0.2,
+            ..Pose::default()
+        };
+        assert!(r.apply(&mut e, turned));
+        assert_eq!(e.pose(), turned);
+        let far = Pose {
+            x_m: 0.011,
+            ..turned
+        };
+        assert!(r.apply(&mut e, far));
+        // Dead reckoning goes on from the fix.
+        let ahead = e.update(10, 10);
+        assert!(ahead.x_m > far.x_m && ahead.theta_rad == far.theta_rad);
     }
 
     #[test]

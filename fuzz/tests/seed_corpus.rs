@@ -295,9 +295,14 @@ fn payload_corpus() {
         sim_time_ns: 1,
         period: 3,
         agent: 1,
-        reserved: 0,
+        flags: Odometry::FIX,
         ticks_left: -7,
         ticks_right: 12,
+        fix: Pose {
+            x_m: 0.4,
+            y_m: 0.24,
+            theta_rad: -1.5,
+        },
     };
     payload(8, "odometry", bytes_of(&o), usize::MAX);
 }

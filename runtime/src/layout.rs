@@ -145,9 +145,10 @@ pub fn layouts() -> Layouts {
             sim_time_ns: u64,
             period: u64,
             agent: u32,
-            reserved: u32,
+            flags: u32,
             ticks_left: i64,
-            ticks_right: i64
+            ticks_right: i64,
+            fix: Pose
         }),
         layout!(Pose {
             x_m: f64,

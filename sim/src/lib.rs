@@ -16,6 +16,7 @@
 //! |---|---|
 //! | [`process`] | the `hnav-sim` process: [`process::SimProcess`] (`new`, `run`), its ports and state, lockstep and realtime; [`process::SimOutcome`]; [`process::SimProcessError`]: the model's errors, transport and checkpoint failures |
 //! | [`world`] | [`World`]: N robots, struct-of-arrays, fixed step, odometry and Truth |
+//! | [`localiser`] | the emulated map-based localisation fix carried by odometry readings: truth plus seeded noise |
 //! | [`robot`] | [`RobotModel`]: validated parameters; motor lag, speed and acceleration limits, braking |
 //! | [`kinematics`] | §D.2 wheel increments and the exact-arc pose update as a rigid motion (nalgebra `Isometry2`, `UnitComplex` headings) |
 //! | [`hall`] | tick quantisation and seeded wheel-slip noise (ChaCha) |
@@ -43,6 +44,7 @@ pub mod collision;
 pub mod error;
 pub mod hall;
 pub mod kinematics;
+pub mod localiser;
 pub mod process;
 pub mod robot;
 pub mod watchdog;

@@ -17,12 +17,14 @@ use crate::collision::{Collision, Detector};
 use crate::error::SimError;
 use crate::hall::{self, SlipNoise};
 use crate::kinematics::{arc_step, heading, Heading};
+use crate::localiser::Localiser;
 use crate::robot::RobotModel;
 use crate::watchdog::Watchdog;
 use hnav_runtime::grid::geometry::{cell_centre_pose, wrap_angle};
 use hnav_runtime::grid::Grid;
 use hnav_runtime::msg::{Odometry, Pose, Truth, MAX_AGENTS};
 use hnav_runtime::scenario::params::{RobotParams, SimParams};
+use hnav_runtime::scenario::LocalisationParams;
 use hnav_runtime::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Translation2};
 
@@ -74,6 +76,10 @@ pub struct World {
     collisions: Vec<Collision>,
     /// The scenario's `[[events]]`: cells that close or open, movers.
     changes: Changes,
+    // Localisation fixes carried by the odometry readings; none unless set.
+    localiser: Option<Localiser>,
+    odometry_hz: u32,
+    seed: u64,
 }
 
 impl World {
@@ -135,13 +141,17 @@ impl World {
             detector: Detector::new(n, &grid, model.cell_size_m, model.body_radius_m),
             collisions: Vec::new(),
             changes: Changes::default(),
+            localiser: None,
+            odometry_hz: sim.odometry_hz,
+            seed: sim.seed,
             model,
             grid,
         })
     }
 
-    /// The world of a scenario: its robot and sim parameters, its map, and one robot per
-    /// agent at the centre of the agent's start cell, facing its `start_heading_deg`.
+    /// The world of a scenario: its robot and sim parameters, its map, one robot per agent
+    /// at the centre of the agent's start cell, facing its `start_heading_deg`, and its
+    /// `[localisation]` fixes.
     pub fn from_scenario(scenario: &Scenario) -> Result<World, SimError> {
         let cs = scenario.robot.cell_size_m;
         let starts: Vec<_> = scenario
@@ -157,6 +167,7 @@ impl World {
         )?;
         world.changes = Changes::new(scenario.events.clone());
         world.apply_changes();
+        world.set_localisation(scenario.localisation);
         Ok(world)
     }
 
@@ -171,6 +182,14 @@ impl World {
     /// The moving obstacles under way: name and centre (m).
     pub fn movers(&self) -> impl Iterator<Item = (&str, Point2<f64>)> {
         self.changes.movers()
+    }
+
+    /// Makes the odometry readings carry localisation fixes as `params` says (a world made
+    /// by [`World::new`] has none), seeded by the run's seed.
+    pub fn set_localisation(&mut self, params: LocalisationParams) {
+        self.localiser = params
+            .enabled()
+            .then(|| Localiser::new(params, self.odometry_hz, self.seed));
     }
 
     /// Number of robots.
@@ -380,16 +399,21 @@ impl World {
         (i < self.robots()).then(|| (hall::ticks(self.phil[i], n), hall::ticks(self.phir[i], n)))
     }
 
-    /// Robot `agent`'s odometry message for control period `period`.
+    /// Robot `agent`'s odometry message for control period `period`, with its localisation
+    /// fix if one is due then.
     pub fn odometry(&self, agent: u32, period: u64) -> Option<Odometry> {
         let (ticks_left, ticks_right) = self.ticks(agent)?;
+        let fix = self
+            .localiser
+            .and_then(|l| l.fix(agent, period, self.pose_at(agent as usize)));
         Some(Odometry {
             sim_time_ns: self.time_ns(),
             period,
             agent,
-            reserved: 0,
+            flags: if fix.is_some() { Odometry::FIX } else { 0 },
             ticks_left,
             ticks_right,
+            fix: fix.unwrap_or_default(),
         })
     }
 

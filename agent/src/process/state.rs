@@ -19,7 +19,7 @@ use super::{AgentError, AgentOutcome};
 use crate::controller::{ControllerParams, FreeSpace, WheelController, WheelDrive};
 use crate::ga_fuzzy::{GaOptions, GaPlanner};
 use crate::navigator::{Guidance, Navigator, Task};
-use crate::odometry::{DeadReckoning, OdometryParams};
+use crate::odometry::{DeadReckoning, OdometryParams, Relocaliser};
 use crate::pso::{PsoOptions, PsoPlanner};
 
 /// How long a realtime agent waits for the commit of its open candidate before it sends it
@@ -38,6 +38,8 @@ pub(super) struct Core {
     width: u32,
     nav: Navigator,
     dr: DeadReckoning,
+    /// Takes the sim's localisation fixes into `dr` when it has drifted.
+    reloc: Relocaliser,
     ctl: WheelDrive,
     checkpoint: Option<CheckpointFile>,
     last_commit: u64,
@@ -111,6 +113,7 @@ impl Core {
             width: grid.width(),
             nav,
             dr,
+            reloc: Relocaliser::new(&scenario.localisation, &odo),
             ctl: wheel_drive(scenario, spec),
             checkpoint,
             last_commit,
@@ -262,7 +265,13 @@ impl Core {
         }
         self.last_period = Some(o.period);
         self.ticks = (o.ticks_left, o.ticks_right);
-        let pose = self.dr.update(o.ticks_left, o.ticks_right);
+        let mut pose = self.dr.update(o.ticks_left, o.ticks_right);
+        if let Some(fix) = o.fix() {
+            if self.reloc.apply(&mut self.dr, fix) {
+                tracing::debug!(?pose, ?fix, "drifted beyond the gate: took the fix");
+                pose = self.dr.pose();
+            }
+        }
         // Silent: the recorder and viewers take the latest at their own pace.
         p.estimate.send_silently(Estimate {
             sim_time_ns: o.sim_time_ns,

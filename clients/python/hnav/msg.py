@@ -133,19 +133,6 @@ class WheelCommand(_Payload):
     ]
 
 
-class Odometry(_Payload):
-    """One robot's Hall-sensor ticks at the end of a period."""
-
-    _fields_ = [
-        ("sim_time_ns", ctypes.c_uint64),
-        ("period", ctypes.c_uint64),
-        ("agent", ctypes.c_uint32),
-        ("reserved", ctypes.c_uint32),
-        ("ticks_left", ctypes.c_int64),
-        ("ticks_right", ctypes.c_int64),
-    ]
-
-
 class Pose(_Payload):
     """A planar pose in metres and radians (x right, y down the map's rows)."""
 
@@ -153,6 +140,21 @@ class Pose(_Payload):
         ("x_m", ctypes.c_double),
         ("y_m", ctypes.c_double),
         ("theta_rad", ctypes.c_double),
+    ]
+
+
+class Odometry(_Payload):
+    """One robot's Hall-sensor ticks at the end of a period; `fix` is a localisation fix
+    when bit 0 of `flags` is set."""
+
+    _fields_ = [
+        ("sim_time_ns", ctypes.c_uint64),
+        ("period", ctypes.c_uint64),
+        ("agent", ctypes.c_uint32),
+        ("flags", ctypes.c_uint32),
+        ("ticks_left", ctypes.c_int64),
+        ("ticks_right", ctypes.c_int64),
+        ("fix", Pose),
     ]
 
 

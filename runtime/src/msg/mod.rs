@@ -21,7 +21,7 @@
 //! | [`Decision`] | 16 | 4 | 0 agent u32, 4 verdict u8, 5 refused u8, 6 kind u8, 7 reserved u8, 8 cell u32, 12 waypoint u32 |
 //! | [`Commit`] | 16 + 16·[`MAX_AGENTS`] = 4112 | 8 | 0 round u64, 8 count u32, 12 reserved u32, 16 decisions [Decision; 256] |
 //! | [`WheelCommand`] | 32 | 8 | 0 period u64, 8 agent u32, 12 flags u32, 16 left_rad_s f64, 24 right_rad_s f64 |
-//! | [`Odometry`] | 40 | 8 | 0 sim_time_ns u64, 8 period u64, 16 agent u32, 20 reserved u32, 24 ticks_left i64, 32 ticks_right i64 |
+//! | [`Odometry`] | 64 | 8 | 0 sim_time_ns u64, 8 period u64, 16 agent u32, 20 flags u32, 24 ticks_left i64, 32 ticks_right i64, 40 fix Pose |
 //! | [`Pose`] | 24 | 8 | 0 x_m f64, 8 y_m f64, 16 theta_rad f64 |
 //! | [`Truth`] | 24 + 24·[`MAX_AGENTS`] = 6168 | 8 | 0 sim_time_ns u64, 8 period u64, 16 robots u32, 20 collisions u32, 24 poses [Pose; 256] |
 //! | [`Estimate`] | 40 | 8 | 0 sim_time_ns u64, 8 agent u32, 12 reserved u32, 16 pose Pose |

@@ -24,9 +24,10 @@ pub struct WheelCommand {
     pub right_rad_s: f64,
 }
 
-/// Cumulative Hall-sensor counts of one robot, as a motor driver reports them.
+/// Cumulative Hall-sensor counts of one robot, as a motor driver reports them, and now and
+/// then a localisation fix: where a map-based localiser puts the robot at the same instant.
 #[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
+    Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
 )]
 #[repr(C)]
 #[type_name("hnav::Odometry")]
@@ -37,12 +38,24 @@ pub struct Odometry {
     pub period: u64,
     /// Agent (robot) index.
     pub agent: u32,
-    /// Zero.
-    pub reserved: u32,
+    /// [`Odometry::FIX`] when `fix` holds a fix; no other bit is used.
+    pub flags: u32,
     /// Signed cumulative ticks of the left wheel.
     pub ticks_left: i64,
     /// Signed cumulative ticks of the right wheel.
     pub ticks_right: i64,
+    /// The localisation fix if `flags` has [`Odometry::FIX`], else zero.
+    pub fix: Pose,
+}
+
+impl Odometry {
+    /// `flags` bit: the reading carries a localisation fix.
+    pub const FIX: u32 = 1;
+
+    /// The localisation fix, if the reading carries one.
+    pub fn fix(&self) -> Option<Pose> {
+        (self.flags & Self::FIX != 0).then_some(self.fix)
+    }
 }
 
 /// A planar pose in metres and radians (x right, y down the map's rows, as the grid).
@@ -129,14 +142,15 @@ mod tests {
         assert_eq!(offset_of!(WheelCommand, flags), 12);
         assert_eq!(offset_of!(WheelCommand, left_rad_s), 16);
         assert_eq!(offset_of!(WheelCommand, right_rad_s), 24);
-        assert_eq!(size_of::<Odometry>(), 40);
+        assert_eq!(size_of::<Odometry>(), 64);
         assert_eq!(align_of::<Odometry>(), 8);
         assert_eq!(offset_of!(Odometry, sim_time_ns), 0);
         assert_eq!(offset_of!(Odometry, period), 8);
         assert_eq!(offset_of!(Odometry, agent), 16);
-        assert_eq!(offset_of!(Odometry, reserved), 20);
+        assert_eq!(offset_of!(Odometry, flags), 20);
         assert_eq!(offset_of!(Odometry, ticks_left), 24);
         assert_eq!(offset_of!(Odometry, ticks_right), 32);
+        assert_eq!(offset_of!(Odometry, fix), 40);
     }
 
     #[test]

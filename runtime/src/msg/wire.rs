@@ -164,7 +164,16 @@ impl Wire for WheelCommand {
 
 impl Wire for Odometry {
     fn check(&self) -> Result<(), String> {
-        agent("agent", self.agent)
+        agent("agent", self.agent)?;
+        if self.flags & !Odometry::FIX != 0 {
+            return Err(format!("flags {:#x} has unknown bits", self.flags));
+        }
+        let Some(fix) = self.fix() else {
+            return Ok(());
+        };
+        finite("the fix's x_m", fix.x_m)?;
+        finite("the fix's y_m", fix.y_m)?;
+        finite("the fix's theta_rad", fix.theta_rad)
     }
 }
 

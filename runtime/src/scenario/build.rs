@@ -32,6 +32,8 @@ pub(super) fn parse(
     let health = super::health::build_health(raw.health, &lines)?;
     let record = super::record::build_record(raw.record, &lines)?;
     let sensing = super::sensing::build_sensing(raw.sensing, &lines)?;
+    let localisation =
+        super::localisation::build_localisation(raw.localisation, sim.odometry_hz, &lines)?;
     if raw.agents.is_empty() {
         return Err(ScenarioError::NoAgents {
             at: Loc::new(source_name, 1),
@@ -80,6 +82,7 @@ pub(super) fn parse(
         run,
         health,
         record,
+        localisation,
         agents,
         faults,
         allow_unreachable,

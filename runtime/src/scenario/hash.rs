@@ -16,10 +16,13 @@
 //! * `allow_unreachable`, only when it is `true` (appended last), so that the hash of every
 //!   scenario without the key, and every log written before it existed, stays the same;
 //!   likewise `[restart] on_give_up`, only when it is `"stop"`, and `[tasks]`, only when
-//!   the section is there (the tag `tasks`, the stream's code and seed, each agent's cycle),
-//!   and `[[events]]`, only when there are some (the tag `events`, then each event's time and
-//!   change: a code, its cells, a mover's name, speed and repeat), after `[sensing]`, only
-//!   when the section is there (the tag `sensing`, range, known_map, the repair rule's code).
+//!   the section is there (the tag `tasks`, the stream's code and seed, each agent's cycle);
+//!   `[localisation]`, only when it differs from its default (the tag `localisation`, rate,
+//!   position and heading noise); `[[events]]`, only when there are some (the tag `events`,
+//!   then each event's time and change: a code, its cells, a mover's name, speed and
+//!   repeat), after `[sensing]`, only when the section is there (the tag `sensing`, range,
+//!   known_map, the repair rule's code); so that the logs written before these sections
+//!   existed keep their hash.
 //!
 //! It does **not** cover the scenario `name`, the source file name, or the map file's path
 //! (only the map's content), so renaming or moving files keeps the hash.
@@ -28,6 +31,7 @@
 //! little-endian `u64`, floats as the little-endian bits of the `f64`, booleans and enum
 //! variants as one `u64` code, options as a presence code then the value.
 
+use super::localisation::LocalisationParams;
 use super::params::{
     ClockMode, FsyncPolicy, GiveUpAction, Planner, RestartPolicy, RestartRule, Rules,
 };
@@ -208,6 +212,13 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
                 h.u64(g.x.into()).u64(g.y.into());
             }
         }
+    }
+    let l = &s.localisation;
+    if *l != LocalisationParams::default() {
+        h.bytes(b"localisation")
+            .f64(l.rate_hz)
+            .f64(l.std_m)
+            .f64(l.std_deg);
     }
     if let Some(v) = &s.sensing {
         let repair = match v.repair {

@@ -75,6 +75,11 @@
 //! max_mb = 64                          # simulated second (0: every truth message), the
 //! maps = true                          # cap of each file in MiB, neural-map snapshots
 //!
+//! [localisation]                       # the sim's map-based pose fix that bounds the agents'
+//! rate_hz = 1.0                        # dead-reckoning drift; fixes per simulated second
+//! std_m = 0.002                        # (0 = none, at most odometry_hz) and the noise of a
+//! std_deg = 0.5                        # fix's position (m) and heading (degrees)
+//!
 //! [[agents]]                           # one table per robot, numbered from 0
 //! start = [0, 0]                       # [x, y]: x = column, y = row, origin top-left
 //! goal = [31, 31]
@@ -168,6 +173,7 @@ pub mod fault_arg;
 mod hash;
 pub mod health;
 pub(crate) mod lines;
+pub mod localisation;
 pub mod params;
 mod raw;
 pub mod record;
@@ -183,6 +189,7 @@ use serde::{Deserialize, Serialize};
 pub use error::{Loc, ScenarioError};
 pub use events::{EventSpec, MoverSpec, WorldChange};
 pub use health::HealthParams;
+pub use localisation::LocalisationParams;
 pub use params::{
     default_startup_timeout_s, ClockMode, ClockModeError, CoordinatorParams, FsyncPolicy,
     GiveUpAction, Planner, RestartConfig, RestartPolicy, RestartRule, RobotParams, Rules,
@@ -342,6 +349,8 @@ pub struct Scenario {
     pub health: HealthParams,
     /// What the recorder keeps (`[record]`).
     pub record: RecordParams,
+    /// The sim's localisation fix that bounds the agents' drift (`[localisation]`).
+    pub localisation: LocalisationParams,
     /// The robots, numbered from 0.
     pub agents: Vec<AgentSpec>,
     /// The fault plan.

@@ -29,6 +29,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
             "run",
             "health",
             "record",
+            "localisation",
             "agents",
             "faults",
             "tasks",
@@ -92,6 +93,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
         ],
     ),
     ("record", &["trajectory_hz", "max_mb", "maps"]),
+    ("localisation", &["rate_hz", "std_m", "std_deg"]),
     (
         "agents",
         &[
@@ -143,6 +145,7 @@ pub(super) struct RawScenario {
     pub run: Option<RawRun>,
     pub health: Option<super::health::RawHealth>,
     pub record: Option<super::record::RawRecord>,
+    pub localisation: Option<super::localisation::RawLocalisation>,
     #[serde(default)]
     pub agents: Vec<Spanned<RawAgent>>,
     #[serde(default)]
