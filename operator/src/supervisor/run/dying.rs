@@ -22,7 +22,9 @@ use super::slots::Slots;
 use crate::supervisor::proc_stat;
 
 /// How often a killed process is looked at until it is exiting: a few reads of `/proc` per
-/// poll, for the millisecond or so the kernel takes to stop every thread.
+/// poll, for the millisecond or so the kernel takes to stop every thread. iceoryx2's
+/// `WaitSet` rounds a timeout up to the next millisecond (its epoll reactor), so in practice
+/// a look comes every millisecond at most.
 const POLL: Duration = Duration::from_micros(250);
 
 /// The incarnations SIGKILLed by the supervisor and not yet told `Down`, in the order they
