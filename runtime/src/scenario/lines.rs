@@ -59,6 +59,27 @@ impl<'a> Lines<'a> {
     pub(super) fn at_opt<T>(&self, s: &Option<Spanned<T>>, fallback: &Loc) -> Loc {
         s.as_ref().map_or_else(|| fallback.clone(), |s| self.at(s))
     }
+
+    /// `v`, if given, when it is in `[lo, hi]`; else an error at its line (`unit` follows
+    /// the range in it: `must be in [1, 15] cells, got 0`).
+    pub(super) fn in_range(
+        &self,
+        v: &Option<Spanned<i64>>,
+        key: &str,
+        (lo, hi): (i64, i64),
+        unit: &str,
+    ) -> Result<Option<i64>, ScenarioError> {
+        let Some(v) = v else { return Ok(None) };
+        let x = *v.get_ref();
+        if (lo..=hi).contains(&x) {
+            return Ok(Some(x));
+        }
+        Err(ScenarioError::InvalidParameter {
+            at: self.at(v),
+            key: key.into(),
+            problem: format!("must be in [{lo}, {hi}]{unit}, got {x}"),
+        })
+    }
 }
 
 /// Converts a `toml` error, recognising serde's unknown/missing field messages so they get

@@ -67,30 +67,16 @@ pub(super) fn build_record(
 ) -> Result<RecordParams, ScenarioError> {
     let d = RecordParams::default();
     let Some(r) = raw else { return Ok(d) };
-    let within = |v: &Option<Spanned<i64>>, key: &str, lo: i64, hi: i64, unit: &str| {
-        let Some(v) = v else { return Ok(None) };
-        let x = *v.get_ref();
-        if (lo..=hi).contains(&x) {
-            return Ok(Some(x));
-        }
-        Err(ScenarioError::InvalidParameter {
-            at: lines.at(v),
-            key: key.into(),
-            problem: format!("must be in [{lo}, {hi}]{unit}, got {x}"),
-        })
-    };
-    let hz = within(
+    let hz = lines.in_range(
         &r.trajectory_hz,
         "record.trajectory_hz",
-        0,
-        i64::from(RecordParams::MAX_HZ),
+        (0, i64::from(RecordParams::MAX_HZ)),
         " samples per second",
     )?;
-    let mb = within(
+    let mb = lines.in_range(
         &r.max_mb,
         "record.max_mb",
-        1,
-        i64::from(RecordParams::MAX_MB),
+        (1, i64::from(RecordParams::MAX_MB)),
         " MiB",
     )?;
     Ok(RecordParams {

@@ -74,24 +74,40 @@ pub(super) fn build_sensing(
 ) -> Result<Option<SensingParams>, ScenarioError> {
     let Some(r) = raw else { return Ok(None) };
     let d = SensingParams::default();
-    let range = match &r.range {
-        None => d.range,
-        Some(v) => {
-            let x = *v.get_ref();
-            let max = i64::from(SensingParams::MAX_RANGE);
-            if !(1..=max).contains(&x) {
-                return Err(ScenarioError::InvalidParameter {
-                    at: lines.at(v),
-                    key: "sensing.range".into(),
-                    problem: format!("must be in [1, {max}] cells, got {x}"),
-                });
-            }
-            x as u32
-        }
-    };
+    let max = i64::from(SensingParams::MAX_RANGE);
+    let range = lines.in_range(&r.range, "sensing.range", (1, max), " cells")?;
+    let range = range.map_or(d.range, |x| x as u32);
     Ok(Some(SensingParams {
         range,
         known_map: r.known_map.unwrap_or(d.known_map),
         repair: r.repair.map_or(d.repair, |s| *s.get_ref()),
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_support::{parse, BASE};
+    use super::*;
+
+    #[test]
+    fn defaults_given_values_and_a_range_out_of_bounds_at_its_line() {
+        assert_eq!(parse(BASE).unwrap().sensing, None);
+        let s = parse(&format!("{BASE}[sensing]\n")).unwrap();
+        assert_eq!(s.sensing, Some(SensingParams::default()));
+        let s = parse(&format!(
+            "{BASE}[sensing]\nrange = 15\nknown_map = false\nrepair = \"partial\"\n"
+        ))
+        .unwrap();
+        let want = SensingParams {
+            range: 15,
+            known_map: false,
+            repair: RepairRule::Partial,
+        };
+        assert_eq!(s.sensing, Some(want));
+        let e = parse(&format!("{BASE}[sensing]\nrange = 0\n")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.toml:17: sensing.range must be in [1, 15] cells, got 0"
+        );
+    }
 }

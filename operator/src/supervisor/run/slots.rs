@@ -39,6 +39,16 @@ struct Slot {
     down_told: Option<u32>,
 }
 
+impl Slot {
+    /// Whether `target` is this slot's running, unreaped incarnation, not yet told `Down`.
+    fn may_tell_down(&self, target: Incarnation) -> bool {
+        self.spec.role == target.role
+            && self.spec.index == target.index
+            && self.down_told != Some(target.pid)
+            && (self.child.as_ref()).is_some_and(|c| c.pid() == target.pid && c.exit().is_none())
+    }
+}
+
 /// Every process of the run: the sim, the coordinator (or its replicas, index = Raft id) and
 /// one agent per robot, in that order.
 pub(super) struct Slots {
@@ -179,19 +189,14 @@ impl Slots {
     /// Whether `target` is the running, unreaped incarnation of its slot, not yet told
     /// `Down`.
     pub(super) fn may_tell_down(&self, target: Incarnation) -> bool {
-        self.slot_of(target)
-            .is_some_and(|s| s.down_told != Some(target.pid))
+        self.slots.iter().any(|s| s.may_tell_down(target))
     }
 
     /// `target`, which the supervisor SIGKILLed, can no longer act: its `Down`, told now
     /// rather than at its reap (which then does not tell it again). None if `target` is not
     /// the slot's running incarnation or was told already.
     pub(super) fn told_down(&mut self, target: Incarnation) -> Option<Action> {
-        if !self.may_tell_down(target) {
-            return None;
-        }
-        let s = (self.slots.iter_mut())
-            .find(|s| s.spec.role == target.role && s.spec.index == target.index)?;
+        let s = self.slots.iter_mut().find(|s| s.may_tell_down(target))?;
         s.down_told = Some(target.pid);
         let (role, index) = (s.spec.role, s.spec.index);
         Some(Action::Publish(Lifecycle::down(
@@ -199,15 +204,6 @@ impl Slots {
             index,
             s.tracker.restarts(),
         )))
-    }
-
-    /// The slot whose running, unreaped incarnation is `target`.
-    fn slot_of(&self, target: Incarnation) -> Option<&Slot> {
-        self.slots.iter().find(|s| {
-            s.spec.role == target.role
-                && s.spec.index == target.index
-                && (s.child.as_ref()).is_some_and(|c| c.pid() == target.pid && c.exit().is_none())
-        })
     }
 
     /// Whether the incarnation `pid` of `role`/`index` is over for good or replaced: it was
