@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use crate::msg::{
     Candidate, Commit, Decision, Estimate, Heartbeat, Lifecycle, MapHeader, Odometry, Pose,
-    Progress, Truth, View, WheelCommand, MAX_AGENTS,
+    Progress, Sighting, Truth, View, WheelCommand, WorldHeader, MAX_AGENTS,
 };
 use crate::topics;
 
@@ -206,6 +206,20 @@ pub fn layouts() -> Layouts {
             seen: [u32; 32],
             blocked: [u32; 32]
         }),
+        layout!(Sighting {
+            round: u64,
+            agent: u32,
+            count: u32,
+            closed: u32,
+            reserved: u32,
+            cells: [u32; 32]
+        }),
+        layout!(WorldHeader {
+            round: u64,
+            closed: u32,
+            reserved: u32,
+            to: [u32; 8]
+        }),
     ];
     let fixed = |topic, payload| TopicLayout {
         topic,
@@ -231,6 +245,13 @@ pub fn layouts() -> Layouts {
         fixed(topics::LIFECYCLE, type_name_of::<Lifecycle>()),
         fixed(topics::HEARTBEAT, type_name_of::<Heartbeat>()),
         fixed(topics::ESTIMATE, type_name_of::<Estimate>()),
+        fixed(topics::SIGHTINGS, type_name_of::<Sighting>()),
+        TopicLayout {
+            topic: topics::WORLD,
+            payload: type_name_of::<u32>(),
+            slice: true,
+            user_header: type_name_of::<WorldHeader>(),
+        },
     ];
     Layouts {
         max_agents: MAX_AGENTS,

@@ -14,6 +14,8 @@
 //! | `ready` | [`Lifecycle`](crate::msg::Lifecycle) (`Up`; the sim's `Hold`) | every process -> supervisor | latest, deep buffer |
 //! | `lifecycle` | [`Lifecycle`](crate::msg::Lifecycle) | supervisor -> every process | latest, deep buffer |
 //! | `heartbeat` | [`Heartbeat`](crate::msg::Heartbeat) | every process -> supervisor | latest, depth 1, not notified |
+//! | `sightings` | [`Sighting`](crate::msg::Sighting) | agents -> coordinator (with `[sensing]`) | reliable |
+//! | `world` | `[u32]` + [`WorldHeader`](crate::msg::WorldHeader) | coordinator -> restarted agents (with `[sensing]`) | latest, shallow ([`world_qos`]) |
 //! | `raft/<i>` | `[u8]`: a Raft message | every other coordinator replica -> replica i | latest ([`raft_qos`]) |
 //!
 //! Why "latest" (overwrite the oldest) for commits and lifecycle events, where every sample
@@ -49,6 +51,11 @@ pub fn wheels(i: usize) -> String {
 pub fn odometry(i: usize) -> String {
     format!("odom/{i}")
 }
+
+/// Cells the agents saw change, for the coordinator's map.
+pub const SIGHTINGS: &str = "sightings";
+/// The coordinator's map of a changing world, for agents that restarted.
+pub const WORLD: &str = "world";
 
 /// Robot `i`'s sensor view (the sim's [`View`](crate::msg::View)).
 pub fn view(i: usize) -> String {
@@ -159,6 +166,17 @@ pub fn commit_qos(agents: usize) -> Qos {
         buffer: 64,
         history: 1,
         delivery: Delivery::LatestOnly,
+    }
+}
+
+/// QoS of the `world` topic of a swarm of `agents`: like the commit stream (one coordinator
+/// publishing at a time, every agent reading), but two samples deep: each sample is the whole
+/// picture and answers every agent that restarted since the last, and a sample holds a cell
+/// per changed cell of the map, which a deep buffer per reader would multiply.
+pub fn world_qos(agents: usize) -> Qos {
+    Qos {
+        buffer: 2,
+        ..commit_qos(agents)
     }
 }
 

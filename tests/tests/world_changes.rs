@@ -1,12 +1,15 @@
 //! A world that changes (issue 35): a door closes across a robot's only short route; the
 //! robot sees it with its range sensor, repairs its neural map and arrives by the other
-//! route, in lockstep, the same log twice.
+//! route, in lockstep, the same log twice. The coordinator logs the change the robot saw and
+//! hands the map as it stands to an agent that restarts.
 
 use std::path::Path;
 
+use hnav_runtime::consensus_log::MapChangeRecord;
 use hnav_runtime::consensus_log::{read_decided, Record};
 use hnav_runtime::msg::{Verdict, NO_CELL};
-use hnav_tests::swarm::{lockstep_all_home, repo_root};
+use hnav_tests::swarm::{lockstep_all_home, repo_root, verify_log, SwarmRun};
+use hnav_tests::TestRun;
 
 /// The door (5, 0) of `scenarios/door.toml` closes at this round.
 const CLOSED_AT: u64 = 150;
@@ -68,6 +71,28 @@ fn a_door_that_closes_is_seen_repaired_around_and_the_run_repeats_byte_for_byte(
                 .all(|&(round, x, y)| !(round > CLOSED_AT && (x, y) == (5, 0))),
             "robot 0 entered the closed door: {walk:?}"
         );
+        // The coordinator took the change from agent 0's sighting, which went out before its
+        // candidate for the round after the period it saw the door in.
+        let changes: Vec<MapChangeRecord> = read_decided(dir.join("log"))
+            .unwrap()
+            .records
+            .into_iter()
+            .filter_map(|r| match r {
+                Record::MapChange(m) => Some(m),
+                _ => None,
+            })
+            .collect();
+        let door = MapChangeRecord {
+            round: sensed + 1,
+            agent: 0,
+            closed: vec![5],
+            opened: vec![],
+        };
+        assert_eq!(
+            changes,
+            [door],
+            "one map change: the door, as agent 0 saw it"
+        );
         let last = walk.last().unwrap();
         assert_eq!(
             (last.1, last.2),
@@ -84,4 +109,42 @@ fn a_door_that_closes_is_seen_repaired_around_and_the_run_repeats_byte_for_byte(
         );
     }
     assert!(logs[0] == logs[1], "the two lockstep logs differ");
+}
+
+#[test]
+fn an_agent_that_restarts_gets_the_map_as_it_stands_not_the_one_at_start() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = repo_root().join("scenarios/door.toml");
+    let dir = tmp.path().join("run");
+    let mut run = TestRun::new("door-restart");
+    // Agent 0 saw the door close at period 186; it is killed and restarted at round 250.
+    let args = ["--mode", "lockstep", "--kill", "agent:0@round:250"];
+    let registry = tmp.path().join("runs");
+    let mut swarm = SwarmRun::start(&mut run, &scenario, &dir, &registry, &args).unwrap();
+    let status = swarm.finish(std::time::Duration::from_secs(300)).unwrap();
+    assert!(status.success(), "{status}\n{}", swarm.log_tails());
+    let s = swarm.summary().unwrap();
+    assert_eq!(s["end"], "all-at-goal", "{s}");
+    assert_eq!(s["restarts"]["agent-0"], 1, "{s}");
+    let (ok, report) = verify_log(&dir.join("log"));
+    assert!(ok, "{report}");
+    let agent_log = std::fs::read_to_string(dir.join("logs/agent-0.log")).unwrap();
+    let got = agent_log
+        .lines()
+        .find(|l| l.contains("the coordinator's map"))
+        .unwrap_or_else(|| panic!("the restarted agent got no map:\n{agent_log}"));
+    assert!(got.contains("closed=1 opened=0"), "{got}");
+    // It learned the door from the map (a repair at its first period back), not by seeing it
+    // again later.
+    let repairs: Vec<u64> = agent_log
+        .lines()
+        .filter(|l| l.contains(" repair ") && l.contains("closed=1"))
+        .filter_map(|l| l.split("period=").nth(1)?.split(' ').next()?.parse().ok())
+        .collect();
+    assert_eq!(
+        repairs.len(),
+        2,
+        "seen once, learned once after the restart: {repairs:?}"
+    );
+    assert!(repairs[1] >= 250 && repairs[1] <= 251, "{repairs:?}");
 }

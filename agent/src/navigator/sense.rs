@@ -57,10 +57,24 @@ impl Navigator {
     /// Folds `view` into the agent's grid and repairs the guide if a cell changed; returns
     /// the repair (none: the view matched the grid).
     pub fn sense(&mut self, view: &View, rule: RepairRule) -> Result<Option<Repair>, Error> {
+        let seen = view
+            .cells()
+            .map(|(x, y, blocked)| (Cell::new(x, y), blocked));
+        self.learn(seen, rule, view.period)
+    }
+
+    /// Folds cells whose state is known (`(cell, blocked)`: seen at control period `period`,
+    /// or the coordinator's map for a restarted agent) into the agent's grid and repairs the
+    /// guide if one changed; returns the repair (none: nothing changed).
+    pub fn learn(
+        &mut self,
+        cells: impl Iterator<Item = (Cell, bool)>,
+        rule: RepairRule,
+        period: u64,
+    ) -> Result<Option<Repair>, Error> {
         let keep = [self.current, self.next, self.target];
         let (mut closed, mut opened) = (Vec::new(), Vec::new());
-        for (x, y, blocked) in view.cells() {
-            let c = Cell::new(x, y);
+        for (c, blocked) in cells {
             if !self.grid.contains(c) || keep.contains(&c) {
                 continue;
             }
@@ -102,7 +116,7 @@ impl Navigator {
         };
         tracing::info!(
             agent = self.task.index,
-            period = view.period,
+            period,
             closed = repair.closed,
             opened = repair.opened,
             kind = ?repair.kind,

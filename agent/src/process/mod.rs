@@ -21,10 +21,12 @@
 //! |---|---|
 //! | `ports` | the topics the agent opens |
 //! | `state` | the agent's state and its handler for each input |
+//! | `sightings` | what the robot saw change, for the coordinator's map (`[sensing]`) |
 //! | [`checkpoint`] | the restart checkpoint in the run directory |
 
 pub mod checkpoint;
 mod ports;
+mod sightings;
 mod state;
 
 use std::path::Path;

@@ -3,11 +3,12 @@
 use hnav_runtime::grid::Grid;
 use hnav_runtime::launch::LifecyclePorts;
 use hnav_runtime::msg::{
-    Candidate, Commit, Estimate, MapHeader, Odometry, Role, View, WheelCommand,
+    Candidate, Commit, Estimate, MapHeader, Odometry, Role, Sighting, View, WheelCommand,
+    WorldHeader,
 };
 use hnav_runtime::topics;
 use hnav_runtime::transport::{
-    Bell, BellWatch, Receiver, Sender, SliceSender, Transport, TransportError,
+    Bell, BellWatch, Receiver, Sender, SliceReceiver, SliceSender, Transport, TransportError,
 };
 
 /// The topics of agent `index`: its odometry and the commits in, its wheel commands,
@@ -16,6 +17,10 @@ pub(super) struct Ports {
     pub(super) odom: Receiver<Odometry>,
     /// The robot's sensor view, when the scenario senses (`[sensing]`).
     pub(super) view: Option<Receiver<View>>,
+    /// The cells the robot saw change, to the coordinator (with `[sensing]`).
+    pub(super) sightings: Option<Sender<Sighting>>,
+    /// The coordinator's map as it stands, sent when this agent restarted (with `[sensing]`).
+    pub(super) world: Option<SliceReceiver<u32, WorldHeader>>,
     pub(super) commit: Receiver<Commit>,
     /// The run's commit bell, watched in place of a datagram per commit (under a supervisor).
     pub(super) bell: Option<BellWatch>,
@@ -48,6 +53,12 @@ impl Ports {
             odom: transport.receiver(&topics::odometry(i), topics::state_qos())?,
             view: sensing
                 .then(|| transport.receiver(&topics::view(i), topics::state_qos()))
+                .transpose()?,
+            sightings: sensing
+                .then(|| transport.sender(topics::SIGHTINGS, topics::candidates_qos(agents)))
+                .transpose()?,
+            world: sensing
+                .then(|| transport.slice_receiver(topics::WORLD, topics::world_qos(agents)))
                 .transpose()?,
             commit,
             bell: bell.map(Bell::into_watch).transpose()?,

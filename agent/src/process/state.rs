@@ -15,6 +15,7 @@ use hnav_runtime::scenario::{AgentSpec, ClockMode, Planner, RepairRule, Scenario
 
 use super::checkpoint::{Checkpoint, CheckpointFile};
 use super::ports::Ports;
+use super::sightings::Sightings;
 use super::{AgentError, AgentOutcome};
 use crate::controller::{ControllerParams, FreeSpace, WheelController, WheelDrive};
 use crate::ga_fuzzy::{GaOptions, GaPlanner};
@@ -58,6 +59,8 @@ pub(super) struct Core {
     ticks: (i64, i64),
     /// How the neural map is repaired when the view differs from it; none: no sensing.
     repair: Option<RepairRule>,
+    /// What the robot saw change, for the coordinator (with `[sensing]`).
+    sightings: Option<Sightings>,
 }
 
 impl Core {
@@ -126,6 +129,7 @@ impl Core {
             candidate_due: false,
             ticks,
             repair: scenario.sensing.map(|s| s.repair),
+            sightings: scenario.sensing.map(|_| Sightings::new(&scenario.map.grid)),
         })
     }
 
@@ -235,13 +239,52 @@ impl Core {
         })?;
         // A repaired map is marked replanned: its snapshot goes out with the next candidate.
         if let Some(v) = latest {
+            if let Some(s) = &mut self.sightings {
+                s.fold(&v);
+            }
             self.nav.sense(&v, rule)?;
         }
         Ok(())
     }
 
+    /// Folds in the coordinator's map as it stands, when it was sent to this agent (it
+    /// restarted): the map at start is out of date by every change the swarm saw since.
+    fn on_world(&mut self, p: &Ports) -> Result<(), AgentError> {
+        let (Some(rx), Some(rule)) = (&p.world, self.repair) else {
+            return Ok(());
+        };
+        let (index, period) = (self.index as usize, self.last_period.unwrap_or(0));
+        let (nav, sightings, width) = (&mut self.nav, &mut self.sightings, self.width);
+        let mut result = Ok(None);
+        rx.drain_pending(|h, cells| {
+            if !h.is_for(index) {
+                return;
+            }
+            let closed = (h.closed as usize).min(cells.len());
+            let state = |k: usize| (cells[k], k < closed);
+            if let Some(s) = sightings.as_mut() {
+                (0..cells.len()).map(state).for_each(|(c, b)| s.learn(c, b));
+            }
+            let known = (0..cells.len())
+                .map(state)
+                .map(|(c, b)| (Cell::new(c % width.max(1), c / width.max(1)), b));
+            tracing::info!(
+                closed,
+                opened = cells.len() - closed,
+                round = h.round,
+                "the coordinator's map"
+            );
+            if result.is_ok() {
+                result = nav.learn(known, rule, period);
+            }
+        })?;
+        result?;
+        Ok(())
+    }
+
     /// Folds in the newest odometry reading and opens the next round.
     fn on_odometry(&mut self, p: &Ports) -> Result<(), AgentError> {
+        self.on_world(p)?;
         self.on_views(p)?;
         let mut latest: Option<Odometry> = None;
         p.odom.drain_pending(|o| {
@@ -319,6 +362,9 @@ impl Core {
             return Ok(()); // decided without this agent; it stood still
         }
         let cand = self.nav.candidate(round);
+        if let (Some(s), Some(tx)) = (&mut self.sightings, &p.sightings) {
+            s.send(tx, round, self.index)?;
+        }
         p.candidates.send(cand)?;
         self.outstanding = Some(round);
         self.sent_at = Some(Instant::now());

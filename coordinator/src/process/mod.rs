@@ -75,6 +75,8 @@ pub struct CoordinatorProcess<'t> {
     state: State,
     heart: Heartbeat,
     agents: usize,
+    /// The map's cells when the run senses (`[sensing]`): the world's ports are opened.
+    world_cells: Option<usize>,
     startup_timeout: Duration,
 }
 
@@ -92,9 +94,10 @@ impl<'t> CoordinatorProcess<'t> {
             return Err(CoordinatorError::TooManyAgents(n));
         }
         let index = replica.map_or(0, |id| id as u32);
+        let world_cells = scenario.sensing.is_some().then(|| scenario.map.grid.len());
         let (ports, state) = match replica {
             None => (
-                Some(Ports::open(transport, n)?),
+                Some(Ports::open(transport, n, world_cells)?),
                 State::open(scenario, run_dir)?,
             ),
             Some(id) => (None, State::open_replica(transport, scenario, run_dir, id)?),
@@ -109,6 +112,7 @@ impl<'t> CoordinatorProcess<'t> {
             life,
             state,
             agents: n,
+            world_cells,
         })
     }
 
@@ -136,7 +140,7 @@ impl<'t> CoordinatorProcess<'t> {
                 tracing::info!(reason = reason.name(), "replica stops while following");
                 return Ok(st.outcome());
             }
-            self.ports = Some(Ports::open(self.transport, self.agents)?);
+            self.ports = Some(Ports::open(self.transport, self.agents, self.world_cells)?);
         }
         let p = self.ports.as_ref().expect("opened above");
         // A coordinator that died between its last round and the run's end ends it now.

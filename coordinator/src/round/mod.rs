@@ -28,6 +28,11 @@
 //! **Tasks** (`tasks.rs`). In a lifelong run (`[tasks]`) an agent that stands on its goal and
 //! is not moved this round is given its next goal: a `task` decision, and a task record the
 //! coordinator logs before the round's. The rules head for the new goal from the next round.
+//!
+//! **A changing world** (`world.rs`). With `[sensing]` the agents report the cells they saw
+//! close or open; what differs from the arbiter's map is a map change, logged before the round
+//! it is first decided in; from then on the rules and the global replans decide on the
+//! changed map.
 
 use hnav_runtime::consensus_log::{LoggedDecision, ReplanRecord, RoundRecord, Tally, TaskRecord};
 use hnav_runtime::grid::{Cell, Direction, Grid};
@@ -51,6 +56,8 @@ enum Round {
 /// The coordinator's round logic; see the [module docs](self).
 pub struct Arbiter {
     grid: Grid,
+    /// The scenario's blocked cells: what [`Arbiter::world`] tells the changes from.
+    start: Vec<bool>,
     scratch: Grid,
     round: Round,
     rows: Vec<AgentRow>,
@@ -90,6 +97,7 @@ impl Arbiter {
             Rules::Lacam => Round::Lacam(Box::new(Lacam::new(&grid, &goals, options))),
         };
         Arbiter {
+            start: grid.blocked().to_vec(),
             scratch: grid.clone(),
             round,
             rows: scenario
@@ -422,3 +430,4 @@ impl Arbiter {
 mod tasks;
 #[cfg(test)]
 mod tests;
+mod world;

@@ -193,7 +193,8 @@ impl RunSummary {
                 | Record::Replan(_)
                 | Record::Raft(_)
                 | Record::RaftState(_)
-                | Record::Snapshot(_) => {}
+                | Record::Snapshot(_)
+                | Record::MapChange(_) => {}
             }
         }
         let mut agents: Vec<AgentSummary> = (0u32..)

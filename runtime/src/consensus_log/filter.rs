@@ -11,7 +11,7 @@ use super::record::{RaftEntryRecord, Record};
 use crate::msg::Role;
 
 /// The kinds a filter can name, as [`Record::kind`] spells them.
-pub const KINDS: [&str; 10] = [
+pub const KINDS: [&str; 11] = [
     "header",
     "round",
     "lifecycle",
@@ -22,6 +22,7 @@ pub const KINDS: [&str; 10] = [
     "raft-state",
     "task",
     "snapshot",
+    "map-change",
 ];
 
 /// What to keep of a log. The empty filter keeps everything; each part given narrows it.
@@ -103,6 +104,7 @@ impl RecordFilter {
             Record::Replan(r) => (r.agent == agent).then(|| record.clone()),
             Record::Unreachable(u) => (u.agent == agent).then(|| record.clone()),
             Record::Task(t) => (t.agent == agent).then(|| record.clone()),
+            Record::MapChange(m) => (m.agent == agent).then(|| record.clone()),
             _ => None,
         }
     }

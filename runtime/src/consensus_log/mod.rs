@@ -65,8 +65,8 @@ pub use frame::{
 pub use reader::{read_log, LogContents, LogReader, RecordPos, TornTail};
 pub use record::{
     candidates_digest, AgentEntry, EndReason, EndRecord, LifecycleRecord, LoggedDecision,
-    RaftEntryRecord, RaftStateRecord, Record, ReplanRecord, RoundRecord, RunHeader, SnapshotRecord,
-    TaskRecord, UnreachableRecord,
+    MapChangeRecord, RaftEntryRecord, RaftStateRecord, Record, ReplanRecord, RoundRecord,
+    RunHeader, SnapshotRecord, TaskRecord, UnreachableRecord,
 };
 pub use replicated::{
     is_replicated, read_decided, replica_dirs, resolve, Decided, ReplicaRole, Resolved, ROLE_FILE,

@@ -36,11 +36,15 @@ pub enum Record {
     /// A replica's snapshot: the applied state of the Raft entries it replaced, which are
     /// gone from its log ([`snapshot`](super::snapshot)).
     Snapshot(SnapshotRecord),
+    /// The coordinator accepted cells an agent saw close or open (`[sensing]`): it decides
+    /// this round and the next on the changed map (after the kinds above so that their
+    /// encoding is unchanged).
+    MapChange(MapChangeRecord),
 }
 
 impl Record {
     /// Lower-case name of the record's kind (`header`, `round`, `lifecycle`, `replan`, `end`,
-    /// `unreachable`, `raft-entry`, `raft-state`, `task`).
+    /// `unreachable`, `raft-entry`, `raft-state`, `task`, `snapshot`, `map-change`).
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Header(_) => "header",
@@ -53,6 +57,7 @@ impl Record {
             Self::RaftState(_) => "raft-state",
             Self::Task(_) => "task",
             Self::Snapshot(_) => "snapshot",
+            Self::MapChange(_) => "map-change",
         }
     }
 
@@ -66,6 +71,7 @@ impl Record {
             Self::End(r) => Some(r.round),
             Self::Unreachable(r) => Some(r.round),
             Self::Task(r) => Some(r.round),
+            Self::MapChange(r) => Some(r.round),
             Self::Raft(_) | Self::RaftState(_) | Self::Snapshot(_) => None,
         }
     }
@@ -305,6 +311,21 @@ pub struct TaskRecord {
     pub task: u64,
     /// The new goal (row-major index).
     pub goal: u32,
+}
+
+/// Cells of the map that changed, as one agent saw them and the coordinator accepted them:
+/// each differed from the coordinator's map when it was logged. Logged before the round's
+/// record, which is the first decided on the changed map.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct MapChangeRecord {
+    /// The round decided first on the changed map.
+    pub round: u64,
+    /// The agent that saw the change.
+    pub agent: u32,
+    /// Cells that closed (row-major indices, ascending).
+    pub closed: Vec<u32>,
+    /// Cells that opened (row-major indices, ascending).
+    pub opened: Vec<u32>,
 }
 
 /// A global replan for one agent.

@@ -120,6 +120,17 @@ pub fn describe(record: &Record, width: u32) -> String {
                 cell(t.goal, width)
             );
         }
+        Record::MapChange(m) => {
+            let _ = write!(s, "map-change round {}  a{} saw", m.round, m.agent);
+            for (what, cells) in [("closed", &m.closed), ("opened", &m.opened)] {
+                if !cells.is_empty() {
+                    let _ = write!(s, "  {what}");
+                    for &c in cells.iter() {
+                        let _ = write!(s, " {}", cell(c, width));
+                    }
+                }
+            }
+        }
         Record::End(e) => {
             let _ = write!(
                 s,
@@ -283,6 +294,12 @@ pub fn to_json(pos: &RecordPos, record: &Record, width: u32) -> Value {
             "agent": t.agent,
             "task": t.task,
             "goal": cell(t.goal),
+        }),
+        Record::MapChange(m) => json!({
+            "round": m.round,
+            "agent": m.agent,
+            "closed": m.closed.iter().map(|&c| cell(c)).collect::<Vec<_>>(),
+            "opened": m.opened.iter().map(|&c| cell(c)).collect::<Vec<_>>(),
         }),
         Record::Raft(e) => json!({
             "term": e.term,

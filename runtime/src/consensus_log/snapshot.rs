@@ -16,8 +16,8 @@ use serde::{Deserialize, Serialize};
 
 use super::error::FrameProblem;
 use super::record::{
-    EndRecord, LifecycleRecord, Record, RoundRecord, RunHeader, SnapshotRecord, TaskRecord,
-    UnreachableRecord,
+    EndRecord, LifecycleRecord, MapChangeRecord, Record, RoundRecord, RunHeader, SnapshotRecord,
+    TaskRecord, UnreachableRecord,
 };
 use super::tally::Tally;
 use crate::msg::{LifecycleEvent, Role};
@@ -84,6 +84,10 @@ pub struct AppliedState {
     /// current goal from them and the summary its task times. This is the one part that
     /// grows with the run, by one record (about 10 bytes encoded) per task done.
     pub tasks: Vec<TaskRecord>,
+    /// The map changes logged (`[sensing]`), in log order: the coordinator rebuilds the map
+    /// it decides on from them. Grows by one record per accepted change of the world, which
+    /// is bounded by the world's changes, not the run's length.
+    pub map_changes: Vec<MapChangeRecord>,
 }
 
 impl AppliedState {
@@ -99,6 +103,7 @@ impl AppliedState {
             end: None,
             processes: Vec::new(),
             tasks: Vec::new(),
+            map_changes: Vec::new(),
         }
     }
 
@@ -114,6 +119,7 @@ impl AppliedState {
             Record::Lifecycle(l) => self.fold_lifecycle(l),
             Record::Unreachable(u) => self.unreachable.push(*u),
             Record::Task(t) => self.tasks.push(*t),
+            Record::MapChange(m) => self.map_changes.push(m.clone()),
             Record::Replan(_) => {}
             Record::Header(_) | Record::Raft(_) | Record::RaftState(_) | Record::Snapshot(_) => {
                 return

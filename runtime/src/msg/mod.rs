@@ -29,10 +29,13 @@
 //! | [`Progress`] | 32 | 8 | 0 round u64, 8 agents u32, 12 at_goal u32, 16 conflicts u32, 20 replans u32, 24 done u8, 25 reserved [u8; 7] |
 //! | [`Heartbeat`] | 32 | 8 | 0 t_ns u64, 8 seq u64, 16 pid u32, 20 index u32, 24 role u8, 25 reserved [u8; 7] |
 //! | [`View`] | 288 | 8 | 0 sim_time_ns u64, 8 period u64, 16 agent u32, 20 x0 u32, 24 y0 u32, 28 size u32, 32 seen [u32; 32], 160 blocked [u32; 32] |
+//! | [`Sighting`] | 152 | 8 | 0 round u64, 8 agent u32, 12 count u32, 16 closed u32, 20 reserved u32, 24 cells [u32; 32] |
+//! | [`WorldHeader`] | 48 | 8 | 0 round u64, 8 closed u32, 12 reserved u32, 16 to [u32; 8] |
 //! | [`MapHeader`] | 32 | 8 | 0 round u64, 8 agent u32, 12 width u32, 16 height u32, 20 iterations u32, 24 target u32, 28 activation u8, 29 reserved [u8; 3] |
 //!
 //! The neural-map snapshot is a slice service of `f32` (one activation per cell, row-major) whose
-//! user header is a [`MapHeader`].
+//! user header is a [`MapHeader`]; the coordinator's map of a changing world is a slice service
+//! of `u32` cells whose user header is a [`WorldHeader`].
 //!
 //! | module | payloads |
 //! |---|---|
@@ -42,6 +45,7 @@
 //! | `map` | the neural-map snapshot: [`MapHeader`], [`ActivationKind`] |
 //! | `health` | a process's proof of life: [`Heartbeat`] |
 //! | `sensing` | what a robot's range sensor sees: [`View`] |
+//! | `world` | the shared picture of a changing world: [`Sighting`], [`WorldHeader`] |
 //! | [`wire`] | a payload as its bytes, checked on arrival, for links that leave the host ([`Wire`]) |
 
 mod health;
@@ -51,6 +55,7 @@ mod motion;
 mod round;
 mod sensing;
 pub mod wire;
+mod world;
 
 pub use health::Heartbeat;
 pub use lifecycle::{
@@ -61,6 +66,7 @@ pub use motion::{Estimate, Odometry, Pose, Truth, WheelCommand};
 pub use round::{Candidate, CandidateFlags, Commit, ConflictKind, Decision, Progress, Verdict};
 pub use sensing::{View, VIEW_EDGE};
 pub use wire::{Wire, WireError};
+pub use world::{Sighting, WorldHeader, SIGHTING_CELLS, WORLD_TO_WORDS};
 
 /// The largest swarm one [`Commit`] or [`Truth`] sample can describe.
 pub const MAX_AGENTS: usize = 256;

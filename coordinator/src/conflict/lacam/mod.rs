@@ -122,6 +122,17 @@ impl Lacam {
         }
     }
 
+    /// The map changed: `grid` has the shape these rounds were made for. The plan being
+    /// followed may cross a cell that closed (or miss a shorter way that opened): it is
+    /// dropped, and the robots settle and are planned for again on the new map.
+    pub fn set_map(&mut self, grid: &Grid) {
+        self.graph = Graph::new(grid, self.options);
+        self.pibt.set_map(grid);
+        if self.schedule.take().is_some() {
+            self.phase = Phase::Settling;
+        }
+    }
+
     /// Sets the search budget.
     pub fn set_budget(&mut self, budget: Budget) {
         self.budget = budget;

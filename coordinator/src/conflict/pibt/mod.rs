@@ -223,6 +223,17 @@ impl Pibt {
             .set_goal(grid, self.options.corner_cutting, agent, goal);
     }
 
+    /// The map changed (a door closed, a pallet was moved away): `grid` has the shape these
+    /// rounds were made for and its blocked cells are copied, and every agent's distance
+    /// table is computed again for its current goal. The agents' dynamic priorities stay.
+    pub fn set_map(&mut self, grid: &Grid) {
+        self.blocked.copy_from_slice(grid.blocked());
+        let goals: Vec<Cell> = (0..self.state.len())
+            .filter_map(|i| self.distances.goal(i))
+            .collect();
+        self.distances = Distances::new(grid, &goals, self.options.corner_cutting);
+    }
+
     /// Agent `agent`'s dynamic priority: rounds since it was last on its goal.
     pub fn waited(&self, agent: usize) -> u32 {
         self.waited.get(agent).copied().unwrap_or(0)

@@ -12,12 +12,14 @@
 //! | `open_round` | [`OpenRound`]: the open round's candidates, its deadline, its record |
 //! | `roster` | [`Roster`]: per agent live, down or lost, and its restarts |
 //! | `dropped` | [`Dropped`]: the counts of dropped candidates, kept across restarts |
+//! | `world` | [`World`]: the agents' sightings waiting for their round, the restarted agents waiting for the map |
 
 mod dropped;
 mod end_watch;
 mod open_round;
 mod roster;
 mod supervisor;
+mod world;
 
 use std::path::Path;
 
@@ -40,6 +42,7 @@ use dropped::Dropped;
 use end_watch::EndWatch;
 use open_round::OpenRound;
 use roster::Roster;
+use world::World;
 
 /// Everything the coordinator knows of the run.
 pub(super) struct State {
@@ -60,6 +63,8 @@ pub(super) struct State {
     /// A restarted single coordinator before its own `Restarted`: the agents' events heard
     /// until then are not logged, since the roster that follows it says what they were.
     roster_due: bool,
+    /// The shared picture's traffic (`[sensing]`).
+    world: World,
 }
 
 /// The header a log of `s` must start with.
@@ -152,6 +157,7 @@ impl State {
             events: Vec::new(),
             heard: Overheard::new(n),
             roster_due: false,
+            world: World::default(),
         }
     }
 
@@ -204,6 +210,7 @@ impl State {
             }
             Record::Unreachable(u) => self.watch.logged_unreachable(u.agent),
             Record::Task(t) => self.arbiter.replay_task(t),
+            Record::MapChange(m) => self.arbiter.apply_map_change(m),
             Record::Header(_)
             | Record::Replan(_)
             | Record::Raft(_)
@@ -232,6 +239,9 @@ impl State {
         for t in &s.tasks {
             self.replay(&Record::Task(*t));
         }
+        for m in &s.map_changes {
+            self.replay(&Record::MapChange(m.clone()));
+        }
     }
 
     /// Logs, once per agent and before the round's record, a goal its agent reports
@@ -258,6 +268,9 @@ impl State {
     pub(super) fn collect(&mut self, p: &Ports) -> Result<(), CoordinatorError> {
         let mut resend = false;
         p.candidates.drain_pending(|&c| {
+            if c.flags & CandidateFlags::RESTARTED != 0 {
+                self.world.asked_by(c.agent as usize, self.arbiter.agents());
+            }
             if let Err(class) = self.arbiter.classify(&c, self.round) {
                 // An agent behind (a restarted one, or one the dead coordinator never
                 // answered): the last commit brings it up to date.
@@ -273,6 +286,9 @@ impl State {
         if resend {
             self.resend_last_commit(p)?;
         }
+        // After the candidates: each agent's sightings go out before its candidate.
+        self.world.collect(p, self.arbiter.agents())?;
+        self.world.answer(p, &self.arbiter, self.round)?;
         Ok(())
     }
 
@@ -309,6 +325,14 @@ impl State {
         tick: &mut dyn FnMut(),
     ) -> Result<(), CoordinatorError> {
         let round = self.round + 1;
+        // What the agents saw, one agent at a time: the second to see a door close finds it
+        // closed already.
+        for (agent, seen) in self.world.take_due(round) {
+            if let Some(m) = self.arbiter.map_change(round, agent, seen) {
+                self.log.append(&Record::MapChange(m.clone()))?;
+                self.arbiter.apply_map_change(&m);
+            }
+        }
         self.confirm_unreachable(round)?;
         let (decisions, replans) = self
             .arbiter

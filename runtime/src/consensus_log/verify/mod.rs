@@ -55,6 +55,8 @@ pub struct KindCounts {
     pub unreachable: u64,
     /// Task records (a lifelong run's assignments).
     pub task: u64,
+    /// Map-change records (cells the agents saw close or open).
+    pub map_change: u64,
 }
 
 impl KindCounts {
@@ -67,6 +69,7 @@ impl KindCounts {
             + self.end
             + self.unreachable
             + self.task
+            + self.map_change
     }
 }
 
@@ -173,6 +176,10 @@ impl VerifyReport {
         if c.task > 0 {
             s.pop();
             let _ = writeln!(s, ", {} task", c.task);
+        }
+        if c.map_change > 0 {
+            s.pop();
+            let _ = writeln!(s, ", {} map-change", c.map_change);
         }
         if let Some((index, term)) = self.raft.and_then(|r| r.snapshot) {
             let _ = writeln!(

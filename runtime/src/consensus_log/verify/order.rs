@@ -23,6 +23,8 @@ const MAX_LISTED: usize = 20;
 #[derive(Default)]
 pub(super) struct OrderCheck {
     agents: Option<usize>,
+    /// Cells of the run's grid (from the header).
+    cells: Option<u64>,
     listed: usize,
     /// Problems found beyond [`MAX_LISTED`].
     pub unlisted: usize,
@@ -46,6 +48,30 @@ impl OrderCheck {
                 self.problem(report, pos, format!("agent {agent} of a run of {n} agents"));
             }
         }
+    }
+
+    /// A map change's cells must be on the grid, each list ascending, no cell in both.
+    fn map_cells(
+        &mut self,
+        report: &mut VerifyReport,
+        pos: RecordPos,
+        closed: &[u32],
+        opened: &[u32],
+    ) {
+        let on_grid = |c: &u32| self.cells.is_none_or(|n| u64::from(*c) < n);
+        let ascending = |v: &[u32]| v.windows(2).all(|w| w[0] < w[1]);
+        let what = if !closed.iter().chain(opened).all(on_grid) {
+            "a map change with a cell off the grid"
+        } else if !ascending(closed) || !ascending(opened) {
+            "a map change whose cells are not ascending"
+        } else if closed.iter().any(|c| opened.binary_search(c).is_ok()) {
+            "a map change that closes and opens the same cell"
+        } else if closed.is_empty() && opened.is_empty() {
+            "a map change without a cell"
+        } else {
+            return;
+        };
+        self.problem(report, pos, what.into());
     }
 
     /// A record other than a round must belong to `expected`, the round it is written at.
@@ -87,6 +113,7 @@ impl OrderCheck {
                     self.problem(report, pos, "a second header record".into());
                 } else {
                     self.agents = Some(h.agents.len());
+                    self.cells = Some(u64::from(h.width) * u64::from(h.height));
                 }
             }
             Record::Round(r) => {
@@ -130,6 +157,12 @@ impl OrderCheck {
             Record::Task(t) => {
                 report.counts.task += 1;
                 self.agent(report, pos, t.agent);
+                self.at_round(report, pos, record, last + 1);
+            }
+            Record::MapChange(m) => {
+                report.counts.map_change += 1;
+                self.agent(report, pos, m.agent);
+                self.map_cells(report, pos, &m.closed, &m.opened);
                 self.at_round(report, pos, record, last + 1);
             }
             Record::End(e) => {

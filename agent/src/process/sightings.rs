@@ -1,0 +1,102 @@
+//! What the agent tells the coordinator of the world (`[sensing]`): the cells its robot saw
+//! differ from the swarm's picture, as far as this agent knows that picture.
+//!
+//! The picture starts as the scenario's map, whatever the agent itself knows of it (an
+//! unmapped agent, `known_map = false`, still reports only changes, not every wall it first
+//! sees), and follows what the robot saw and what the coordinator sent. A cell is reported
+//! when it is seen in another state than the picture's, once, with the candidate that follows
+//! (stamped with its round, so that a lockstep round is decided on exactly the sightings sent
+//! before it). The coordinator decides what it accepts; a sighting it never received (it died
+//! first) is not sent again until the cell changes once more.
+
+use hnav_runtime::grid::Grid;
+use hnav_runtime::msg::{Sighting, View};
+use hnav_runtime::transport::{Sender, TransportError};
+
+/// The agent's copy of the swarm's picture and the changes not reported yet.
+pub(super) struct Sightings {
+    /// Per cell, blocked in the picture.
+    picture: Vec<bool>,
+    width: u32,
+    /// (cell, closed) seen since the last candidate, oldest first.
+    unsent: Vec<(u32, bool)>,
+}
+
+impl Sightings {
+    /// The picture of the scenario's `map`.
+    pub(super) fn new(map: &Grid) -> Self {
+        Sightings {
+            picture: map.blocked().to_vec(),
+            width: map.width(),
+            unsent: Vec::new(),
+        }
+    }
+
+    /// Notes every cell of `view` seen in another state than the picture's.
+    pub(super) fn fold(&mut self, view: &View) {
+        for (x, y, blocked) in view.cells() {
+            let i = (y * self.width + x) as usize;
+            if let Some(known) = self.picture.get_mut(i).filter(|k| **k != blocked) {
+                *known = blocked;
+                self.unsent.push((i as u32, blocked));
+            }
+        }
+    }
+
+    /// Takes the coordinator's word on `cell` (the map it sent a restarted agent).
+    pub(super) fn learn(&mut self, cell: u32, blocked: bool) {
+        if let Some(known) = self.picture.get_mut(cell as usize) {
+            *known = blocked;
+        }
+    }
+
+    /// Sends what was seen since the last call, as agent `agent`'s sightings before its
+    /// candidate for `round`, silently: the candidate that follows wakes the coordinator.
+    pub(super) fn send(
+        &mut self,
+        tx: &Sender<Sighting>,
+        round: u64,
+        agent: u32,
+    ) -> Result<(), TransportError> {
+        for chunk in self.unsent.chunks(hnav_runtime::msg::SIGHTING_CELLS) {
+            let mut s = Sighting::new(round, agent);
+            for &(cell, closed) in chunk {
+                s.push(cell, closed);
+            }
+            tx.send_silently(s)?;
+        }
+        self.unsent.clear();
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_change_is_reported_once_and_a_known_wall_never() {
+        let mut map = Grid::new(4, 4).unwrap();
+        map.set_blocked(hnav_runtime::grid::Cell::new(0, 0), true);
+        let mut s = Sightings::new(&map);
+        let mut v = View::default();
+        v.reset(0, 0, 4);
+        v.mark(0, 0, true); // a wall of the map: no news
+        v.mark(1, 0, true); // closed
+        v.mark(2, 0, false);
+        s.fold(&v);
+        s.fold(&v);
+        assert_eq!(s.unsent, [(1, true)]);
+        let mut v = View::default();
+        v.reset(0, 0, 4);
+        v.mark(1, 0, false); // opened again
+        s.fold(&v);
+        assert_eq!(s.unsent, [(1, true), (1, false)]);
+        s.learn(5, true);
+        let mut v = View::default();
+        v.reset(0, 0, 4);
+        v.mark(1, 1, true); // cell 5: the coordinator said so already
+        s.fold(&v);
+        assert_eq!(s.unsent.len(), 2);
+    }
+}
