@@ -217,7 +217,7 @@ pub fn layouts() -> Layouts {
         layout!(WorldHeader {
             round: u64,
             closed: u32,
-            reserved: u32,
+            opened: u32,
             to: [u32; 8]
         }),
     ];

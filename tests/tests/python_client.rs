@@ -1,7 +1,8 @@
 //! The Python client (`clients/python/`) against the Rust side: its `ctypes` mirrors match the
 //! layout table of `hnav layout --json` field by field, and its example joins a live run by
-//! its id and prints commits, ground truth and an agent's neural map; given a run id that no
-//! run has, it leaves nothing of it in `/dev/shm` or iceoryx2's root (issue 34).
+//! its id and prints commits, ground truth and an agent's neural map; its second example reads
+//! a changing world (a robot's view, the agents' sightings, the coordinator's map); given a run
+//! id that no run has, it leaves nothing of it in `/dev/shm` or iceoryx2's root (issue 34).
 //!
 //! The Python is the virtual environment's with the pinned `iceoryx2` package: `$HNAV_PYTHON`,
 //! else `target/py-venv/bin/python` (made by the command in docs/how-to/python-client.md). Without either the tests
@@ -147,6 +148,72 @@ fn the_python_example_watches_a_live_run() {
     assert!(rows.iter().all(|r| r.chars().count() == 12 + 4), "{text}");
     // The map's pillars are blocked cells: '@' where demo.toml has them ([2,2]).
     assert_eq!(rows[2].chars().nth(3 + 2), Some('@'), "{text}");
+}
+
+/// `scenarios/door.toml` slowed for a client that joins late: the door closes at round 500
+/// (about 5 s into a realtime run), seen from 6 cells away; agent 0 is killed at round 700
+/// and, restarted, is sent the coordinator's map.
+fn late_door(dir: &std::path::Path) -> PathBuf {
+    let text = std::fs::read_to_string(repo_root().join("scenarios/door.toml")).unwrap();
+    let text = text
+        .replace("at_round = 150", "at_round = 500")
+        .replace("range = 3", "range = 6");
+    assert!(text.contains("at_round = 500") && text.contains("range = 6"));
+    let path = dir.join("late-door.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn the_python_world_example_reads_views_sightings_and_the_coordinators_map() {
+    let Some(python) = python() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let mut run = TestRun::new("pyworld");
+    let scenario = late_door(tmp.path());
+    let args = ["--mode", "realtime", "--kill", "agent:0@round:700"];
+    let out = tmp.path().join("out");
+    let mut swarm = SwarmRun::start(&mut run, &scenario, &out, &tmp.path().join("runs"), &args)
+        .expect("hnav run starts");
+    let example = repo_root().join("clients/python/examples/watch_world.py");
+    let args = [example.display().to_string(), run.run.as_str().to_string()];
+    let args = [
+        &args[..],
+        &[
+            "--width".into(),
+            "10".into(),
+            "--timeout".into(),
+            "60".into(),
+        ],
+    ];
+    let mut watcher = run
+        .spawn_exact(&python.display().to_string(), &args.concat())
+        .expect("the example starts");
+    let deadline = Instant::now() + WATCH_TIMEOUT;
+    let mut lines = Vec::new();
+    while let Ok(line) = watcher.next_line(deadline.saturating_duration_since(Instant::now())) {
+        lines.push(line);
+    }
+    let status = watcher
+        .wait_exit(deadline.saturating_duration_since(Instant::now()))
+        .expect("the example exits");
+    swarm.peer.signal(Signal::SIGTERM).unwrap();
+    swarm.finish(RUN_TIMEOUT).expect("hnav run stops");
+    let text = lines.join("\n");
+    assert!(status.success(), "the example failed ({status}):\n{text}");
+    let has = |start: &str, part: &str| {
+        lines
+            .iter()
+            .any(|l| l.starts_with(start) && l.contains(part))
+    };
+    assert!(has("view agent 0 period ", " cells seen, "), "{text}");
+    assert!(
+        has("sighting round ", "a0: closed [5,0]; opened -"),
+        "{text}"
+    );
+    assert!(
+        has("world round ", "for [0]: closed [5,0]; opened -"),
+        "{text}"
+    );
 }
 
 #[test]

@@ -8,7 +8,7 @@ use std::path::Path;
 use hnav_runtime::consensus_log::MapChangeRecord;
 use hnav_runtime::consensus_log::{read_decided, Record};
 use hnav_runtime::msg::{Verdict, NO_CELL};
-use hnav_tests::swarm::{lockstep_all_home, repo_root, verify_log, SwarmRun};
+use hnav_tests::swarm::{lockstep_all_home, repo_root, verify_log, workspace_bin, SwarmRun};
 use hnav_tests::TestRun;
 
 /// The door (5, 0) of `scenarios/door.toml` closes at this round.
@@ -127,7 +127,30 @@ fn an_agent_that_restarts_gets_the_map_as_it_stands_not_the_one_at_start() {
     assert_eq!(s["end"], "all-at-goal", "{s}");
     assert_eq!(s["restarts"]["agent-0"], 1, "{s}");
     let (ok, report) = verify_log(&dir.join("log"));
-    assert!(ok, "{report}");
+    assert!(ok && report.contains(", 1 map-change"), "{report}");
+    // `hnav log show` prints the change; a replay decides every round, on the changed map
+    // and with the restart, as logged.
+    let hnav = |args: &[&str]| {
+        let out = std::process::Command::new(workspace_bin("hnav"))
+            .args(args)
+            .env("HNAV_RUNS_DIR", &registry)
+            .output()
+            .unwrap();
+        let said = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            out.status.success(),
+            "{args:?}: {said}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        said
+    };
+    let d = dir.to_str().unwrap();
+    let shown = hnav(&["log", "show", d, "--kind", "map-change"]);
+    assert_eq!(shown.trim(), "map-change round 187  a0 saw  closed [5, 0]");
+    let replay_run = TestRun::new("door-replay");
+    let said = hnav(&["log", "replay", d, "--run", replay_run.run.as_str()]);
+    assert!(said.contains("identical"), "{said}");
+    drop(replay_run);
     let agent_log = std::fs::read_to_string(dir.join("logs/agent-0.log")).unwrap();
     let got = agent_log
         .lines()

@@ -158,8 +158,11 @@ def newest_map(topic, current):
     for s in topic.drain():
         header = msg.MapHeader.from_buffer_copy(bytes(s.user_header().contents))
         values = s.payload()
-        # Copied out: the sample's chunk goes back to the agent when `s` is dropped.
-        current = (header, list((ctypes.c_float * values.len()).from_address(values.as_ptr())))
+        # One value per cell: width x height, not `values.len()`, which the binding gives in
+        # bytes (four per value). Copied out: the chunk goes back to the agent when `s` is
+        # dropped.
+        n = header.width * header.height
+        current = (header, list((ctypes.c_float * n).from_address(values.as_ptr())))
     return current
 
 

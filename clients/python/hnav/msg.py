@@ -278,6 +278,47 @@ class View(_Payload):
                     yield (self.x0 + c, self.y0 + r, bool(self.blocked[r] >> c & 1))
 
 
+# The most cells one Sighting carries (msg::SIGHTING_CELLS).
+SIGHTING_CELLS = 32
+
+
+class Sighting(_Payload):
+    """Cells robot `agent` saw change from the swarm's picture, sent before its candidate for
+    `round`: `cells[k]` (k < count) closed if bit k of `closed` is set, else it opened."""
+
+    _fields_ = [
+        ("round", ctypes.c_uint64),
+        ("agent", ctypes.c_uint32),
+        ("count", ctypes.c_uint32),
+        ("closed", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+        ("cells", ctypes.c_uint32 * SIGHTING_CELLS),
+    ]
+
+    def changes(self):
+        """Every cell, as (cell index, closed)."""
+        for k in range(min(self.count, SIGHTING_CELLS)):
+            yield (self.cells[k], bool(self.closed >> k & 1))
+
+
+class WorldHeader(_Payload):
+    """The user header of the coordinator's map (`world`, a slice of u32 cell indices): the
+    cells that differ from the scenario's map after `round`, the `closed` ones first, then the
+    `opened` ones (read closed + opened cells: the binding's slice length is in bytes). Bit i % 32 of `to[i // 32]` names agent i, a restarted agent it
+    answers."""
+
+    _fields_ = [
+        ("round", ctypes.c_uint64),
+        ("closed", ctypes.c_uint32),
+        ("opened", ctypes.c_uint32),
+        ("to", ctypes.c_uint32 * 8),
+    ]
+
+    def addressees(self):
+        """The agents it answers."""
+        return [i for i in range(32 * len(self.to)) if self.to[i // 32] >> (i % 32) & 1]
+
+
 # Every payload mirror, for the layout test.
 PAYLOADS = [
     Candidate,
@@ -293,4 +334,6 @@ PAYLOADS = [
     Heartbeat,
     MapHeader,
     View,
+    Sighting,
+    WorldHeader,
 ]

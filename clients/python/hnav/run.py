@@ -41,6 +41,8 @@ TOPICS = {
     "lifecycle": (msg.Lifecycle, None),
     "heartbeat": (msg.Heartbeat, None),
     "estimate": (msg.Estimate, None),
+    "sightings": (msg.Sighting, None),
+    "world": (iox2.Slice[ctypes.c_uint32], msg.WorldHeader),
 }
 
 _RUN_ID = re.compile(r"^[A-Za-z0-9_-]{1,48}$")

@@ -250,4 +250,21 @@ mod tests {
         assert_eq!(s.records, 7);
         assert_eq!(AppliedState::decode(&s.encode()).unwrap(), s);
     }
+
+    #[test]
+    fn the_state_keeps_every_map_change_in_log_order() {
+        let mut s = AppliedState::new(&header());
+        let change = |round, closed: Vec<u32>, opened: Vec<u32>| MapChangeRecord {
+            round,
+            agent: 1,
+            closed,
+            opened,
+        };
+        let (shut, reopened) = (change(3, vec![5], vec![]), change(8, vec![], vec![5]));
+        s.fold(&Record::MapChange(shut.clone()));
+        s.fold(&Record::MapChange(reopened.clone()));
+        assert_eq!(s.map_changes, [shut, reopened]);
+        assert_eq!(s.records, 2);
+        assert_eq!(AppliedState::decode(&s.encode()).unwrap(), s);
+    }
 }

@@ -89,10 +89,11 @@ pub const WORLD_TO_WORDS: usize = crate::msg::MAX_AGENTS / 32;
 pub struct WorldHeader {
     /// The last round decided on this map.
     pub round: u64,
-    /// How many of the slice's cells closed; the rest opened.
+    /// How many of the slice's cells closed (they come first).
     pub closed: u32,
-    /// Zero.
-    pub reserved: u32,
+    /// How many opened (they follow): with `closed`, the slice's length, said again for
+    /// readers whose binding reports a slice's length in bytes (iceoryx2's Python does).
+    pub opened: u32,
     /// The agents it answers, one bit each.
     pub to: [u32; WORLD_TO_WORDS],
 }
@@ -134,7 +135,7 @@ mod tests {
         assert_eq!(align_of::<WorldHeader>(), 8);
         assert_eq!(offset_of!(WorldHeader, round), 0);
         assert_eq!(offset_of!(WorldHeader, closed), 8);
-        assert_eq!(offset_of!(WorldHeader, reserved), 12);
+        assert_eq!(offset_of!(WorldHeader, opened), 12);
         assert_eq!(offset_of!(WorldHeader, to), 16);
     }
 

@@ -87,6 +87,7 @@ impl World {
         *h = WorldHeader {
             round,
             closed: closed as u32,
+            opened: (self.cells.len() - closed) as u32,
             ..WorldHeader::default()
         };
         for &a in &self.asking {

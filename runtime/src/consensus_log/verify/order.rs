@@ -184,3 +184,55 @@ impl OrderCheck {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::consensus_log::record::{MapChangeRecord, Record, RunHeader};
+    use crate::consensus_log::LogWriter;
+    use crate::consensus_log::{verify, FORMAT_VERSION};
+    use crate::scenario::FsyncPolicy;
+
+    /// The problems `verify` finds in a 4 x 4 run's log holding `change` before round 1.
+    fn problems(change: MapChangeRecord) -> Vec<String> {
+        let dir = tempfile::tempdir().unwrap();
+        let (mut log, _) = LogWriter::open(dir.path(), FsyncPolicy::EveryRecord).unwrap();
+        log.append(&Record::Header(RunHeader::tiny(FORMAT_VERSION)))
+            .unwrap();
+        log.append(&Record::MapChange(change)).unwrap();
+        drop(log);
+        verify(dir.path()).problems
+    }
+
+    #[test]
+    fn a_map_change_must_name_cells_of_the_grid_once_each_in_order() {
+        let change = |closed: Vec<u32>, opened: Vec<u32>| MapChangeRecord {
+            round: 1,
+            agent: 0,
+            closed,
+            opened,
+        };
+        // The tiny run has no agents: every map change names an agent it does not have.
+        let agent = "agent 0 of a run of 0 agents";
+        let with = |p: Vec<String>, what: &str| p.iter().any(|l| l.ends_with(what));
+        let good = problems(change(vec![1, 5], vec![7]));
+        assert!(good.len() == 1 && with(good.clone(), agent), "{good:?}");
+        for (bad, what) in [
+            (
+                change(vec![16], vec![]),
+                "a map change with a cell off the grid",
+            ),
+            (
+                change(vec![5, 1], vec![]),
+                "a map change whose cells are not ascending",
+            ),
+            (
+                change(vec![5], vec![5]),
+                "a map change that closes and opens the same cell",
+            ),
+            (change(vec![], vec![]), "a map change without a cell"),
+        ] {
+            let p = problems(bad);
+            assert!(with(p.clone(), what), "{what}: {p:?}");
+        }
+    }
+}
