@@ -8,7 +8,7 @@
 //! else `target/py-venv/bin/python` (made by the command in docs/how-to/python-client.md). Without either the tests
 //! skip, saying so, unless `HNAV_REQUIRE_PYTHON` is set (CI sets it): then they fail.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -51,6 +51,28 @@ fn python() -> Option<PathBuf> {
     None
 }
 
+/// Runs the Python example `args` against `swarm`'s run until it exits, then stops the run
+/// (the rest of it is not the test's business, and takes minutes on a loaded machine); the
+/// lines it printed, once it exited 0.
+fn watch(run: &mut TestRun, python: &Path, args: &[String], mut swarm: SwarmRun) -> Vec<String> {
+    let mut watcher = run
+        .spawn_exact(&python.display().to_string(), args)
+        .expect("the example starts");
+    let deadline = Instant::now() + WATCH_TIMEOUT;
+    let mut lines = Vec::new();
+    while let Ok(line) = watcher.next_line(deadline.saturating_duration_since(Instant::now())) {
+        lines.push(line);
+    }
+    let status = watcher
+        .wait_exit(deadline.saturating_duration_since(Instant::now()))
+        .expect("the example exits");
+    swarm.peer.signal(Signal::SIGTERM).unwrap();
+    swarm.finish(RUN_TIMEOUT).expect("hnav run stops");
+    let text = lines.join("\n");
+    assert!(status.success(), "the example failed ({status}):\n{text}");
+    lines
+}
+
 #[test]
 fn ctypes_mirrors_match_the_rust_layout_table() {
     let Some(python) = python() else { return };
@@ -83,7 +105,7 @@ fn the_python_example_watches_a_live_run() {
     let Some(python) = python() else { return };
     let tmp = tempfile::tempdir().unwrap();
     let mut run = TestRun::new("pywatch");
-    let mut swarm = SwarmRun::start(
+    let swarm = SwarmRun::start(
         &mut run,
         &repo_root().join("scenarios/demo.toml"),
         &tmp.path().join("out"),
@@ -100,22 +122,8 @@ fn the_python_example_watches_a_live_run() {
         "--commits".into(),
         COMMITS.to_string(),
     ];
-    let mut watcher = run
-        .spawn_exact(&python.display().to_string(), &args)
-        .expect("the example starts");
-    let deadline = Instant::now() + WATCH_TIMEOUT;
-    let mut lines = Vec::new();
-    while let Ok(line) = watcher.next_line(deadline.saturating_duration_since(Instant::now())) {
-        lines.push(line);
-    }
-    let status = watcher
-        .wait_exit(deadline.saturating_duration_since(Instant::now()))
-        .expect("the example exits");
-    // The rest of the run is not the test's business (and takes minutes on a loaded machine).
-    swarm.peer.signal(Signal::SIGTERM).unwrap();
-    swarm.finish(RUN_TIMEOUT).expect("hnav run stops");
+    let lines = watch(&mut run, &python, &args, swarm);
     let text = lines.join("\n");
-    assert!(status.success(), "the example failed ({status}):\n{text}");
 
     let commits: Vec<&String> = lines.iter().filter(|l| l.starts_with("commit ")).collect();
     assert!(
@@ -172,7 +180,7 @@ fn the_python_world_example_reads_views_sightings_and_the_coordinators_map() {
     let scenario = late_door(tmp.path());
     let args = ["--mode", "realtime", "--kill", "agent:0@round:700"];
     let out = tmp.path().join("out");
-    let mut swarm = SwarmRun::start(&mut run, &scenario, &out, &tmp.path().join("runs"), &args)
+    let swarm = SwarmRun::start(&mut run, &scenario, &out, &tmp.path().join("runs"), &args)
         .expect("hnav run starts");
     let example = repo_root().join("clients/python/examples/watch_world.py");
     let args = [example.display().to_string(), run.run.as_str().to_string()];
@@ -185,21 +193,8 @@ fn the_python_world_example_reads_views_sightings_and_the_coordinators_map() {
             "60".into(),
         ],
     ];
-    let mut watcher = run
-        .spawn_exact(&python.display().to_string(), &args.concat())
-        .expect("the example starts");
-    let deadline = Instant::now() + WATCH_TIMEOUT;
-    let mut lines = Vec::new();
-    while let Ok(line) = watcher.next_line(deadline.saturating_duration_since(Instant::now())) {
-        lines.push(line);
-    }
-    let status = watcher
-        .wait_exit(deadline.saturating_duration_since(Instant::now()))
-        .expect("the example exits");
-    swarm.peer.signal(Signal::SIGTERM).unwrap();
-    swarm.finish(RUN_TIMEOUT).expect("hnav run stops");
+    let lines = watch(&mut run, &python, &args.concat(), swarm);
     let text = lines.join("\n");
-    assert!(status.success(), "the example failed ({status}):\n{text}");
     let has = |start: &str, part: &str| {
         lines
             .iter()
