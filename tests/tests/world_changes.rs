@@ -171,3 +171,37 @@ fn an_agent_that_restarts_gets_the_map_as_it_stands_not_the_one_at_start() {
     );
     assert!(repairs[1] >= 250 && repairs[1] <= 251, "{repairs:?}");
 }
+
+#[test]
+fn the_all_knowing_baseline_tells_every_agent_the_door_when_it_closes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo_root().join("scenarios/door.toml")).unwrap();
+    let text = text.replace("range = 3\n", "range = 3\nall_knowing = true\n");
+    assert!(text.contains("all_knowing = true"));
+    let scenario = tmp.path().join("door-all-knowing.toml");
+    std::fs::write(&scenario, text).unwrap();
+    let dir = tmp.path().join("run");
+    let registry = tmp.path().join("runs");
+    lockstep_all_home("door-all", &scenario, &dir, &registry, 2);
+    // The door closes at 1.5 s of sim time, the end of period 149: both agents repair then,
+    // wherever their robots are (agent 1's is in the bottom corridor, out of sight).
+    for agent in 0..2 {
+        let log = std::fs::read_to_string(dir.join(format!("logs/agent-{agent}.log"))).unwrap();
+        assert_eq!(
+            first_repair(&log),
+            Some(CLOSED_AT - 1),
+            "agent {agent}:\n{log}"
+        );
+    }
+    // Both report it; the coordinator logs agent 0's and finds agent 1's no news.
+    let changes: Vec<(u64, u32)> = read_decided(dir.join("log"))
+        .unwrap()
+        .records
+        .into_iter()
+        .filter_map(|r| match r {
+            Record::MapChange(m) => Some((m.round, m.agent)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(changes, [(CLOSED_AT, 0)]);
+}

@@ -22,9 +22,11 @@
 //! | `ports` | the topics the agent opens |
 //! | `state` | the agent's state and its handler for each input |
 //! | `sightings` | what the robot saw change, for the coordinator's map (`[sensing]`) |
+//! | `oracle` | the all-knowing baseline: the scenario's closes and opens told when they happen |
 //! | [`checkpoint`] | the restart checkpoint in the run directory |
 
 pub mod checkpoint;
+mod oracle;
 mod ports;
 mod sightings;
 mod state;

@@ -35,11 +35,20 @@ impl Sightings {
     /// Notes every cell of `view` seen in another state than the picture's.
     pub(super) fn fold(&mut self, view: &View) {
         for (x, y, blocked) in view.cells() {
-            let i = (y * self.width + x) as usize;
-            if let Some(known) = self.picture.get_mut(i).filter(|k| **k != blocked) {
-                *known = blocked;
-                self.unsent.push((i as u32, blocked));
-            }
+            self.see(y * self.width + x, blocked);
+        }
+    }
+
+    /// Notes `cell` if it is `blocked` otherwise than in the picture (seen, or told by the
+    /// all-knowing baseline, which the agent reports like a sighting).
+    pub(super) fn see(&mut self, cell: u32, blocked: bool) {
+        if let Some(known) = self
+            .picture
+            .get_mut(cell as usize)
+            .filter(|k| **k != blocked)
+        {
+            *known = blocked;
+            self.unsent.push((cell, blocked));
         }
     }
 

@@ -14,6 +14,7 @@ use hnav_runtime::msg::{Estimate, MapHeader, Odometry, Pose, View, WheelCommand}
 use hnav_runtime::scenario::{AgentSpec, ClockMode, Planner, RepairRule, Scenario};
 
 use super::checkpoint::{Checkpoint, CheckpointFile};
+use super::oracle::Oracle;
 use super::ports::Ports;
 use super::sightings::Sightings;
 use super::{AgentError, AgentOutcome};
@@ -61,6 +62,8 @@ pub(super) struct Core {
     repair: Option<RepairRule>,
     /// What the robot saw change, for the coordinator (with `[sensing]`).
     sightings: Option<Sightings>,
+    /// The all-knowing baseline's events (`[sensing] all_knowing`).
+    oracle: Option<Oracle>,
 }
 
 impl Core {
@@ -130,6 +133,7 @@ impl Core {
             ticks,
             repair: scenario.sensing.map(|s| s.repair),
             sightings: scenario.sensing.map(|_| Sightings::new(&scenario.map.grid)),
+            oracle: Oracle::of(scenario),
         })
     }
 
@@ -247,6 +251,25 @@ impl Core {
         Ok(())
     }
 
+    /// The all-knowing baseline: the scenario's closes and opens due by `sim_time_ns`, folded
+    /// in as if seen (and reported like sightings, so the coordinator knows them at once).
+    fn tell(&mut self, sim_time_ns: u64, period: u64) -> Result<(), AgentError> {
+        let (Some(oracle), Some(rule)) = (&mut self.oracle, self.repair) else {
+            return Ok(());
+        };
+        let due = oracle.due(sim_time_ns as f64 * 1e-9);
+        if due.is_empty() {
+            return Ok(());
+        }
+        if let Some(s) = &mut self.sightings {
+            for &(c, blocked) in &due {
+                s.see(c.y * self.width + c.x, blocked);
+            }
+        }
+        self.nav.learn(due.into_iter(), rule, period)?;
+        Ok(())
+    }
+
     /// Folds in the coordinator's map as it stands, when it was sent to this agent (it
     /// restarted): the map at start is out of date by every change the swarm saw since.
     fn on_world(&mut self, p: &Ports) -> Result<(), AgentError> {
@@ -307,6 +330,7 @@ impl Core {
             return Ok(());
         }
         self.last_period = Some(o.period);
+        self.tell(o.sim_time_ns, o.period)?;
         self.ticks = (o.ticks_left, o.ticks_right);
         let mut pose = self.dr.update(o.ticks_left, o.ticks_right);
         if let Some(fix) = o.fix() {

@@ -21,7 +21,7 @@
 //!   position and heading noise); `[[events]]`, only when there are some (the tag `events`,
 //!   then each event's time and change: a code, its cells, a mover's name, speed and
 //!   repeat), after `[sensing]`, only when the section is there (the tag `sensing`, range,
-//!   known_map, the repair rule's code); so that the logs written before these sections
+//!   known_map, the repair rule's code, and the tag `all-knowing` when it is on); so that the logs written before these sections
 //!   existed keep their hash.
 //!
 //! It does **not** cover the scenario `name`, the source file name, or the map file's path
@@ -230,6 +230,9 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
             .u64(v.range.into())
             .u64(v.known_map.into())
             .u64(repair);
+        if v.all_knowing {
+            h.bytes(b"all-knowing");
+        }
     }
     if !s.events.is_empty() {
         h.bytes(b"events");

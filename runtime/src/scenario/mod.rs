@@ -124,6 +124,7 @@
 //! range = 5                            # cells seen in line of sight, in [1, 15]
 //! known_map = true                     # false: only the walls seen so far are known
 //! repair = "auto"                      # neural-map repair: "auto", "partial", "rebuild"
+//! all_knowing = false                  # true: also told every close/open as it happens
 //! ```
 //!
 //! Unknown keys are errors (a typo must not silently fall back to a default). Every semantic

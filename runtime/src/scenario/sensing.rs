@@ -6,6 +6,9 @@
 //! known_map = true     # the map at Start is known (its changes are not); false: only the
 //!                      # walls seen so far are known (seed 003's unmapped setting)
 //! repair = "auto"      # how an agent repairs its neural map: "auto", "partial", "rebuild"
+//! all_knowing = false  # true: every agent is also told each close and open of [[events]]
+//!                      # when it happens, wherever it is (the baseline experiments compare
+//!                      # sensing with)
 //! ```
 //!
 //! Without the section the robots sense nothing and plan on the scenario's map: every run
@@ -26,6 +29,7 @@ pub(super) struct RawSensing {
     pub range: Option<Spanned<i64>>,
     pub known_map: Option<bool>,
     pub repair: Option<Spanned<RepairRule>>,
+    pub all_knowing: Option<bool>,
 }
 
 /// How an agent repairs its neural map when its view differs from it (§2.10).
@@ -50,6 +54,9 @@ pub struct SensingParams {
     pub known_map: bool,
     /// How a neural map is repaired.
     pub repair: RepairRule,
+    /// Whether every agent is told each close and open of `[[events]]` when it happens (the
+    /// all-knowing baseline), besides what it sees.
+    pub all_knowing: bool,
 }
 
 impl SensingParams {
@@ -63,6 +70,7 @@ impl Default for SensingParams {
             range: 5,
             known_map: true,
             repair: RepairRule::Auto,
+            all_knowing: false,
         }
     }
 }
@@ -81,6 +89,7 @@ pub(super) fn build_sensing(
         range,
         known_map: r.known_map.unwrap_or(d.known_map),
         repair: r.repair.map_or(d.repair, |s| *s.get_ref()),
+        all_knowing: r.all_knowing.unwrap_or(d.all_knowing),
     }))
 }
 
@@ -95,13 +104,14 @@ mod tests {
         let s = parse(&format!("{BASE}[sensing]\n")).unwrap();
         assert_eq!(s.sensing, Some(SensingParams::default()));
         let s = parse(&format!(
-            "{BASE}[sensing]\nrange = 15\nknown_map = false\nrepair = \"partial\"\n"
+            "{BASE}[sensing]\nrange = 15\nknown_map = false\nrepair = \"partial\"\nall_knowing = true\n"
         ))
         .unwrap();
         let want = SensingParams {
             range: 15,
             known_map: false,
             repair: RepairRule::Partial,
+            all_knowing: true,
         };
         assert_eq!(s.sensing, Some(want));
         let e = parse(&format!("{BASE}[sensing]\nrange = 0\n")).unwrap_err();
