@@ -1,7 +1,7 @@
 //! Running a whole swarm from a benchmark: `hnav run` as a child process with its own run
 //! id, output directory and run registry, and what every such run is checked for afterwards
 //! (its summary, `hnav log verify`, nothing of it left in shared memory). Shared by the chaos
-//! campaign ([`crate::chaos`]) and the MAPF benchmark ([`crate::mapf`]).
+//! campaign ([`crate::chaos`]), the MAPF benchmark ([`crate::mapf`]) and the `dynamic` experiment.
 
 use std::path::{Path, PathBuf};
 

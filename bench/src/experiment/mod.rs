@@ -7,6 +7,7 @@
 //!
 //! | module | experiment | what |
 //! |---|---|---|
+//! | [`dynamic`] | `dynamic` | issue 35: a warehouse whose doors close and whose aisles people walk; partial correction against rebuild against an all-knowing baseline, beside §2.10 |
 //! | [`fidelity`] | `fidelity` | every number the seeds publish that HNAV computes, beside ours, with a status; writes `docs/experiments/fidelity.md` |
 //! | [`ga_fuzzy`] | `ga-fuzzy` | seed 004: the GA + fuzzy planner against A* and HNAV on the MovingAI maps and on the seed's setting with moving robots |
 //! | [`hnav_vs_astar`] | `hnav-vs-astar` | dissertation Tables 3-8/3-9: HNAV against A* on four 20x20 tasks, tanh against linear, partial against full activation; then MovingAI scenario samples |
@@ -18,6 +19,7 @@
 
 use serde::Serialize;
 
+pub mod dynamic;
 pub mod fidelity;
 pub mod ga_fuzzy;
 pub mod hnav_vs_astar;
@@ -59,6 +61,11 @@ pub const EXPERIMENTS: &[Experiment] = &[
         name: ga_fuzzy::NAME,
         about: "seed 004: GA + fuzzy vs A* and HNAV on the MovingAI maps and the seed's moving-robot setting",
         run: ga_fuzzy::run,
+    },
+    Experiment {
+        name: dynamic::NAME,
+        about: "a changing warehouse (doors, walkers): partial correction vs rebuild vs all-knowing, beside §2.10",
+        run: dynamic::run,
     },
 ];
 

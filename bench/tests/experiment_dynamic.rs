@@ -1,0 +1,59 @@
+//! `hnav-bench experiment dynamic --quick --json` through the binary: the three variants run
+//! the same world to the end, each repairs the way it is told to, and the coordinator logs
+//! the changes the agents saw.
+
+use serde_json::Value;
+
+mod common;
+use common::bench_within;
+
+#[test]
+fn the_quick_dynamic_experiment_runs_every_variant_on_the_same_world() {
+    // Three lockstep runs of six robots: about 15 s on two idle cores.
+    let limit = std::time::Duration::from_secs(240);
+    let out = bench_within(&["experiment", "dynamic", "--quick", "--json"], limit);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).expect("one JSON document");
+    let rows = v["data"].as_array().expect("rows");
+    let names: Vec<&str> = rows
+        .iter()
+        .map(|r| r["variant"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["partial", "rebuild", "all-knowing"], "{v}");
+    let optimal = rows[0]["optimal_sum"].as_f64().unwrap();
+    for r in rows {
+        let o = &r["outcome"];
+        assert_eq!(
+            r["optimal_sum"].as_f64(),
+            Some(optimal),
+            "one world for all: {r}"
+        );
+        assert!(
+            o["at_goal"].as_u64().unwrap() <= r["robots"].as_u64().unwrap(),
+            "{r}"
+        );
+        assert!(o["rounds"].as_u64().unwrap() > 0, "{r}");
+        assert!(o["length_sum"].as_f64().unwrap() >= optimal * 0.5, "{r}");
+        assert!(
+            o["map_changes"].as_u64().unwrap() > 0,
+            "a door was seen: {r}"
+        );
+    }
+    let repairs = |i: usize, kind: &str| rows[i]["outcome"]["repairs"][kind].as_u64().unwrap();
+    assert!(
+        repairs(0, "partial") > 0,
+        "the partial variant corrects partially"
+    );
+    assert_eq!(
+        repairs(1, "partial"),
+        0,
+        "the rebuild variant only rebuilds"
+    );
+    assert!(repairs(1, "rebuild") > 0);
+    let md = v["markdown"].as_str().unwrap();
+    assert!(md.contains("| 6 | all-knowing | "), "{md}");
+}
