@@ -202,8 +202,9 @@ fn report(options: Options, outcomes: &[(Shape, Variant, f64, Outcome)]) -> Repo
         "\n§2.10's claims, beside ours (the `partial` and `rebuild` rows above):\n\n\
          - A, partial correction \"significantly reduces trajectory-computation time\": ours is the \
          µs per partial against per rebuild.\n\
-         - Б, a new map with partial activation: 13 sweeps against 19 for full activation on a 10 x 10 \
-         maze, \"near-identical path quality\": ours is length / shortest, rebuild against partial.\n\
+         - Б, a new map with partial activation (our `rebuild`): 13 sweeps against 19 for full \
+         activation on a 10 x 10 maze, \"near-identical path quality\"; between A and Б ours is \
+         length / shortest, rebuild against partial.\n\
          - Fig. 2-17: 1 more sweep after a change gives a path of 29.3, 5 give 28.3 (20 x 20; partial \
          correction here runs 5)."
     );
