@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use base64::Engine as _;
 use hnav_runtime::consensus_log::MapChangeRecord;
 use hnav_runtime::consensus_log::{read_decided, Record};
 use hnav_runtime::msg::{Verdict, NO_CELL};
@@ -147,6 +148,34 @@ fn an_agent_that_restarts_gets_the_map_as_it_stands_not_the_one_at_start() {
     let d = dir.to_str().unwrap();
     let shown = hnav(&["log", "show", d, "--kind", "map-change"]);
     assert_eq!(shown.trim(), "map-change round 187  a0 saw  closed [5, 0]");
+    // The MCAP export shows the truth's change (`/map` at 1.5 s) and the coordinator's
+    // (`/map/shared` at round 187), each after the map at the start, the door's cell occupied.
+    let mcap = tmp.path().join("door.mcap");
+    hnav(&["log", "export", d, "--mcap", mcap.to_str().unwrap()]);
+    let bytes = std::fs::read(&mcap).unwrap();
+    let mut maps: Vec<(String, u64, Vec<u8>)> = Vec::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        if m.channel.topic.starts_with("/map") {
+            let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+            let data = base64::engine::general_purpose::STANDARD
+                .decode(v["data"].as_str().unwrap())
+                .unwrap();
+            maps.push((m.channel.topic.clone(), m.log_time, data));
+        }
+    }
+    let at = |topic: &str| -> Vec<(u64, u8)> {
+        maps.iter()
+            .filter(|(t, _, _)| t == topic)
+            .map(|(_, time, data)| (*time, data[5]))
+            .collect()
+    };
+    assert_eq!(at("/map"), [(0, 0), (1_500_000_000, 1)], "the truth");
+    assert_eq!(
+        at("/map/shared"),
+        [(0, 0), (1_870_000_000, 1)],
+        "the picture"
+    );
     let replay_run = TestRun::new("door-replay");
     let said = hnav(&["log", "replay", d, "--run", replay_run.run.as_str()]);
     assert!(said.contains("identical"), "{said}");

@@ -7,7 +7,8 @@
 //!
 //! | topic | schema | from | one message per |
 //! |---|---|---|---|
-//! | `/map` | `foxglove.Grid` | the scenario (`invocation.json`) | the run (field `occupied`, 1 = wall) |
+//! | `/map` | `foxglove.Grid` | the scenario (`invocation.json`) | the run (field `occupied`, 1 = wall), and again at each close or open of its `[[events]]` |
+//! | `/map/shared` | `foxglove.Grid` | the scenario and `log/` (with `[sensing]`) | the coordinator's map at the start and after each map-change record |
 //! | `/robots/<i>/truth` | `foxglove.PoseInFrame` | `recording/trajectories.bin` | ground-truth sample of robot `i` |
 //! | `/robots/<i>/estimate` | `foxglove.PoseInFrame` | `recording/trajectories.bin` | dead-reckoned sample of robot `i` |
 //! | `/robots/<i>/neural_map` | `foxglove.Grid` | `recording/maps.bin` | snapshot of agent `i` (fields `activation`, `log10_activation`) |
@@ -23,6 +24,7 @@
 
 mod messages;
 pub mod schemas;
+mod world;
 
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -37,9 +39,7 @@ use hnav_runtime::consensus_log::{read_decided, LogError, Record, RunHeader};
 use hnav_runtime::msg::{LifecycleEvent, Role, Verdict, NO_CELL};
 use hnav_runtime::scenario::Scenario;
 pub use messages::FRAME;
-use messages::{
-    cell, decision_message, grid_message, neural_map_message, pose_message, stamp, NUMERIC_UINT8,
-};
+use messages::{cell, decision_message, neural_map_message, pose_message, stamp};
 
 /// The control period assumed when the run's scenario cannot be loaded (the default
 /// `[sim]`: 100 Hz odometry, 1 ms steps).
@@ -188,15 +188,21 @@ fn write_all(
     notes: &mut Vec<String>,
 ) -> Result<(), ExportError> {
     if let Some(s) = &info.scenario {
-        let g = &s.map.grid;
-        let occupied: Vec<u8> = g
-            .tiles()
-            .iter()
-            .map(|t| u8::from(!t.is_passable()))
-            .collect();
-        let fields = [("occupied", 0, NUMERIC_UINT8)];
-        let msg = grid_message(0, (g.width(), info.cell_size_m), 1, &fields, &occupied);
-        w.message("/map", schemas::GRID, 0, &msg)?;
+        let cell_m = info.cell_size_m;
+        w.message(
+            "/map",
+            schemas::GRID,
+            0,
+            &world::occupancy(&s.map.grid, 0, cell_m),
+        )?;
+        for (t, msg) in world::truth(s, cell_m) {
+            w.message("/map", schemas::GRID, t, &msg)?;
+        }
+        if s.sensing.is_some() {
+            for (t, msg) in world::shared(&s.map.grid, records, info.period_ns, cell_m) {
+                w.message("/map/shared", schemas::GRID, t, &msg)?;
+            }
+        }
     }
     let rec_dir = run_dir.join(recording::DIR);
     let trajectories = rec_dir.join(recording::TRAJECTORIES);
