@@ -1,6 +1,7 @@
 //! `hnav check` and `hnav run` refuse, before anything is spawned, a scenario the runtime
 //! cannot carry out: more agents than the message format holds, or a goal that cannot be
-//! reached from its start (unless the scenario allows it).
+//! reached from its start (unless the scenario allows it), or a world change (`[[events]]`)
+//! that cannot happen.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -191,4 +192,61 @@ fn an_unreachable_goal_is_refused_by_check_and_run_unless_allowed() {
         stdout.contains("warning: agent 0: goal [4, 2] is unreachable from start [0, 0]"),
         "{stdout}"
     );
+}
+
+/// A 6 x 4 map with a wall at (1..2, 1) and two robots; `[[events]]` bodies follow from line 15.
+const WITH_EVENTS: &str = r#"name = "events"
+[map]
+rows = [
+  "......",
+  ".@@...",
+  "......",
+  "......",
+]
+[[agents]]
+start = [0, 0]
+goal = [5, 3]
+[[agents]]
+start = [5, 0]
+goal = [0, 3]
+"#;
+
+#[test]
+fn every_event_mistake_is_refused_by_check_and_run_at_its_line_before_anything_is_spawned() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cases: &[(&str, &str)] = &[
+        (
+            "at_s = 1\nclose = [[5, 0]]\n",
+            "17: events.close (5, 0) is agent 1's start: the robot would begin inside it",
+        ),
+        (
+            "at_s = 1\nmover = \"p\"\npath = [[0, 1], [4, 1]]\nspeed = 1\n",
+            "18: events.path passes (1, 1), a wall or a closed cell",
+        ),
+        (
+            "at_s = 2\nclose = [[4, 2]]\n[[events]]\nat_s = 1\nclose = [[4, 3]]\n",
+            "18: events happens at 1 s, before the event at line 15 (2 s); list the events in time order",
+        ),
+        ("at_s = 1\nopen = [[4, 2]]\n", "17: events.open (4, 2) is free already: nothing to open"),
+        ("at_round = 3\n", "15: events event 0 must be exactly one of close, close_rect, open, open_rect and mover; it gives none"),
+    ];
+    for (i, (body, problem)) in cases.iter().enumerate() {
+        let path = dir.path().join(format!("events-{i}.toml"));
+        std::fs::write(&path, format!("{WITH_EVENTS}[[events]]\n{body}")).unwrap();
+        let want = format!("error: {}:{problem}", path.display());
+        let o = hnav(&["check", path.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(
+            stderr(&o).starts_with(&want),
+            "{}\nwanted {want}",
+            stderr(&o)
+        );
+        // No binaries where `--bin-dir` points: a run that got as far as spawning would fail
+        // otherwise, and the run directory would exist.
+        let o = run(&path, &out, &["--bin-dir", dir.path().to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).starts_with(&want), "{}", stderr(&o));
+        assert!(!out.exists(), "refused before the run directory was made");
+    }
 }

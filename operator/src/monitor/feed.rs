@@ -7,7 +7,7 @@ use super::health::HealthRow;
 use crate::supervisor::registry::LiveRunError;
 use hnav_runtime::grid::Grid;
 use hnav_runtime::msg::{Commit, Lifecycle, Pose, Progress, Truth};
-use hnav_runtime::scenario::{Scenario, ScenarioError};
+use hnav_runtime::scenario::{Scenario, ScenarioError, WorldChange};
 use hnav_runtime::transport::TransportError;
 
 /// The static picture of a run: what does not change while it runs.
@@ -28,6 +28,20 @@ pub struct RunInfo {
     pub goals: Vec<u32>,
     /// Side of a cell in metres, to place ground-truth poses.
     pub cell_size_m: f64,
+    /// The scenario's closes and opens (`[[events]]`), in time order: the view's map follows
+    /// them as the sim's time passes them.
+    pub changes: Vec<WorldStep>,
+}
+
+/// One close or open of the scenario's `[[events]]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WorldStep {
+    /// When, ns of sim time.
+    pub at_ns: u64,
+    /// The cells (0-based row-major indices).
+    pub cells: Vec<u32>,
+    /// Whether they close (else they open).
+    pub closed: bool,
 }
 
 impl RunInfo {
@@ -43,6 +57,22 @@ impl RunInfo {
             starts: scenario.agents.iter().map(|a| id(a.start)).collect(),
             goals: scenario.agents.iter().map(|a| id(a.goal)).collect(),
             cell_size_m: scenario.robot.cell_size_m,
+            changes: scenario
+                .events
+                .iter()
+                .filter_map(|e| {
+                    let (cells, closed) = match &e.change {
+                        WorldChange::Close(c) => (c, true),
+                        WorldChange::Open(c) => (c, false),
+                        WorldChange::Mover(_) => return None,
+                    };
+                    Some(WorldStep {
+                        at_ns: (e.at_s * 1e9).round() as u64,
+                        cells: cells.iter().map(|&c| id(c)).collect(),
+                        closed,
+                    })
+                })
+                .collect(),
             grid,
         }
     }

@@ -360,6 +360,7 @@ fn run_info(
         starts: header.agents.iter().map(|a| a.start).collect(),
         goals: header.agents.iter().map(|a| a.goal).collect(),
         cell_size_m,
+        changes: Vec::new(),
     })
 }
 

@@ -269,6 +269,8 @@ pub struct ViewState {
     rate: RateMeter,
     last_commit: Option<u64>,
     truth_period: Option<u64>,
+    /// The scenario's closes and opens applied to the map so far.
+    changed: usize,
 }
 
 impl ViewState {
@@ -294,6 +296,7 @@ impl ViewState {
             rate: RateMeter::default(),
             last_commit: None,
             truth_period: None,
+            changed: 0,
         }
     }
 
@@ -336,6 +339,18 @@ impl ViewState {
         }
         self.truth_period = Some(t.period);
         self.collisions = t.collisions;
+        // The world's changes the sim has made by now: closed cells are walls on screen.
+        while let Some(step) = self.info.changes.get(self.changed) {
+            if step.at_ns > t.sim_time_ns {
+                break;
+            }
+            for &c in &step.cells {
+                if let Some(cell) = self.info.grid.cell_at(c as usize) {
+                    self.info.grid.set_blocked(cell, step.closed);
+                }
+            }
+            self.changed += 1;
+        }
         for (agent, pose) in self.agents.iter_mut().zip(t.poses()) {
             let cell = self.info.cell_of(pose);
             agent.place(cell, *pose);

@@ -11,6 +11,7 @@ fn view() -> ViewState {
         starts: vec![0, 4],
         goals: vec![2, 7],
         cell_size_m: 1.0,
+        changes: Vec::new(),
     })
 }
 
@@ -301,4 +302,34 @@ fn the_rate_is_rounds_over_the_last_second() {
     young.note(t0 + Duration::from_millis(200), 50);
     let r = young.rate(t0 + Duration::from_millis(200));
     assert!((r - 250.0).abs() < 1e-6, "{r}");
+}
+
+#[test]
+fn the_map_follows_the_worlds_closes_and_opens_as_sim_time_passes_them() {
+    let mut v = view();
+    v.info.changes = vec![
+        super::super::feed::WorldStep {
+            at_ns: 1_000,
+            cells: vec![5, 6],
+            closed: true,
+        },
+        super::super::feed::WorldStep {
+            at_ns: 3_000,
+            cells: vec![6],
+            closed: false,
+        },
+    ];
+    let blocked =
+        |v: &ViewState| -> Vec<usize> { (0..8).filter(|&i| v.info.grid.blocked()[i]).collect() };
+    let at = |period: u64, ns: u64| Truth {
+        sim_time_ns: ns,
+        ..truth(period, &[(0.5, 0.5), (0.5, 1.5)])
+    };
+    let now = Instant::now();
+    v.apply(Update::Truth(&at(1, 999)), now);
+    assert!(blocked(&v).is_empty());
+    v.apply(Update::Truth(&at(2, 1_000)), now);
+    assert_eq!(blocked(&v), [5, 6]);
+    v.apply(Update::Truth(&at(3, 5_000)), now);
+    assert_eq!(blocked(&v), [5]);
 }
