@@ -12,9 +12,11 @@
 //! | `open_round` | [`OpenRound`]: the open round's candidates, its deadline, its record |
 //! | `roster` | [`Roster`]: per agent live, down or lost, and its restarts |
 //! | `dropped` | [`Dropped`]: the counts of dropped candidates, kept across restarts |
+//! | `latency` | [`Latency`]: the rounds' candidate-to-commit latencies, kept across restarts |
 
 mod dropped;
 mod end_watch;
+mod latency;
 mod open_round;
 mod roster;
 mod supervisor;
@@ -38,6 +40,7 @@ use crate::replication::{Overheard, RaftLog};
 use crate::round::Arbiter;
 use dropped::Dropped;
 use end_watch::EndWatch;
+use latency::Latency;
 use open_round::OpenRound;
 use roster::Roster;
 
@@ -53,6 +56,7 @@ pub(super) struct State {
     roster: Roster,
     watch: EndWatch,
     dropped: Dropped,
+    latency: Latency,
     /// The supervisor's events of one drain, kept so that draining allocates nothing once warm.
     events: Vec<Lifecycle>,
     /// A following replica's memory of the supervisor.
@@ -149,6 +153,7 @@ impl State {
             roster: Roster::new(n),
             watch: EndWatch::new(scenario),
             dropped: Dropped::load(run_dir),
+            latency: Latency::load(run_dir),
             events: Vec::new(),
             heard: Overheard::new(n),
             roster_due: false,
@@ -276,10 +281,11 @@ impl State {
         Ok(())
     }
 
-    /// Logs the totals of dropped candidates (if any) and keeps them for the run summary and
-    /// for a coordinator restarted after this one.
+    /// Logs the totals of dropped candidates (if any) and keeps them, with the rounds'
+    /// latencies, for the run summary and for a coordinator restarted after this one.
     pub(super) fn report_rejections(&self) {
         self.dropped.report();
+        self.latency.report();
     }
 
     /// Publishes the last logged round's commit again, if there is one.
@@ -329,6 +335,7 @@ impl State {
         // A replica's round is final once a majority holds it; only then may it leave.
         if self.settle(waiter, tick)? {
             publish_commit(p, &rec, self.log.term())?;
+            self.latency.note(self.open.came());
         }
         self.last_record = Some(rec);
         self.round = round;

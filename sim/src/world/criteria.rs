@@ -1,0 +1,68 @@
+//! What the sim measures of each robot for the run summary's criteria: the energy its
+//! motors draw (the model of [`hnav_runtime::criteria::energy`], priced every physics step
+//! from the wheel speeds the motor model gives) and when its true pose first ended a control
+//! period in its goal cell. Kept in the restart checkpoint, written to
+//! `DIR/sim-criteria.json` at exit.
+
+use hnav_runtime::criteria::energy::{MotorModel, WheelEnergy};
+use hnav_runtime::criteria::{RobotCriteria, SimCriteria};
+use hnav_runtime::grid::Cell;
+use nalgebra::Point2;
+
+/// Per robot: energy so far, goal cell, first time at it.
+#[derive(Debug, Clone)]
+pub(crate) struct Meter {
+    pub(crate) wheel: WheelEnergy,
+    pub(crate) energy_j: Vec<f64>,
+    goals: Vec<Option<Cell>>,
+    pub(crate) goal_at_ns: Vec<Option<u64>>,
+}
+
+impl Meter {
+    /// A meter of `robots` robots with wheels of `wheel_radius_m` stepped every `dt_s`; no
+    /// goals until [`Meter::set_goals`].
+    pub(crate) fn new(robots: usize, wheel_radius_m: f64, dt_s: f64) -> Self {
+        Meter {
+            wheel: WheelEnergy::new(&MotorModel::S_BOT, wheel_radius_m, dt_s),
+            energy_j: vec![0.0; robots],
+            goals: vec![None; robots],
+            goal_at_ns: vec![None; robots],
+        }
+    }
+
+    /// The robots' goal cells, in index order.
+    pub(crate) fn set_goals(&mut self, goals: impl IntoIterator<Item = Cell>) {
+        for (g, c) in self.goals.iter_mut().zip(goals) {
+            *g = Some(c);
+        }
+    }
+
+    /// Notes, at sim time `now_ns`, which robots at `pos` (cells `cell_m` wide) stand in
+    /// their goal cells for the first time.
+    pub(crate) fn note_goals(&mut self, pos: &[Point2<f64>], cell_m: f64, now_ns: u64) {
+        for ((at, goal), p) in self.goal_at_ns.iter_mut().zip(&self.goals).zip(pos) {
+            let Some(g) = goal.filter(|_| at.is_none()) else {
+                continue;
+            };
+            if (p.x / cell_m).floor() == f64::from(g.x) && (p.y / cell_m).floor() == f64::from(g.y)
+            {
+                *at = Some(now_ns);
+            }
+        }
+    }
+
+    /// The figures for the summary.
+    pub(crate) fn criteria(&self) -> SimCriteria {
+        SimCriteria {
+            robots: self
+                .energy_j
+                .iter()
+                .zip(&self.goal_at_ns)
+                .map(|(&energy_j, at)| RobotCriteria {
+                    energy_j,
+                    goal_at_s: at.map(|ns| ns as f64 * 1e-9),
+                })
+                .collect(),
+        }
+    }
+}
