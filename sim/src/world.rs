@@ -171,7 +171,9 @@ impl World {
             &starts,
         )?;
         world.changes = Changes::new(scenario.events.clone());
-        world.meter.set_goals(scenario.agents.iter().map(|a| a.goal));
+        world
+            .meter
+            .set_goals(scenario.agents.iter().map(|a| a.goal));
         world.apply_changes();
         world.set_localisation(scenario.localisation);
         Ok(world)
@@ -352,8 +354,7 @@ impl World {
         self.steps += 1;
         let t = self.time_ns();
         if self.odometry_due() {
-            self.meter
-                .note_goals(&self.pos, self.model.cell_size_m, t);
+            self.meter.note_goals(&self.pos, self.model.cell_size_m, t);
         }
         if self.changes.is_empty() {
             return self

@@ -15,13 +15,15 @@ use serde::Serialize;
 
 use hnav_runtime::consensus_log::{read_decided, LogError, Record, Tally};
 
+mod criteria;
 mod tasks;
+pub use criteria::LatencySummary;
 use hnav_runtime::msg::{LifecycleEvent, Role, Truth};
 use hnav_runtime::rejected::Rejections;
 pub use tasks::TaskSummary;
 
 /// One agent's line of the summary.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct AgentSummary {
     /// Agent index.
     pub id: u32,
@@ -45,6 +47,26 @@ pub struct AgentSummary {
     /// supervisor gave it up): its robot stood for the rest of the run and its goal counts
     /// as not reached, wherever the robot is.
     pub lost: bool,
+    /// Octile shortest path from its start to its goal on the map the run ended with, cells
+    /// (`None`: none there, or a run with `[tasks]`).
+    pub shortest: Option<f64>,
+    /// Path optimality: `length / shortest`, for a robot that reached its goal.
+    pub optimality: Option<f64>,
+    /// Simulated seconds until its true pose first ended a control period in its goal cell
+    /// (the sim's measure; `None` if it never did or the sim left no figures).
+    pub time_to_goal_s: Option<f64>,
+    /// Energy its motors drew over the run, J (the sim's wheel model).
+    pub energy_j: Option<f64>,
+    /// Energy of `shortest` driven straight at its nominal speed under the same model, J.
+    pub energy_budget_j: Option<f64>,
+    /// Partial corrections of its neural map (§2.10 A), from its log.
+    pub repairs_partial: u32,
+    /// Neural map rebuilt from zero (§2.10 Б), from its log.
+    pub repairs_rebuild: u32,
+    /// New routes of a route planner (PSO, GA) after a change, from its log.
+    pub repairs_replan: u32,
+    /// Requests into a cell that was closed in the sim's truth at that round.
+    pub false_positives: u32,
 }
 
 /// A robot lost during the run: its agent's process exited and was not restarted.
@@ -106,6 +128,9 @@ pub struct RunSummary {
     /// A lifelong run's tasks (`[tasks]`); absent for a run without.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tasks: Option<TaskSummary>,
+    /// The rounds' candidate-to-commit latencies as the coordinator measured them (`None`:
+    /// it left none, as on a host without the coordinator).
+    pub consensus_latency_us: Option<LatencySummary>,
 }
 
 impl RunSummary {
@@ -208,6 +233,7 @@ impl RunSummary {
                 replans: t.replans,
                 unreachable: unreachable.contains(&id),
                 lost: lost.contains(&id),
+                ..AgentSummary::default()
             })
             .collect();
         if let (Some(t), Some(h)) = (truth, header) {
@@ -237,6 +263,7 @@ impl RunSummary {
             report_error: None,
             counts_on_host: None,
             tasks: lifelong.map(|period| TaskSummary::new(&tasks, rounds, period)),
+            consensus_latency_us: None,
         })
     }
 
@@ -273,6 +300,7 @@ impl RunSummary {
                 replans: 0,
                 unreachable: false,
                 lost: false,
+                ..AgentSummary::default()
             })
             .collect();
         let all_home = !agents.is_empty() && agents.iter().all(|a| a.reached_goal);
@@ -303,7 +331,17 @@ impl RunSummary {
             report_error: None,
             counts_on_host: None,
             tasks: None,
+            consensus_latency_us: None,
         }
+    }
+
+    /// Fills the criteria of the dissertation (§2.1) that are not in the log's tally: path
+    /// optimality, time to goal, energy and its budget, repairs, false positives and the
+    /// consensus latency, from `scenario`, the run directory `run_dir` and the consensus log
+    /// (`log`; see the `criteria` module).
+    pub fn fill_criteria(&mut self, scenario: &hnav_runtime::scenario::Scenario, run_dir: &Path) {
+        let log = self.log.clone();
+        criteria::fill(self, scenario, run_dir, &log);
     }
 
     /// Writes `summary.json` into `dir` atomically; returns its path.
@@ -323,7 +361,9 @@ impl RunSummary {
     /// ran, so that runs under different rules are not compared by mistake) and, when any
     /// process was restarted, its restarts.
     pub fn render(&self) -> String {
-        let mut s = String::from("agent  goal  steps  length  conflicts  waited  replans\n");
+        let mut s = String::from(
+            "agent  goal  steps  length  conflicts  waited  replans  optimal  to-goal  energy  budget  repairs  false+\n",
+        );
         for a in &self.agents {
             let goal = match (a.reached_goal, a.unreachable, a.lost) {
                 (true, _, _) => "yes",
@@ -333,18 +373,31 @@ impl RunSummary {
             };
             s += &match self.counts_on_host {
                 None => format!(
-                    "{:>5}  {:>4}  {:>5}  {:>6.2}  {:>9}  {:>6}  {:>7}\n",
-                    a.id, goal, a.steps, a.length, a.conflicts, a.waited, a.replans
+                    "{:>5}  {:>4}  {:>5}  {:>6.2}  {:>9}  {:>6}  {:>7}  {}\n",
+                    a.id,
+                    goal,
+                    a.steps,
+                    a.length,
+                    a.conflicts,
+                    a.waited,
+                    a.replans,
+                    criteria_columns(a, true)
                 ),
                 Some(_) => format!(
-                    "{:>5}  {goal:>4}  {:>5}  {:>6}  {:>9}  {:>6}  {:>7}\n",
-                    a.id, "-", "-", "-", "-", "-"
+                    "{:>5}  {goal:>4}  {:>5}  {:>6}  {:>9}  {:>6}  {:>7}  {}\n",
+                    a.id,
+                    "-",
+                    "-",
+                    "-",
+                    "-",
+                    "-",
+                    criteria_columns(a, false)
                 ),
             };
         }
         if let Some(host) = &self.counts_on_host {
             s += &format!(
-                "(steps, length, conflicts, waited, replans: in the consensus log on host {host}; goals, collisions and rounds: from what crossed the bridge)\n"
+                "(steps, length, conflicts, waited, replans, optimal, false+: in the consensus log on host {host}; goals, collisions and rounds: from what crossed the bridge)\n"
             );
         }
         let at_goal = self.agents.iter().filter(|a| a.reached_goal).count();
@@ -363,6 +416,12 @@ impl RunSummary {
             self.mode,
             self.end
         );
+        if let Some(l) = &self.consensus_latency_us {
+            s += &format!(
+                "consensus: candidate -> commit p50 {} us, p99 {} us; last candidate -> commit p50 {} us, p99 {} us ({} rounds)\n",
+                l.p50, l.p99, l.decide_p50, l.decide_p99, l.rounds
+            );
+        }
         if let Some(t) = &self.tasks {
             s += &t.render();
         }
@@ -376,6 +435,31 @@ impl RunSummary {
         }
         s
     }
+}
+
+/// The criteria columns of agent `a`'s line: optimality, time to goal (s), energy and its
+/// budget (J), repairs (partial/rebuild/route), false positives; `-` for what is not known
+/// (the log-based ones without the log: `from_log` false).
+fn criteria_columns(a: &AgentSummary, from_log: bool) -> String {
+    let or_dash =
+        |v: Option<f64>, prec: usize| v.map_or("-".to_string(), |v| format!("{v:.prec$}"));
+    let fp = if from_log {
+        a.false_positives.to_string()
+    } else {
+        "-".to_string()
+    };
+    format!(
+        "{:>7}  {:>7}  {:>6}  {:>6}  {:>7}  {:>6}",
+        or_dash(a.optimality.filter(|_| from_log), 3),
+        or_dash(a.time_to_goal_s, 2),
+        or_dash(a.energy_j, 2),
+        or_dash(a.energy_budget_j, 2),
+        format!(
+            "{}/{}/{}",
+            a.repairs_partial, a.repairs_rebuild, a.repairs_replan
+        ),
+        fp
+    )
 }
 
 /// The coordinator's counts of dropped candidates in `run_dir` (see [`hnav_runtime::rejected`]);
@@ -436,13 +520,13 @@ mod tests {
         home.counts_on_host = Some("base".into());
         let table = home.render();
         assert!(
-            table.contains("    0   yes      -       -          -       -        -\n"),
+            table.contains("    0   yes      -       -          -       -        -        -        -       -       -    0/0/0       -\n"),
             "{table}"
         );
         assert!(!table.contains("0.00"), "{table}");
         assert!(
             table.contains(
-                "(steps, length, conflicts, waited, replans: in the consensus log on host base;"
+                "(steps, length, conflicts, waited, replans, optimal, false+: in the consensus log on host base;"
             ),
             "{table}"
         );

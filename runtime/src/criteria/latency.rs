@@ -134,7 +134,19 @@ mod tests {
 
     #[test]
     fn buckets_are_exact_below_64_and_within_1_6_percent_above() {
-        for us in [0u64, 1, 63, 64, 65, 127, 128, 1000, 12_345, 10_000_000, u64::MAX / 4] {
+        for us in [
+            0u64,
+            1,
+            63,
+            64,
+            65,
+            127,
+            128,
+            1000,
+            12_345,
+            10_000_000,
+            u64::MAX / 4,
+        ] {
             let b = bucket(us);
             assert!(lower(b) <= us, "{us}: bucket from {}", lower(b));
             if b + 1 < BUCKETS {
