@@ -53,12 +53,18 @@ fn check_criteria(s: &serde_json::Value) {
         let t = f(a, "time_to_goal_s");
         assert!(t > 0.0 && t <= sim_s + 0.01, "{a}: {t} s of {sim_s} s");
         let (e, budget) = (f(a, "energy_j"), f(a, "energy_budget_j"));
-        assert!(budget > 0.0 && e >= 0.5 * budget, "{a}: {e} J, budget {budget} J");
+        assert!(
+            budget > 0.0 && e >= 0.5 * budget,
+            "{a}: {e} J, budget {budget} J"
+        );
         assert!(a["false_positives"].is_u64(), "{a}");
     }
     let robot0 = &s["agents"][0];
     let repairs = f(robot0, "repairs_partial") + f(robot0, "repairs_rebuild");
-    assert!(repairs >= 1.0, "robot 0 repaired its map after the door: {robot0}");
+    assert!(
+        repairs >= 1.0,
+        "robot 0 repaired its map after the door: {robot0}"
+    );
     // Robot 0 took the long way: its shortest path on the final map is around the door.
     assert!(f(robot0, "shortest") > 11.0, "{robot0}");
     let l = &s["consensus_latency_us"];
@@ -84,8 +90,7 @@ fn a_door_that_closes_is_seen_repaired_around_and_the_run_repeats_byte_for_byte(
     let mut logs = Vec::new();
     for k in 0..2 {
         let dir = tmp.path().join(format!("run{k}"));
-        let (summary, log) =
-            lockstep_all_home(&format!("door{k}"), &scenario, &dir, &registry, 2);
+        let (summary, log) = lockstep_all_home(&format!("door{k}"), &scenario, &dir, &registry, 2);
         logs.push(log);
         if k > 0 {
             continue;
