@@ -66,3 +66,31 @@ impl Meter {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_robot_is_at_its_goal_from_the_first_period_it_ends_in_the_cell() {
+        let mut m = Meter::new(2, 0.02, 1e-3);
+        m.set_goals([Cell::new(2, 1), Cell::new(0, 0)]);
+        let cell = 0.16;
+        // Robot 0 a hair short of cell (2, 1), robot 1 in cell (1, 0).
+        let mut pos = [
+            Point2::new(2.0 * cell - 1e-6, 1.5 * cell),
+            Point2::new(0.2, 0.05),
+        ];
+        m.note_goals(&pos, cell, 10_000_000);
+        assert_eq!(m.goal_at_ns, [None, None]);
+        pos[0].x = 2.0 * cell + 1e-6;
+        m.note_goals(&pos, cell, 20_000_000);
+        // It leaves again: the first arrival stands.
+        pos[0].x = 3.5 * cell;
+        m.note_goals(&pos, cell, 30_000_000);
+        let c = m.criteria();
+        assert_eq!(c.robots[0].goal_at_s, Some(0.02));
+        assert_eq!(c.robots[1].goal_at_s, None);
+        assert_eq!(c.robots[0].energy_j, 0.0);
+    }
+}

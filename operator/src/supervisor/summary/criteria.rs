@@ -287,6 +287,66 @@ mod tests {
         assert_eq!(requested(&hold, 23, 10), None);
     }
 
+    /// Robot 0 of `scenarios/door.toml` stands at (4, 0) beside the door (5, 0), which closes
+    /// at round 150: held at 149 (no request known), accepted into the closed door at 160
+    /// (one false positive), back to (4, 0) at 161 (free), refused east into the door at 170
+    /// and 171 (one more: the same refusal repeated is one request).
+    #[test]
+    fn a_request_into_a_closed_cell_is_a_false_positive_once() {
+        use hnav_runtime::consensus_log::{
+            AgentEntry, LogWriter, RoundRecord, RunHeader, FORMAT_VERSION,
+        };
+        use hnav_runtime::scenario::FsyncPolicy;
+        let s =
+            Scenario::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/door.toml"))
+                .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let (mut log, _) = LogWriter::open(dir.path(), FsyncPolicy::None).unwrap();
+        let entry = |start: u32, goal: u32| AgentEntry {
+            start,
+            goal,
+            speed: 1.0,
+            priority: 1.0,
+        };
+        log.append(&Record::Header(RunHeader {
+            version: FORMAT_VERSION,
+            scenario_hash: 1,
+            seed: 0,
+            clock: "lockstep".into(),
+            width: 10,
+            height: 4,
+            agents: vec![entry(4, 9), entry(39, 30)],
+        }))
+        .unwrap();
+        let round = |round: u64, d: LoggedDecision| {
+            Record::Round(RoundRecord {
+                round,
+                candidates: 1,
+                candidates_digest: 0,
+                decisions: vec![d],
+            })
+        };
+        let east = 1 << Direction::E.index();
+        for r in [
+            round(149, decision(Verdict::Hold, ConflictKind::Crossing, 0, 4)),
+            round(160, decision(Verdict::Accept, ConflictKind::None, 0, 5)),
+            round(161, decision(Verdict::Accept, ConflictKind::None, 0, 4)),
+            round(
+                170,
+                decision(Verdict::Block, ConflictKind::Invalid, east, NO_CELL),
+            ),
+            round(
+                171,
+                decision(Verdict::Block, ConflictKind::Invalid, east, NO_CELL),
+            ),
+        ] {
+            log.append(&r).unwrap();
+        }
+        drop(log);
+        let fps = false_positives(dir.path(), &s, s.sim.control_period_s());
+        assert_eq!(fps, [2, 0]);
+    }
+
     #[test]
     fn the_final_map_has_the_events_due_and_optimality_is_over_its_shortest_path() {
         let s =
