@@ -16,6 +16,9 @@ use hnav_runtime::criteria::ConsensusLatency;
 pub(super) struct Latency {
     counts: ConsensusLatency,
     run_dir: PathBuf,
+    /// Whether this coordinator committed a round: a replica that only followed leaves the
+    /// file to the one that led.
+    counted: bool,
 }
 
 impl Latency {
@@ -31,6 +34,7 @@ impl Latency {
         Latency {
             counts,
             run_dir: run_dir.to_path_buf(),
+            counted: false,
         }
     }
 
@@ -42,12 +46,16 @@ impl Latency {
         if let (Some(f), Some(l)) = (first, last) {
             self.counts.from_first.record(us(f));
             self.counts.from_last.record(us(l));
+            self.counted = true;
         }
     }
 
     /// Keeps the latencies in `DIR/consensus-latency.json` for the run summary and for a
-    /// coordinator restarted after this one.
+    /// coordinator restarted after this one, if this one committed any round.
     pub(super) fn report(&self) {
+        if !self.counted {
+            return;
+        }
         if let Err(e) = self.counts.store(&self.run_dir) {
             let path = self.run_dir.join(LATENCY_FILE);
             tracing::warn!("cannot write {}: {e}", path.display());
