@@ -60,7 +60,9 @@ impl Meter {
                 .zip(&self.goal_at_ns)
                 .map(|(&energy_j, at)| RobotCriteria {
                     energy_j,
-                    goal_at_s: at.map(|ns| ns as f64 * 1e-9),
+                    // Divided, not multiplied by 1e-9 (inexact): 20 880 000 000 ns is 20.88 s, not
+                    // 20.880000000000003.
+                    goal_at_s: at.map(|ns| ns as f64 / 1e9),
                 })
                 .collect(),
         }
