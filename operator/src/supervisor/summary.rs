@@ -423,7 +423,7 @@ mod tests {
         assert!(!table.contains("0.00"), "{table}");
         assert!(
             table.contains(
-                "(steps, length, conflicts, waited, replans, optimal, false+: in the consensus log on host base;"
+                "(steps, length, conflicts, waited, replans: in the consensus log on host base; optimal and false+ too;"
             ),
             "{table}"
         );

@@ -43,7 +43,7 @@ impl RunSummary {
         }
         if let Some(host) = &self.counts_on_host {
             s += &format!(
-                "(steps, length, conflicts, waited, replans, optimal, false+: in the consensus log on host {host}; goals, collisions and rounds: from what crossed the bridge)\n"
+                "(steps, length, conflicts, waited, replans: in the consensus log on host {host}; optimal and false+ too; goals, collisions and rounds: from what crossed the bridge)\n"
             );
         }
         let at_goal = self.agents.iter().filter(|a| a.reached_goal).count();
