@@ -23,6 +23,7 @@
 //! | [`health`] | a process's heartbeat, beaten from its main loop for the supervisor's hang detection |
 //! | [`consensus_log`] | the durable consensus log: record types, segment format, writer, reader, verifier |
 //! | [`placement`] | `hosts.toml`: which host runs which process of a run across hosts, and how their bridges reach each other |
+//! | [`criteria`] | the criteria only a process can measure (motor energy, candidate-to-commit latency) and the run-directory files that carry them to the summary |
 //! | [`scenario`] | the TOML description of a run, validated with file/line errors |
 //! | [`rejected`] | the classes of hostile or malformed messages a receiver drops, and their counts for the run summary |
 //! | [`layout`] | the table of every payload's size, alignment and field offsets, and of the topic that carries it, for clients in other languages (`hnav layout --json`) |
@@ -40,6 +41,7 @@
 
 pub mod clock;
 pub mod consensus_log;
+pub mod criteria;
 pub mod diag;
 pub mod durable;
 pub mod file_lock;

@@ -29,10 +29,12 @@ use hnav_runtime::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Translation2};
 
 mod changes;
+mod criteria;
 mod sensing;
 mod snapshot;
 
 use changes::Changes;
+use criteria::Meter;
 
 pub use snapshot::SnapshotError;
 
@@ -76,6 +78,8 @@ pub struct World {
     collisions: Vec<Collision>,
     /// The scenario's `[[events]]`: cells that close or open, movers.
     changes: Changes,
+    /// Energy drawn and goal times, for the summary's criteria.
+    meter: Meter,
     // Localisation fixes carried by the odometry readings; none unless set.
     localiser: Option<Localiser>,
     odometry_hz: u32,
@@ -141,6 +145,7 @@ impl World {
             detector: Detector::new(n, &grid, model.cell_size_m, model.body_radius_m),
             collisions: Vec::new(),
             changes: Changes::default(),
+            meter: Meter::new(n, model.wheel_radius_m, model.dt),
             localiser: None,
             odometry_hz: sim.odometry_hz,
             seed: sim.seed,
@@ -166,6 +171,9 @@ impl World {
             &starts,
         )?;
         world.changes = Changes::new(scenario.events.clone());
+        world
+            .meter
+            .set_goals(scenario.agents.iter().map(|a| a.goal));
         world.apply_changes();
         world.set_localisation(scenario.localisation);
         Ok(world)
@@ -305,6 +313,7 @@ impl World {
         // Re-derive the heading vectors from the angles now and then (cost amortised to
         // nothing) so that rounding in the rotations cannot accumulate.
         let resync = self.steps.is_multiple_of(RESYNC_STEPS);
+        let wheel = self.meter.wheel;
         let redraw = self.slip_on && self.steps.is_multiple_of(self.steps_per_slip);
         for i in 0..self.pos.len() {
             let (l0, r0) = (self.wl[i], self.wr[i]);
@@ -323,6 +332,7 @@ impl World {
             };
             self.wl[i] = l1;
             self.wr[i] = r1;
+            self.meter.energy_j[i] += wheel.step_j(l0, l1) + wheel.step_j(r0, r1);
             // Trapezoidal wheel angle: exact for the acceleration-limited (linear) ramp.
             let (dphl, dphr) = (0.5 * (l0 + l1) * dt, 0.5 * (r0 + r1) * dt);
             self.phil[i] += dphl;
@@ -343,6 +353,9 @@ impl World {
         }
         self.steps += 1;
         let t = self.time_ns();
+        if self.odometry_due() {
+            self.meter.note_goals(&self.pos, self.model.cell_size_m, t);
+        }
         if self.changes.is_empty() {
             return self
                 .detector
@@ -433,6 +446,12 @@ impl World {
                 Pose::default()
             };
         }
+    }
+
+    /// What the sim measured of each robot for the summary: energy drawn, first time at
+    /// its goal.
+    pub fn criteria(&self) -> hnav_runtime::criteria::SimCriteria {
+        self.meter.criteria()
     }
 
     /// Every collision recorded so far, in order of the step that began it (robot contacts

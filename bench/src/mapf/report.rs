@@ -44,6 +44,21 @@ pub struct Row {
     pub conflicts: u32,
     /// Global replans (the log).
     pub replans: u32,
+    /// Energy the robots' motors drew, J, summed (`summary.json`'s `energy_j`).
+    #[serde(default)]
+    pub energy_j: f64,
+    /// Energy of their shortest paths, J, summed (`summary.json`'s `energy_budget_j`).
+    #[serde(default)]
+    pub energy_budget_j: f64,
+    /// Median candidate-to-commit latency, µs (`summary.json`'s `consensus_latency_us`).
+    #[serde(default)]
+    pub consensus_p50_us: Option<u64>,
+    /// Its 99th percentile, µs.
+    #[serde(default)]
+    pub consensus_p99_us: Option<u64>,
+    /// Requests into a closed cell, summed (`summary.json`'s `false_positives`).
+    #[serde(default)]
+    pub false_positives: u64,
     /// Wall time of `hnav run`, start-up included.
     pub wall_s: f64,
     /// How the run ended (`summary.json`'s `end`).
@@ -83,6 +98,11 @@ impl Row {
             length_ratio: 0.0,
             conflicts: 0,
             replans: 0,
+            energy_j: 0.0,
+            energy_budget_j: 0.0,
+            consensus_p50_us: None,
+            consensus_p99_us: None,
+            false_positives: 0,
             wall_s: 0.0,
             end: String::new(),
             exit: String::new(),
@@ -122,8 +142,8 @@ fn mib(kib: u64) -> String {
 /// whose log does not verify.
 pub fn render_table(rows: &[Row]) -> String {
     let mut out = String::new();
-    out += "| N | rules | at goal | collisions | makespan (rounds) | sum of lengths | lower bound | ratio | conflicts | replans | wall s | end | sim MiB | coordinator MiB | agent MiB | PSS sum MiB |\n";
-    out += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    out += "| N | rules | at goal | collisions | makespan (rounds) | sum of lengths | lower bound | ratio | conflicts | replans | energy J | budget J | consensus p50/p99 µs | false+ | wall s | end | sim MiB | coordinator MiB | agent MiB | PSS sum MiB |\n";
+    out += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for r in rows {
         let makespan = r
             .makespan_rounds
@@ -133,9 +153,13 @@ pub fn render_table(rows: &[Row]) -> String {
         } else {
             r.end.clone()
         };
+        let consensus = match (r.consensus_p50_us, r.consensus_p99_us) {
+            (Some(a), Some(b)) => format!("{a}/{b}"),
+            _ => "-".to_string(),
+        };
         let _ = writeln!(
             out,
-            "| {} | {} | {}/{} | {} | {} | {:.1} | {:.1} | {:.3} | {} | {} | {:.1} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {}/{} | {} | {} | {:.1} | {:.1} | {:.3} | {} | {} | {:.2} | {:.2} | {} | {} | {:.1} | {} | {} | {} | {} | {} |",
             r.agents,
             r.rules,
             r.at_goal,
@@ -147,6 +171,10 @@ pub fn render_table(rows: &[Row]) -> String {
             r.length_ratio,
             r.conflicts,
             r.replans,
+            r.energy_j,
+            r.energy_budget_j,
+            consensus,
+            r.false_positives,
             r.wall_s,
             end,
             mib(r.memory.sim.hwm_kib),

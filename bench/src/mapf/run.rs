@@ -123,6 +123,12 @@ fn read_results(hnav: &Path, out: &Path, row: &mut Row) -> Result<(), String> {
     row.at_goal = agents.iter().filter(|a| a["reached_goal"] == true).count();
     row.collisions = summary["collisions"].as_u64().unwrap_or(u64::MAX);
     row.end = summary["end"].as_str().unwrap_or("").to_string();
+    let sum = |k: &str| agents.iter().filter_map(|a| a[k].as_f64()).sum::<f64>();
+    row.energy_j = sum("energy_j");
+    row.energy_budget_j = sum("energy_budget_j");
+    row.false_positives = sum("false_positives") as u64;
+    row.consensus_p50_us = summary["consensus_latency_us"]["p50"].as_u64();
+    row.consensus_p99_us = summary["consensus_latency_us"]["p99"].as_u64();
     row.log_verified = verify_log(hnav, out).is_ok();
     let log = LogNumbers::read(&out.join("log"))?;
     row.rounds = log.rounds;

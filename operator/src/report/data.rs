@@ -96,6 +96,9 @@ pub struct RunData {
     pub collision_marks: Vec<CollisionMark>,
     /// The chosen agents' final neural maps, in the order asked for.
     pub maps: Vec<MapSnapshot>,
+    /// The summary's criteria in at most two lines (see [`criteria_lines`]); none when the
+    /// summary has none.
+    pub criteria: Vec<String>,
     /// What is missing from the picture, and why.
     pub notes: Vec<String>,
 }
@@ -318,6 +321,7 @@ impl RunData {
             .and_then(serde_json::Value::as_u64)
             .and_then(|c| u32::try_from(c).ok())
             .ok_or_else(|| bad("no collision count".into()))?;
+        self.criteria = criteria_lines(&v);
         Ok(collisions_at_ns(&v))
     }
 
@@ -410,6 +414,53 @@ fn involved(poses: &[(u32, f64, f64)]) -> Vec<(u32, f64, f64)> {
         Some((d, i, j)) if d <= 1.0 => vec![poses[i], poses[j]],
         _ => poses.to_vec(),
     }
+}
+
+/// The summary's criteria in two lines: over the robots, mean and largest path optimality,
+/// the last time to goal, energy beside its budget, repairs and false positives; then the
+/// consensus latency. None when `summary` has no criteria (a summary of before them).
+pub fn criteria_lines(summary: &serde_json::Value) -> Vec<String> {
+    let Some(agents) = summary.get("agents").and_then(serde_json::Value::as_array) else {
+        return Vec::new();
+    };
+    let f = |a: &serde_json::Value, k: &str| a.get(k).and_then(serde_json::Value::as_f64);
+    let all = |k: &str| agents.iter().filter_map(|a| f(a, k)).collect::<Vec<f64>>();
+    let sum = |k: &str| all(k).iter().sum::<f64>();
+    if agents.iter().all(|a| a.get("energy_j").is_none()) {
+        return Vec::new();
+    }
+    let opt = all("optimality");
+    let optimality = match opt.len() {
+        0 => "optimality -".to_string(),
+        n => format!(
+            "optimality mean {:.3} (max {:.3})",
+            opt.iter().sum::<f64>() / n as f64,
+            opt.iter().copied().fold(f64::MIN, f64::max)
+        ),
+    };
+    let to_goal = all("time_to_goal_s")
+        .into_iter()
+        .reduce(f64::max)
+        .map_or("-".to_string(), |t| format!("{t:.2} s"));
+    let mut lines = vec![format!(
+        "criteria: {optimality}, last at goal {to_goal}, energy {:.2} J (budget {:.2} J), repairs {:.0} partial / {:.0} rebuild / {:.0} route, {:.0} false positives",
+        sum("energy_j"),
+        sum("energy_budget_j"),
+        sum("repairs_partial"),
+        sum("repairs_rebuild"),
+        sum("repairs_replan"),
+        sum("false_positives"),
+    )];
+    if let Some(l) = summary.get("consensus_latency_us").filter(|l| !l.is_null()) {
+        let u = |k: &str| l.get(k).and_then(serde_json::Value::as_u64).unwrap_or(0);
+        lines.push(format!(
+            "consensus: candidate -> commit p50 {} us, p99 {} us ({} rounds)",
+            u("p50"),
+            u("p99"),
+            u("rounds")
+        ));
+    }
+    lines
 }
 
 /// The simulated times at which a run's collision count rose, from its `summary.json`

@@ -41,7 +41,9 @@ type DrawResult = Result<(), DrawingAreaErrorKind<std::io::Error>>;
 
 /// Draws `data` into the SVG file `path`.
 pub fn draw(data: &RunData, path: &Path) -> Result<(), ReportError> {
-    let events = event_lines(&data.lifecycle);
+    let mut events = data.criteria.clone();
+    events.truncate(super::layout::MAX_CRITERIA_LINES);
+    events.extend(event_lines(&data.lifecycle));
     let layout = Layout::with_events(
         data.width,
         data.height,

@@ -34,6 +34,9 @@ pub const AXIS_TOP: i32 = 16;
 pub const AXIS_SPACING_PX: f64 = 24.0;
 /// The process events listed under the legend at most (the rest is counted in one more line).
 pub const MAX_EVENT_LINES: usize = 8;
+/// The criteria lines (summary's optimality, energy, ...; consensus latency) above the process
+/// events at most.
+pub const MAX_CRITERIA_LINES: usize = 2;
 /// Marker kinds in the legend after the robots (start, goal, committed cell, conflict,
 /// replan, agent down, collision).
 pub const LEGEND_MARKERS: usize = 7;
@@ -120,7 +123,7 @@ impl Layout {
         Self::with_events(cols, rows, heatmaps, robots, 0)
     }
 
-    /// [`Layout::new`] with `events` lines of process events under the legend.
+    /// [`Layout::new`] with `events` lines of criteria and process events under the legend.
     pub fn with_events(
         cols: u32,
         rows: u32,
@@ -171,7 +174,7 @@ impl Layout {
         );
         let event_lines = match events {
             0 => 0,
-            n => 1 + n.min(MAX_EVENT_LINES + 1) as i32,
+            n => 1 + n.min(MAX_EVENT_LINES + 1 + MAX_CRITERIA_LINES) as i32,
         };
         Layout {
             width: (right + MARGIN) as u32,
@@ -245,7 +248,7 @@ mod tests {
         let many = Layout::with_events(12, 12, 1, 6, 100);
         assert_eq!(
             many.height as i32,
-            plain.height as i32 + (2 + MAX_EVENT_LINES as i32) * LEGEND_LINE
+            plain.height as i32 + (2 + (MAX_EVENT_LINES + MAX_CRITERIA_LINES) as i32) * LEGEND_LINE
         );
     }
 

@@ -20,9 +20,11 @@ pub const LOCK_FILE: &str = ".hnav-run.lock";
 
 /// What a run writes into its directory: the consensus log, the agents' and the sim's
 /// checkpoints, the processes' output, the summary, the event journal, the coordinator's
-/// counts of dropped candidates, the recording, the copy of the map, the report and how the
-/// run was started (for `hnav log replay`). `--force` removes these and nothing else.
-pub const RUN_OUTPUTS: [&str; 12] = [
+/// counts of dropped candidates, the sim's and the coordinator's criteria, the recording,
+/// the copy of the map, the report and how the run was started (for `hnav log replay`).
+/// `--force` removes these and nothing else (a restarted coordinator or sim reads its own
+/// file back, so an earlier run's must not be left).
+pub const RUN_OUTPUTS: [&str; 14] = [
     "log",
     "agents",
     "sim.ckpt.0",
@@ -31,6 +33,8 @@ pub const RUN_OUTPUTS: [&str; 12] = [
     "summary.json",
     "events.jsonl",
     hnav_runtime::rejected::FILE,
+    hnav_runtime::criteria::files::SIM_FILE,
+    hnav_runtime::criteria::files::LATENCY_FILE,
     crate::recording::DIR,
     crate::report::MAP_FILE,
     crate::report::FILE,

@@ -15,13 +15,16 @@ use serde::Serialize;
 
 use hnav_runtime::consensus_log::{read_decided, LogError, Record, Tally};
 
+mod criteria;
+mod table;
 mod tasks;
+pub use criteria::LatencySummary;
 use hnav_runtime::msg::{LifecycleEvent, Role, Truth};
 use hnav_runtime::rejected::Rejections;
 pub use tasks::TaskSummary;
 
 /// One agent's line of the summary.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct AgentSummary {
     /// Agent index.
     pub id: u32,
@@ -45,6 +48,26 @@ pub struct AgentSummary {
     /// supervisor gave it up): its robot stood for the rest of the run and its goal counts
     /// as not reached, wherever the robot is.
     pub lost: bool,
+    /// Octile shortest path from its start to its goal on the map the run ended with, cells
+    /// (`None`: none there, or a run with `[tasks]`).
+    pub shortest: Option<f64>,
+    /// Path optimality: `length / shortest`, for a robot that reached its goal.
+    pub optimality: Option<f64>,
+    /// Simulated seconds until its true pose first ended a control period in its goal cell
+    /// (the sim's measure; `None` if it never did or the sim left no figures).
+    pub time_to_goal_s: Option<f64>,
+    /// Energy its motors drew over the run, J (the sim's wheel model).
+    pub energy_j: Option<f64>,
+    /// Energy of `shortest` driven straight at its nominal speed under the same model, J.
+    pub energy_budget_j: Option<f64>,
+    /// Partial corrections of its neural map (§2.10 A), from its log.
+    pub repairs_partial: u32,
+    /// Neural map rebuilt from zero (§2.10 Б), from its log.
+    pub repairs_rebuild: u32,
+    /// New routes of a route planner (PSO, GA) after a change, from its log.
+    pub repairs_replan: u32,
+    /// Requests into a cell that was closed in the sim's truth at that round.
+    pub false_positives: u32,
 }
 
 /// A robot lost during the run: its agent's process exited and was not restarted.
@@ -106,6 +129,9 @@ pub struct RunSummary {
     /// A lifelong run's tasks (`[tasks]`); absent for a run without.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tasks: Option<TaskSummary>,
+    /// The rounds' candidate-to-commit latencies as the coordinator measured them (`None`:
+    /// it left none, as on a host without the coordinator).
+    pub consensus_latency_us: Option<LatencySummary>,
 }
 
 impl RunSummary {
@@ -209,6 +235,7 @@ impl RunSummary {
                 replans: t.replans,
                 unreachable: unreachable.contains(&id),
                 lost: lost.contains(&id),
+                ..AgentSummary::default()
             })
             .collect();
         if let (Some(t), Some(h)) = (truth, header) {
@@ -238,6 +265,7 @@ impl RunSummary {
             report_error: None,
             counts_on_host: None,
             tasks: lifelong.map(|period| TaskSummary::new(&tasks, rounds, period)),
+            consensus_latency_us: None,
         })
     }
 
@@ -274,6 +302,7 @@ impl RunSummary {
                 replans: 0,
                 unreachable: false,
                 lost: false,
+                ..AgentSummary::default()
             })
             .collect();
         let all_home = !agents.is_empty() && agents.iter().all(|a| a.reached_goal);
@@ -304,7 +333,17 @@ impl RunSummary {
             report_error: None,
             counts_on_host: None,
             tasks: None,
+            consensus_latency_us: None,
         }
+    }
+
+    /// Fills the criteria of the dissertation (§2.1) that are not in the log's tally: path
+    /// optimality, time to goal, energy and its budget, repairs, false positives and the
+    /// consensus latency, from `scenario`, the run directory `run_dir` and the consensus log
+    /// (`log`; see the `criteria` module).
+    pub fn fill_criteria(&mut self, scenario: &hnav_runtime::scenario::Scenario, run_dir: &Path) {
+        let log = self.log.clone();
+        criteria::fill(self, scenario, run_dir, &log);
     }
 
     /// Writes `summary.json` into `dir` atomically; returns its path.
@@ -318,64 +357,6 @@ impl RunSummary {
         let text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)? + "\n";
         hnav_runtime::durable::replace_file(&path, text.as_bytes())?;
         Ok(path)
-    }
-
-    /// The table `hnav run` prints: a line per agent, the run's line (naming the rules it
-    /// ran, so that runs under different rules are not compared by mistake) and, when any
-    /// process was restarted, its restarts.
-    pub fn render(&self) -> String {
-        let mut s = String::from("agent  goal  steps  length  conflicts  waited  replans\n");
-        for a in &self.agents {
-            let goal = match (a.reached_goal, a.unreachable, a.lost) {
-                (true, _, _) => "yes",
-                (false, _, true) => "lost",
-                (false, true, false) => "unreachable",
-                (false, false, false) => "NO",
-            };
-            s += &match self.counts_on_host {
-                None => format!(
-                    "{:>5}  {:>4}  {:>5}  {:>6.2}  {:>9}  {:>6}  {:>7}\n",
-                    a.id, goal, a.steps, a.length, a.conflicts, a.waited, a.replans
-                ),
-                Some(_) => format!(
-                    "{:>5}  {goal:>4}  {:>5}  {:>6}  {:>9}  {:>6}  {:>7}\n",
-                    a.id, "-", "-", "-", "-", "-"
-                ),
-            };
-        }
-        if let Some(host) = &self.counts_on_host {
-            s += &format!(
-                "(steps, length, conflicts, waited, replans: in the consensus log on host {host}; goals, collisions and rounds: from what crossed the bridge)\n"
-            );
-        }
-        let at_goal = self.agents.iter().filter(|a| a.reached_goal).count();
-        let rules = if self.rules.is_empty() {
-            String::new()
-        } else {
-            format!("{} rules, ", self.rules)
-        };
-        s += &format!(
-            "{} of {} at goal, {} collisions, {} rounds, {:.2} s wall ({}, {rules}{})\n",
-            at_goal,
-            self.agents.len(),
-            self.collisions,
-            self.rounds,
-            self.wall_time_s,
-            self.mode,
-            self.end
-        );
-        if let Some(t) = &self.tasks {
-            s += &t.render();
-        }
-        if !self.restarts.is_empty() {
-            let each: Vec<String> = self
-                .restarts
-                .iter()
-                .map(|(p, n)| format!("{p} {n}"))
-                .collect();
-            s += &format!("restarts: {}\n", each.join(", "));
-        }
-        s
     }
 }
 
@@ -437,13 +418,13 @@ mod tests {
         home.counts_on_host = Some("base".into());
         let table = home.render();
         assert!(
-            table.contains("    0   yes      -       -          -       -        -\n"),
+            table.contains("    0   yes      -       -          -       -        -        -        -       -       -    0/0/0       -\n"),
             "{table}"
         );
         assert!(!table.contains("0.00"), "{table}");
         assert!(
             table.contains(
-                "(steps, length, conflicts, waited, replans: in the consensus log on host base;"
+                "(steps, length, conflicts, waited, replans: in the consensus log on host base; optimal and false+ too;"
             ),
             "{table}"
         );

@@ -5,6 +5,7 @@
 use std::process::ExitCode;
 
 use clap::Parser;
+use hnav_runtime::criteria::files::SIM_FILE;
 use hnav_runtime::launch::{process_main, LifecyclePorts, ProcessArgs};
 use hnav_runtime::msg::Role;
 use hnav_runtime::transport::Transport;
@@ -42,6 +43,12 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         sim = sim.with_lifecycle(ports);
     }
     let out = sim.run(args.periods)?;
+    // The summary's energy and goal times; a run without them still counts.
+    if let Some(dir) = &args.common.dir {
+        if let Err(e) = sim.world().criteria().store(dir) {
+            tracing::warn!("cannot write {}: {e}", dir.join(SIM_FILE).display());
+        }
+    }
     for c in sim.world().collisions() {
         tracing::warn!(
             t_s = c.time_ns as f64 * 1e-9,

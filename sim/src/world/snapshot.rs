@@ -5,11 +5,12 @@
 //! that a step reads and the scenario does not fix (step count, poses with the carried
 //! heading rotations, wheel speeds, commands, wheel angles, slip factors and each robot's
 //! position in its slip stream, the collision detector's contacts in progress, the collisions
-//! so far). Floats travel as their bits, so a restored world steps on bit for bit as the
-//! original would have: in lockstep a run resumed from a checkpoint decides what the run
+//! so far, the energy each robot's motors drew and when it first stood in its goal cell).
+//! Floats travel as their bits, so a restored world steps on bit for bit as the original
+//! would have: in lockstep a run resumed from a checkpoint decides what the run
 //! without the kill decided.
 //!
-//! Encoding: little-endian `u64` words — a magic, the robot count, the step count, 20 words
+//! Encoding: little-endian `u64` words — a magic, the robot count, the step count, 23 words
 //! per robot, the contacts and collisions each as a count and fixed-size entries; the
 //! caller frames it (the process adds its own header and a checksum).
 
@@ -18,7 +19,7 @@ use nalgebra::{Complex, Point2, UnitComplex};
 use super::World;
 use crate::collision::{Collision, Hit};
 
-const MAGIC: u64 = 0x5753_5641_4e48_0001; // "HNAVSW" v1
+const MAGIC: u64 = 0x5753_5641_4e48_0002; // "HNAVSW" v2
 /// Words of one collision entry.
 const COLLISION_WORDS: usize = 9;
 
@@ -106,11 +107,13 @@ impl World {
                 self.phir[i],
                 self.slip_l[i],
                 self.slip_r[i],
+                self.meter.energy_j[i],
             ] {
                 put(out, v.to_bits());
             }
             put_option(out, self.cmd_at[i]);
             put_option(out, self.cmd_period[i]);
+            put_option(out, self.meter.goal_at_ns[i]);
             put(out, word as u64);
             put(out, (word >> 64) as u64);
             put(out, u64::from(self.detector.on_wall(i)));
@@ -164,8 +167,10 @@ impl World {
             next.phir[i] = w.f64()?;
             next.slip_l[i] = w.f64()?;
             next.slip_r[i] = w.f64()?;
+            next.meter.energy_j[i] = w.f64()?;
             next.cmd_at[i] = w.option()?;
             next.cmd_period[i] = w.option()?;
+            next.meter.goal_at_ns[i] = w.option()?;
             let (lo, hi) = (w.next()?, w.next()?);
             next.noise[i].set_word_pos(u128::from(lo) | (u128::from(hi) << 64));
             let on_wall = w.next()? != 0;
@@ -273,6 +278,8 @@ mod tests {
         drive(&mut b, 900);
         assert_eq!(truth_bytes(&a), truth_bytes(&b));
         assert_eq!(a.collisions(), b.collisions());
+        assert_eq!(a.criteria(), b.criteria());
+        assert!(a.criteria().robots.iter().all(|r| r.energy_j > 0.0));
     }
 
     #[test]

@@ -13,9 +13,11 @@
 //! | `roster` | [`Roster`]: per agent live, down or lost, and its restarts |
 //! | `dropped` | [`Dropped`]: the counts of dropped candidates, kept across restarts |
 //! | `world` | [`World`]: the agents' sightings waiting for their round, the restarted agents waiting for the map |
+//! | `latency` | [`Latency`]: the rounds' candidate-to-commit latencies, kept across restarts |
 
 mod dropped;
 mod end_watch;
+mod latency;
 mod open_round;
 mod roster;
 mod supervisor;
@@ -40,6 +42,7 @@ use crate::replication::{Overheard, RaftLog};
 use crate::round::Arbiter;
 use dropped::Dropped;
 use end_watch::EndWatch;
+use latency::Latency;
 use open_round::OpenRound;
 use roster::Roster;
 use world::World;
@@ -56,6 +59,7 @@ pub(super) struct State {
     roster: Roster,
     watch: EndWatch,
     dropped: Dropped,
+    latency: Latency,
     /// The supervisor's events of one drain, kept so that draining allocates nothing once warm.
     events: Vec<Lifecycle>,
     /// A following replica's memory of the supervisor.
@@ -154,6 +158,7 @@ impl State {
             roster: Roster::new(n),
             watch: EndWatch::new(scenario),
             dropped: Dropped::load(run_dir),
+            latency: Latency::load(run_dir),
             events: Vec::new(),
             heard: Overheard::new(n),
             roster_due: false,
@@ -292,10 +297,11 @@ impl State {
         Ok(())
     }
 
-    /// Logs the totals of dropped candidates (if any) and keeps them for the run summary and
-    /// for a coordinator restarted after this one.
+    /// Logs the totals of dropped candidates (if any) and keeps them, with the rounds'
+    /// latencies, for the run summary and for a coordinator restarted after this one.
     pub(super) fn report_rejections(&self) {
         self.dropped.report();
+        self.latency.report();
     }
 
     /// Publishes the last logged round's commit again, if there is one.
@@ -353,6 +359,7 @@ impl State {
         // A replica's round is final once a majority holds it; only then may it leave.
         if self.settle(waiter, tick)? {
             publish_commit(p, &rec, self.log.term())?;
+            self.latency.note(self.open.came());
         }
         self.last_record = Some(rec);
         self.round = round;

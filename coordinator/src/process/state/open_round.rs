@@ -18,6 +18,8 @@ pub(super) struct OpenRound {
     present: Vec<Candidate>,
     /// When its first candidate came; `None` while it has none.
     opened: Option<Instant>,
+    /// When its last candidate came.
+    last: Option<Instant>,
     clock: ClockMode,
     /// `round_deadline_ms`: how long a realtime round waits after its first candidate.
     deadline: Duration,
@@ -31,6 +33,7 @@ impl OpenRound {
             pending: vec![None; n],
             present: Vec::with_capacity(n),
             opened: None,
+            last: None,
             clock: scenario.sim.clock,
             deadline: Duration::from_millis(u64::from(scenario.coordinator.round_deadline_ms)),
         }
@@ -38,10 +41,17 @@ impl OpenRound {
 
     /// Takes in a candidate for this round (checked, of a known agent).
     pub(super) fn take(&mut self, c: Candidate) {
+        let now = Instant::now();
         if self.pending.iter().all(Option::is_none) {
-            self.opened = Some(Instant::now());
+            self.opened = Some(now);
         }
+        self.last = Some(now);
         self.pending[c.agent as usize] = Some(c);
+    }
+
+    /// When its first and its last candidate came (`None` while it has none).
+    pub(super) fn came(&self) -> (Option<Instant>, Option<Instant>) {
+        (self.opened, self.last)
     }
 
     /// Per agent, its candidate or `None`.
@@ -92,5 +102,6 @@ impl OpenRound {
     pub(super) fn clear(&mut self) {
         self.pending.iter_mut().for_each(|c| *c = None);
         self.opened = None;
+        self.last = None;
     }
 }

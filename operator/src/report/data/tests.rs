@@ -326,3 +326,27 @@ fn the_drawing_holds_one_element_per_mark() {
     );
     assert!(svg.contains("1 process restarts"), "{svg}");
 }
+
+#[test]
+fn the_criteria_lines_add_up_the_agents_and_name_the_latency() {
+    let v = serde_json::json!({
+        "agents": [
+            {"optimality": 1.0, "time_to_goal_s": 3.5, "energy_j": 2.0, "energy_budget_j": 1.5,
+             "repairs_partial": 1, "repairs_rebuild": 0, "repairs_replan": 0, "false_positives": 2},
+            {"optimality": 1.5, "time_to_goal_s": 7.25, "energy_j": 1.0, "energy_budget_j": 0.5,
+             "repairs_partial": 0, "repairs_rebuild": 1, "repairs_replan": 0, "false_positives": 0},
+        ],
+        "consensus_latency_us": {"rounds": 700, "p50": 120, "p99": 950, "decide_p50": 40, "decide_p99": 300},
+    });
+    let lines = super::criteria_lines(&v);
+    assert_eq!(
+        lines,
+        [
+            "criteria: optimality mean 1.250 (max 1.500), last at goal 7.25 s, energy 3.00 J \
+             (budget 2.00 J), repairs 1 partial / 1 rebuild / 0 route, 2 false positives",
+            "consensus: candidate -> commit p50 120 us, p99 950 us (700 rounds)",
+        ]
+    );
+    // A summary of before the criteria: nothing to say.
+    assert!(super::criteria_lines(&serde_json::json!({"agents": [{"steps": 3}]})).is_empty());
+}

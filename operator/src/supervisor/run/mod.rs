@@ -289,6 +289,7 @@ fn summarize(
             RunSummary::from_truth(run.as_str(), scenario, truth, progress, ended.elapsed_s);
         summary.counts_on_host = Some(h.coordinator_host().to_string());
         summary.restarts = ended.restarts;
+        summary.fill_criteria(scenario, dir);
         summary.write_json(dir).map_err(io(dir))?;
         return Ok(summary);
     }
@@ -318,6 +319,7 @@ fn summarize(
     if let End::CannotGoOn(why) = ended.end {
         summary.cannot_go_on = Some(why);
     }
+    summary.fill_criteria(scenario, dir);
     summary.recording = ended.recording;
     summary.write_json(dir).map_err(io(dir))?;
     if let Err(e) = crate::report::write_report(dir, &crate::report::ReportOptions::default()) {
