@@ -32,7 +32,7 @@ mod changes;
 mod sensing;
 mod snapshot;
 
-use changes::Changes;
+use changes::{Changes, Robots};
 
 pub use snapshot::SnapshotError;
 
@@ -64,6 +64,9 @@ pub struct World {
     // Whether the watchdog brakes each robot, as of the last step: a change is logged (a
     // robot whose agent went silent, its host cut off, say, and its rejoining).
     braked: Vec<bool>,
+    // Whether each robot is in motion at this step (its wheels turn or are commanded to, the
+    // watchdog not braking): a mover that yields waits for one about to enter its next cell.
+    in_motion: Vec<bool>,
     // Wheel angles since the start (what the Hall sensors see), rad.
     phil: Vec<f64>,
     phir: Vec<f64>,
@@ -130,6 +133,7 @@ impl World {
             cmd_at: vec![None; n],
             cmd_period: vec![None; n],
             braked: vec![true; n],
+            in_motion: vec![false; n],
             phil: vec![0.0; n],
             phir: vec![0.0; n],
             slip_l: vec![0.0; n],
@@ -323,6 +327,8 @@ impl World {
             };
             self.wl[i] = l1;
             self.wr[i] = r1;
+            let commanded = !expired && (self.cmd_l[i] != 0.0 || self.cmd_r[i] != 0.0);
+            self.in_motion[i] = commanded || l1 != 0.0 || r1 != 0.0;
             // Trapezoidal wheel angle: exact for the acceleration-limited (linear) ramp.
             let (dphl, dphr) = (0.5 * (l0 + l1) * dt, 0.5 * (r0 + r1) * dt);
             self.phil[i] += dphl;
@@ -349,13 +355,15 @@ impl World {
                 .check(&self.grid, &self.pos, t, &mut self.collisions);
         }
         self.apply_changes();
-        let (r, cell) = (self.model.body_radius_m, self.model.cell_size_m);
-        let movers = self.changes.mover_contacts(
-            t as f64 * 1e-9,
-            t,
-            (&self.pos, r, cell),
-            &mut self.collisions,
-        );
+        let robots = Robots {
+            centres: &self.pos,
+            in_motion: &self.in_motion,
+            radius: self.model.body_radius_m,
+            cell: self.model.cell_size_m,
+        };
+        let movers =
+            self.changes
+                .mover_contacts(t as f64 * 1e-9, t, &robots, &mut self.collisions);
         movers
             + self
                 .detector

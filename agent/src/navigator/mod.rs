@@ -30,6 +30,10 @@
 //! - **Task** (lifelong runs, `[tasks]`): the waypoint is the agent's next goal. The robots it
 //!   learned as obstacles are forgotten (they have moved on) and the map is rebuilt toward it.
 //!
+//! A mover (`[[events]] mover`, seen with `[sensing]`) is a transient obstacle, never a map
+//! change: the agent does not ask for a cell it holds or is about to enter, nor set off
+//! into one (`movers.rs`).
+//!
 //! A step that does not climb (every neighbour lower, e.g. the visited cells the path
 //! constructor negates) is a local extremum: the agent says so in its candidate and stands,
 //! and the coordinator replans it. Right after a block, a step down is allowed: that is the
@@ -37,6 +41,7 @@
 
 mod climb;
 mod follow;
+mod movers;
 mod sense;
 #[cfg(test)]
 mod tests;
@@ -51,6 +56,7 @@ use crate::neural_map::NeuralMap;
 use crate::route::RoutePlanner;
 use climb::Climb;
 use follow::Follow;
+pub use movers::SET_OFF_CELLS;
 pub use sense::{Repair, RepairKind, PARTIAL_SWEEPS};
 
 /// What the agent is told at start.
@@ -116,6 +122,8 @@ pub struct Navigator {
     replanned: bool,
     /// The cells learned as obstacles (standing robots), forgotten at a new task.
     learned: Vec<Cell>,
+    /// The cells the newest view marks moving (`movers.rs`): kept out of, never learned.
+    movers: Vec<Cell>,
 }
 
 impl Navigator {
@@ -149,6 +157,7 @@ impl Navigator {
             unreachable,
             replanned: false,
             learned: Vec::new(),
+            movers: Vec::new(),
         })
     }
 
@@ -276,12 +285,19 @@ impl Navigator {
         } else if self.unreachable || self.guide_sees_no_path() {
             flags |= CandidateFlags::NO_PATH | CandidateFlags::STANDING;
         } else if !self.is_moving() {
+            let movers = self.mover_directions();
             let proposal = match &mut self.guide {
-                Guide::Climb(c) => c.propose(&self.grid, self.current),
+                Guide::Climb(c) => {
+                    c.refused(movers);
+                    c.propose(&self.grid, self.current)
+                }
                 Guide::Follow(f) => {
                     let (p, replanned) = f.propose(&self.grid, self.current, self.target);
                     self.replanned |= replanned;
-                    p
+                    match p {
+                        Proposal::Step(c) if self.movers.contains(&c) => Proposal::Wait,
+                        p => p,
+                    }
                 }
             };
             match proposal {
