@@ -85,6 +85,9 @@ pub struct World {
     seed: u64,
 }
 
+/// A wheel turning slower than this, rad/s, stands still (a mover does not wait for it).
+const STILL_RAD_S: f64 = 1e-3;
+
 impl World {
     /// A world of robots at `starts` on `grid`, with the scenario's robot and sim parameters.
     pub fn new(
@@ -328,7 +331,8 @@ impl World {
             self.wl[i] = l1;
             self.wr[i] = r1;
             let commanded = !expired && (self.cmd_l[i] != 0.0 || self.cmd_r[i] != 0.0);
-            self.in_motion[i] = commanded || l1 != 0.0 || r1 != 0.0;
+            // The motor lag decays a wheel speed geometrically, never quite to zero.
+            self.in_motion[i] = commanded || l1.abs() > STILL_RAD_S || r1.abs() > STILL_RAD_S;
             // Trapezoidal wheel angle: exact for the acceleration-limited (linear) ramp.
             let (dphl, dphr) = (0.5 * (l0 + l1) * dt, 0.5 * (r0 + r1) * dt);
             self.phil[i] += dphl;

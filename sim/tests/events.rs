@@ -175,17 +175,18 @@ fn turn(w: &mut World, steps: u64) {
 
 #[test]
 fn a_mover_that_yields_waits_at_a_cell_centre_while_a_robot_may_enter_its_next_cell() {
-    // Along row 1 past (2, 1), the cell above the robot's, at 1 cell/s.
+    // Along row 1 past (1, 1), (2, 1) and (3, 1), above the robot at (2, 2), at 1 cell/s.
     let path = "[[events]]\nat_s = 0\nmover = \"p\"\npath = [[0, 1], [5, 1]]\nspeed = 1\n";
     let cell = hnav_runtime::scenario::params::RobotParams::default().cell_size_m;
     let mut w = world(path);
     turn(&mut w, 5_000);
     let (_, at) = w.movers().next().unwrap();
-    assert_eq!((at.x / cell, at.y / cell), (1.5, 1.5), "waits at (1, 1)");
-    // Its view: the cell it holds and the one it waits to enter.
+    // (1, 1) is one diagonal move from the robot: claimed.
+    assert_eq!((at.x / cell, at.y / cell), (0.5, 1.5), "waits at (0, 1)");
+    // Its view: the cell it holds.
     let mut v = hnav_runtime::msg::View::default();
     w.fill_view(0, 0, 3, &mut v);
-    assert_eq!(v.moving_cells().collect::<Vec<_>>(), [(1, 1), (2, 1)]);
+    assert_eq!(v.moving_cells().collect::<Vec<_>>(), [(0, 1)]);
 
     // A checkpoint restores the wait: restored, it still waits.
     let mut bytes = Vec::new();
@@ -196,7 +197,7 @@ fn a_mover_that_yields_waits_at_a_cell_centre_while_a_robot_may_enter_its_next_c
     assert_eq!(back.movers().next().unwrap().1, at);
 
     // The robot stands: the mover walks by (a cell apart, no contact) to its end.
-    stand(&mut back, 5_000);
+    stand(&mut back, 7_000);
     let (_, end) = back.movers().next().unwrap();
     assert_eq!((end.x / cell, end.y / cell), (5.5, 1.5));
     assert!(back.collisions().is_empty(), "{:?}", back.collisions());
@@ -209,16 +210,29 @@ fn a_mover_that_yields_waits_at_a_cell_centre_while_a_robot_may_enter_its_next_c
 }
 
 #[test]
-fn a_view_marks_the_cells_a_mover_holds_and_the_one_beyond_the_one_it_enters() {
+fn a_mover_that_has_waited_long_turns_back() {
+    // West along row 1 from (5, 1); the turning robot at (2, 2) claims (3, 1), one diagonal
+    // move away: the mover waits at (4, 1) from 1 s, turns back at 4 s.
+    let path = "[[events]]\nat_s = 0\nmover = \"p\"\npath = [[5, 1], [0, 1]]\nspeed = 1\nrepeat = true\n";
+    let cell = hnav_runtime::scenario::params::RobotParams::default().cell_size_m;
+    let mut w = world(path);
+    turn(&mut w, 3_900);
+    let (_, at) = w.movers().next().unwrap();
+    assert_eq!((at.x / cell, at.y / cell), (4.5, 1.5), "waits at (4, 1)");
+    turn(&mut w, 500);
+    let (_, at) = w.movers().next().unwrap();
+    assert!(at.x / cell > 4.8, "back towards (5, 1): {}", at.x / cell);
+    assert!(w.collisions().is_empty(), "{:?}", w.collisions());
+}
+
+#[test]
+fn a_view_marks_the_cells_of_the_leg_a_mover_walks() {
     let mut w = world("[[events]]\nat_s = 0\nmover = \"p\"\npath = [[4, 0], [4, 4]]\nspeed = 1\n");
     stand(&mut w, 1500); // 1.5 cells walked: between (4, 1) and (4, 2)
     let mut v = hnav_runtime::msg::View::default();
     w.fill_view(0, 0, 5, &mut v);
-    assert_eq!(
-        v.moving_cells().collect::<Vec<_>>(),
-        [(4, 1), (4, 2), (4, 3)]
-    );
-    // Blocked: the cells its disc covers, both moving.
+    assert_eq!(v.moving_cells().collect::<Vec<_>>(), [(4, 1), (4, 2)]);
+    // Blocked: the cells its disc covers, here the same.
     let blocked: Vec<_> = v.cells().filter(|c| c.2).map(|c| (c.0, c.1)).collect();
     assert_eq!(blocked, [(4, 1), (4, 2)]);
 }

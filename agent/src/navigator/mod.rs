@@ -31,8 +31,8 @@
 //!   learned as obstacles are forgotten (they have moved on) and the map is rebuilt toward it.
 //!
 //! A mover (`[[events]] mover`, seen with `[sensing]`) is a transient obstacle, never a map
-//! change: the agent does not ask for a cell it holds or is about to enter, nor set off
-//! into one (`movers.rs`).
+//! change: the agent does not ask for a cell a mover holds or one next to it, nor set off
+//! into a held one (`movers.rs`).
 //!
 //! A step that does not climb (every neighbour lower, e.g. the visited cells the path
 //! constructor negates) is a local extremum: the agent says so in its candidate and stands,
@@ -285,21 +285,7 @@ impl Navigator {
         } else if self.unreachable || self.guide_sees_no_path() {
             flags |= CandidateFlags::NO_PATH | CandidateFlags::STANDING;
         } else if !self.is_moving() {
-            let movers = self.mover_directions();
-            let proposal = match &mut self.guide {
-                Guide::Climb(c) => {
-                    c.refused(movers);
-                    c.propose(&self.grid, self.current)
-                }
-                Guide::Follow(f) => {
-                    let (p, replanned) = f.propose(&self.grid, self.current, self.target);
-                    self.replanned |= replanned;
-                    match p {
-                        Proposal::Step(c) if self.movers.contains(&c) => Proposal::Wait,
-                        p => p,
-                    }
-                }
-            };
+            let proposal = self.propose_clear_of_movers();
             match proposal {
                 Proposal::Step(c) => probable = self.grid.index(c) as u32,
                 Proposal::Extremum => flags |= CandidateFlags::LOCAL_EXTREMUM,
@@ -316,6 +302,18 @@ impl Navigator {
             speed: self.task.speed as f32,
             flags,
             reserved: 0,
+        }
+    }
+
+    /// The guide's proposal from the robot's cell (movers aside).
+    fn guide_propose(&mut self) -> Proposal {
+        match &mut self.guide {
+            Guide::Climb(c) => c.propose(&self.grid, self.current),
+            Guide::Follow(f) => {
+                let (p, replanned) = f.propose(&self.grid, self.current, self.target);
+                self.replanned |= replanned;
+                p
+            }
         }
     }
 

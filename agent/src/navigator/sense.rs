@@ -6,7 +6,7 @@
 //! blocked opened, unless it is a standing robot the agent learned (those are not in the
 //! view: robots are known through the decision round). The cells the robot stands on,
 //! drives to or heads for are never closed in its own grid. A cell seen moving (a mover holds
-//! it or is about to enter it) is neither: it says nothing about the map (`movers.rs`).
+//! it) is neither: it says nothing about the map (`movers.rs`).
 //!
 //! The repair, for the neural map:
 //! - **rebuild** (§2.10 Б, a new map from zero) when a cell opened (partial correction only

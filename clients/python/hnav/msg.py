@@ -257,7 +257,8 @@ class View(_Payload):
     """What robot `agent`'s range sensor sees: a `size` x `size` window of cells from
     (`x0`, `y0`); bit `c` of row `r` is cell (`x0 + c`, `y0 + r`), in `seen` if it is in range
     and in line of sight, in `blocked` if it is then a wall, a closed cell or a mover's, in
-    `moving` if a mover holds it or is about to enter it (then it says nothing about the map)."""
+    `moving` if a mover holds it: stands in it or walks the leg into or out of it (then it says
+    nothing about the map)."""
 
     _fields_ = [
         ("sim_time_ns", ctypes.c_uint64),
@@ -280,7 +281,7 @@ class View(_Payload):
                     yield (self.x0 + c, self.y0 + r, bool(self.blocked[r] >> c & 1))
 
     def moving_cells(self):
-        """Every cell seen that a mover holds or is about to enter, as (x, y), row by row."""
+        """Every cell seen that a mover holds, as (x, y), row by row."""
         for x, y, _ in self.cells():
             if self.moving[y - self.y0] >> (x - self.x0) & 1:
                 yield (x, y)

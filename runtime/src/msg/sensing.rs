@@ -1,7 +1,6 @@
 //! What a robot's range sensor sees of the world (an emulated LiDAR, seed 000 §3.1.1): the
 //! cells within range and in line of sight, free or blocked, as the sim's truth has them, and
-//! which of them a moving obstacle holds or is about to enter (a tracker's estimate of its
-//! motion).
+//! which of them a moving obstacle holds.
 
 use iceoryx2::prelude::ZeroCopySend;
 
@@ -12,9 +11,9 @@ pub const VIEW_EDGE: usize = 32;
 /// cells whose top-left cell is (`x0`, `y0`), centred on the robot's cell (clipped to the
 /// map). Bit `c` of row `r` stands for cell (`x0 + c`, `y0 + r`): in `seen` if it is within
 /// range and in line of sight, in `blocked` if it is then a wall, a closed cell or a moving
-/// obstacle's, in `moving` if a mover holds it or is about to enter it (then it says nothing
-/// about the map: the agent keeps out of it for now and does not learn it). A cell not seen
-/// says nothing.
+/// obstacle's, in `moving` if a mover holds it: stands in it, or walks the leg into or out of
+/// it (then it says nothing about the map: the agent keeps out of it for now and does not
+/// learn it). A cell not seen says nothing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C)]
 #[type_name("hnav::View")]
@@ -35,7 +34,7 @@ pub struct View {
     pub seen: [u32; VIEW_EDGE],
     /// Per window row, the cells seen blocked.
     pub blocked: [u32; VIEW_EDGE],
-    /// Per window row, the cells seen that a mover holds or is about to enter.
+    /// Per window row, the cells seen that a mover holds.
     pub moving: [u32; VIEW_EDGE],
 }
 

@@ -13,12 +13,20 @@
 //! **Who yields.** A person or a forklift driver stops for a robot in the way, so a mover that
 //! yields (the default) waits at a cell centre while the next cell of its path is *claimed*
 //! by a robot: the robot's disc overlaps it, or the robot is in motion (its wheels turn or are
-//! commanded to) with its centre within one cell of that cell's centre, about to enter it. It
+//! commanded to) with its centre within one move (straight or diagonal) of that cell's
+//! centre, about to enter it. It
 //! looks only at cell centres, where it stands wholly in one cell: once it has set off into a
 //! cell it walks through. The robots keep the other half of the bargain (the agent's rule,
-//! `agent/src/navigator/movers.rs`): the view marks the cells a mover holds and the cell
-//! beyond the one it is entering (see [`Changes::moving_cells`]), and a robot does not set off
-//! into a marked cell. A mover with `yields = false` walks on regardless.
+//! `agent/src/navigator/movers.rs`): the view marks the cells a mover holds (see
+//! [`Changes::moving_cells`]), and a robot asks for none of them nor for a cell next to one
+//! (where a mover may go next), and does not set off into a held one. A robot in motion
+//! claims the cell it enters, so a mover that yields never walks into a robot's way; a robot
+//! standing next to a mover's next cell does not claim it, so the mover passes it, a cell
+//! away (with the default body, two radii are 0.725 cell: robots a cell apart do not touch).
+//! A mover that walks back and forth and has waited [`TURN_BACK_S`] turns back: the robot it
+//! waits for may itself be waiting for the mover to leave (pushed into the mover's cell by
+//! the coordinator, or head-on in a one-cell corridor), and a person would give way. A mover
+//! with `yields = false` walks on regardless.
 
 use hnav_runtime::scenario::{EventSpec, MoverSpec, WorldChange};
 use nalgebra::Point2;
@@ -34,6 +42,8 @@ struct Active {
     walked: f64,
     /// The time it was moved to last, s.
     moved_s: f64,
+    /// How long it has waited at its cell centre, s.
+    waited_s: f64,
     /// Per robot: touching it at the last step.
     touching: Vec<bool>,
     /// Where it is now, m.
@@ -53,15 +63,16 @@ pub(crate) struct Robots<'a> {
 }
 
 impl Robots<'_> {
-    /// Whether a robot is in cell `c` or about to enter it (in motion, within one cell of its
-    /// centre).
+    /// Whether a robot is in cell `c` or about to enter it (in motion, one move, straight or
+    /// diagonal, from its centre).
     fn claim(&self, c: Cell) -> bool {
         let (x, y) = (i64::from(c.x), i64::from(c.y));
         let centre = Point2::new(
             (f64::from(c.x) + 0.5) * self.cell,
             (f64::from(c.y) + 0.5) * self.cell,
         );
-        let near = self.cell * (1.0 + 1e-6);
+        // One move away, straight or diagonal.
+        let near = self.cell * (std::f64::consts::SQRT_2 + 1e-6);
         self.centres.iter().zip(self.in_motion).any(|(p, &moving)| {
             disc_overlaps_cell(p, self.radius, x, y, self.cell)
                 || (moving && (p - centre).norm_squared() <= near * near)
@@ -69,7 +80,26 @@ impl Robots<'_> {
     }
 }
 
+/// How long a mover that yields and walks back and forth waits for a robot before it turns
+/// back, s: a robot committed to the cell it stands in may be waiting for it to leave (a
+/// robot pushed there by the coordinator, or one in a one-cell corridor), and one of the two
+/// must give way.
+pub(crate) const TURN_BACK_S: f64 = 3.0;
+
 impl Active {
+    /// Walks the other way from its cell centre: the same cell of its back-and-forth path,
+    /// the other direction.
+    fn turn_back(&mut self) {
+        let period = 2 * (self.spec.cells.len() as u64 - 1);
+        if period == 0 {
+            return;
+        }
+        let k = self.walked as u64 % period;
+        self.walked += ((period - k) % period) as f64 - k as f64;
+        self.waited_s = 0.0;
+        tracing::info!(mover = self.spec.name, "mover turned back");
+    }
+
     /// Walks on to `t_s`, waiting at a cell centre while a robot claims the next cell if it
     /// yields. It stops at every centre it reaches, so it looks there before going on.
     fn walk(&mut self, t_s: f64, robots: &Robots<'_>) {
@@ -80,8 +110,13 @@ impl Active {
             let from = self.walked.floor();
             let ahead = self.spec.cell_at(from as u64 + 1);
             if self.walked == from && self.spec.yields && robots.claim(ahead) {
+                self.waited_s += left / self.spec.speed;
+                if self.spec.repeat && self.waited_s >= TURN_BACK_S {
+                    self.turn_back();
+                }
                 return;
             }
+            self.waited_s = 0.0;
             let to = from + 1.0;
             let step = (to - self.walked).min(left);
             left -= step;
@@ -136,6 +171,7 @@ impl Changes {
                         spec: m.clone(),
                         walked: 0.0,
                         moved_s: e.at_s,
+                        waited_s: 0.0,
                         touching: vec![false; robots],
                         at: Point2::origin(),
                     });
@@ -184,32 +220,32 @@ impl Changes {
         self.movers.iter().map(|m| (m.spec.name.as_str(), m.at))
     }
 
-    /// The cells the views mark moving: per mover, the cells of its path from the one it
-    /// stands in or leaves to the one beyond the one it enters. A robot that sets off into
-    /// none of them cannot meet a mover in the period it sets off in (a mover walks a cell
-    /// in far more than a period), and once it is under way it claims the cell ahead, for
-    /// which a mover that yields waits.
+    /// The cells the movers hold, which the views mark moving: the cell a mover stands in
+    /// at a centre, or the two of the leg it walks (the one it leaves and the one it
+    /// enters). The cells next to those are where a mover may go next; the agents keep out
+    /// of them too (`agent/src/navigator/movers.rs`).
     pub(crate) fn moving_cells(&self) -> impl Iterator<Item = Cell> + '_ {
         self.movers.iter().flat_map(|m| {
-            let from = m.walked.floor() as u64;
-            let to = (m.walked + 1.0).ceil() as u64;
+            let (from, to) = (m.walked.floor() as u64, m.walked.ceil() as u64);
             (from..=to).map(|k| m.spec.cell_at(k))
         })
     }
 
-    /// How far each mover under way has walked, for the sim's checkpoint.
-    pub(crate) fn walked(&self) -> impl Iterator<Item = f64> + '_ {
-        self.movers.iter().map(|m| m.walked)
+    /// How far each mover under way has walked and how long it has waited, for the sim's
+    /// checkpoint.
+    pub(crate) fn walked(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
+        self.movers.iter().map(|m| (m.walked, m.waited_s))
     }
 
-    /// Takes how far each mover walked from a checkpoint taken at `t_s`; false if the count
-    /// is not that of the movers under way.
-    pub(crate) fn restore_walked(&mut self, walked: &[f64], t_s: f64, cell: f64) -> bool {
+    /// Takes how far each mover walked and how long it waited from a checkpoint taken at
+    /// `t_s`; false if the count is not that of the movers under way.
+    pub(crate) fn restore_walked(&mut self, walked: &[(f64, f64)], t_s: f64, cell: f64) -> bool {
         if walked.len() != self.movers.len() {
             return false;
         }
-        for (m, &w) in self.movers.iter_mut().zip(walked) {
+        for (m, &(w, waited)) in self.movers.iter_mut().zip(walked) {
             m.walked = w;
+            m.waited_s = waited;
             m.moved_s = t_s;
             let (x, y) = m.spec.point_at(w);
             m.at = Point2::new((x + 0.5) * cell, (y + 0.5) * cell);

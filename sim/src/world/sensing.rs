@@ -1,8 +1,8 @@
 //! What each robot's range sensor sees (an emulated LiDAR, seed 000 §3.1.1): the cells
 //! within `range` of the robot's cell whose centres it sees in a straight line, free or
 //! blocked (a wall, a closed cell, a cell a mover's disc covers), as the truth has them now,
-//! and of those the cells a mover holds or is about to enter (moving: a tracker's estimate of
-//! each mover's motion, `changes.rs`'s [`Changes::moving_cells`](super::changes::Changes)).
+//! and of those the cells a mover holds (moving: the cell it stands in, or the two of the leg
+//! it walks; `changes.rs`).
 //!
 //! Line of sight runs from the robot's cell to the cell's, over the cells a Bresenham line
 //! crosses: any blocked cell strictly between hides it (the first blocked cell on a line is

@@ -11,7 +11,7 @@
 //!
 //! Encoding: little-endian `u64` words — a magic, the robot count, the step count, 20 words
 //! per robot, the contacts and collisions each as a count and fixed-size entries, the
-//! movers' walks (cells) as a count and a word each; the caller frames it (the process adds its own header and a checksum).
+//! movers' walks (cells walked, seconds waited) as a count and two words each; the caller frames it (the process adds its own header and a checksum).
 
 use nalgebra::{Complex, Point2, UnitComplex};
 
@@ -136,8 +136,9 @@ impl World {
             }
         }
         put(out, self.changes.walked().count() as u64);
-        for walked in self.changes.walked() {
+        for (walked, waited) in self.changes.walked() {
             put(out, walked.to_bits());
+            put(out, waited.to_bits());
         }
     }
 
@@ -200,8 +201,10 @@ impl World {
                 other_position: Point2::new(w.f64()?, w.f64()?),
             });
         }
-        let movers = w.count(1)?;
-        let walked = (0..movers).map(|_| w.f64()).collect::<Result<Vec<_>, _>>()?;
+        let movers = w.count(2)?;
+        let walked = (0..movers)
+            .map(|_| Ok((w.f64()?, w.f64()?)))
+            .collect::<Result<Vec<_>, SnapshotError>>()?;
         if !w.0.is_empty() {
             return Err(SnapshotError::Length);
         }
