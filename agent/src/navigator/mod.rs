@@ -123,7 +123,7 @@ pub struct Navigator {
     /// The cells learned as obstacles (standing robots), forgotten at a new task.
     learned: Vec<Cell>,
     /// The cells the newest view marks moving (`movers.rs`): kept out of, never learned.
-    movers: Vec<Cell>,
+    movers: movers::Movers,
 }
 
 impl Navigator {
@@ -157,7 +157,7 @@ impl Navigator {
             unreachable,
             replanned: false,
             learned: Vec::new(),
-            movers: Vec::new(),
+            movers: movers::Movers::default(),
         })
     }
 

@@ -36,6 +36,15 @@ use super::{Guide, Navigator, Proposal};
 /// body (0.36 cell radius) would touch a mover at the next cell's centre.
 pub const SET_OFF_CELLS: f64 = 0.15;
 
+/// The movers as the agent knows them.
+#[derive(Debug, Default)]
+pub(super) struct Movers {
+    /// The cells the newest view marks moving.
+    held: Vec<Cell>,
+    /// The last proposal waited for a mover.
+    waiting: bool,
+}
+
 /// Which cells a move must keep clear of.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Margin {
@@ -48,14 +57,13 @@ enum Margin {
 impl Navigator {
     /// Takes the cells `view` marks moving, in place of the last view's.
     pub(super) fn note_movers(&mut self, view: &View) {
-        self.movers.clear();
-        self.movers
-            .extend(view.moving_cells().map(|(x, y)| Cell::new(x, y)));
+        self.movers.held.clear();
+        (self.movers.held).extend(view.moving_cells().map(|(x, y)| Cell::new(x, y)));
     }
 
     /// Whether the newest view marks cell `c` held by a mover.
     pub fn mover_in(&self, c: Cell) -> bool {
-        self.movers.contains(&c)
+        self.movers.held.contains(&c)
     }
 
     /// Whether a mover holds cell `c` or one next to it along a row or a column.
@@ -81,6 +89,7 @@ impl Navigator {
     pub(super) fn propose_clear_of_movers(&mut self) -> Proposal {
         let near = self.mover_directions();
         if near == 0 {
+            self.movers.waiting = false;
             return self.guide_propose();
         }
         if self.mover_stands_next() {
@@ -88,7 +97,7 @@ impl Navigator {
                 c.refused(near);
             }
         }
-        match self.guide_propose() {
+        let p = match self.guide_propose() {
             Proposal::Step(c)
                 if Direction::between(self.current, c)
                     .is_some_and(|d| near & 1 << d.index() != 0) =>
@@ -96,7 +105,22 @@ impl Navigator {
                 Proposal::Wait
             }
             p => p,
+        };
+        self.note_kept_clear(p == Proposal::Wait);
+        p
+    }
+
+    /// Logs the start of each wait for a mover (once, not every round of it).
+    fn note_kept_clear(&mut self, waits: bool) {
+        if waits && !self.movers.waiting {
+            tracing::info!(
+                agent = self.task.index,
+                x = self.current.x,
+                y = self.current.y,
+                "waits for a mover"
+            );
         }
+        self.movers.waiting = waits;
     }
 
     /// Whether a mover stands still next to the robot's cell: a held cell there with no
@@ -107,7 +131,7 @@ impl Navigator {
 
     /// The directions from the robot's cell it must not ask for (bit `d` = direction `d`).
     fn mover_directions(&self) -> u8 {
-        if self.movers.is_empty() {
+        if self.movers.held.is_empty() {
             return 0;
         }
         Direction::ALL

@@ -211,13 +211,21 @@ fn hnav_check_lists_the_events() {
     let s = events(&[
         "at_round = 100\nclose = [[4, 1]]\n",
         "at_s = 3\nmover = \"forklift\"\npath = [[0, 2], [3, 2]]\nspeed = 0.5\n",
+        "at_s = 4\nmover = \"cart\"\npath = [[0, 3], [1, 3]]\nspeed = 1\nyields = false\n",
     ])
     .unwrap();
     let text = ScenarioReport::new(&s).render();
     assert!(text.contains("event     at 1.00 s: close (4, 1)"), "{text}");
     assert!(
         text.contains(
-            "event     at 3.00 s: mover `forklift` at 0.5 cells/s from (0, 2) over 4 cells"
+            "event     at 3.00 s: mover `forklift` at 0.5 cells/s from (0, 2) over 4 cells\n"
+        ),
+        "{text}"
+    );
+    assert!(
+        text.contains(
+            "event     at 4.00 s: mover `cart` at 1 cells/s from (0, 3) over 2 cells, yielding \
+             to no robot"
         ),
         "{text}"
     );

@@ -110,6 +110,10 @@ impl Active {
             let from = self.walked.floor();
             let ahead = self.spec.cell_at(from as u64 + 1);
             if self.walked == from && self.spec.yields && robots.claim(ahead) {
+                if self.waited_s == 0.0 {
+                    let (x, y) = (ahead.x, ahead.y);
+                    tracing::info!(mover = self.spec.name, x, y, t_s, "mover waits for a robot");
+                }
                 self.waited_s += left / self.spec.speed;
                 if self.spec.repeat && self.waited_s >= TURN_BACK_S {
                     self.turn_back();
