@@ -365,9 +365,9 @@ impl World {
             radius: self.model.body_radius_m,
             cell: self.model.cell_size_m,
         };
-        let movers =
-            self.changes
-                .mover_contacts(t as f64 * 1e-9, t, &robots, &mut self.collisions);
+        let movers = self
+            .changes
+            .mover_contacts(t as f64 * 1e-9, t, &robots, &mut self.collisions);
         movers
             + self
                 .detector

@@ -213,7 +213,8 @@ fn a_mover_that_yields_waits_at_a_cell_centre_while_a_robot_may_enter_its_next_c
 fn a_mover_that_has_waited_long_turns_back() {
     // West along row 1 from (5, 1); the turning robot at (2, 2) claims (3, 1), one diagonal
     // move away: the mover waits at (4, 1) from 1 s, turns back at 4 s.
-    let path = "[[events]]\nat_s = 0\nmover = \"p\"\npath = [[5, 1], [0, 1]]\nspeed = 1\nrepeat = true\n";
+    let path =
+        "[[events]]\nat_s = 0\nmover = \"p\"\npath = [[5, 1], [0, 1]]\nspeed = 1\nrepeat = true\n";
     let cell = hnav_runtime::scenario::params::RobotParams::default().cell_size_m;
     let mut w = world(path);
     turn(&mut w, 3_900);

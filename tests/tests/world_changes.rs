@@ -102,8 +102,13 @@ fn doors_and_movers_in_a_warehouse_every_robot_home_no_contact_and_the_run_repea
     for k in 0..2 {
         let dir = tmp.path().join(format!("run{k}"));
         // Exit 0, every robot at its goal, `collisions` 0: robot, wall and mover contacts.
-        let (summary, log) =
-            lockstep_all_home(&format!("warehouse-doors{k}"), &scenario, &dir, &registry, 4);
+        let (summary, log) = lockstep_all_home(
+            &format!("warehouse-doors{k}"),
+            &scenario,
+            &dir,
+            &registry,
+            4,
+        );
         logs.push(log);
         if k > 0 {
             continue;

@@ -126,7 +126,8 @@ impl Navigator {
     /// Whether a mover stands still next to the robot's cell: a held cell there with no
     /// held cell next to it (a mover walking a leg holds two).
     fn mover_stands_next(&self) -> bool {
-        neighbours(self.current).any(|c| self.mover_in(c) && !neighbours(c).any(|n| self.mover_in(n)))
+        neighbours(self.current)
+            .any(|c| self.mover_in(c) && !neighbours(c).any(|n| self.mover_in(n)))
     }
 
     /// The directions from the robot's cell it must not ask for (bit `d` = direction `d`).

@@ -304,7 +304,11 @@ fn event_line(e: &super::EventSpec) -> String {
             m.cells[0].x,
             m.cells[0].y,
             m.cells.len(),
-            if m.yields { "" } else { ", yielding to no robot" }
+            if m.yields {
+                ""
+            } else {
+                ", yielding to no robot"
+            }
         ),
     };
     format!("at {:.2} s: {what}", e.at_s)

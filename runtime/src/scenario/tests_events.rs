@@ -73,7 +73,19 @@ fn a_mover_goes_along_its_cells_and_back_or_stays_at_the_end() {
     assert_eq!(m.position(13.0), (0.5, 2.0), "and out again");
     // The cells it passes, every return counted.
     let passed: Vec<(u32, u32)> = (0..8).map(|k| m.cell_at(k)).map(|c| (c.x, c.y)).collect();
-    assert_eq!(passed, [(0, 2), (1, 2), (2, 2), (2, 1), (2, 2), (1, 2), (0, 2), (1, 2)]);
+    assert_eq!(
+        passed,
+        [
+            (0, 2),
+            (1, 2),
+            (2, 2),
+            (2, 1),
+            (2, 2),
+            (1, 2),
+            (0, 2),
+            (1, 2)
+        ]
+    );
     assert_eq!(m.end(), None);
     m.repeat = false;
     assert_eq!((m.cell_at(7), m.end()), (Cell::new(2, 1), Some(3.0)));
