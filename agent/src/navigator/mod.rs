@@ -45,6 +45,8 @@ mod movers;
 mod sense;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_movers;
 
 use hnav_runtime::grid::{reachable_from, Cell, CornerCutting, Direction, Grid};
 use hnav_runtime::msg::{
