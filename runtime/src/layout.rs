@@ -204,7 +204,8 @@ pub fn layouts() -> Layouts {
             y0: u32,
             size: u32,
             seen: [u32; 32],
-            blocked: [u32; 32]
+            blocked: [u32; 32],
+            moving: [u32; 32]
         }),
         layout!(Sighting {
             round: u64,

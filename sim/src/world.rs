@@ -33,7 +33,7 @@ mod criteria;
 mod sensing;
 mod snapshot;
 
-use changes::Changes;
+use changes::{Changes, Robots};
 use criteria::Meter;
 
 pub use snapshot::SnapshotError;
@@ -66,6 +66,9 @@ pub struct World {
     // Whether the watchdog brakes each robot, as of the last step: a change is logged (a
     // robot whose agent went silent, its host cut off, say, and its rejoining).
     braked: Vec<bool>,
+    // Whether each robot is in motion at this step (its wheels turn or are commanded to, the
+    // watchdog not braking): a mover that yields waits for one about to enter its next cell.
+    in_motion: Vec<bool>,
     // Wheel angles since the start (what the Hall sensors see), rad.
     phil: Vec<f64>,
     phir: Vec<f64>,
@@ -85,6 +88,9 @@ pub struct World {
     odometry_hz: u32,
     seed: u64,
 }
+
+/// A wheel turning slower than this, rad/s, stands still (a mover does not wait for it).
+const STILL_RAD_S: f64 = 1e-3;
 
 impl World {
     /// A world of robots at `starts` on `grid`, with the scenario's robot and sim parameters.
@@ -134,6 +140,7 @@ impl World {
             cmd_at: vec![None; n],
             cmd_period: vec![None; n],
             braked: vec![true; n],
+            in_motion: vec![false; n],
             phil: vec![0.0; n],
             phir: vec![0.0; n],
             slip_l: vec![0.0; n],
@@ -333,6 +340,9 @@ impl World {
             self.wl[i] = l1;
             self.wr[i] = r1;
             self.meter.energy_j[i] += wheel.step_j(l0, l1) + wheel.step_j(r0, r1);
+            let commanded = !expired && (self.cmd_l[i] != 0.0 || self.cmd_r[i] != 0.0);
+            // The motor lag decays a wheel speed geometrically, never quite to zero.
+            self.in_motion[i] = commanded || l1.abs() > STILL_RAD_S || r1.abs() > STILL_RAD_S;
             // Trapezoidal wheel angle: exact for the acceleration-limited (linear) ramp.
             let (dphl, dphr) = (0.5 * (l0 + l1) * dt, 0.5 * (r0 + r1) * dt);
             self.phil[i] += dphl;
@@ -362,13 +372,15 @@ impl World {
                 .check(&self.grid, &self.pos, t, &mut self.collisions);
         }
         self.apply_changes();
-        let (r, cell) = (self.model.body_radius_m, self.model.cell_size_m);
-        let movers = self.changes.mover_contacts(
-            t as f64 * 1e-9,
-            t,
-            (&self.pos, r, cell),
-            &mut self.collisions,
-        );
+        let robots = Robots {
+            centres: &self.pos,
+            in_motion: &self.in_motion,
+            radius: self.model.body_radius_m,
+            cell: self.model.cell_size_m,
+        };
+        let movers = self
+            .changes
+            .mover_contacts(t as f64 * 1e-9, t, &robots, &mut self.collisions);
         movers
             + self
                 .detector

@@ -63,7 +63,9 @@ fn a_cell_closed_ahead_is_hit_and_one_opened_again_is_not() {
 fn a_mover_crossing_the_robots_way_is_touched_once() {
     // Down column 7 and back at 0.5 cells/s for ever: the robot, driving along row 2,
     // meets it there.
-    let mover = "[[events]]\nat_s = 0\nmover = \"person\"\npath = [[7, 0], [7, 4]]\nspeed = 0.5\nrepeat = true\n";
+    // It walks on regardless (`yields = false`); one that yields would have walked on too,
+    // having set off into (7, 2) before the robot came near.
+    let mover = "[[events]]\nat_s = 0\nmover = \"person\"\npath = [[7, 0], [7, 4]]\nspeed = 0.5\nrepeat = true\nyields = false\n";
     let mut w = world(mover);
     drive(&mut w, 30_000);
     let hits: Vec<_> = (w.collisions().iter())
@@ -137,7 +139,10 @@ fn a_view_sees_what_is_in_range_and_in_sight_and_a_wall_hides_what_is_behind() {
 
 #[test]
 fn a_mover_in_range_is_seen_as_blocked_cells() {
-    let w = world("[[events]]\nat_s = 0\nmover = \"p\"\npath = [[4, 0], [4, 4]]\nspeed = 1\n");
+    // Walks on: one that yields would wait at (4, 1) for the robot driving along row 2.
+    let w = world(
+        "[[events]]\nat_s = 0\nmover = \"p\"\npath = [[4, 0], [4, 4]]\nspeed = 1\nyields = false\n",
+    );
     let mut w = w;
     drive(&mut w, 2000); // 2 s: the mover near (4, 2)
     let blocked: Vec<_> = seen(&w, 5)
@@ -147,4 +152,88 @@ fn a_mover_in_range_is_seen_as_blocked_cells() {
         .collect();
     assert!(blocked.iter().all(|&(x, _)| x == 4), "{blocked:?}");
     assert!(blocked.contains(&(4, 2)), "{blocked:?}");
+}
+
+/// Steps the world `steps` times with no command (the robot stands).
+fn stand(w: &mut World, steps: u64) {
+    for _ in 0..steps {
+        w.step();
+    }
+}
+
+/// Turns robot 0 on the spot for `steps` steps (commands renewed every 10): in motion,
+/// about to set off into a neighbour.
+fn turn(w: &mut World, steps: u64) {
+    for _ in 0..steps {
+        if w.steps().is_multiple_of(10) {
+            let (now, period) = (w.time_ns(), w.steps() / 10);
+            w.apply_command(0, period, -5.0, 5.0, now).unwrap();
+        }
+        w.step();
+    }
+}
+
+#[test]
+fn a_mover_that_yields_waits_at_a_cell_centre_while_a_robot_may_enter_its_next_cell() {
+    // Along row 1 past (1, 1), (2, 1) and (3, 1), above the robot at (2, 2), at 1 cell/s.
+    let path = "[[events]]\nat_s = 0\nmover = \"p\"\npath = [[0, 1], [5, 1]]\nspeed = 1\n";
+    let cell = hnav_runtime::scenario::params::RobotParams::default().cell_size_m;
+    let mut w = world(path);
+    turn(&mut w, 5_000);
+    let (_, at) = w.movers().next().unwrap();
+    // (1, 1) is one diagonal move from the robot: claimed.
+    assert_eq!((at.x / cell, at.y / cell), (0.5, 1.5), "waits at (0, 1)");
+    // Its view: the cell it holds.
+    let mut v = hnav_runtime::msg::View::default();
+    w.fill_view(0, 0, 3, &mut v);
+    assert_eq!(v.moving_cells().collect::<Vec<_>>(), [(0, 1)]);
+
+    // A checkpoint restores the wait: restored, it still waits.
+    let mut bytes = Vec::new();
+    w.write_snapshot(&mut bytes);
+    let mut back = world(path);
+    back.restore_snapshot(&bytes).unwrap();
+    turn(&mut back, 1000);
+    assert_eq!(back.movers().next().unwrap().1, at);
+
+    // The robot stands: the mover walks by (a cell apart, no contact) to its end.
+    stand(&mut back, 7_000);
+    let (_, end) = back.movers().next().unwrap();
+    assert_eq!((end.x / cell, end.y / cell), (5.5, 1.5));
+    assert!(back.collisions().is_empty(), "{:?}", back.collisions());
+
+    // One that does not yield walks by while the robot turns.
+    let mut on = world(&format!("{path}yields = false\n"));
+    turn(&mut on, 7_000);
+    let (_, end) = on.movers().next().unwrap();
+    assert_eq!((end.x / cell, end.y / cell), (5.5, 1.5));
+}
+
+#[test]
+fn a_mover_that_has_waited_long_turns_back() {
+    // West along row 1 from (5, 1); the turning robot at (2, 2) claims (3, 1), one diagonal
+    // move away: the mover waits at (4, 1) from 1 s, turns back at 4 s.
+    let path =
+        "[[events]]\nat_s = 0\nmover = \"p\"\npath = [[5, 1], [0, 1]]\nspeed = 1\nrepeat = true\n";
+    let cell = hnav_runtime::scenario::params::RobotParams::default().cell_size_m;
+    let mut w = world(path);
+    turn(&mut w, 3_900);
+    let (_, at) = w.movers().next().unwrap();
+    assert_eq!((at.x / cell, at.y / cell), (4.5, 1.5), "waits at (4, 1)");
+    turn(&mut w, 500);
+    let (_, at) = w.movers().next().unwrap();
+    assert!(at.x / cell > 4.8, "back towards (5, 1): {}", at.x / cell);
+    assert!(w.collisions().is_empty(), "{:?}", w.collisions());
+}
+
+#[test]
+fn a_view_marks_the_cells_of_the_leg_a_mover_walks() {
+    let mut w = world("[[events]]\nat_s = 0\nmover = \"p\"\npath = [[4, 0], [4, 4]]\nspeed = 1\n");
+    stand(&mut w, 1500); // 1.5 cells walked: between (4, 1) and (4, 2)
+    let mut v = hnav_runtime::msg::View::default();
+    w.fill_view(0, 0, 5, &mut v);
+    assert_eq!(v.moving_cells().collect::<Vec<_>>(), [(4, 1), (4, 2)]);
+    // Blocked: the cells its disc covers, here the same.
+    let blocked: Vec<_> = v.cells().filter(|c| c.2).map(|c| (c.0, c.1)).collect();
+    assert_eq!(blocked, [(4, 1), (4, 2)]);
 }

@@ -2,7 +2,8 @@
 //! robot sees it with its range sensor, repairs its neural map and arrives by the other
 //! route, in lockstep, the same log twice; the summary has the dissertation's criteria. The
 //! coordinator logs the change the robot saw and hands the map as it stands to an agent that
-//! restarts.
+//! restarts. And a warehouse with doors that close and open and two movers walking the
+//! robots' aisles: every robot home, no collision, no contact, the same log twice.
 
 use std::path::Path;
 
@@ -278,4 +279,68 @@ fn the_all_knowing_baseline_tells_every_agent_the_door_when_it_closes() {
         })
         .collect();
     assert_eq!(changes, [(CLOSED_AT, 0)]);
+}
+
+/// The rounds `scenarios/warehouse-doors.toml`'s doors are closed: from this round ...
+const DOORS_CLOSE: u64 = 100;
+/// ... to this one.
+const DOORS_OPEN: u64 = 1500;
+
+#[test]
+fn doors_and_movers_in_a_warehouse_every_robot_home_no_contact_and_the_run_repeats() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = repo_root().join("scenarios/warehouse-doors.toml");
+    let registry = tmp.path().join("runs");
+    let mut logs = Vec::new();
+    for k in 0..2 {
+        let dir = tmp.path().join(format!("run{k}"));
+        // Exit 0, every robot at its goal, `collisions` 0: robot, wall and mover contacts.
+        let (summary, log) = lockstep_all_home(
+            &format!("warehouse-doors{k}"),
+            &scenario,
+            &dir,
+            &registry,
+            4,
+        );
+        logs.push(log);
+        if k > 0 {
+            continue;
+        }
+        // No robot entered a door while it was closed.
+        for agent in 0..4 {
+            let walk = steps(&dir.join("log"), agent, 16);
+            assert!(
+                walk.iter().all(|&(round, x, y)| {
+                    !((DOORS_CLOSE..DOORS_OPEN).contains(&round)
+                        && [(5, 2), (10, 7)].contains(&(x, y)))
+                }),
+                "robot {agent} entered a closed door: {walk:?}"
+            );
+        }
+        let agent_logs: String = (0..4)
+            .map(|a| std::fs::read_to_string(dir.join(format!("logs/agent-{a}.log"))).unwrap())
+            .collect();
+        let repairs = |what: &str| {
+            (agent_logs.lines())
+                .filter(|l| l.contains("repair") && l.contains(what))
+                .count()
+        };
+        // The doors were seen closing and opening; the movers were not map changes.
+        let (closed, opened) = (repairs("closed=1"), repairs("opened=1"));
+        assert!(closed > 0 && opened > 0, "{agent_logs}");
+        // The robots met the movers and kept clear of them.
+        let kept_clear = agent_logs.matches("waits for a mover").count();
+        assert!(kept_clear > 0, "{agent_logs}");
+        let sim_log = std::fs::read_to_string(dir.join("logs/sim.log")).unwrap();
+        println!(
+            "warehouse-doors: {} rounds, {} collisions, repairs with a closed cell {closed}, \
+             with an opened cell {opened}; robots waited for a mover {kept_clear} times, movers \
+             for a robot {} times, turned back {} times",
+            summary["rounds"],
+            summary["collisions"],
+            sim_log.matches("mover waits for a robot").count(),
+            sim_log.matches("mover turned back").count()
+        );
+    }
+    assert!(logs[0] == logs[1], "the two lockstep logs differ");
 }

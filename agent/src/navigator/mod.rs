@@ -30,6 +30,10 @@
 //! - **Task** (lifelong runs, `[tasks]`): the waypoint is the agent's next goal. The robots it
 //!   learned as obstacles are forgotten (they have moved on) and the map is rebuilt toward it.
 //!
+//! A mover (`[[events]] mover`, seen with `[sensing]`) is a transient obstacle, never a map
+//! change: the agent does not ask for a cell a mover holds or one next to it, nor set off
+//! into a held one (`movers.rs`).
+//!
 //! A step that does not climb (every neighbour lower, e.g. the visited cells the path
 //! constructor negates) is a local extremum: the agent says so in its candidate and stands,
 //! and the coordinator replans it. Right after a block, a step down is allowed: that is the
@@ -37,9 +41,12 @@
 
 mod climb;
 mod follow;
+mod movers;
 mod sense;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_movers;
 
 use hnav_runtime::grid::{reachable_from, Cell, CornerCutting, Direction, Grid};
 use hnav_runtime::msg::{
@@ -51,6 +58,7 @@ use crate::neural_map::NeuralMap;
 use crate::route::RoutePlanner;
 use climb::Climb;
 use follow::Follow;
+pub use movers::SET_OFF_CELLS;
 pub use sense::{Repair, RepairKind, PARTIAL_SWEEPS};
 
 /// What the agent is told at start.
@@ -116,6 +124,8 @@ pub struct Navigator {
     replanned: bool,
     /// The cells learned as obstacles (standing robots), forgotten at a new task.
     learned: Vec<Cell>,
+    /// The cells the newest view marks moving (`movers.rs`): kept out of, never learned.
+    movers: movers::Movers,
 }
 
 impl Navigator {
@@ -149,6 +159,7 @@ impl Navigator {
             unreachable,
             replanned: false,
             learned: Vec::new(),
+            movers: movers::Movers::default(),
         })
     }
 
@@ -276,14 +287,7 @@ impl Navigator {
         } else if self.unreachable || self.guide_sees_no_path() {
             flags |= CandidateFlags::NO_PATH | CandidateFlags::STANDING;
         } else if !self.is_moving() {
-            let proposal = match &mut self.guide {
-                Guide::Climb(c) => c.propose(&self.grid, self.current),
-                Guide::Follow(f) => {
-                    let (p, replanned) = f.propose(&self.grid, self.current, self.target);
-                    self.replanned |= replanned;
-                    p
-                }
-            };
+            let proposal = self.propose_clear_of_movers();
             match proposal {
                 Proposal::Step(c) => probable = self.grid.index(c) as u32,
                 Proposal::Extremum => flags |= CandidateFlags::LOCAL_EXTREMUM,
@@ -300,6 +304,18 @@ impl Navigator {
             speed: self.task.speed as f32,
             flags,
             reserved: 0,
+        }
+    }
+
+    /// The guide's proposal from the robot's cell (movers aside).
+    fn guide_propose(&mut self) -> Proposal {
+        match &mut self.guide {
+            Guide::Climb(c) => c.propose(&self.grid, self.current),
+            Guide::Follow(f) => {
+                let (p, replanned) = f.propose(&self.grid, self.current, self.target);
+                self.replanned |= replanned;
+                p
+            }
         }
     }
 

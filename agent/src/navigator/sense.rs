@@ -2,10 +2,11 @@
 //! since its map was built, and the repair of its guide (§2.10).
 //!
 //! The view is the sim's truth within range and in line of sight. A cell seen blocked that
-//! the agent's grid has free closed (a door, a pallet, a passing mover); one seen free that
-//! the grid has blocked opened, unless it is a standing robot the agent learned (those are
-//! not in the view: robots are known through the decision round). The cells the robot
-//! stands on, drives to or heads for are never closed in its own grid.
+//! the agent's grid has free closed (a door, a pallet); one seen free that the grid has
+//! blocked opened, unless it is a standing robot the agent learned (those are not in the
+//! view: robots are known through the decision round). The cells the robot stands on,
+//! drives to or heads for are never closed in its own grid. A cell seen moving (a mover holds
+//! it) is neither: it says nothing about the map (`movers.rs`).
 //!
 //! The repair, for the neural map:
 //! - **rebuild** (§2.10 Б, a new map from zero) when a cell opened (partial correction only
@@ -57,8 +58,11 @@ impl Navigator {
     /// Folds `view` into the agent's grid and repairs the guide if a cell changed; returns
     /// the repair (none: the view matched the grid).
     pub fn sense(&mut self, view: &View, rule: RepairRule) -> Result<Option<Repair>, Error> {
+        self.note_movers(view);
+        // A mover's cells are transient, not a change of the map (`movers.rs`).
         let seen = view
             .cells()
+            .filter(|&(x, y, _)| !view.is_moving(x, y))
             .map(|(x, y, blocked)| (Cell::new(x, y), blocked));
         self.learn(seen, rule, view.period)
     }

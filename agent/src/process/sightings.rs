@@ -32,9 +32,11 @@ impl Sightings {
         }
     }
 
-    /// Notes every cell of `view` seen in another state than the picture's.
+    /// Notes every cell of `view` seen in another state than the picture's, but a mover's.
     pub(super) fn fold(&mut self, view: &View) {
-        for (x, y, blocked) in view.cells() {
+        // A mover's cells are not a change of the map: the coordinator would close and open
+        // them behind every person walking by.
+        for (x, y, blocked) in view.cells().filter(|&(x, y, _)| !view.is_moving(x, y)) {
             self.see(y * self.width + x, blocked);
         }
     }
@@ -105,6 +107,12 @@ mod tests {
         let mut v = View::default();
         v.reset(0, 0, 4);
         v.mark(1, 1, true); // cell 5: the coordinator said so already
+        s.fold(&v);
+        assert_eq!(s.unsent.len(), 2);
+        let mut v = View::default();
+        v.reset(0, 0, 4);
+        v.mark(3, 3, true);
+        v.mark_moving(3, 3); // a person walking by: no change of the map
         s.fold(&v);
         assert_eq!(s.unsent.len(), 2);
     }

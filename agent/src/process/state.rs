@@ -407,7 +407,9 @@ impl Core {
             return Ok(());
         }
         let pose = self.dr.pose();
-        let (l, r) = if self.nav.is_moving() {
+        let (cx, cy) = cell_centre_m(self.cell_size_m, self.nav.current());
+        let from_centre = (pose.x_m - cx).hypot(pose.y_m - cy) / self.cell_size_m;
+        let (l, r) = if self.nav.is_moving() && !self.nav.waits_for_mover(from_centre) {
             let (x, y) = cell_centre_m(self.cell_size_m, self.nav.next());
             let free = if self.ctl.needs_free_space() {
                 FreeSpace::from_grid(self.nav.grid(), self.cell_size_m, pose, self.ctl.range_m())

@@ -256,7 +256,9 @@ class MapHeader(_Payload):
 class View(_Payload):
     """What robot `agent`'s range sensor sees: a `size` x `size` window of cells from
     (`x0`, `y0`); bit `c` of row `r` is cell (`x0 + c`, `y0 + r`), in `seen` if it is in range
-    and in line of sight, in `blocked` if it is then a wall, a closed cell or a mover's."""
+    and in line of sight, in `blocked` if it is then a wall, a closed cell or a mover's, in
+    `moving` if a mover holds it: stands in it or walks the leg into or out of it (then it says
+    nothing about the map)."""
 
     _fields_ = [
         ("sim_time_ns", ctypes.c_uint64),
@@ -267,6 +269,7 @@ class View(_Payload):
         ("size", ctypes.c_uint32),
         ("seen", ctypes.c_uint32 * 32),
         ("blocked", ctypes.c_uint32 * 32),
+        ("moving", ctypes.c_uint32 * 32),
     ]
 
     def cells(self):
@@ -276,6 +279,12 @@ class View(_Payload):
             for c in range(size):
                 if self.seen[r] >> c & 1:
                     yield (self.x0 + c, self.y0 + r, bool(self.blocked[r] >> c & 1))
+
+    def moving_cells(self):
+        """Every cell seen that a mover holds, as (x, y), row by row."""
+        for x, y, _ in self.cells():
+            if self.moving[y - self.y0] >> (x - self.x0) & 1:
+                yield (x, y)
 
 
 # The most cells one Sighting carries (msg::SIGHTING_CELLS).

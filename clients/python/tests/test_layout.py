@@ -80,3 +80,16 @@ class LayoutTest(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class ViewTest(unittest.TestCase):
+    """A View's bitsets read back as cells: seen, blocked and moving."""
+
+    def test_moving_cells_are_the_seen_cells_marked_moving(self):
+        v = msg.View()
+        v.x0, v.y0, v.size = 3, 4, 5
+        v.seen[0] = 0b00011  # (3, 4) and (4, 4)
+        v.blocked[0] = 0b00010  # (4, 4): a mover's disc covers it
+        v.moving[0] = 0b00110  # (4, 4), and (5, 4), which is not seen
+        self.assertEqual(list(v.cells()), [(3, 4, False), (4, 4, True)])
+        self.assertEqual(list(v.moving_cells()), [(4, 4)])

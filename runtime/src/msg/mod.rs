@@ -28,7 +28,7 @@
 //! | [`Lifecycle`] | 24 | 8 | 0 time_ns u64, 8 pid u32, 12 index u32, 16 role u8, 17 event u8, 18 reason u8, 19 reserved u8, 20 restarts u32 |
 //! | [`Progress`] | 32 | 8 | 0 round u64, 8 agents u32, 12 at_goal u32, 16 conflicts u32, 20 replans u32, 24 done u8, 25 reserved [u8; 7] |
 //! | [`Heartbeat`] | 32 | 8 | 0 t_ns u64, 8 seq u64, 16 pid u32, 20 index u32, 24 role u8, 25 reserved [u8; 7] |
-//! | [`View`] | 288 | 8 | 0 sim_time_ns u64, 8 period u64, 16 agent u32, 20 x0 u32, 24 y0 u32, 28 size u32, 32 seen [u32; 32], 160 blocked [u32; 32] |
+//! | [`View`] | 416 | 8 | 0 sim_time_ns u64, 8 period u64, 16 agent u32, 20 x0 u32, 24 y0 u32, 28 size u32, 32 seen [u32; 32], 160 blocked [u32; 32], 288 moving [u32; 32] |
 //! | [`Sighting`] | 152 | 8 | 0 round u64, 8 agent u32, 12 count u32, 16 closed u32, 20 reserved u32, 24 cells [u32; 32] |
 //! | [`WorldHeader`] | 48 | 8 | 0 round u64, 8 closed u32, 12 opened u32, 16 to [u32; 8] |
 //! | [`MapHeader`] | 32 | 8 | 0 round u64, 8 agent u32, 12 width u32, 16 height u32, 20 iterations u32, 24 target u32, 28 activation u8, 29 reserved [u8; 3] |

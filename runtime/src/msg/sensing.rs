@@ -1,5 +1,6 @@
 //! What a robot's range sensor sees of the world (an emulated LiDAR, seed 000 §3.1.1): the
-//! cells within range and in line of sight, free or blocked, as the sim's truth has them.
+//! cells within range and in line of sight, free or blocked, as the sim's truth has them, and
+//! which of them a moving obstacle holds.
 
 use iceoryx2::prelude::ZeroCopySend;
 
@@ -10,7 +11,9 @@ pub const VIEW_EDGE: usize = 32;
 /// cells whose top-left cell is (`x0`, `y0`), centred on the robot's cell (clipped to the
 /// map). Bit `c` of row `r` stands for cell (`x0 + c`, `y0 + r`): in `seen` if it is within
 /// range and in line of sight, in `blocked` if it is then a wall, a closed cell or a moving
-/// obstacle's. A cell not seen says nothing.
+/// obstacle's, in `moving` if a mover holds it: stands in it, or walks the leg into or out of
+/// it (then it says nothing about the map: the agent keeps out of it for now and does not
+/// learn it). A cell not seen says nothing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C)]
 #[type_name("hnav::View")]
@@ -31,6 +34,8 @@ pub struct View {
     pub seen: [u32; VIEW_EDGE],
     /// Per window row, the cells seen blocked.
     pub blocked: [u32; VIEW_EDGE],
+    /// Per window row, the cells seen that a mover holds.
+    pub moving: [u32; VIEW_EDGE],
 }
 
 impl Default for View {
@@ -48,21 +53,45 @@ impl View {
         self.size = size.min(VIEW_EDGE as u32);
         self.seen = [0; VIEW_EDGE];
         self.blocked = [0; VIEW_EDGE];
+        self.moving = [0; VIEW_EDGE];
+    }
+
+    /// The window row and column bit of cell (`x`, `y`) of the map, if it is in the window.
+    fn bit(&self, x: u32, y: u32) -> Option<(usize, u32)> {
+        let (c, r) = (x.checked_sub(self.x0)?, y.checked_sub(self.y0)?);
+        (c < self.size && r < self.size).then_some((r as usize, 1 << c))
     }
 
     /// Marks cell (`x`, `y`) of the map seen, blocked or not; one outside the window is
     /// ignored.
     pub fn mark(&mut self, x: u32, y: u32, blocked: bool) {
-        let (Some(c), Some(r)) = (x.checked_sub(self.x0), y.checked_sub(self.y0)) else {
+        let Some((r, bit)) = self.bit(x, y) else {
             return;
         };
-        if c >= self.size || r >= self.size {
-            return;
-        }
-        self.seen[r as usize] |= 1 << c;
+        self.seen[r] |= bit;
         if blocked {
-            self.blocked[r as usize] |= 1 << c;
+            self.blocked[r] |= bit;
         }
+    }
+
+    /// Marks cell (`x`, `y`) moving if it is seen (a mover out of sight is not sensed).
+    pub fn mark_moving(&mut self, x: u32, y: u32) {
+        if let Some((r, bit)) = self.bit(x, y).filter(|&(r, bit)| self.seen[r] & bit != 0) {
+            self.moving[r] |= bit;
+        }
+    }
+
+    /// Whether cell (`x`, `y`) of the map is seen moving.
+    pub fn is_moving(&self, x: u32, y: u32) -> bool {
+        self.bit(x, y)
+            .is_some_and(|(r, bit)| self.moving[r] & bit != 0)
+    }
+
+    /// Every cell seen moving, as (`x`, `y`), row by row.
+    pub fn moving_cells(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.cells()
+            .filter(|&(x, y, _)| self.is_moving(x, y))
+            .map(|(x, y, _)| (x, y))
     }
 
     /// Every cell seen, as (`x`, `y`, blocked), row by row.
@@ -87,7 +116,7 @@ mod tests {
 
     #[test]
     fn view_layout() {
-        assert_eq!(size_of::<View>(), 288);
+        assert_eq!(size_of::<View>(), 416);
         assert_eq!(align_of::<View>(), 8);
         assert_eq!(offset_of!(View, sim_time_ns), 0);
         assert_eq!(offset_of!(View, period), 8);
@@ -97,6 +126,7 @@ mod tests {
         assert_eq!(offset_of!(View, size), 28);
         assert_eq!(offset_of!(View, seen), 32);
         assert_eq!(offset_of!(View, blocked), 160);
+        assert_eq!(offset_of!(View, moving), 288);
     }
 
     #[test]
@@ -108,6 +138,11 @@ mod tests {
         v.mark(8, 8, true);
         v.mark(2, 5, true);
         assert_eq!(v.cells().collect::<Vec<_>>(), [(3, 4, false), (7, 8, true)]);
+        // Moving only where seen.
+        v.mark_moving(7, 8);
+        v.mark_moving(4, 4);
+        assert_eq!(v.moving_cells().collect::<Vec<_>>(), [(7, 8)]);
+        assert!(v.is_moving(7, 8) && !v.is_moving(3, 4));
         v.reset(0, 0, 3);
         assert_eq!(v.cells().count(), 0);
     }

@@ -18,6 +18,8 @@
 //! path = [[1, 1], [1, 8], [6, 8]]  # corners of a path of straight legs along rows or columns
 //! speed = 0.5              # cells per second
 //! repeat = true            # back and forth for ever (default: once, then it stays at the end)
+//! yields = true            # waits at a cell centre while a robot is in or entering the next
+//!                          # cell of its path (the default); false: walks on regardless
 //! ```
 //!
 //! Each entry is exactly one change: `close`, `close_rect`, `open`, `open_rect` or `mover`
@@ -62,6 +64,7 @@ pub(super) struct RawEvent {
     pub path: Option<RawCells>,
     pub speed: Option<Spanned<f64>>,
     pub repeat: Option<bool>,
+    pub yields: Option<bool>,
 }
 
 /// One validated change of the world.
@@ -95,26 +98,52 @@ pub struct MoverSpec {
     pub speed: f64,
     /// Back and forth for ever; otherwise once, then it stays at its last cell.
     pub repeat: bool,
+    /// It waits for a robot in its way, as a person or a forklift driver does (the sim's
+    /// rule, `sim/src/world/changes.rs`); `false`: it walks on regardless.
+    pub yields: bool,
 }
 
 impl MoverSpec {
     /// Where it is `since_s` seconds after it appeared: a point in cell units (`x`, `y` of
-    /// the cell centres), moving at `speed` along its cells.
+    /// the cell centres), moving at `speed` along its cells,
+    /// had it never waited.
     pub fn position(&self, since_s: f64) -> (f64, f64) {
-        let legs = (self.cells.len() - 1) as f64;
-        let mut d = (since_s.max(0.0) * self.speed).max(0.0);
-        if self.repeat && legs > 0.0 {
-            d %= 2.0 * legs;
-            if d > legs {
-                d = 2.0 * legs - d;
-            }
-        }
-        let d = d.min(legs);
-        let k = (d.floor() as usize).min(self.cells.len() - 1);
-        let (a, b) = (self.cells[k], self.cells[(k + 1).min(self.cells.len() - 1)]);
-        let f = d - k as f64;
+        self.point_at(since_s.max(0.0) * self.speed)
+    }
+
+    /// Where it is after walking `walked` cells along its path (back and forth if it
+    /// repeats, every return counted): a point in cell units.
+    pub fn point_at(&self, walked: f64) -> (f64, f64) {
+        let d = walked.clamp(0.0, self.end().unwrap_or(f64::MAX));
+        let k = d.floor();
+        let (a, b) = (self.cell_at(k as u64), self.cell_at(k as u64 + 1));
+        let f = d - k;
         let lerp = |p: u32, q: u32| f64::from(p) + f * (f64::from(q) - f64::from(p));
         (lerp(a.x, b.x), lerp(a.y, b.y))
+    }
+
+    /// The `k`-th cell it passes (0: its first), counting every return of a repeating
+    /// mover; a mover that does not repeat stays at its last cell.
+    pub fn cell_at(&self, k: u64) -> Cell {
+        let legs = (self.cells.len() - 1) as u64;
+        let i = match (self.repeat, legs) {
+            (_, 0) => 0,
+            (true, _) => {
+                let k = k % (2 * legs);
+                if k > legs {
+                    2 * legs - k
+                } else {
+                    k
+                }
+            }
+            (false, _) => k.min(legs),
+        };
+        self.cells[i as usize]
+    }
+
+    /// How many cells it walks before it stops for good: none for a repeating mover.
+    pub fn end(&self) -> Option<f64> {
+        (!self.repeat || self.cells.len() < 2).then(|| (self.cells.len() - 1) as f64)
     }
 }
 
@@ -223,8 +252,14 @@ impl World<'_> {
             );
             return Err(bad(at.clone(), "events", p));
         }
-        if e.mover.is_none() && (e.path.is_some() || e.speed.is_some() || e.repeat.is_some()) {
-            let p = format!("event {i}: `path`, `speed` and `repeat` are for a `mover`");
+        let mover_keys = [
+            e.path.is_some(),
+            e.speed.is_some(),
+            e.repeat.is_some(),
+            e.yields.is_some(),
+        ];
+        if e.mover.is_none() && mover_keys.contains(&true) {
+            let p = format!("event {i}: `path`, `speed`, `repeat` and `yields` are for a `mover`");
             return Err(bad(at.clone(), "events", p));
         }
         let cells = |raw: &RawCells, key: &str, rect: bool| {
@@ -359,6 +394,7 @@ impl World<'_> {
             cells,
             speed: v,
             repeat: e.repeat.unwrap_or(false),
+            yields: e.yields.unwrap_or(true),
         })
     }
 }

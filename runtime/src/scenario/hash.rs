@@ -260,6 +260,10 @@ fn event(h: &mut Fnv1a64, e: &EventSpec) {
                 .bytes(m.name.as_bytes())
                 .f64(m.speed)
                 .u64(m.repeat.into());
+            if !m.yields {
+                // Only then: a mover that yields keeps the hash it had before `yields`.
+                h.bytes(b"walks-on");
+            }
             &m.cells
         }
     };

@@ -119,6 +119,7 @@
 //! # path = [[1, 1], [1, 8]]            # legs along rows or columns, speed in cells/s,
 //! # speed = 0.5                        # back and forth with repeat = true
 //! # repeat = true
+//! # yields = true                      # waits for robots in its way (default)
 //!
 //! [sensing]                            # optional: robots sense the world ([`sensing`]);
 //! range = 5                            # cells seen in line of sight, in [1, 15]

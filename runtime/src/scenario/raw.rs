@@ -127,6 +127,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
             "path",
             "speed",
             "repeat",
+            "yields",
         ],
     ),
 ];

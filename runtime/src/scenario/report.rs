@@ -297,13 +297,18 @@ fn event_line(e: &super::EventSpec) -> String {
         super::WorldChange::Close(c) => format!("close {}", cells(c)),
         super::WorldChange::Open(c) => format!("open {}", cells(c)),
         super::WorldChange::Mover(m) => format!(
-            "mover `{}` at {} cells/s{} from ({}, {}) over {} cells",
+            "mover `{}` at {} cells/s{} from ({}, {}) over {} cells{}",
             m.name,
             m.speed,
             if m.repeat { ", back and forth" } else { "" },
             m.cells[0].x,
             m.cells[0].y,
-            m.cells.len()
+            m.cells.len(),
+            if m.yields {
+                ""
+            } else {
+                ", yielding to no robot"
+            }
         ),
     };
     format!("at {:.2} s: {what}", e.at_s)

@@ -47,7 +47,7 @@ fn closes_opens_and_movers_parse_in_time_order() {
     };
     let cells: Vec<(u32, u32)> = m.cells.iter().map(|c| (c.x, c.y)).collect();
     assert_eq!(cells, [(0, 2), (1, 2), (2, 2), (3, 2), (3, 1)]);
-    assert_eq!((m.speed, m.repeat), (0.5, true));
+    assert_eq!((m.speed, m.repeat, m.yields), (0.5, true, true));
 }
 
 #[test]
@@ -59,6 +59,7 @@ fn a_mover_goes_along_its_cells_and_back_or_stays_at_the_end() {
             .to_vec(),
         speed: 0.5,
         repeat: false,
+        yields: true,
     };
     assert_eq!(m.position(0.0), (0.0, 2.0));
     assert_eq!(m.position(1.0), (0.5, 2.0));
@@ -70,6 +71,24 @@ fn a_mover_goes_along_its_cells_and_back_or_stays_at_the_end() {
     assert_eq!(m.position(8.0), (2.0, 2.0), "one cell back");
     assert_eq!(m.position(12.0), (0.0, 2.0), "home again");
     assert_eq!(m.position(13.0), (0.5, 2.0), "and out again");
+    // The cells it passes, every return counted.
+    let passed: Vec<(u32, u32)> = (0..8).map(|k| m.cell_at(k)).map(|c| (c.x, c.y)).collect();
+    assert_eq!(
+        passed,
+        [
+            (0, 2),
+            (1, 2),
+            (2, 2),
+            (2, 1),
+            (2, 2),
+            (1, 2),
+            (0, 2),
+            (1, 2)
+        ]
+    );
+    assert_eq!(m.end(), None);
+    m.repeat = false;
+    assert_eq!((m.cell_at(7), m.end()), (Cell::new(2, 1), Some(3.0)));
 }
 
 #[test]
@@ -94,7 +113,11 @@ fn every_mistake_names_its_line() {
         ),
         (
             &["at_s = 1\nclose = [[4, 1]]\nspeed = 1\n"],
-            "t.toml:16: events event 0: `path`, `speed` and `repeat` are for a `mover`",
+            "t.toml:16: events event 0: `path`, `speed`, `repeat` and `yields` are for a `mover`",
+        ),
+        (
+            &["at_s = 1\nclose = [[4, 1]]\nyields = false\n"],
+            "t.toml:16: events event 0: `path`, `speed`, `repeat` and `yields` are for a `mover`",
         ),
         (
             &["at_s = 2\nclose = [[4, 1]]\n", "at_s = 1\nclose = [[4, 2]]\n"],
@@ -175,11 +198,18 @@ fn events_change_the_hash_and_none_keep_it() {
     let close = events(&["at_s = 1\nclose = [[4, 1]]\n"]).unwrap();
     let later = events(&["at_s = 2\nclose = [[4, 1]]\n"]).unwrap();
     let open = events(&["at_s = 1\nopen = [[1, 1]]\n"]).unwrap();
+    let mover = "at_s = 1\nmover = \"p\"\npath = [[0, 2], [2, 2]]\nspeed = 1\n";
+    let yields = events(&[mover]).unwrap().scenario_hash();
+    let said = events(&[&format!("{mover}yields = true\n")]).unwrap();
+    assert_eq!(yields, said.scenario_hash(), "yielding is the default");
+    let walks_on = events(&[&format!("{mover}yields = false\n")]).unwrap();
     let hashes = [
         base,
         close.scenario_hash(),
         later.scenario_hash(),
         open.scenario_hash(),
+        yields,
+        walks_on.scenario_hash(),
     ];
     for i in 0..hashes.len() {
         for j in i + 1..hashes.len() {
@@ -193,13 +223,21 @@ fn hnav_check_lists_the_events() {
     let s = events(&[
         "at_round = 100\nclose = [[4, 1]]\n",
         "at_s = 3\nmover = \"forklift\"\npath = [[0, 2], [3, 2]]\nspeed = 0.5\n",
+        "at_s = 4\nmover = \"cart\"\npath = [[0, 3], [1, 3]]\nspeed = 1\nyields = false\n",
     ])
     .unwrap();
     let text = ScenarioReport::new(&s).render();
     assert!(text.contains("event     at 1.00 s: close (4, 1)"), "{text}");
     assert!(
         text.contains(
-            "event     at 3.00 s: mover `forklift` at 0.5 cells/s from (0, 2) over 4 cells"
+            "event     at 3.00 s: mover `forklift` at 0.5 cells/s from (0, 2) over 4 cells\n"
+        ),
+        "{text}"
+    );
+    assert!(
+        text.contains(
+            "event     at 4.00 s: mover `cart` at 1 cells/s from (0, 3) over 2 cells, yielding \
+             to no robot"
         ),
         "{text}"
     );

@@ -3,28 +3,133 @@
 //!
 //! The sim owns the truth, so it alone applies them, at the first step at or after each
 //! event's time, from the scenario and the sim time only: a lockstep run with events is as
-//! reproducible as one without, and a restarted sim catches up to its checkpoint's time. A closed cell is a blocked cell of the sim's grid, so a robot that
-//! enters one is a wall contact (`Hit::Cell`); a mover is a disc of the robots' body radius
-//! at its point of the path, and a robot touching one is a `Hit::Mover` contact, recorded
-//! when it begins as robot contacts are (a contact in progress when the sim restarts is
-//! recorded again).
+//! reproducible as one without, and a restarted sim catches up to its checkpoint's time (and
+//! takes how far each mover walked from the checkpoint). A closed cell is a blocked cell of
+//! the sim's grid, so a robot that enters one is a wall contact (`Hit::Cell`); a mover is a
+//! disc of the robots' body radius at its point of the path, and a robot touching one is a
+//! `Hit::Mover` contact, recorded when it begins as robot contacts are (a contact in progress
+//! when the sim restarts is recorded again).
+//!
+//! **Who yields.** A person or a forklift driver stops for a robot in the way, so a mover that
+//! yields (the default) waits at a cell centre while the next cell of its path is *claimed*
+//! by a robot: the robot's disc overlaps it, or the robot is in motion (its wheels turn or are
+//! commanded to) with its centre within one move (straight or diagonal) of that cell's
+//! centre, about to enter it. It
+//! looks only at cell centres, where it stands wholly in one cell: once it has set off into a
+//! cell it walks through. The robots keep the other half of the bargain (the agent's rule,
+//! `agent/src/navigator/movers.rs`): the view marks the cells a mover holds (see
+//! [`Changes::moving_cells`]), and a robot asks for none of them nor for a cell next to one
+//! (where a mover may go next), and does not set off into a held one. A robot in motion
+//! claims the cell it enters, so a mover that yields never walks into a robot's way; a robot
+//! standing next to a mover's next cell does not claim it, so the mover passes it, a cell
+//! away (with the default body, two radii are 0.725 cell: robots a cell apart do not touch).
+//! A mover that walks back and forth and has waited [`TURN_BACK_S`] turns back: the robot it
+//! waits for may itself be waiting for the mover to leave (pushed into the mover's cell by
+//! the coordinator, or head-on in a one-cell corridor), and a person would give way. A mover
+//! with `yields = false` walks on regardless.
 
 use hnav_runtime::scenario::{EventSpec, MoverSpec, WorldChange};
 use nalgebra::Point2;
 
-use crate::collision::{discs_overlap, Collision, Hit};
-use hnav_runtime::grid::Grid;
+use crate::collision::{disc_overlaps_cell, discs_overlap, Collision, Hit};
+use hnav_runtime::grid::{Cell, Grid};
 
 /// A mover that has appeared.
 #[derive(Debug, Clone)]
 struct Active {
     spec: MoverSpec,
-    /// When it appeared, s.
-    from_s: f64,
+    /// Cells walked along its path so far (every return counted).
+    walked: f64,
+    /// The time it was moved to last, s.
+    moved_s: f64,
+    /// How long it has waited at its cell centre, s.
+    waited_s: f64,
     /// Per robot: touching it at the last step.
     touching: Vec<bool>,
     /// Where it is now, m.
     at: Point2<f64>,
+}
+
+/// The robots as a mover sees them at one step.
+pub(crate) struct Robots<'a> {
+    /// Centres, m.
+    pub(crate) centres: &'a [Point2<f64>],
+    /// Whether each is in motion (its wheels turn or are commanded to).
+    pub(crate) in_motion: &'a [bool],
+    /// Body radius, m.
+    pub(crate) radius: f64,
+    /// Cell edge, m.
+    pub(crate) cell: f64,
+}
+
+impl Robots<'_> {
+    /// Whether a robot is in cell `c` or about to enter it (in motion, one move, straight or
+    /// diagonal, from its centre).
+    fn claim(&self, c: Cell) -> bool {
+        let (x, y) = (i64::from(c.x), i64::from(c.y));
+        let centre = Point2::new(
+            (f64::from(c.x) + 0.5) * self.cell,
+            (f64::from(c.y) + 0.5) * self.cell,
+        );
+        // One move away, straight or diagonal.
+        let near = self.cell * (std::f64::consts::SQRT_2 + 1e-6);
+        self.centres.iter().zip(self.in_motion).any(|(p, &moving)| {
+            disc_overlaps_cell(p, self.radius, x, y, self.cell)
+                || (moving && (p - centre).norm_squared() <= near * near)
+        })
+    }
+}
+
+/// How long a mover that yields and walks back and forth waits for a robot before it turns
+/// back, s: a robot committed to the cell it stands in may be waiting for it to leave (a
+/// robot pushed there by the coordinator, or one in a one-cell corridor), and one of the two
+/// must give way.
+pub(crate) const TURN_BACK_S: f64 = 3.0;
+
+impl Active {
+    /// Walks the other way from its cell centre: the same cell of its back-and-forth path,
+    /// the other direction.
+    fn turn_back(&mut self) {
+        let period = 2 * (self.spec.cells.len() as u64 - 1);
+        if period == 0 {
+            return;
+        }
+        let k = self.walked as u64 % period;
+        self.walked += ((period - k) % period) as f64 - k as f64;
+        self.waited_s = 0.0;
+        tracing::info!(mover = self.spec.name, "mover turned back");
+    }
+
+    /// Walks on to `t_s`, waiting at a cell centre while a robot claims the next cell if it
+    /// yields. It stops at every centre it reaches, so it looks there before going on.
+    fn walk(&mut self, t_s: f64, robots: &Robots<'_>) {
+        let mut left = (t_s - self.moved_s).max(0.0) * self.spec.speed;
+        self.moved_s = t_s;
+        let end = self.spec.end().unwrap_or(f64::INFINITY);
+        while left > 0.0 && self.walked < end {
+            let from = self.walked.floor();
+            let ahead = self.spec.cell_at(from as u64 + 1);
+            if self.walked == from && self.spec.yields && robots.claim(ahead) {
+                if self.waited_s == 0.0 {
+                    let (x, y) = (ahead.x, ahead.y);
+                    tracing::info!(mover = self.spec.name, x, y, t_s, "mover waits for a robot");
+                }
+                self.waited_s += left / self.spec.speed;
+                if self.spec.repeat && self.waited_s >= TURN_BACK_S {
+                    self.turn_back();
+                }
+                return;
+            }
+            self.waited_s = 0.0;
+            let to = from + 1.0;
+            let step = (to - self.walked).min(left);
+            left -= step;
+            self.walked += step;
+            if to - self.walked < 1e-12 {
+                self.walked = to;
+            }
+        }
+    }
 }
 
 /// The scenario's events, those applied so far and the movers under way.
@@ -68,7 +173,9 @@ impl Changes {
                     tracing::info!(t_s, mover = m.name, "mover appeared");
                     self.movers.push(Active {
                         spec: m.clone(),
-                        from_s: e.at_s,
+                        walked: 0.0,
+                        moved_s: e.at_s,
+                        waited_s: 0.0,
                         touching: vec![false; robots],
                         at: Point2::origin(),
                     });
@@ -79,20 +186,23 @@ impl Changes {
         cells_changed
     }
 
-    /// Moves the movers to time `t_s` and appends the contacts with the robots at `centres`
-    /// (discs of radius `r`) that began now. Returns how many.
+    /// Moves the movers to time `t_s` (a mover that yields waits for the robots that claim
+    /// its next cell) and appends the contacts with the robots (discs of their body radius)
+    /// that began now. Returns how many.
     pub(crate) fn mover_contacts(
         &mut self,
         t_s: f64,
         time_ns: u64,
-        (centres, r, cell): (&[Point2<f64>], f64, f64),
+        robots: &Robots<'_>,
         out: &mut Vec<Collision>,
     ) -> usize {
         let before = out.len();
+        let (r, cell) = (robots.radius, robots.cell);
         for (k, m) in self.movers.iter_mut().enumerate() {
-            let (x, y) = m.spec.position(t_s - m.from_s);
+            m.walk(t_s, robots);
+            let (x, y) = m.spec.point_at(m.walked);
             m.at = Point2::new((x + 0.5) * cell, (y + 0.5) * cell);
-            for (i, p) in centres.iter().enumerate() {
+            for (i, p) in robots.centres.iter().enumerate() {
                 let touching = discs_overlap(p, &m.at, r, r);
                 if touching && !m.touching[i] {
                     out.push(Collision {
@@ -112,5 +222,38 @@ impl Changes {
     /// The movers under way: name and centre (m), in the order they appeared.
     pub(crate) fn movers(&self) -> impl Iterator<Item = (&str, Point2<f64>)> {
         self.movers.iter().map(|m| (m.spec.name.as_str(), m.at))
+    }
+
+    /// The cells the movers hold, which the views mark moving: the cell a mover stands in
+    /// at a centre, or the two of the leg it walks (the one it leaves and the one it
+    /// enters). The cells next to those are where a mover may go next; the agents keep out
+    /// of them too (`agent/src/navigator/movers.rs`).
+    pub(crate) fn moving_cells(&self) -> impl Iterator<Item = Cell> + '_ {
+        self.movers.iter().flat_map(|m| {
+            let (from, to) = (m.walked.floor() as u64, m.walked.ceil() as u64);
+            (from..=to).map(|k| m.spec.cell_at(k))
+        })
+    }
+
+    /// How far each mover under way has walked and how long it has waited, for the sim's
+    /// checkpoint.
+    pub(crate) fn walked(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
+        self.movers.iter().map(|m| (m.walked, m.waited_s))
+    }
+
+    /// Takes how far each mover walked and how long it waited from a checkpoint taken at
+    /// `t_s`; false if the count is not that of the movers under way.
+    pub(crate) fn restore_walked(&mut self, walked: &[(f64, f64)], t_s: f64, cell: f64) -> bool {
+        if walked.len() != self.movers.len() {
+            return false;
+        }
+        for (m, &(w, waited)) in self.movers.iter_mut().zip(walked) {
+            m.walked = w;
+            m.waited_s = waited;
+            m.moved_s = t_s;
+            let (x, y) = m.spec.point_at(w);
+            m.at = Point2::new((x + 0.5) * cell, (y + 0.5) * cell);
+        }
+        true
     }
 }

@@ -1,6 +1,8 @@
 //! What each robot's range sensor sees (an emulated LiDAR, seed 000 §3.1.1): the cells
 //! within `range` of the robot's cell whose centres it sees in a straight line, free or
-//! blocked (a wall, a closed cell, a cell a mover's disc covers), as the truth has them now.
+//! blocked (a wall, a closed cell, a cell a mover's disc covers), as the truth has them now,
+//! and of those the cells a mover holds (moving: the cell it stands in, or the two of the leg
+//! it walks; `changes.rs`).
 //!
 //! Line of sight runs from the robot's cell to the cell's, over the cells a Bresenham line
 //! crosses: any blocked cell strictly between hides it (the first blocked cell on a line is
@@ -42,6 +44,9 @@ impl World {
                 }
                 view.mark(x as u32, y as u32, self.blocked_now(x, y));
             }
+        }
+        for c in self.changes.moving_cells() {
+            view.mark_moving(c.x, c.y);
         }
     }
 

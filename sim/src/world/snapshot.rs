@@ -11,15 +11,16 @@
 //! without the kill decided.
 //!
 //! Encoding: little-endian `u64` words — a magic, the robot count, the step count, 23 words
-//! per robot, the contacts and collisions each as a count and fixed-size entries; the
-//! caller frames it (the process adds its own header and a checksum).
+//! per robot, the contacts and collisions each as a count and fixed-size entries, the
+//! movers' walks (cells walked, seconds waited) as a count and two words each; the caller
+//! frames it (the process adds its own header and a checksum).
 
 use nalgebra::{Complex, Point2, UnitComplex};
 
 use super::World;
 use crate::collision::{Collision, Hit};
 
-const MAGIC: u64 = 0x5753_5641_4e48_0002; // "HNAVSW" v2
+const MAGIC: u64 = 0x5753_5641_4e48_0003; // "HNAVSW" v3: with the criteria meter and the movers' walks
 /// Words of one collision entry.
 const COLLISION_WORDS: usize = 9;
 
@@ -138,6 +139,11 @@ impl World {
                 put(out, v.y.to_bits());
             }
         }
+        put(out, self.changes.walked().count() as u64);
+        for (walked, waited) in self.changes.walked() {
+            put(out, walked.to_bits());
+            put(out, waited.to_bits());
+        }
     }
 
     /// Replaces the world's dynamic state by a snapshot of a world built from the same
@@ -201,11 +207,23 @@ impl World {
                 other_position: Point2::new(w.f64()?, w.f64()?),
             });
         }
+        let movers = w.count(2)?;
+        let walked = (0..movers)
+            .map(|_| Ok((w.f64()?, w.f64()?)))
+            .collect::<Result<Vec<_>, SnapshotError>>()?;
         if !w.0.is_empty() {
             return Err(SnapshotError::Length);
         }
-        // The world changes by the scenario and the time alone: catch up to the snapshot's.
+        // The cells change by the scenario and the time alone: catch up to the snapshot's;
+        // the movers are where they had walked to (they wait for robots).
         next.apply_changes();
+        let t_s = next.time_ns() as f64 * 1e-9;
+        if !next
+            .changes
+            .restore_walked(&walked, t_s, next.model.cell_size_m)
+        {
+            return Err(SnapshotError::Length);
+        }
         *self = next;
         Ok(())
     }
