@@ -6,7 +6,7 @@ use std::time::Instant;
 use super::health::HealthRow;
 use crate::supervisor::registry::LiveRunError;
 use hnav_runtime::grid::Grid;
-use hnav_runtime::msg::{Commit, Lifecycle, Pose, Progress, Truth};
+use hnav_runtime::msg::{Commit, Lifecycle, Pose, Progress, Truth, View};
 use hnav_runtime::scenario::{Scenario, ScenarioError, WorldChange};
 use hnav_runtime::transport::TransportError;
 
@@ -127,6 +127,8 @@ pub enum Update<'a> {
     Lifecycle(&'a Lifecycle),
     /// The run's processes now.
     Health(&'a [HealthRow]),
+    /// What a robot's range sensor sees now (`[sensing]`).
+    View(&'a View),
     /// The run is over; nothing follows.
     Ended(RunEnd),
 }

@@ -24,7 +24,7 @@ use crate::supervisor::registry::LiveRunError;
 use crate::supervisor::registry::{RunRecord, RunRegistry};
 use hnav_runtime::consensus_log::reader::LogReader;
 use hnav_runtime::consensus_log::record::Record;
-use hnav_runtime::msg::{Commit, Lifecycle, Progress, Truth};
+use hnav_runtime::msg::{Commit, Lifecycle, Progress, Truth, View};
 use hnav_runtime::topics;
 use hnav_runtime::transport::{Receiver, RunId, Transport, TransportError, Waiter, Wake};
 
@@ -89,6 +89,8 @@ pub struct LiveFeed {
     commit: Receiver<Commit>,
     progress: Receiver<Progress>,
     life: Receiver<Lifecycle>,
+    /// Each robot's view, with `[sensing]`.
+    views: Vec<Receiver<View>>,
     waiter: Waiter,
     sampler: HealthSampler,
     rows: Vec<HealthRow>,
@@ -144,6 +146,13 @@ impl LiveFeed {
             ))
         };
         let (truth, commit, progress, life, waiter) = open().map_err(transport_err)?;
+        let views = match scenario.sensing {
+            Some(_) => (0..n)
+                .map(|i| transport.receiver::<View>(&topics::view(i), topics::state_qos()))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(transport_err)?,
+            None => Vec::new(),
+        };
         Ok(LiveFeed {
             info: RunInfo::of(&run_id, &scenario),
             registry: registry.clone(),
@@ -152,6 +161,7 @@ impl LiveFeed {
             commit,
             progress,
             life,
+            views,
             waiter,
             sampler: HealthSampler::new(),
             rows: Vec::new(),
@@ -236,6 +246,15 @@ impl Feed for LiveFeed {
         truth.map_err(|e| self.err(e))?;
         let commits = self.commit.drain_pending(|c| apply(Update::Commit(c)));
         commits.map_err(|e| self.err(e))?;
+        for rx in &self.views {
+            // The newest view is what the robot sees now; older ones are gone already.
+            let mut newest: Option<View> = None;
+            rx.drain_pending(|v| newest = Some(*v))
+                .map_err(|e| self.err(e))?;
+            if let Some(v) = &newest {
+                apply(Update::View(v));
+            }
+        }
         if end.is_none() {
             end = self.health(apply);
         }

@@ -6,7 +6,8 @@
 //! a larger one is shown in square blocks of `step x step` cells, one character each, a block
 //! drawn as a wall when all its cells are blocked and as shaded when some are. Robots are
 //! drawn over goals, goals over the floor; in a block holding several robots the lowest
-//! index shows.
+//! index shows. With `[sensing]` the floor a robot's range sensor sees now is drawn `:`
+//! instead of `.` (a block: when it sees any of its cells).
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
@@ -92,6 +93,15 @@ pub fn floor_of(grid: &Grid, scale: MapScale, bx: u32, by: u32) -> Floor {
     }
 }
 
+/// Whether any cell of block (`bx`, `by`) at `scale` is `sensed` (one flag per cell of a grid
+/// `width` wide).
+fn block_sensed(sensed: &[bool], width: u32, scale: MapScale, bx: u32, by: u32) -> bool {
+    let (x0, y0) = (bx * scale.step, by * scale.step);
+    let height = sensed.len() as u32 / width.max(1);
+    (y0..(y0 + scale.step).min(height))
+        .any(|y| (x0..(x0 + scale.step).min(width)).any(|x| sensed[(y * width + x) as usize]))
+}
+
 /// Agent `i`'s label: `0`-`9`, then `A`-`Z`, then `a`-`z`; `@` for the rest.
 pub fn agent_label(i: usize) -> char {
     const LABELS: &[u8] = b"0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz";
@@ -146,14 +156,18 @@ impl Widget for MapWidget<'_> {
         };
         let wall = Style::default().fg(Color::Gray);
         let floor = Style::default().fg(Color::DarkGray);
-        let (free_s, partly_s, wall_s) = if scale.cols == 2 {
-            (" .", "▒▒", "██")
+        let (free_s, sensed_s, partly_s, wall_s) = if scale.cols == 2 {
+            (" .", " :", "▒▒", "██")
         } else {
-            (".", "▒", "█")
+            (".", ":", "▒", "█")
         };
+        let sensed = self.state.sensed();
         for by in 0..u32::from(rows) {
             for bx in 0..u32::from(cols / scale.cols) {
                 let (text, style) = match floor_of(grid, scale, bx, by) {
+                    Floor::Free if block_sensed(&sensed, grid.width(), scale, bx, by) => {
+                        (sensed_s, floor)
+                    }
                     Floor::Free => (free_s, floor),
                     Floor::Partly => (partly_s, wall),
                     Floor::Wall => (wall_s, wall),
@@ -186,6 +200,19 @@ impl Widget for MapWidget<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_block_is_sensed_when_any_of_its_cells_is() {
+        // 4 x 2 cells, cell (3, 1) seen.
+        let mut sensed = vec![false; 8];
+        sensed[7] = true;
+        let one = MapScale { step: 1, cols: 2 };
+        assert!(block_sensed(&sensed, 4, one, 3, 1));
+        assert!(!block_sensed(&sensed, 4, one, 2, 1));
+        let two = MapScale { step: 2, cols: 1 };
+        assert!(block_sensed(&sensed, 4, two, 1, 0));
+        assert!(!block_sensed(&sensed, 4, two, 0, 0));
+    }
 
     #[test]
     fn a_small_map_gets_two_columns_per_cell() {

@@ -31,7 +31,7 @@ use super::feed::{RunEnd, RunInfo, Update};
 use super::health::HealthRow;
 use hnav_runtime::msg::{
     Commit, ConflictKind, Decision, Lifecycle, LifecycleEvent, Pose, Progress, Role, RosterState,
-    Truth, Verdict,
+    Truth, Verdict, View,
 };
 
 /// How many of the latest decisions and events the view keeps.
@@ -84,6 +84,8 @@ pub struct AgentView {
     last: Option<(Verdict, ConflictKind)>,
     down: bool,
     lost: bool,
+    /// Its robot's latest view (`[sensing]`).
+    view: Option<View>,
 }
 
 impl AgentView {
@@ -97,6 +99,7 @@ impl AgentView {
             last: None,
             down: false,
             lost: false,
+            view: None,
         }
     }
 
@@ -314,7 +317,27 @@ impl ViewState {
             Update::Ended(why) => {
                 self.ended.get_or_insert(why);
             }
+            Update::View(v) => {
+                if let Some(a) = self.agents.get_mut(v.agent as usize) {
+                    a.view = Some(*v);
+                }
+            }
         }
+    }
+
+    /// Per cell of the map, whether a robot's range sensor sees it now (its latest view).
+    pub fn sensed(&self) -> Vec<bool> {
+        let g = &self.info.grid;
+        let mut out = vec![false; g.len()];
+        for v in self.agents.iter().filter_map(|a| a.view.as_ref()) {
+            for (x, y, _) in v
+                .cells()
+                .filter(|&(x, y, _)| x < g.width() && y < g.height())
+            {
+                out[(y * g.width() + x) as usize] = true;
+            }
+        }
+        out
     }
 
     /// Rounds per second over the last second.

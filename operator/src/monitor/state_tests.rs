@@ -333,3 +333,31 @@ fn the_map_follows_the_worlds_closes_and_opens_as_sim_time_passes_them() {
     v.apply(Update::Truth(&at(3, 5_000)), now);
     assert_eq!(blocked(&v), [5]);
 }
+
+#[test]
+fn the_sensed_cells_are_each_robots_latest_view() {
+    let mut v = view();
+    let now = Instant::now();
+    assert!(v.sensed().iter().all(|s| !s));
+    let mut seen = View {
+        agent: 1,
+        ..View::default()
+    };
+    seen.reset(0, 1, 2);
+    seen.mark(0, 1, false);
+    seen.mark(1, 1, true);
+    v.apply(Update::View(&seen), now);
+    let cells = |v: &ViewState| -> Vec<usize> { (0..8).filter(|&i| v.sensed()[i]).collect() };
+    assert_eq!(cells(&v), [4, 5]);
+    seen.reset(2, 0, 2);
+    seen.mark(3, 0, false);
+    v.apply(Update::View(&seen), now);
+    assert_eq!(cells(&v), [3], "the latest view replaces the one before");
+    let stranger = View { agent: 7, ..seen };
+    v.apply(Update::View(&stranger), now);
+    assert_eq!(
+        cells(&v),
+        [3],
+        "a view of a robot not in the run is ignored"
+    );
+}
