@@ -11,6 +11,13 @@
 //! when it is done ([`FileLock::remove`]); a newcomer that opened the file just before it was
 //! removed would then hold a lock nobody else can see, so [`try_lock`] checks after locking
 //! that the path still names the file it locked, and starts again if not.
+//!
+//! A lock this very process released can still be held for a moment: a child forked by
+//! another thread (a `Command` spawning a process) holds a copy of every descriptor until it
+//! execs, and close-on-exec only closes them then. A lock file naming our own pid as its
+//! holder is therefore tried again for up to [`OWN_RELEASE_WAIT`] before it counts as held
+//! (`log_cli::summary` reopened its own log while a sibling test spawned `hnav`, and was
+//! refused, at a load average of 5).
 
 use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{self, Read, Seek, Write};
@@ -81,6 +88,9 @@ impl Holder {
 /// attempt needs a holder to remove the file in between, so this is never reached in practice.
 const ATTEMPTS: usize = 16;
 
+/// How long a lock whose file names this process is tried again (see the module docs).
+pub const OWN_RELEASE_WAIT: std::time::Duration = std::time::Duration::from_millis(500);
+
 /// Takes the exclusive lock on `path` (created if missing, parent directories too) without
 /// waiting, and writes `fields` into it as `key=value` lines. When someone else holds it,
 /// returns what the file says about them.
@@ -88,7 +98,11 @@ pub fn try_lock(path: &Path, fields: &[(&str, String)]) -> io::Result<TryLock> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)?;
     }
-    for _ in 0..ATTEMPTS {
+    let own = std::process::id().to_string();
+    let patience = std::time::Instant::now() + OWN_RELEASE_WAIT;
+    let mut attempts = 0;
+    while attempts < ATTEMPTS {
+        attempts += 1;
         let mut file = OpenOptions::new()
             .read(true)
             .write(true)
@@ -101,7 +115,14 @@ pub fn try_lock(path: &Path, fields: &[(&str, String)]) -> io::Result<TryLock> {
                 let mut text = String::new();
                 // The holder may be between truncating and writing: an empty holder then.
                 let _ = file.read_to_string(&mut text);
-                return Ok(TryLock::Held(Holder::parse(&text)));
+                let holder = Holder::parse(&text);
+                if holder.get("pid") == Some(own.as_str()) && std::time::Instant::now() < patience {
+                    // No event says when a forked child execs: look again shortly.
+                    std::thread::sleep(std::time::Duration::from_millis(2));
+                    attempts -= 1;
+                    continue;
+                }
+                return Ok(TryLock::Held(holder));
             }
             Err(TryLockError::Error(e)) => return Err(e),
         }
@@ -155,5 +176,35 @@ mod tests {
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "pid=44\n");
         again.remove().unwrap();
         assert!(!path.exists());
+    }
+
+    #[test]
+    fn a_lock_this_process_is_releasing_is_waited_for_and_one_it_keeps_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("own.lock");
+        let me = [("pid", std::process::id().to_string())];
+        let TryLock::Acquired(lock) = try_lock(&path, &me).unwrap() else {
+            panic!("the first lock is refused");
+        };
+        // As a forked child's copy of the descriptor would, the lock outlives its release by
+        // a moment.
+        let (tx, rx) = std::sync::mpsc::channel::<()>();
+        let late = std::thread::spawn(move || {
+            let _ = rx.recv();
+            std::thread::sleep(std::time::Duration::from_millis(50));
+            drop(lock);
+        });
+        tx.send(()).unwrap();
+        let TryLock::Acquired(mine) = try_lock(&path, &me).unwrap() else {
+            panic!("a lock of this process released 50 ms later was refused");
+        };
+        late.join().unwrap();
+        let started = std::time::Instant::now();
+        match try_lock(&path, &me).unwrap() {
+            TryLock::Held(h) => assert_eq!(h.get("pid"), Some(me[0].1.as_str())),
+            TryLock::Acquired(_) => panic!("two holders of one lock"),
+        }
+        assert!(started.elapsed() >= OWN_RELEASE_WAIT);
+        drop(mine);
     }
 }

@@ -101,6 +101,9 @@ pub struct RunData {
     pub criteria: Vec<String>,
     /// What is missing from the picture, and why.
     pub notes: Vec<String>,
+    /// Cells the swarm saw close during the run (`[sensing]`: the log's map changes), each
+    /// once.
+    pub closed: Vec<CellXy>,
 }
 
 impl RunData {
@@ -203,6 +206,13 @@ impl RunData {
                         event,
                         cell,
                     });
+                }
+                Record::MapChange(m) => {
+                    for c in m.closed.iter().map(|&c| xy(c)) {
+                        if !data.closed.contains(&c) {
+                            data.closed.push(c);
+                        }
+                    }
                 }
                 _ => {}
             }

@@ -173,6 +173,13 @@ fn draw_map(root: &Area<'_>, data: &RunData, map: &Panel) -> DrawResult {
             style::OBSTACLE.filled(),
         ))?;
     }
+    // Cells the swarm saw close: outlined, since they were floor for part of the run.
+    for &(c, r) in &data.closed {
+        root.draw(&Rectangle::new(
+            map.cell_rect(c, r),
+            style::CLOSED.stroke_width(2),
+        ))?;
+    }
     frame(root, map)?;
     let s = Sizes::of(map.cell);
     for (i, cells) in data.committed.iter().enumerate() {

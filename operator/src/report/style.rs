@@ -6,6 +6,8 @@ use plotters::style::colors::colormaps::ViridisRGB;
 
 /// Obstacle cells (map and heatmaps).
 pub const OBSTACLE: RGBColor = RGBColor(64, 64, 64);
+/// The outline of a cell that closed during the run (a door): gold, a colour no robot has.
+pub const CLOSED: RGBColor = RGBColor(255, 215, 0);
 /// The frame of a panel.
 pub const FRAME: RGBColor = RGBColor(160, 160, 160);
 /// Collision rings.

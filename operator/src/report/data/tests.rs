@@ -350,3 +350,37 @@ fn the_criteria_lines_add_up_the_agents_and_name_the_latency() {
     // A summary of before the criteria: nothing to say.
     assert!(super::criteria_lines(&serde_json::json!({"agents": [{"steps": 3}]})).is_empty());
 }
+
+#[test]
+fn cells_the_swarm_saw_close_are_kept_once_each() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut log, _) = LogWriter::open(dir.path().join("log"), FsyncPolicy::None).unwrap();
+    log.append(&Record::Header(RunHeader {
+        version: FORMAT_VERSION,
+        scenario_hash: 1,
+        seed: 0,
+        clock: "lockstep".into(),
+        width: W,
+        height: 3,
+        agents: vec![],
+    }))
+    .unwrap();
+    let change = |round, closed: Vec<u32>, opened: Vec<u32>| {
+        Record::MapChange(hnav_runtime::consensus_log::MapChangeRecord {
+            round,
+            agent: 0,
+            closed,
+            opened,
+        })
+    };
+    for r in [
+        change(1, vec![5, 6], vec![]),
+        change(4, vec![], vec![6]),
+        change(9, vec![6], vec![]),
+    ] {
+        log.append(&r).unwrap();
+    }
+    drop(log);
+    let d = RunData::from_log(&dir.path().join("log")).unwrap();
+    assert_eq!(d.closed, vec![(1, 1), (2, 1)]);
+}
