@@ -168,8 +168,8 @@ mod tests {
         assert_eq!(detail(&[4]), "the payload ends 1 byte early");
         assert_eq!(detail(&[1, 0xFF]), "a malformed integer");
         assert_eq!(
-            detail(&[10]),
-            "invalid value: integer `10`, expected variant index 0 <= i < 10"
+            detail(&[11]),
+            "invalid value: integer `11`, expected variant index 0 <= i < 11"
         );
     }
 

@@ -113,7 +113,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
     ),
     ("tasks", &["stream", "seed", "goals"]),
     ("tasks.goals", &["agent", "cells"]),
-    ("sensing", &["range", "known_map", "repair"]),
+    ("sensing", &["range", "known_map", "repair", "all_knowing"]),
     (
         "events",
         &[
