@@ -59,7 +59,8 @@ impl View {
     /// The window row and column bit of cell (`x`, `y`) of the map, if it is in the window.
     fn bit(&self, x: u32, y: u32) -> Option<(usize, u32)> {
         let (c, r) = (x.checked_sub(self.x0)?, y.checked_sub(self.y0)?);
-        (c < self.size && r < self.size).then_some((r as usize, 1 << c))
+        // Lazily: `1 << c` overflows for a cell 32 or more columns right of the window.
+        (c < self.size && r < self.size).then(|| (r as usize, 1 << c))
     }
 
     /// Marks cell (`x`, `y`) of the map seen, blocked or not; one outside the window is
@@ -144,6 +145,17 @@ mod tests {
         assert_eq!(v.moving_cells().collect::<Vec<_>>(), [(7, 8)]);
         assert!(v.is_moving(7, 8) && !v.is_moving(3, 4));
         v.reset(0, 0, 3);
+        assert_eq!(v.cells().count(), 0);
+    }
+
+    #[test]
+    fn a_cell_far_right_of_the_window_is_ignored_not_a_panic() {
+        // A mover 40 columns right of a robot's window: the sim marks every mover cell.
+        let mut v = View::default();
+        v.reset(0, 0, 5);
+        v.mark(40, 0, true);
+        v.mark_moving(40, 0);
+        assert!(!v.is_moving(40, 0));
         assert_eq!(v.cells().count(), 0);
     }
 }
