@@ -8,7 +8,7 @@
 //! in `sim/src/world/changes.rs`), so a lockstep run stays reproducible.
 
 use hnav_runtime::grid::Cell;
-use hnav_runtime::scenario::{Scenario, WorldChange};
+use hnav_runtime::scenario::Scenario;
 
 /// The scenario's closes and opens, in time order, and how many were told.
 pub(super) struct Oracle {
@@ -24,10 +24,9 @@ impl Oracle {
         let events = scenario
             .events
             .iter()
-            .filter_map(|e| match &e.change {
-                WorldChange::Close(cells) => Some((e.at_s, cells.clone(), true)),
-                WorldChange::Open(cells) => Some((e.at_s, cells.clone(), false)),
-                WorldChange::Mover(_) => None,
+            .filter_map(|e| {
+                let (cells, closed) = e.change.cells()?;
+                Some((e.at_s, cells.to_vec(), closed))
             })
             .collect();
         Some(Oracle { events, told: 0 })

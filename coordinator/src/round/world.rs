@@ -53,8 +53,7 @@ impl Arbiter {
     /// Decides from now on on the map `m` changed (a logged record, or one just made by
     /// [`Arbiter::map_change`]); the rules' tables follow the new map.
     pub fn apply_map_change(&mut self, m: &MapChangeRecord) {
-        let closed = m.closed.iter().map(|&c| (c, true));
-        for (c, close) in closed.chain(m.opened.iter().map(|&c| (c, false))) {
+        for (c, close) in m.changes() {
             if let Some(cell) = self.grid.cell_at(c as usize) {
                 self.grid.set_blocked(cell, close);
             }

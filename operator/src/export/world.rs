@@ -7,7 +7,7 @@ use serde_json::Value;
 
 use hnav_runtime::consensus_log::Record;
 use hnav_runtime::grid::Grid;
-use hnav_runtime::scenario::{Scenario, WorldChange};
+use hnav_runtime::scenario::Scenario;
 
 use super::messages::{grid_message, NUMERIC_UINT8};
 
@@ -24,10 +24,8 @@ pub(super) fn truth(s: &Scenario, cell_m: f64) -> Vec<(u64, Value)> {
     let mut g = s.map.grid.clone();
     let mut out = Vec::new();
     for e in &s.events {
-        let (cells, close) = match &e.change {
-            WorldChange::Close(c) => (c, true),
-            WorldChange::Open(c) => (c, false),
-            WorldChange::Mover(_) => continue,
+        let Some((cells, close)) = e.change.cells() else {
+            continue;
         };
         for &c in cells {
             g.set_blocked(c, close);
@@ -50,8 +48,7 @@ pub(super) fn shared(
     let mut out = vec![(0, occupancy(&g, 0, cell_m))];
     for r in records {
         let Record::MapChange(m) = r else { continue };
-        let changes = m.closed.iter().map(|&c| (c, true));
-        for (c, close) in changes.chain(m.opened.iter().map(|&c| (c, false))) {
+        for (c, close) in m.changes() {
             if let Some(cell) = g.cell_at(c as usize) {
                 g.set_blocked(cell, close);
             }

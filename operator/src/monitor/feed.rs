@@ -7,7 +7,7 @@ use super::health::HealthRow;
 use crate::supervisor::registry::LiveRunError;
 use hnav_runtime::grid::Grid;
 use hnav_runtime::msg::{Commit, Lifecycle, Pose, Progress, Truth, View};
-use hnav_runtime::scenario::{Scenario, ScenarioError, WorldChange};
+use hnav_runtime::scenario::{Scenario, ScenarioError};
 use hnav_runtime::transport::TransportError;
 
 /// The static picture of a run: what does not change while it runs.
@@ -61,11 +61,7 @@ impl RunInfo {
                 .events
                 .iter()
                 .filter_map(|e| {
-                    let (cells, closed) = match &e.change {
-                        WorldChange::Close(c) => (c, true),
-                        WorldChange::Open(c) => (c, false),
-                        WorldChange::Mover(_) => return None,
-                    };
+                    let (cells, closed) = e.change.cells()?;
                     Some(WorldStep {
                         at_ns: (e.at_s * 1e9).round() as u64,
                         cells: cells.iter().map(|&c| id(c)).collect(),

@@ -328,6 +328,14 @@ pub struct MapChangeRecord {
     pub opened: Vec<u32>,
 }
 
+impl MapChangeRecord {
+    /// Every changed cell, as (cell, closed): the closed ones, then the opened ones.
+    pub fn changes(&self) -> impl Iterator<Item = (u32, bool)> + '_ {
+        let closed = self.closed.iter().map(|&c| (c, true));
+        closed.chain(self.opened.iter().map(|&c| (c, false)))
+    }
+}
+
 /// A global replan for one agent.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ReplanRecord {

@@ -87,6 +87,18 @@ pub enum WorldChange {
     Mover(MoverSpec),
 }
 
+impl WorldChange {
+    /// The cells a close or an open changes and whether they close; `None` for a mover,
+    /// which changes no cell of the map.
+    pub fn cells(&self) -> Option<(&[Cell], bool)> {
+        match self {
+            WorldChange::Close(c) => Some((c, true)),
+            WorldChange::Open(c) => Some((c, false)),
+            WorldChange::Mover(_) => None,
+        }
+    }
+}
+
 /// A moving obstacle: a person or a forklift that HNAV does not control.
 #[derive(Clone, PartialEq, Debug)]
 pub struct MoverSpec {

@@ -32,7 +32,7 @@ use hnav_runtime::grid::neighbours::Direction;
 use hnav_runtime::grid::shortest::octile_shortest_path_len;
 use hnav_runtime::grid::{Cell, Grid};
 use hnav_runtime::msg::{ConflictKind, Role, Verdict, NO_CELL};
-use hnav_runtime::scenario::{EventSpec, Scenario, WorldChange};
+use hnav_runtime::scenario::{EventSpec, Scenario};
 
 use super::{AgentSummary, RunSummary};
 
@@ -70,8 +70,7 @@ impl LatencySummary {
 fn apply_due(grid: &mut Grid, events: &[EventSpec], next: &mut usize, t_s: f64) -> bool {
     let mut changed = false;
     while let Some(e) = events.get(*next).filter(|e| e.at_s <= t_s + 1e-9) {
-        if let WorldChange::Close(cells) | WorldChange::Open(cells) = &e.change {
-            let close = matches!(e.change, WorldChange::Close(_));
+        if let Some((cells, close)) = e.change.cells() {
             for &c in cells {
                 grid.set_blocked(c, close);
             }
