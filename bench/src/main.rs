@@ -88,6 +88,12 @@ struct ExperimentCli {
     /// Seed of the experiment's random stream.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Keep the run directories of experiments that run swarms, and print where they are.
+    #[arg(long)]
+    keep: bool,
+    /// Only the swarm size of N robots, in experiments with several sizes.
+    #[arg(long, value_name = "N")]
+    robots: Option<usize>,
 }
 
 fn experiment(args: ExperimentCli) -> Result<()> {
@@ -101,6 +107,8 @@ fn experiment(args: ExperimentCli) -> Result<()> {
     let options = Options {
         quick: args.quick,
         seed: args.seed,
+        keep: args.keep,
+        robots: args.robots,
     };
     let report = experiment::run(&args.name, options)?;
     if args.json {

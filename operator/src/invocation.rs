@@ -116,6 +116,26 @@ impl Invocation {
         Ok(inv)
     }
 
+    /// The scenario of the run in `dir` as its processes loaded it: the file `invocation.json`
+    /// names with its overrides, if it still hashes as `scenario_hash` (the log header's)
+    /// says. Readers of a finished run (the export, the playback) take what only the
+    /// scenario holds from it (events, sensor range, periods); `Err` says why there is none.
+    pub fn logged_scenario(dir: &Path, scenario_hash: u64) -> Result<Scenario, String> {
+        let inv = Invocation::read(dir).map_err(|e| e.to_string())?;
+        let s = inv
+            .process_args("reader", dir)
+            .scenario()
+            .map_err(|e| e.to_string())?;
+        if s.scenario_hash() == scenario_hash {
+            Ok(s)
+        } else {
+            Err(format!(
+                "{}: the scenario no longer hashes as the log's header says",
+                inv.scenario.display()
+            ))
+        }
+    }
+
     /// The processes' arguments that start this run again as run `run` in `dir`.
     pub fn process_args(&self, run: &str, dir: &Path) -> ProcessArgs {
         ProcessArgs {

@@ -132,6 +132,7 @@ fn recording(dir: &Path, poses: u64, maps: u64) {
         height: HEIGHT,
         truncated: false,
         control_period_us: 10_000,
+        movers: 0,
     };
     let mut t =
         TrajectoryWriter::create(&rec.join(recording::TRAJECTORIES), header, 1 << 20).unwrap();

@@ -12,8 +12,9 @@ use iceoryx2::prelude::ZeroCopySend;
 use serde::Serialize;
 
 use crate::msg::{
-    Candidate, Commit, Decision, Estimate, Heartbeat, Lifecycle, MapHeader, Odometry, Pose,
-    Progress, Sighting, Truth, View, WheelCommand, WorldHeader, MAX_AGENTS,
+    Candidate, Commit, Decision, Estimate, Heartbeat, Lifecycle, MapHeader, MoverPlace,
+    MoversHeader, Odometry, Pose, Progress, Sighting, Truth, View, WheelCommand, WorldHeader,
+    MAX_AGENTS,
 };
 use crate::topics;
 
@@ -221,6 +222,15 @@ pub fn layouts() -> Layouts {
             opened: u32,
             to: [u32; 8]
         }),
+        layout!(MoversHeader {
+            sim_time_ns: u64,
+            period: u64
+        }),
+        layout!(MoverPlace {
+            mover: u32,
+            reserved: u32,
+            pose: Pose
+        }),
     ];
     let fixed = |topic, payload| TopicLayout {
         topic,
@@ -252,6 +262,12 @@ pub fn layouts() -> Layouts {
             payload: type_name_of::<u32>(),
             slice: true,
             user_header: type_name_of::<WorldHeader>(),
+        },
+        TopicLayout {
+            topic: topics::MOVERS,
+            payload: type_name_of::<MoverPlace>(),
+            slice: true,
+            user_header: type_name_of::<MoversHeader>(),
         },
     ];
     Layouts {
@@ -328,6 +344,6 @@ mod tests {
         let map = l.topics.iter().find(|t| t.topic == "map/<i>").unwrap();
         assert_eq!((map.payload, map.user_header), ("f32", "hnav::MapHeader"));
         let json: serde_json::Value = serde_json::from_str(&l.to_json()).unwrap();
-        assert_eq!(json["types"].as_array().unwrap().len(), 15);
+        assert_eq!(json["types"].as_array().unwrap().len(), 17);
     }
 }

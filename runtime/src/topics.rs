@@ -16,6 +16,7 @@
 //! | `heartbeat` | [`Heartbeat`](crate::msg::Heartbeat) | every process -> supervisor | latest, depth 1, not notified |
 //! | `sightings` | [`Sighting`](crate::msg::Sighting) | agents -> coordinator (with `[sensing]`) | reliable |
 //! | `world` | `[u32]` + [`WorldHeader`](crate::msg::WorldHeader) | coordinator -> restarted agents (with `[sensing]`) | latest, shallow ([`world_qos`]) |
+//! | `movers` | [`MoverPlace`](crate::msg::MoverPlace) slice + [`MoversHeader`](crate::msg::MoversHeader) | sim -> recorder, viewers (a run with movers) | latest, deep buffer ([`truth_qos`]) |
 //! | `raft/<i>` | `[u8]`: a Raft message | every other coordinator replica -> replica i | latest ([`raft_qos`]) |
 //!
 //! Why "latest" (overwrite the oldest) for commits and lifecycle events, where every sample
@@ -56,6 +57,8 @@ pub fn odometry(i: usize) -> String {
 pub const SIGHTINGS: &str = "sightings";
 /// The coordinator's map of a changing world, for agents that restarted.
 pub const WORLD: &str = "world";
+/// Where the moving obstacles are, from the sim (a run with movers).
+pub const MOVERS: &str = "movers";
 
 /// Robot `i`'s sensor view (the sim's [`View`](crate::msg::View)).
 pub fn view(i: usize) -> String {

@@ -22,7 +22,7 @@ use crate::robot::RobotModel;
 use crate::watchdog::Watchdog;
 use hnav_runtime::grid::geometry::{cell_centre_pose, wrap_angle};
 use hnav_runtime::grid::Grid;
-use hnav_runtime::msg::{Odometry, Pose, Truth, MAX_AGENTS};
+use hnav_runtime::msg::{MoverPlace, Odometry, Pose, Truth, MAX_AGENTS};
 use hnav_runtime::scenario::params::{RobotParams, SimParams};
 use hnav_runtime::scenario::LocalisationParams;
 use hnav_runtime::scenario::Scenario;
@@ -197,6 +197,27 @@ impl World {
     /// The moving obstacles under way: name and centre (m).
     pub fn movers(&self) -> impl Iterator<Item = (&str, Point2<f64>)> {
         self.changes.movers()
+    }
+
+    /// How many movers are on the floor.
+    pub fn movers_on_floor(&self) -> usize {
+        self.changes.movers_on_floor()
+    }
+
+    /// The `n`-th mover on the floor as the `movers` topic carries it: its index (in the
+    /// order the movers appeared), centre (m) and heading along its leg.
+    pub fn mover_place(&self, n: usize) -> MoverPlace {
+        self.changes
+            .mover_pose(n)
+            .map_or_else(MoverPlace::default, |(k, at, heading)| MoverPlace {
+                mover: u32::try_from(k).unwrap_or(u32::MAX),
+                reserved: 0,
+                pose: Pose {
+                    x_m: at.x,
+                    y_m: at.y,
+                    theta_rad: heading,
+                },
+            })
     }
 
     /// Makes the odometry readings carry localisation fixes as `params` says (a world made

@@ -237,3 +237,43 @@ fn a_view_marks_the_cells_of_the_leg_a_mover_walks() {
     let blocked: Vec<_> = v.cells().filter(|c| c.2).map(|c| (c.0, c.1)).collect();
     assert_eq!(blocked, [(4, 1), (4, 2)]);
 }
+
+#[test]
+fn a_mover_that_yields_comes_on_only_when_no_robot_claims_its_first_cell() {
+    // The robot drives east along row 2; when is it in (5, 2)?
+    let cell = hnav_runtime::scenario::params::RobotParams::default().cell_size_m;
+    let in_cell = |w: &World, x: f64| (w.position(0).unwrap().x / cell).floor() == x;
+    let mut probe = world("");
+    let mut steps = 0;
+    while !in_cell(&probe, 5.0) {
+        drive(&mut probe, 1);
+        steps += 1;
+        assert!(steps < 20_000, "the robot never reached (5, 2)");
+    }
+    // A person due at that very time on (5, 2), walking up column 5: it waits to come on.
+    let t_s = probe.time_ns() as f64 / 1e9;
+    let person =
+        format!("[[events]]\nat_s = {t_s}\nmover = \"p\"\npath = [[5, 2], [5, 0]]\nspeed = 1\n");
+    let mut w = world(&person);
+    drive(&mut w, steps + 1);
+    assert!(in_cell(&w, 5.0));
+    assert_eq!(w.movers().count(), 0, "it came on over the robot");
+    assert_eq!(w.movers_on_floor(), 0);
+    // A checkpoint keeps it off the floor.
+    let mut bytes = Vec::new();
+    w.write_snapshot(&mut bytes);
+    let mut back = world(&person);
+    back.restore_snapshot(&bytes).unwrap();
+    assert_eq!(back.movers().count(), 0);
+    // The robot drives on, out of (5, 2) and past its neighbours, and stops: the person
+    // comes on and walks its way. Nobody touched anybody.
+    for w in [&mut w, &mut back] {
+        while (w.position(0).unwrap().x / cell) < 7.5 {
+            drive(w, 1);
+        }
+        stand(w, 3_000);
+        assert_eq!(w.movers().count(), 1);
+        assert_eq!(w.mover_place(0).mover, 0);
+        assert!(w.collisions().is_empty(), "{:?}", w.collisions());
+    }
+}

@@ -281,6 +281,85 @@ fn the_all_knowing_baseline_tells_every_agent_the_door_when_it_closes() {
     assert_eq!(changes, [(CLOSED_AT, 0)]);
 }
 
+/// The warehouse run in `dir` as the report and the playback show it: the movers' tracks, the
+/// doors closing and opening at their time, and what the robots' sensors saw.
+fn seen_as_it_happens(dir: &Path) {
+    use hnav_operator::monitor::feed::{Feed, Update};
+    use hnav_operator::monitor::playback::PlaybackFeed;
+    use hnav_operator::monitor::state::ViewState;
+    use hnav_operator::recording::{PoseSource, TrajectoryReader};
+    use hnav_runtime::grid::Cell;
+    use std::time::{Duration, Instant};
+
+    let (samples, _) = TrajectoryReader::open(&dir.join("recording/trajectories.bin"))
+        .unwrap()
+        .read_all()
+        .unwrap();
+    for k in 0..2 {
+        let n = samples
+            .iter()
+            .filter(|s| s.source == PoseSource::Mover && s.robot == k)
+            .count();
+        assert!(n > 100, "mover {k}: {n} samples recorded");
+    }
+    // The report: both movers' tracks and the sensed floor, the doors among it.
+    let data = hnav_operator::report::RunData::load(dir, &[]).unwrap();
+    assert_eq!(data.movers.len(), 2);
+    assert!(data.movers.iter().all(|t| t.len() > 100));
+    let sensed = |x: u32, y: u32| data.sensed[(y * data.width + x) as usize];
+    assert!(sensed(5, 2) && sensed(10, 7), "the doors were seen");
+    let svg = std::fs::read_to_string(dir.join("report.svg")).unwrap();
+    assert!(
+        svg.contains("mover (dashed: its track)"),
+        "the report's legend"
+    );
+    // The playback: doors closed between their rounds (10 ms each), movers, rebuilt views.
+    let mut feed = PlaybackFeed::open(dir, 10_000.0).unwrap();
+    let mut state = ViewState::new(feed.info().clone());
+    let door = Cell::new(5, 2);
+    let (started, mut movers, mut views) = (Instant::now(), 0, 0);
+    let (mut closed_in_time, mut closed_out_of_time) = (false, false);
+    while state.ended.is_none() {
+        assert!(
+            started.elapsed() < Duration::from_secs(120),
+            "playback too slow"
+        );
+        feed.wait(Instant::now() + Duration::from_millis(5))
+            .unwrap();
+        let mut t_ns = None;
+        feed.pump(&mut |u| {
+            match u {
+                Update::Movers(m) => movers += usize::from(m.len() == 2),
+                Update::View(_) => views += 1,
+                Update::Truth(t) => t_ns = Some(t.sim_time_ns),
+                _ => {}
+            }
+            state.apply(u, Instant::now());
+            if let Some(t) = t_ns {
+                let round = t / 10_000_000;
+                let shut = state.info.grid.is_blocked(door);
+                let inside = (DOORS_CLOSE + 1..DOORS_OPEN).contains(&round);
+                closed_in_time |= shut && inside;
+                closed_out_of_time |= shut && !(DOORS_CLOSE..=DOORS_OPEN).contains(&round);
+            }
+        })
+        .unwrap();
+    }
+    assert!(
+        movers > 100 && views > 100,
+        "movers {movers}, views {views}"
+    );
+    assert!(
+        closed_in_time && !closed_out_of_time,
+        "the door in the playback"
+    );
+    assert_eq!(state.movers.len(), 2);
+    assert!(
+        state.sensed().iter().any(|&s| s),
+        "a sensed area in the playback"
+    );
+}
+
 /// The rounds `scenarios/warehouse-doors.toml`'s doors are closed: from this round ...
 const DOORS_CLOSE: u64 = 100;
 /// ... to this one.
@@ -331,6 +410,7 @@ fn doors_and_movers_in_a_warehouse_every_robot_home_no_contact_and_the_run_repea
         // The robots met the movers and kept clear of them.
         let kept_clear = agent_logs.matches("waits for a mover").count();
         assert!(kept_clear > 0, "{agent_logs}");
+        seen_as_it_happens(&dir);
         let sim_log = std::fs::read_to_string(dir.join("logs/sim.log")).unwrap();
         println!(
             "warehouse-doors: {} rounds, {} collisions, repairs with a closed cell {closed}, \
@@ -342,5 +422,20 @@ fn doors_and_movers_in_a_warehouse_every_robot_home_no_contact_and_the_run_repea
             sim_log.matches("mover turned back").count()
         );
     }
-    assert!(logs[0] == logs[1], "the two lockstep logs differ");
+    if logs[0] != logs[1] {
+        panic!(
+            "the two lockstep logs differ: {}",
+            first_difference(&tmp.path().join("run0"), &tmp.path().join("run1"))
+        );
+    }
+}
+
+/// The first decided record in which the logs of the runs in `a` and `b` differ.
+fn first_difference(a: &Path, b: &Path) -> String {
+    let records = |d: &Path| read_decided(d.join("log")).unwrap().records;
+    let (ra, rb) = (records(a), records(b));
+    match ra.iter().zip(&rb).position(|(x, y)| x != y) {
+        Some(i) => format!("record {i}:\n{:?}\nagainst\n{:?}", ra[i], rb[i]),
+        None => format!("{} records against {}", ra.len(), rb.len()),
+    }
 }

@@ -76,6 +76,12 @@ pub struct Options {
     pub quick: bool,
     /// Seed of the experiment's random stream.
     pub seed: u64,
+    /// Experiments that run whole swarms (`dynamic`) keep their run directories (scenario,
+    /// consensus log, process logs, recording) and say where, instead of deleting them: a
+    /// surprising row can then be looked into, or run again with `hnav run`.
+    pub keep: bool,
+    /// Experiments with several swarm sizes (`dynamic`) run only this one.
+    pub robots: Option<usize>,
 }
 
 /// What an experiment produced: the markdown table(s) for a reader and the same figures for a

@@ -329,6 +329,27 @@ class WorldHeader(_Payload):
 
 
 # Every payload mirror, for the layout test.
+class MoversHeader(_Payload):
+    """The user header of the sim's `movers` topic (a slice of MoverPlace): where the moving
+    obstacles on the floor are at the end of control period `period` (read len // 32 places:
+    the binding's slice length is in bytes)."""
+
+    _fields_ = [
+        ("sim_time_ns", ctypes.c_uint64),
+        ("period", ctypes.c_uint64),
+    ]
+
+
+class MoverPlace(_Payload):
+    """One mover on the floor: its index (the order the movers appeared in) and its pose."""
+
+    _fields_ = [
+        ("mover", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+        ("pose", Pose),
+    ]
+
+
 PAYLOADS = [
     Candidate,
     Decision,
@@ -345,4 +366,6 @@ PAYLOADS = [
     View,
     Sighting,
     WorldHeader,
+    MoversHeader,
+    MoverPlace,
 ]

@@ -43,6 +43,7 @@ TOPICS = {
     "estimate": (msg.Estimate, None),
     "sightings": (msg.Sighting, None),
     "world": (iox2.Slice[ctypes.c_uint32], msg.WorldHeader),
+    "movers": (iox2.Slice[msg.MoverPlace], msg.MoversHeader),
 }
 
 _RUN_ID = re.compile(r"^[A-Za-z0-9_-]{1,48}$")

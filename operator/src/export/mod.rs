@@ -141,22 +141,7 @@ pub fn export_mcap(run_dir: &Path, out: &Path) -> Result<ExportReport, ExportErr
 /// The period and cell size of the run: from its scenario when `invocation.json` names one
 /// that still hashes as the log's header says, else the defaults (noted).
 fn run_info(run_dir: &Path, header: RunHeader, notes: &mut Vec<String>) -> RunInfo {
-    let scenario = Invocation::read(run_dir)
-        .map_err(|e| e.to_string())
-        .and_then(|inv| {
-            let s = inv
-                .process_args("export", run_dir)
-                .scenario()
-                .map_err(|e| e.to_string())?;
-            if s.scenario_hash() == header.scenario_hash {
-                Ok(s)
-            } else {
-                Err(format!(
-                    "{}: the scenario no longer hashes as the log's header says",
-                    inv.scenario.display()
-                ))
-            }
-        });
+    let scenario = Invocation::logged_scenario(run_dir, header.scenario_hash);
     match scenario {
         Ok(s) => RunInfo {
             period_ns: s.sim.steps_per_control_period() * u64::from(s.sim.step_ms) * 1_000_000,
@@ -214,10 +199,14 @@ fn write_all(
             w.channel(&format!("/robots/{i}/truth"), schemas::POSE_IN_FRAME)?;
             w.channel(&format!("/robots/{i}/estimate"), schemas::POSE_IN_FRAME)?;
         }
+        for k in 0..r.header().movers {
+            w.channel(&format!("/movers/{k}"), schemas::POSE_IN_FRAME)?;
+        }
         while let Some(s) = r.next_sample()? {
             let topic = match s.source {
                 PoseSource::Truth => format!("/robots/{}/truth", s.robot),
                 PoseSource::Estimate => format!("/robots/{}/estimate", s.robot),
+                PoseSource::Mover => format!("/movers/{}", s.robot),
             };
             w.message(&topic, schemas::POSE_IN_FRAME, s.t_ns, &pose_message(&s))?;
         }

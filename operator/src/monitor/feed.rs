@@ -4,9 +4,10 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use super::health::HealthRow;
+pub use crate::recording::world::{world_steps, WorldStep};
 use crate::supervisor::registry::LiveRunError;
 use hnav_runtime::grid::Grid;
-use hnav_runtime::msg::{Commit, Lifecycle, Pose, Progress, Truth, View};
+use hnav_runtime::msg::{Commit, Lifecycle, MoverPlace, Pose, Progress, Truth, View};
 use hnav_runtime::scenario::{Scenario, ScenarioError};
 use hnav_runtime::transport::TransportError;
 
@@ -31,17 +32,8 @@ pub struct RunInfo {
     /// The scenario's closes and opens (`[[events]]`), in time order: the view's map follows
     /// them as the sim's time passes them.
     pub changes: Vec<WorldStep>,
-}
-
-/// One close or open of the scenario's `[[events]]`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct WorldStep {
-    /// When, ns of sim time.
-    pub at_ns: u64,
-    /// The cells (0-based row-major indices).
-    pub cells: Vec<u32>,
-    /// Whether they close (else they open).
-    pub closed: bool,
+    /// The robots' sensor range, cells (`[sensing] range`), when they sense.
+    pub sensor_range: Option<u32>,
 }
 
 impl RunInfo {
@@ -57,18 +49,8 @@ impl RunInfo {
             starts: scenario.agents.iter().map(|a| id(a.start)).collect(),
             goals: scenario.agents.iter().map(|a| id(a.goal)).collect(),
             cell_size_m: scenario.robot.cell_size_m,
-            changes: scenario
-                .events
-                .iter()
-                .filter_map(|e| {
-                    let (cells, closed) = e.change.cells()?;
-                    Some(WorldStep {
-                        at_ns: (e.at_s * 1e9).round() as u64,
-                        cells: cells.iter().map(|&c| id(c)).collect(),
-                        closed,
-                    })
-                })
-                .collect(),
+            changes: world_steps(scenario, &grid),
+            sensor_range: scenario.sensing.map(|s| s.range),
             grid,
         }
     }
@@ -125,6 +107,8 @@ pub enum Update<'a> {
     Health(&'a [HealthRow]),
     /// What a robot's range sensor sees now (`[sensing]`).
     View(&'a View),
+    /// Where the moving obstacles on the floor are now (a run with movers).
+    Movers(&'a [MoverPlace]),
     /// The run is over; nothing follows.
     Ended(RunEnd),
 }

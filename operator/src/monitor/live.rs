@@ -24,9 +24,11 @@ use crate::supervisor::registry::LiveRunError;
 use crate::supervisor::registry::{RunRecord, RunRegistry};
 use hnav_runtime::consensus_log::reader::LogReader;
 use hnav_runtime::consensus_log::record::Record;
-use hnav_runtime::msg::{Commit, Lifecycle, Progress, Truth, View};
+use hnav_runtime::msg::{Commit, Lifecycle, MoverPlace, MoversHeader, Progress, Truth, View};
 use hnav_runtime::topics;
-use hnav_runtime::transport::{Receiver, RunId, Transport, TransportError, Waiter, Wake};
+use hnav_runtime::transport::{
+    Receiver, RunId, SliceReceiver, Transport, TransportError, Waiter, Wake,
+};
 
 /// How often the registry and `/proc` are read for the health rows.
 pub const HEALTH_PERIOD: Duration = Duration::from_secs(1);
@@ -91,6 +93,8 @@ pub struct LiveFeed {
     life: Receiver<Lifecycle>,
     /// Each robot's view, with `[sensing]`.
     views: Vec<Receiver<View>>,
+    /// The movers' places, in a run with movers.
+    movers: Option<SliceReceiver<MoverPlace, MoversHeader>>,
     waiter: Waiter,
     sampler: HealthSampler,
     rows: Vec<HealthRow>,
@@ -153,6 +157,10 @@ impl LiveFeed {
                 .map_err(transport_err)?,
             None => Vec::new(),
         };
+        let movers = (scenario.movers().next().is_some())
+            .then(|| transport.slice_receiver(topics::MOVERS, topics::truth_qos()))
+            .transpose()
+            .map_err(transport_err)?;
         Ok(LiveFeed {
             info: RunInfo::of(&run_id, &scenario),
             registry: registry.clone(),
@@ -162,6 +170,7 @@ impl LiveFeed {
             progress,
             life,
             views,
+            movers,
             waiter,
             sampler: HealthSampler::new(),
             rows: Vec::new(),
@@ -253,6 +262,17 @@ impl Feed for LiveFeed {
                 .map_err(|e| self.err(e))?;
             if let Some(v) = &newest {
                 apply(Update::View(v));
+            }
+        }
+        if let Some(rx) = &self.movers {
+            // Only the newest sample counts; holding one at a time, it is handed on in place.
+            rx.take_wakeup().map_err(|e| self.err(e))?;
+            let mut newest = None;
+            while let Some(sample) = rx.receive().map_err(|e| self.err(e))? {
+                newest = Some(sample);
+            }
+            if let Some(sample) = &newest {
+                apply(Update::Movers(sample.payload()));
             }
         }
         if end.is_none() {

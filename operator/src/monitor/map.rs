@@ -180,6 +180,15 @@ impl Widget for MapWidget<'_> {
             let (bx, by) = scale.block_of(a.goal, w);
             put(buf, bx, by, goal, Style::default().fg(agent_color(i)));
         }
+        // Movers before robots: a robot on a mover's block (a contact) shows over it.
+        let mover = if scale.cols == 2 { "@@" } else { "@" };
+        let mover_s = Style::default()
+            .fg(Color::LightRed)
+            .add_modifier(Modifier::BOLD);
+        for cell in self.state.mover_cells() {
+            let (bx, by) = scale.block_of(cell, w);
+            put(buf, bx, by, mover, mover_s);
+        }
         // Drawn from the last agent to the first, so the lowest index shows on a shared block.
         for (i, a) in self.state.agents.iter().enumerate().rev() {
             let Some(cell) = a.cell else { continue };

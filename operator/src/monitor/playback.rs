@@ -4,7 +4,12 @@
 //! Everything comes from the run directory, so a run can be looked at after its scenario
 //! file has changed or moved: the map from `map.map`, starts, goals and the clock mode from
 //! the consensus log's header, poses from `recording/trajectories.bin`, decisions and process
-//! events from the log, the collision count from `summary.json`. The feed yields the same
+//! events from the log, the collision count from `summary.json`. What only the scenario holds
+//! comes from the scenario `invocation.json` names, if it still hashes as the log's header
+//! says (otherwise the map stays as it started and no sensed area is shown): the world's
+//! closes and opens, applied at their time, and the sensor range, with which each robot's
+//! view is rebuilt from its recorded pose and the recorded movers
+//! ([`crate::recording::world::RecordedWorld`]). The feed yields the same
 //! [`Update`]s as the live one, so the state and the view are the same code:
 //!
 //! - **Ground truth**: one [`Truth`] per sampling time of the recording (all robots' samples
@@ -32,15 +37,17 @@ use std::time::{Duration, Instant};
 
 use iceoryx2_bb_posix::signal::SignalHandler;
 
-use super::feed::RunInfo;
+use super::feed::{world_steps, RunInfo};
 use super::feed::{Feed, FeedError, RunEnd, Update, Waited};
+use crate::invocation::Invocation;
+use crate::recording::world::RecordedWorld;
 use crate::recording::{self, PoseSample, PoseSource, TrajectoryReader};
 use crate::report::MAP_FILE;
 use hnav_runtime::consensus_log::read_decided;
 use hnav_runtime::consensus_log::record::{EndReason, Record, RunHeader};
 use hnav_runtime::consensus_log::tally::Tally;
 use hnav_runtime::grid::movingai::read_map_file;
-use hnav_runtime::msg::{Commit, Lifecycle, Pose, Progress, Truth, MAX_AGENTS};
+use hnav_runtime::msg::{Commit, Lifecycle, Pose, Progress, Truth, View, MAX_AGENTS};
 
 /// The slowest and fastest playback speeds `--speed` takes.
 pub const SPEEDS: std::ops::RangeInclusive<f64> = 0.01..=10_000.0;
@@ -55,6 +62,9 @@ pub struct PlaybackFeed {
     /// The next ground-truth sample, read ahead to know when a time's samples are complete.
     pending: Option<PoseSample>,
     truth: Box<Truth>,
+    /// The map with the scenario's changes, the movers, and the views rebuilt from them.
+    world: RecordedWorld,
+    view: View,
     collisions_at: Vec<u64>,
     records: std::vec::IntoIter<Record>,
     next: Option<Record>,
@@ -116,7 +126,10 @@ impl PlaybackFeed {
         for (pose, a) in truth.poses.iter_mut().zip(&header.agents) {
             *pose = cell_centre(a.start, header.width, th.cell_size_m);
         }
+        let world = RecordedWorld::new(info.grid.clone(), info.changes.clone(), info.cell_size_m);
         Ok(PlaybackFeed {
+            world,
+            view: View::default(),
             info,
             speed,
             period_ns: u64::from(th.control_period_us) * 1_000,
@@ -145,6 +158,11 @@ impl PlaybackFeed {
         while self.pending.is_none() {
             match self.trajectories.next_sample()? {
                 Some(s) if s.source == PoseSource::Truth => self.pending = Some(s),
+                // The recorder writes a time's movers after its truth, so they are read
+                // here, ahead of the next time's truth, and shown with their own time's.
+                Some(s) if s.source == PoseSource::Mover => {
+                    self.world.place_mover(u32::from(s.robot), pose_of(&s));
+                }
                 Some(_) => {}
                 None => return Ok(None),
             }
@@ -176,11 +194,7 @@ impl PlaybackFeed {
     fn emit_truth(&mut self, t: u64, apply: &mut dyn FnMut(Update<'_>)) -> Result<(), FeedError> {
         while let Some(s) = self.pending.filter(|s| s.t_ns == t) {
             if let Some(p) = self.truth.poses.get_mut(usize::from(s.robot)) {
-                *p = Pose {
-                    x_m: f64::from(s.x_m),
-                    y_m: f64::from(s.y_m),
-                    theta_rad: f64::from(s.theta_rad),
-                };
+                *p = pose_of(&s);
             }
             self.pending = None;
             self.next_truth_time()?;
@@ -190,6 +204,18 @@ impl PlaybackFeed {
         let seen = self.collisions_at.partition_point(|&c| c <= t);
         self.truth.collisions = u32::try_from(seen).unwrap_or(u32::MAX);
         apply(Update::Truth(&self.truth));
+        self.world.advance(t);
+        if !self.world.movers().is_empty() {
+            apply(Update::Movers(self.world.movers()));
+        }
+        if let Some(range) = self.info.sensor_range {
+            for (i, pose) in self.truth.poses().iter().enumerate() {
+                self.world
+                    .fill_view(i as u32, pose, range, t, &mut self.view);
+                self.view.period = self.truth.period;
+                apply(Update::View(&self.view));
+            }
+        }
         Ok(())
     }
 
@@ -347,6 +373,11 @@ fn run_info(
             ),
         });
     }
+    // What only the scenario holds (its changes, the sensor range), if it is still the run's.
+    let scenario = Invocation::logged_scenario(dir, header.scenario_hash).ok();
+    let changes = scenario
+        .as_ref()
+        .map_or_else(Vec::new, |s| world_steps(s, &grid));
     let name = dir
         .canonicalize()
         .ok()
@@ -360,8 +391,18 @@ fn run_info(
         starts: header.agents.iter().map(|a| a.start).collect(),
         goals: header.agents.iter().map(|a| a.goal).collect(),
         cell_size_m,
-        changes: Vec::new(),
+        changes,
+        sensor_range: scenario.and_then(|s| s.sensing.map(|s| s.range)),
     })
+}
+
+/// A sample's pose.
+fn pose_of(s: &PoseSample) -> Pose {
+    Pose {
+        x_m: f64::from(s.x_m),
+        y_m: f64::from(s.y_m),
+        theta_rad: f64::from(s.theta_rad),
+    }
 }
 
 /// The centre of row-major cell `c`, where a robot stands before its first sample.

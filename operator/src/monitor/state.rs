@@ -30,8 +30,8 @@ use std::time::{Duration, Instant};
 use super::feed::{RunEnd, RunInfo, Update};
 use super::health::HealthRow;
 use hnav_runtime::msg::{
-    Commit, ConflictKind, Decision, Lifecycle, LifecycleEvent, Pose, Progress, Role, RosterState,
-    Truth, Verdict, View,
+    Commit, ConflictKind, Decision, Lifecycle, LifecycleEvent, MoverPlace, Pose, Progress, Role,
+    RosterState, Truth, Verdict, View,
 };
 
 /// How many of the latest decisions and events the view keeps.
@@ -269,6 +269,8 @@ pub struct ViewState {
     pub health: Vec<HealthRow>,
     /// Set once the run is over.
     pub ended: Option<RunEnd>,
+    /// Where the moving obstacles on the floor are (a run with movers).
+    pub movers: Vec<MoverPlace>,
     rate: RateMeter,
     last_commit: Option<u64>,
     truth_period: Option<u64>,
@@ -296,6 +298,7 @@ impl ViewState {
             events: VecDeque::with_capacity(RECENT),
             health: Vec::new(),
             ended: None,
+            movers: Vec::new(),
             rate: RateMeter::default(),
             last_commit: None,
             truth_period: None,
@@ -322,7 +325,18 @@ impl ViewState {
                     a.view = Some(*v);
                 }
             }
+            Update::Movers(poses) => {
+                self.movers.clear();
+                self.movers.extend_from_slice(poses);
+            }
         }
+    }
+
+    /// The cells (0-based row-major) the moving obstacles' centres are in now.
+    pub fn mover_cells(&self) -> impl Iterator<Item = u32> + '_ {
+        self.movers
+            .iter()
+            .filter_map(|m| self.info.cell_of(&m.pose))
     }
 
     /// Per cell of the map, whether a robot's range sensor sees it now (its latest view).

@@ -12,6 +12,7 @@ fn view() -> ViewState {
         goals: vec![2, 7],
         cell_size_m: 1.0,
         changes: Vec::new(),
+        sensor_range: None,
     })
 }
 
@@ -360,4 +361,28 @@ fn the_sensed_cells_are_each_robots_latest_view() {
         [3],
         "a view of a robot not in the run is ignored"
     );
+}
+
+#[test]
+fn movers_replace_the_last_and_are_placed_on_their_cells() {
+    let mut v = view();
+    assert_eq!(v.mover_cells().count(), 0);
+    let at = |x_m, y_m| MoverPlace {
+        mover: 0,
+        reserved: 0,
+        pose: Pose {
+            x_m,
+            y_m,
+            theta_rad: 0.0,
+        },
+    };
+    v.apply(
+        Update::Movers(&[at(1.5, 0.5), at(3.5, 1.5)]),
+        Instant::now(),
+    );
+    assert_eq!(v.mover_cells().collect::<Vec<_>>(), [1, 7]);
+    // Off the map is nowhere; a later sample replaces the whole picture.
+    v.apply(Update::Movers(&[at(9.0, 0.5)]), Instant::now());
+    assert_eq!(v.mover_cells().count(), 0);
+    assert_eq!(v.movers.len(), 1);
 }

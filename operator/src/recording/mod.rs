@@ -11,6 +11,9 @@
 //! | [`TRAJECTORIES`] | [`trajectory`] | fixed 24-byte pose samples: ground truth and each agent's dead-reckoned estimate |
 //! | [`MAPS`] | [`maps`] | neural-map snapshots, one checksummed frame each |
 //!
+//! [`world`] reads them back as a world: the map with the scenario's changes applied by
+//! time, the movers' places and each robot's sensed area, for the playback and the report.
+//!
 //! Both are little-endian, start with an 8-byte magic whose last byte is the format version,
 //! and are written append-only through a size cap: a sample beyond the cap is dropped and
 //! counted, and [`trajectory::TrajectoryWriter::finish`] marks the file truncated, so a long
@@ -21,6 +24,7 @@
 
 pub mod maps;
 pub mod trajectory;
+pub mod world;
 
 use std::path::PathBuf;
 

@@ -10,11 +10,12 @@
 //! header, 32 bytes                      sample, 24 bytes
 //!   0  magic  "HNAVTRJ" + version 1       0  t_ns       u64  simulated time since Start
 //!   8  robots        u16                  8  robot      u16
-//!  10  rate_hz       u16 (0 = every       10 source     u8   1 truth, 2 estimate
+//!  10  rate_hz       u16 (0 = every       10 source     u8   1 truth, 2 estimate, 3 mover
 //!                     truth message)      11 reserved   u8   0
 //!  12  flags         u16 (bit 0:          12 x_m        f32
 //!                     truncated by cap)   16 y_m        f32
-//!  14  reserved      u16                  20 theta_rad  f32
+//!  14  movers        u16                  20 theta_rad  f32
+//!                                         (source 3: robot is the mover's index)
 //!  16  cell_size_m   f32
 //!  20  width, height u32, u32 (cells)
 //!  28  control period u32, microseconds
@@ -25,7 +26,7 @@
 //! use hnav_operator::recording::{PoseSample, PoseSource, TrajectoryHeader, TrajectoryReader, TrajectoryWriter};
 //! let dir = tempfile::tempdir().unwrap();
 //! let path = dir.path().join("trajectories.bin");
-//! let header = TrajectoryHeader { robots: 2, rate_hz: 20, cell_size_m: 0.16, width: 12, height: 12, truncated: false, control_period_us: 10_000 };
+//! let header = TrajectoryHeader { robots: 2, rate_hz: 20, cell_size_m: 0.16, width: 12, height: 12, truncated: false, control_period_us: 10_000, movers: 0 };
 //! let mut w = TrajectoryWriter::create(&path, header, 1 << 20).unwrap();
 //! let s = PoseSample { t_ns: 50_000_000, robot: 1, source: PoseSource::Truth, x_m: 0.24, y_m: 0.4, theta_rad: 1.57 };
 //! assert!(w.push(&s).unwrap());
@@ -61,6 +62,9 @@ pub enum PoseSource {
     Truth = 1,
     /// The agent's dead-reckoned estimate (what it believes).
     Estimate = 2,
+    /// A moving obstacle's place (the sim's `movers`); the sample's `robot` is the mover's
+    /// index, in the order the movers appeared.
+    Mover = 3,
 }
 
 impl PoseSource {
@@ -69,6 +73,7 @@ impl PoseSource {
         match v {
             1 => Some(Self::Truth),
             2 => Some(Self::Estimate),
+            3 => Some(Self::Mover),
             _ => None,
         }
     }
@@ -94,6 +99,9 @@ pub struct TrajectoryHeader {
     /// a playback can place each round's decisions in simulated time; 0 when not recorded.
     /// It took a field that earlier writers of version 1 left zero, hence no version bump.
     pub control_period_us: u32,
+    /// The scenario's movers (`[[events]]` movers): every [`PoseSource::Mover`] sample's
+    /// index is below it. Also a field version 1 writers left zero (no movers).
+    pub movers: u16,
 }
 
 impl TrajectoryHeader {
@@ -105,6 +113,7 @@ impl TrajectoryHeader {
         b[10..12].copy_from_slice(&self.rate_hz.to_le_bytes());
         let flags = if self.truncated { FLAG_TRUNCATED } else { 0 };
         b[12..14].copy_from_slice(&flags.to_le_bytes());
+        b[14..16].copy_from_slice(&self.movers.to_le_bytes());
         b[16..20].copy_from_slice(&self.cell_size_m.to_le_bytes());
         b[20..24].copy_from_slice(&self.width.to_le_bytes());
         b[24..28].copy_from_slice(&self.height.to_le_bytes());
@@ -137,6 +146,7 @@ impl TrajectoryHeader {
             width: u32_at(20),
             height: u32_at(24),
             control_period_us: u32_at(28),
+            movers: u16_at(14),
         })
     }
 }
@@ -171,13 +181,17 @@ impl PoseSample {
     }
 
     /// Decodes a sample, or says what is impossible about it.
-    fn decode(b: &[u8; SAMPLE_LEN], robots: u16) -> Result<Self, String> {
+    fn decode(b: &[u8; SAMPLE_LEN], header: &TrajectoryHeader) -> Result<Self, String> {
         let f32_at = |i: usize| f32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
         let robot = u16::from_le_bytes([b[8], b[9]]);
-        if robot >= robots {
-            return Err(format!("robot {robot}, the run has {robots}"));
-        }
         let source = PoseSource::from_u8(b[10]).ok_or_else(|| format!("source byte {}", b[10]))?;
+        let (what, of) = match source {
+            PoseSource::Mover => ("mover", header.movers),
+            PoseSource::Truth | PoseSource::Estimate => ("robot", header.robots),
+        };
+        if robot >= of {
+            return Err(format!("{what} {robot}, the run has {of}"));
+        }
         if b[11] != 0 {
             return Err(format!("reserved byte {}", b[11]));
         }
@@ -324,13 +338,12 @@ impl TrajectoryReader {
         if let Some(frames) = &self.frames {
             b.copy_from_slice(frames.payload());
         }
-        let s = PoseSample::decode(&b, self.header.robots).map_err(|problem| {
-            RecordingError::Corrupt {
+        let s =
+            PoseSample::decode(&b, &self.header).map_err(|problem| RecordingError::Corrupt {
                 path: self.path.clone(),
                 offset,
                 problem,
-            }
-        })?;
+            })?;
         Ok(Some(s))
     }
 
@@ -367,6 +380,7 @@ mod tests {
             height: 32,
             truncated: false,
             control_period_us: 10_000,
+            movers: 0,
         }
     }
 
@@ -383,6 +397,30 @@ mod tests {
             y_m: 1.0 - i as f32 * 0.01,
             theta_rad: -0.5,
         }
+    }
+
+    #[test]
+    fn mover_samples_are_checked_against_the_movers_not_the_robots() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.bin");
+        let h = TrajectoryHeader {
+            movers: 2,
+            ..header()
+        };
+        let mut w = TrajectoryWriter::create(&path, h, u64::MAX).unwrap();
+        let mover = |robot| PoseSample {
+            robot,
+            source: PoseSource::Mover,
+            ..sample(0)
+        };
+        w.push(&mover(1)).unwrap();
+        w.push(&mover(2)).unwrap();
+        w.finish().unwrap();
+        let mut r = TrajectoryReader::open(&path).unwrap();
+        assert_eq!(r.header().movers, 2);
+        assert_eq!(r.next_sample().unwrap(), Some(mover(1)));
+        let e = r.next_sample().unwrap_err().to_string();
+        assert!(e.contains("mover 2, the run has 2"), "{e}");
     }
 
     #[test]

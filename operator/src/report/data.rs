@@ -104,6 +104,13 @@ pub struct RunData {
     /// Cells the swarm saw close during the run (`[sensing]`: the log's map changes), each
     /// once.
     pub closed: Vec<CellXy>,
+    /// Per mover (`[[events]]` movers): its recorded positions, in cell units.
+    pub movers: Vec<Vec<(f64, f64)>>,
+    /// Row-major: cells some robot's range sensor saw during the run (`[sensing]`); empty
+    /// when the run did not sense or its scenario is not at hand.
+    pub sensed: Vec<bool>,
+    /// The log header's scenario hash: which scenario the run's was.
+    pub scenario_hash: u64,
 }
 
 impl RunData {
@@ -124,7 +131,9 @@ impl RunData {
         let trajectories = rec.join(recording::TRAJECTORIES);
         let mut cell_size = None;
         if trajectories.exists() {
-            cell_size = Some(data.read_trajectories(&trajectories)?);
+            let cs = data.read_trajectories(&trajectories)?;
+            data.read_world(dir, &trajectories, cs)?;
+            cell_size = Some(cs);
         } else {
             data.notes.push(format!(
                 "{}: absent, no trajectories",
@@ -170,6 +179,7 @@ impl RunData {
             goals: header.agents.iter().map(|a| xy(a.goal)).collect(),
             committed: vec![Vec::new(); n],
             trajectories: vec![Vec::new(); n],
+            scenario_hash: header.scenario_hash,
             ..RunData::default()
         };
         let mut at = data.starts.clone();
@@ -486,3 +496,4 @@ pub(crate) fn collisions_at_ns(summary: &serde_json::Value) -> Vec<u64> {
 
 #[cfg(test)]
 mod tests;
+mod world;

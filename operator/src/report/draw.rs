@@ -25,6 +25,7 @@
 use std::path::Path;
 
 use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -166,6 +167,11 @@ fn draw_map(root: &Area<'_>, data: &RunData, map: &Panel) -> DrawResult {
         "map: committed cells, true trajectories; cells [x, y]".into(),
     )?;
     draw_axes(root, map)?;
+    // Under the obstacles: a wall seen is still drawn as a wall.
+    for (i, _) in data.sensed.iter().enumerate().filter(|(_, s)| **s) {
+        let (c, r) = (i as u32 % map.cols.max(1), i as u32 / map.cols.max(1));
+        root.draw(&Rectangle::new(map.cell_rect(c, r), style::SENSED.filled()))?;
+    }
     for (i, _) in data.blocked.iter().enumerate().filter(|(_, b)| **b) {
         let (c, r) = (i as u32 % map.cols.max(1), i as u32 / map.cols.max(1));
         root.draw(&Rectangle::new(
@@ -194,6 +200,17 @@ fn draw_map(root: &Area<'_>, data: &RunData, map: &Panel) -> DrawResult {
         }
         let points: Vec<(i32, i32)> = t.iter().map(|&(x, y)| map.px(x, y)).collect();
         root.draw(&PathElement::new(points, style::robot(i).stroke_width(2)))?;
+    }
+    for track in data.movers.iter().filter(|t| !t.is_empty()) {
+        let points: Vec<(i32, i32)> = track.iter().map(|&(x, y)| map.px(x, y)).collect();
+        let last = points[points.len() - 1];
+        root.draw(&DashedPathElement::new(
+            points,
+            4,
+            3,
+            style::MOVER.stroke_width(2),
+        ))?;
+        mover_mark(root, last, s.start, style::MOVER)?;
     }
     for (i, (&start, &goal)) in data.starts.iter().zip(&data.goals).enumerate() {
         let colour = style::robot(i);
@@ -392,7 +409,31 @@ fn draw_legend(root: &Area<'_>, data: &RunData, layout: &Layout) -> DrawResult {
     diamond(root, centre(5), 6, style::OBSTACLE)?;
     label(robots + 5, "agent down".into())?;
     root.draw(&Circle::new(centre(6), 7, style::COLLISION.stroke_width(3)))?;
-    label(robots + 6, "collision".into())
+    label(robots + 6, "collision".into())?;
+    let (x, y) = centre(7);
+    root.draw(&Rectangle::new(
+        [(x - h + 1, y - h + 3), (x + h - 1, y + h - 1)],
+        style::CLOSED.stroke_width(2),
+    ))?;
+    label(robots + 7, "closed during the run".into())?;
+    root.draw(&Rectangle::new(
+        [
+            (centre(8).0 - h + 1, centre(8).1 - h + 3),
+            (centre(8).0 + h - 1, centre(8).1 + h - 1),
+        ],
+        style::SENSED.filled(),
+    ))?;
+    label(robots + 8, "sensed by a robot".into())?;
+    mover_mark(root, centre(9), 5, style::MOVER)?;
+    label(robots + 9, "mover (dashed: its track)".into())
+}
+
+/// A mover's last place: a filled square, a shape no robot's mark has.
+fn mover_mark(root: &Area<'_>, (x, y): (i32, i32), r: i32, colour: RGBColor) -> DrawResult {
+    root.draw(&Rectangle::new(
+        [(x - r, y - r), (x + r, y + r)],
+        colour.filled(),
+    ))
 }
 
 /// The lines of the process events under the legend: one per round and process, at most

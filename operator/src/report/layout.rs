@@ -38,8 +38,8 @@ pub const MAX_EVENT_LINES: usize = 8;
 /// events at most.
 pub const MAX_CRITERIA_LINES: usize = 2;
 /// Marker kinds in the legend after the robots (start, goal, committed cell, conflict,
-/// replan, agent down, collision).
-pub const LEGEND_MARKERS: usize = 7;
+/// replan, agent down, collision, a cell closed during the run, a sensed cell, a mover).
+pub const LEGEND_MARKERS: usize = 10;
 
 /// A grid drawn on the canvas: its top-left pixel, its cells' size and count.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -8,6 +8,10 @@ use plotters::style::colors::colormaps::ViridisRGB;
 pub const OBSTACLE: RGBColor = RGBColor(64, 64, 64);
 /// The outline of a cell that closed during the run (a door): gold, a colour no robot has.
 pub const CLOSED: RGBColor = RGBColor(255, 215, 0);
+/// Floor a robot's range sensor saw during the run: a pale blue under everything.
+pub const SENSED: RGBColor = RGBColor(222, 235, 247);
+/// A mover's track and last place (a person, a forklift): dark red-brown, no robot's colour.
+pub const MOVER: RGBColor = RGBColor(120, 40, 20);
 /// The frame of a panel.
 pub const FRAME: RGBColor = RGBColor(160, 160, 160);
 /// Collision rings.

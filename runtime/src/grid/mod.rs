@@ -11,6 +11,7 @@
 //! | [`movingai`] | `.map` reader/writer |
 //! | [`scen`] | `.scen` reader/writer and validation against a map |
 //! | [`scen_gen`] | seeded random `.scen` files for maps that have none (`hnav map scen`) |
+//! | [`sight`] | what a range sensor sees from a cell: the cells within a radius in line of sight |
 //! | [`shortest`] | octile shortest paths (the "free oracle") and reachability |
 //! | [`check`] | the `hnav map check` report |
 //! | [`error`] | [`GridError`], every variant naming file and line |
@@ -37,6 +38,7 @@ pub mod neighbours;
 pub mod scen;
 pub mod scen_gen;
 pub mod shortest;
+pub mod sight;
 pub mod terrain;
 pub mod tile;
 

@@ -29,13 +29,16 @@
 //! | [`Progress`] | 32 | 8 | 0 round u64, 8 agents u32, 12 at_goal u32, 16 conflicts u32, 20 replans u32, 24 done u8, 25 reserved [u8; 7] |
 //! | [`Heartbeat`] | 32 | 8 | 0 t_ns u64, 8 seq u64, 16 pid u32, 20 index u32, 24 role u8, 25 reserved [u8; 7] |
 //! | [`View`] | 416 | 8 | 0 sim_time_ns u64, 8 period u64, 16 agent u32, 20 x0 u32, 24 y0 u32, 28 size u32, 32 seen [u32; 32], 160 blocked [u32; 32], 288 moving [u32; 32] |
+//! | [`MoversHeader`] | 16 | 8 | 0 sim_time_ns u64, 8 period u64 |
+//! | [`MoverPlace`] | 32 | 8 | 0 mover u32, 4 reserved u32, 8 pose Pose |
 //! | [`Sighting`] | 152 | 8 | 0 round u64, 8 agent u32, 12 count u32, 16 closed u32, 20 reserved u32, 24 cells [u32; 32] |
 //! | [`WorldHeader`] | 48 | 8 | 0 round u64, 8 closed u32, 12 opened u32, 16 to [u32; 8] |
 //! | [`MapHeader`] | 32 | 8 | 0 round u64, 8 agent u32, 12 width u32, 16 height u32, 20 iterations u32, 24 target u32, 28 activation u8, 29 reserved [u8; 3] |
 //!
 //! The neural-map snapshot is a slice service of `f32` (one activation per cell, row-major) whose
 //! user header is a [`MapHeader`]; the coordinator's map of a changing world is a slice service
-//! of `u32` cells whose user header is a [`WorldHeader`].
+//! of `u32` cells whose user header is a [`WorldHeader`]; the movers' places are a slice service of
+//! [`MoverPlace`] whose user header is a [`MoversHeader`].
 //!
 //! | module | payloads |
 //! |---|---|
@@ -44,7 +47,7 @@
 //! | `lifecycle` | the supervisor's protocol: [`Role`] and its names, [`LifecycleEvent`], [`StopReason`], [`StartupPhase`], [`Lifecycle`] and its constructors |
 //! | `map` | the neural-map snapshot: [`MapHeader`], [`ActivationKind`] |
 //! | `health` | a process's proof of life: [`Heartbeat`] |
-//! | `sensing` | what a robot's range sensor sees: [`View`] |
+//! | `sensing` | what a robot's range sensor sees, and the movers it may see: [`View`], [`MoversHeader`], [`MoverPlace`] |
 //! | `world` | the shared picture of a changing world: [`Sighting`], [`WorldHeader`] |
 //! | [`wire`] | a payload as its bytes, checked on arrival, for links that leave the host ([`Wire`]) |
 
@@ -64,7 +67,7 @@ pub use lifecycle::{
 pub use map::{ActivationKind, MapHeader};
 pub use motion::{Estimate, Odometry, Pose, Truth, WheelCommand};
 pub use round::{Candidate, CandidateFlags, Commit, ConflictKind, Decision, Progress, Verdict};
-pub use sensing::{View, VIEW_EDGE};
+pub use sensing::{MoverPlace, MoversHeader, View, VIEW_EDGE};
 pub use wire::{Wire, WireError};
 pub use world::{Sighting, WorldHeader, SIGHTING_CELLS, WORLD_TO_WORDS};
 

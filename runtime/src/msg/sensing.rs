@@ -110,10 +110,61 @@ impl View {
     }
 }
 
+/// The user header of the sim's `movers` topic, a slice of [`MoverPlace`]: where the moving
+/// obstacles (`[[events]]` movers: a person, a forklift) on the floor are at the end of
+/// control period `period`. Published with the truth, only by a run that has movers: the
+/// recorder keeps them, so the report, the replay and the MCAP export draw them and the
+/// sensed areas they hid, as `hnav top` does live.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
+)]
+#[repr(C)]
+#[type_name("hnav::MoversHeader")]
+pub struct MoversHeader {
+    /// Simulated time, ns since the start of the run.
+    pub sim_time_ns: u64,
+    /// Control period.
+    pub period: u64,
+}
+
+/// One mover on the floor: its index `mover` (the order the movers appeared in: mover `k` of
+/// a contact) and its pose, heading along the leg it walks. A mover that waits to come on
+/// (its first cell claimed by a robot) is not in the slice.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
+)]
+#[repr(C)]
+#[type_name("hnav::MoverPlace")]
+pub struct MoverPlace {
+    /// The mover's index.
+    pub mover: u32,
+    /// Zero.
+    pub reserved: u32,
+    /// Where it is.
+    pub pose: crate::msg::Pose,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use core::mem::{align_of, offset_of, size_of};
+
+    #[test]
+    fn mover_place_layout() {
+        assert_eq!(size_of::<MoverPlace>(), 32);
+        assert_eq!(align_of::<MoverPlace>(), 8);
+        assert_eq!(offset_of!(MoverPlace, mover), 0);
+        assert_eq!(offset_of!(MoverPlace, reserved), 4);
+        assert_eq!(offset_of!(MoverPlace, pose), 8);
+    }
+
+    #[test]
+    fn movers_header_layout() {
+        assert_eq!(size_of::<MoversHeader>(), 16);
+        assert_eq!(align_of::<MoversHeader>(), 8);
+        assert_eq!(offset_of!(MoversHeader, sim_time_ns), 0);
+        assert_eq!(offset_of!(MoversHeader, period), 8);
+    }
 
     #[test]
     fn view_layout() {

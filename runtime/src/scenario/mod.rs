@@ -398,6 +398,15 @@ impl Scenario {
         validate::revalidate(self)
     }
 
+    /// The moving obstacles of `[[events]]`, in the order they appear (the sim's mover
+    /// index: the `movers` topic, a contact with mover `k`).
+    pub fn movers(&self) -> impl Iterator<Item = &MoverSpec> + '_ {
+        self.events.iter().filter_map(|e| match &e.change {
+            WorldChange::Mover(m) => Some(m),
+            _ => None,
+        })
+    }
+
     /// A stable FNV-1a 64 hash of the scenario's content, for the consensus log's run header.
     /// Covers the map cells, corner cutting, every parameter section, the agents and the
     /// faults; not the name or file paths. See [`Fnv1a64`](crate::hash::Fnv1a64) and the

@@ -91,7 +91,12 @@ impl<'t> SimProcess<'t> {
     /// `start_heading_deg`) and opens the ports.
     pub fn new(transport: &'t Transport, scenario: &Scenario) -> Result<Self, SimProcessError> {
         let world = World::from_scenario(scenario)?;
-        let ports = Ports::open(transport, world.robots(), scenario.sensing.is_some())?;
+        let ports = Ports::open(
+            transport,
+            world.robots(),
+            scenario.sensing.is_some(),
+            scenario.movers().count(),
+        )?;
         let heart = Heartbeat::open(
             transport,
             Role::Sim,

@@ -2,9 +2,11 @@
 //! (and, when the scenario senses, one view sender) per robot, the Truth sender and, when joined to the run's lifecycle protocol, its ports.
 
 use hnav_runtime::launch::LifecyclePorts;
-use hnav_runtime::msg::{Odometry, Truth, View, WheelCommand};
+use hnav_runtime::msg::{MoverPlace, MoversHeader, Odometry, Truth, View, WheelCommand};
 use hnav_runtime::topics;
-use hnav_runtime::transport::{Attachment, Receiver, Sender, Transport, TransportError, Waiter};
+use hnav_runtime::transport::{
+    Attachment, Receiver, Sender, SliceSender, Transport, TransportError, Waiter,
+};
 
 /// The process's open ports. Kept apart from the [`State`](super::state::State) so that the
 /// waiter's attachments can borrow the receivers while the loop mutates the state.
@@ -17,16 +19,20 @@ pub(crate) struct Ports {
     pub(crate) view: Vec<Sender<View>>,
     /// Ground truth of every robot, once per control period.
     pub(crate) truth: Sender<Truth>,
+    /// Where the movers are, once per control period (a world with movers only).
+    pub(crate) movers: Option<SliceSender<MoverPlace, MoversHeader>>,
     /// The lifecycle protocol's ports, if joined.
     pub(crate) life: Option<LifecyclePorts>,
 }
 
 impl Ports {
-    /// Opens the topics of a world of `robots` robots, with their views if `sensing`.
+    /// Opens the topics of a world of `robots` robots, with their views if `sensing` and the
+    /// movers' places if it has `movers`.
     pub(crate) fn open(
         transport: &Transport,
         robots: usize,
         sensing: bool,
+        movers: usize,
     ) -> Result<Self, TransportError> {
         let q = topics::state_qos();
         let wheels = (0..robots)
@@ -44,6 +50,9 @@ impl Ports {
             odom,
             view,
             truth: transport.sender(topics::TRUTH, topics::truth_qos())?,
+            movers: (movers > 0)
+                .then(|| transport.slice_sender(topics::MOVERS, movers, topics::truth_qos()))
+                .transpose()?,
             life: None,
         })
     }

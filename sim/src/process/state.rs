@@ -4,7 +4,7 @@
 use std::collections::VecDeque;
 use std::time::Duration;
 
-use hnav_runtime::msg::{LifecycleEvent, Role, RosterState};
+use hnav_runtime::msg::{LifecycleEvent, MoversHeader, Role, RosterState};
 use hnav_runtime::scenario::params::ClockMode;
 
 use super::checkpoint::SimCheckpoint;
@@ -278,6 +278,14 @@ impl State {
         }
         let world = &self.world;
         ports.truth.send_in_place(|t| world.fill_truth(period, t))?;
+        if let Some(tx) = &ports.movers {
+            let header = MoversHeader {
+                sim_time_ns: world.time_ns(),
+                period,
+            };
+            let n = world.movers_on_floor().min(tx.max_len());
+            tx.send_from_fn(header, n, |k| world.mover_place(k))?;
+        }
         Ok(())
     }
 

@@ -46,6 +46,10 @@ struct Active {
     waited_s: f64,
     /// Per robot: touching it at the last step.
     touching: Vec<bool>,
+    /// On the floor: a mover that yields comes on at its first cell only when no robot
+    /// claims that cell (a person waits at the aisle's end for a robot to pass); until then
+    /// it is nowhere: no contact, no view, no moving cell.
+    on_floor: bool,
     /// Where it is now, m.
     at: Point2<f64>,
 }
@@ -178,6 +182,7 @@ impl Changes {
                         waited_s: 0.0,
                         touching: vec![false; robots],
                         at: Point2::origin(),
+                        on_floor: false,
                     });
                 }
             }
@@ -199,6 +204,21 @@ impl Changes {
         let before = out.len();
         let (r, cell) = (robots.radius, robots.cell);
         for (k, m) in self.movers.iter_mut().enumerate() {
+            if !m.on_floor {
+                let first = m.spec.cell_at(0);
+                if m.spec.yields && robots.claim(first) {
+                    // moved_s is -1 once it has said that it waits (it restarts at entry).
+                    if m.moved_s >= 0.0 {
+                        let (x, y) = (first.x, first.y);
+                        tracing::info!(mover = m.spec.name, x, y, t_s, "mover waits to come on");
+                        m.moved_s = -1.0;
+                    }
+                    continue;
+                }
+                m.on_floor = true;
+                m.moved_s = t_s;
+                tracing::info!(mover = m.spec.name, t_s, "mover came on");
+            }
             m.walk(t_s, robots);
             let (x, y) = m.spec.point_at(m.walked);
             m.at = Point2::new((x + 0.5) * cell, (y + 0.5) * cell);
@@ -221,7 +241,36 @@ impl Changes {
 
     /// The movers under way: name and centre (m), in the order they appeared.
     pub(crate) fn movers(&self) -> impl Iterator<Item = (&str, Point2<f64>)> {
-        self.movers.iter().map(|m| (m.spec.name.as_str(), m.at))
+        self.on_floor().map(|(_, m)| (m.spec.name.as_str(), m.at))
+    }
+
+    /// The movers on the floor, with their index (in the order they appeared).
+    fn on_floor(&self) -> impl Iterator<Item = (usize, &Active)> {
+        self.movers.iter().enumerate().filter(|(_, m)| m.on_floor)
+    }
+
+    /// The `n`-th mover on the floor: its index (in the order the movers appeared), its
+    /// centre (m) and its heading along the leg it walks (rad, 0 along +x; 0 on a path of
+    /// one cell).
+    pub(crate) fn mover_pose(&self, n: usize) -> Option<(usize, Point2<f64>, f64)> {
+        let (k, m) = self.on_floor().nth(n)?;
+        let leg = m.walked.floor() as u64;
+        let (a, b) = (m.spec.cell_at(leg), m.spec.cell_at(leg + 1));
+        let (dx, dy) = (
+            f64::from(b.x) - f64::from(a.x),
+            f64::from(b.y) - f64::from(a.y),
+        );
+        let heading = if dx == 0.0 && dy == 0.0 {
+            0.0
+        } else {
+            dy.atan2(dx)
+        };
+        Some((k, m.at, heading))
+    }
+
+    /// How many movers are on the floor.
+    pub(crate) fn movers_on_floor(&self) -> usize {
+        self.on_floor().count()
     }
 
     /// The cells the movers hold, which the views mark moving: the cell a mover stands in
@@ -229,16 +278,18 @@ impl Changes {
     /// enters). The cells next to those are where a mover may go next; the agents keep out
     /// of them too (`agent/src/navigator/movers.rs`).
     pub(crate) fn moving_cells(&self) -> impl Iterator<Item = Cell> + '_ {
-        self.movers.iter().flat_map(|m| {
+        self.on_floor().flat_map(|(_, m)| {
             let (from, to) = (m.walked.floor() as u64, m.walked.ceil() as u64);
             (from..=to).map(|k| m.spec.cell_at(k))
         })
     }
 
     /// How far each mover under way has walked and how long it has waited, for the sim's
-    /// checkpoint.
+    /// checkpoint; a mover not on the floor yet has walked -1 (a walk is never negative).
     pub(crate) fn walked(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
-        self.movers.iter().map(|m| (m.walked, m.waited_s))
+        self.movers
+            .iter()
+            .map(|m| (if m.on_floor { m.walked } else { -1.0 }, m.waited_s))
     }
 
     /// Takes how far each mover walked and how long it waited from a checkpoint taken at
@@ -248,6 +299,8 @@ impl Changes {
             return false;
         }
         for (m, &(w, waited)) in self.movers.iter_mut().zip(walked) {
+            m.on_floor = w >= 0.0;
+            let w = w.max(0.0);
             m.walked = w;
             m.waited_s = waited;
             m.moved_s = t_s;

@@ -130,12 +130,32 @@ pub fn run(options: Options) -> Result<Report> {
             })
             .to_vec()
     };
+    if let Some(n) = options.robots {
+        if !shapes.iter().any(|s| s.robots == n) {
+            let sizes: Vec<String> = shapes.iter().map(|s| s.robots.to_string()).collect();
+            anyhow::bail!(
+                "no setting of {n} robots here; the sizes are {}",
+                sizes.join(", ")
+            );
+        }
+    }
     let cap = Duration::from_secs(if options.quick { 120 } else { 1800 });
-    let tmp = tempfile::tempdir().context("a temporary directory")?;
+    let tmp = tempfile::Builder::new()
+        .prefix("hnav-dynamic-")
+        .tempdir()
+        .context("a temporary directory")?;
+    if options.keep {
+        eprintln!("the runs are kept in {}", tmp.path().display());
+    }
+    // Every size's world is drawn, run or not, so that `--robots N` runs the same world as
+    // the whole experiment does.
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let mut outcomes = Vec::new();
     for shape in shapes {
         let w = world::draw(&grid, shape, &mut rng)?;
+        if options.robots.is_some_and(|n| n != shape.robots) {
+            continue;
+        }
         for variant in Variant::ALL {
             let text = scenario(&map_toml, variant, &w.toml, options.seed);
             let dir = tmp
@@ -143,8 +163,23 @@ pub fn run(options: Options) -> Result<Report> {
                 .join(format!("{}-{}", shape.robots, variant.name()));
             let o = outcome::run(&dir, &text, cap)
                 .with_context(|| format!("{} robots, {}", shape.robots, variant.name()))?;
+            // A long campaign says each run as it ends, not only in the final tables.
+            eprintln!(
+                "{} robots, {}: {}/{} at goal, {} contacts+collisions, {} rounds, {}, {:.1} s",
+                shape.robots,
+                variant.name(),
+                o.at_goal,
+                shape.robots,
+                o.collisions,
+                o.rounds,
+                o.end,
+                o.wall_s
+            );
             outcomes.push((shape, variant, w.optimal_sum, o));
         }
+    }
+    if options.keep {
+        let _ = tmp.keep();
     }
     Ok(report(options, &outcomes))
 }

@@ -129,6 +129,7 @@ fn write_recording(dir: &Path) {
         height: 3,
         truncated: false,
         control_period_us: 10_000,
+        movers: 0,
     };
     let mut w =
         TrajectoryWriter::create(&rec.join(recording::TRAJECTORIES), header, u64::MAX).unwrap();

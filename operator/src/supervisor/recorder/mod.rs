@@ -3,7 +3,8 @@
 //!
 //! It has its own iceoryx2 node ("recorder") and subscribers: `truth` (notified; its deep
 //! buffer, [`topics::truth_qos`], keeps the messages of a burst), `estimate` (depth 1, not
-//! notified: read whenever truth wakes the thread) and, with `[record] maps`, every
+//! notified: read whenever truth wakes the thread), in a run with movers `movers` (read as
+//! `estimate` is, with truth's deep buffer), and, with `[record] maps`, every
 //! `map/<i>`. It blocks in a [`Waiter`](hnav_runtime::transport::Waiter) on those and on a stop pipe
 //! that [`Recorder::finish`] closes; every subscription is "latest", so a slow recorder
 //! loses samples (counted) and never holds a publisher back. What is kept is decided by
@@ -25,7 +26,7 @@ use serde::Serialize;
 use crate::recording::{
     self, MapWriter, PoseSample, PoseSource, RecordingError, TrajectoryHeader, TrajectoryWriter,
 };
-use hnav_runtime::msg::{Estimate, MapHeader, Truth};
+use hnav_runtime::msg::{Estimate, MapHeader, MoverPlace, MoversHeader, Pose, Truth};
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::topics;
 use hnav_runtime::transport::{Receiver, RunId, SliceReceiver, Transport, TransportError};
@@ -119,6 +120,7 @@ impl Recorder {
         let run = run.clone();
         let agents = scenario.agents.len();
         let maps = scenario.record.maps;
+        let movers = scenario.movers().next().is_some();
         let grid_len = scenario.map.grid.len();
         let thread = std::thread::Builder::new()
             .name("hnav-recorder".into())
@@ -127,7 +129,7 @@ impl Recorder {
                     dir: out,
                     ..RecordingSummary::default()
                 };
-                let mut rec = match Live::open(&run, agents, maps) {
+                let mut rec = match Live::open(&run, agents, movers, maps) {
                     Ok(live) => {
                         let _ = ready_tx.send(Ok(()));
                         Thread::new(files, agents, grid_len, live)
@@ -216,6 +218,7 @@ impl Files {
             height: g.height(),
             truncated: false,
             control_period_us: (scenario.sim.control_period_s() * 1e6).round() as u32,
+            movers: u16::try_from(scenario.movers().count()).unwrap_or(u16::MAX),
         };
         let max_bytes = scenario.record.max_bytes();
         let trajectories =
@@ -239,11 +242,13 @@ struct Live {
     transport: Transport,
     truth: Receiver<Truth>,
     estimate: Receiver<Estimate>,
+    /// The movers' places (a run with movers): read whenever truth wakes the thread.
+    movers: Option<SliceReceiver<MoverPlace, MoversHeader>>,
     maps: Vec<SliceReceiver<f32, MapHeader>>,
 }
 
 impl Live {
-    fn open(run: &RunId, agents: usize, maps: bool) -> Result<Self, TransportError> {
+    fn open(run: &RunId, agents: usize, movers: bool, maps: bool) -> Result<Self, TransportError> {
         // Signals are the supervisor's business: it ends the run and then this thread.
         let transport = Transport::builder(run)
             .node_name("recorder")
@@ -251,6 +256,9 @@ impl Live {
             .create()?;
         let truth = transport.receiver(topics::TRUTH, topics::truth_qos())?;
         let estimate = transport.receiver(topics::ESTIMATE, topics::estimate_qos(agents))?;
+        let movers = movers
+            .then(|| transport.slice_receiver(topics::MOVERS, topics::truth_qos()))
+            .transpose()?;
         let maps = if maps {
             (0..agents)
                 .map(|i| transport.slice_receiver(&topics::map(i), topics::state_qos()))
@@ -262,6 +270,7 @@ impl Live {
             transport,
             truth,
             estimate,
+            movers,
             maps,
         })
     }
@@ -285,6 +294,8 @@ struct State {
     files: Files,
     truth: TruthSampler,
     estimates: Vec<sampler::SimClock>,
+    /// The movers' sampling (all movers of one message at a time).
+    movers: sampler::SimClock,
     throttle: MapThrottle,
     held: Vec<Held>,
     /// The latest simulated time seen on truth: the time stamp of a snapshot.
@@ -303,6 +314,7 @@ impl Thread {
             state: State {
                 truth: TruthSampler::new(rate),
                 estimates: vec![sampler::SimClock::new(rate); agents],
+                movers: sampler::SimClock::new(rate),
                 throttle: MapThrottle::new(agents),
                 held: (0..agents)
                     .map(|_| Held {
@@ -354,6 +366,7 @@ impl State {
             files,
             truth,
             estimates,
+            movers,
             throttle,
             held,
             now_ns,
@@ -390,6 +403,19 @@ impl State {
                 Err(err) => failed = Some(err),
             }
         })?;
+        if let Some(rx) = &live.movers {
+            rx.drain_pending(|h, places| {
+                if failed.is_some() || !movers.take(h.sim_time_ns) {
+                    return;
+                }
+                for m in places {
+                    let s = sample(h.sim_time_ns, m.mover as usize, PoseSource::Mover, &m.pose);
+                    if let Err(e) = files.trajectories.push(&s) {
+                        failed = Some(e);
+                    }
+                }
+            })?;
+        }
         if let Some(e) = failed {
             return Err(e.into());
         }
@@ -492,7 +518,7 @@ fn hold(slot: &mut Held, t_ns: u64, header: &MapHeader, values: &[f32]) {
     slot.values.extend_from_slice(values);
 }
 
-fn sample(t_ns: u64, robot: usize, source: PoseSource, p: &hnav_runtime::msg::Pose) -> PoseSample {
+fn sample(t_ns: u64, robot: usize, source: PoseSource, p: &Pose) -> PoseSample {
     PoseSample {
         t_ns,
         robot: u16::try_from(robot).unwrap_or(u16::MAX),
