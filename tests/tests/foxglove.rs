@@ -1,6 +1,7 @@
 //! The live Foxglove view against a client that shares no code with HNAV
-//! (`clients/python/examples/foxglove_client.py`: PyPI `websockets` speaking
-//! `foxglove.websocket.v1`, PyPI `mcap`): during a live `hnav run --foxglove ADDR` it reads the
+//! (`clients/python/examples/foxglove_client.py`: PyPI `websockets` speaking the Foxglove
+//! WebSocket protocol, offering it as `foxglove.websocket.v1` and `foxglove.sdk.v1`, its old
+//! and new names, PyPI `mcap`): during a live `hnav run --foxglove ADDR` it reads the
 //! advertised channels, subscribes, decodes the binary frames and sees the demo's 12 x 12 map
 //! and its six robots moving (after a first connection of its own dropped mid-stream, which
 //! the run does not notice); then the run's `hnav log export --mcap` holds every channel
@@ -67,8 +68,8 @@ fn a_foxglove_client_watches_a_live_run_and_its_export_holds_the_same_channels()
             format!("--timeout={CLIENT_READS_S}"),
         ],
     );
-    let said = String::from_utf8_lossy(&live.stdout).into_owned()
-        + &String::from_utf8_lossy(&live.stderr);
+    let said =
+        String::from_utf8_lossy(&live.stdout).into_owned() + &String::from_utf8_lossy(&live.stderr);
     let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
     assert!(live.status.success(), "the live client failed:\n{said}");
     assert!(said.contains("ok a client dropped in the middle"), "{said}");
@@ -97,10 +98,13 @@ fn a_foxglove_client_watches_a_live_run_and_its_export_holds_the_same_channels()
             format!("--advertised={}", advertised.display()),
         ],
     );
-    let said = String::from_utf8_lossy(&read.stdout).into_owned()
-        + &String::from_utf8_lossy(&read.stderr);
+    let said =
+        String::from_utf8_lossy(&read.stdout).into_owned() + &String::from_utf8_lossy(&read.stderr);
     assert!(read.status.success(), "the MCAP check failed:\n{said}");
-    assert!(said.contains("holds the 15 channels advertised live"), "{said}");
+    assert!(
+        said.contains("holds the 15 channels advertised live"),
+        "{said}"
+    );
 }
 
 /// `hnav run --foxglove ADDR` with `extra`, into a fresh directory: must refuse with exit 2,

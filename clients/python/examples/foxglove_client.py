@@ -3,9 +3,9 @@
 `hnav run --foxglove ADDR` (or `hnav view`) serves, and that `hnav log export --mcap`
 writes the same channels.
 
-    live URL --width W --height H --advertised OUT.json [--timeout S]
-        Connects with the subprotocol `foxglove.websocket.v1` (retrying until the server
-        listens), reads `serverInfo` and `advertise`, first drops one connection in the
+    live URL --width W --height H --robots N --advertised OUT.json [--timeout S]
+        Connects offering the subprotocols `foxglove.websocket.v1` and `foxglove.sdk.v1`
+        (the protocol's old and new names; retrying until the server listens), reads `serverInfo` and `advertise`, first drops one connection in the
         middle of the stream (the server must not mind), then subscribes to /map, /scene,
         /log and every /robots/<i>/stats and decodes the binary `messageData` frames
         (opcode 0x01: subscription id u32 LE, log time u64 LE, payload) until the server
@@ -30,7 +30,11 @@ import struct
 import sys
 import time
 
-SUBPROTOCOL = "foxglove.websocket.v1"
+# The Foxglove WebSocket protocol's name, old and new: the Foxglove SDK (the `foxglove` crate
+# HNAV serves with) negotiates it as `foxglove.sdk.v1`, Foxglove's current name for the
+# protocol first published as `foxglove.websocket.v1` (the same messages and frames), and
+# refuses a client that offers only the old name with HTTP 400.
+SUBPROTOCOLS = ["foxglove.websocket.v1", "foxglove.sdk.v1"]
 MESSAGE_DATA = 0x01
 
 
@@ -44,7 +48,10 @@ async def connect(url, deadline):
 
     while True:
         try:
-            return await ws_connect(url, subprotocols=[SUBPROTOCOL], max_size=None)
+            ws = await ws_connect(url, subprotocols=SUBPROTOCOLS, max_size=None)
+            if ws.subprotocol not in SUBPROTOCOLS:
+                fail(f"the server chose the subprotocol {ws.subprotocol!r}")
+            return ws
         except OSError:
             if time.monotonic() > deadline:
                 fail(f"no Foxglove server at {url}")
@@ -128,7 +135,7 @@ async def live(args):
     await drop_mid_stream(args.url, deadline)
     ws = await connect(args.url, deadline)
     info, channels = await handshake(ws)
-    print(f"ok serverInfo from {info.get('name')!r}", flush=True)
+    print(f"ok subprotocol {ws.subprotocol}, serverInfo from {info.get('name')!r}", flush=True)
     subs = await subscribe(ws, channels)
     grids, scenes, logs, speeds = [], [], [], {}
     try:

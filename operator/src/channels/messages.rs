@@ -45,7 +45,12 @@ pub(crate) fn decision_message(t: u64, round: u64, d: &LoggedDecision, width: u3
 }
 
 pub(crate) fn pose_message(s: &PoseSample) -> Value {
-    let pose = pose(f64::from(s.x_m), f64::from(s.y_m), 0.0, f64::from(s.theta_rad));
+    let pose = pose(
+        f64::from(s.x_m),
+        f64::from(s.y_m),
+        0.0,
+        f64::from(s.theta_rad),
+    );
     json!({"timestamp": stamp(s.t_ns), "frame_id": FRAME, "pose": pose})
 }
 

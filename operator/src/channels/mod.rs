@@ -95,7 +95,11 @@ mod tests {
         for c in shown(2) {
             let s: serde_json::Value = serde_json::from_slice(&schemas::schema(c.schema)).unwrap();
             assert_eq!(s["title"], c.schema, "{}", c.topic);
-            assert!(s["properties"].is_object(), "{}: a schema of fields", c.topic);
+            assert!(
+                s["properties"].is_object(),
+                "{}: a schema of fields",
+                c.topic
+            );
         }
         assert_eq!(shown(3).len(), 3 + 2 * 3);
     }

@@ -157,7 +157,12 @@ impl SceneFold {
                 }
                 _ => continue,
             };
-            out.push(log(t_ns, level, &format!("agent-{}", d.agent), format!("round {}: {text}", c.round)));
+            out.push(log(
+                t_ns,
+                level,
+                &format!("agent-{}", d.agent),
+                format!("round {}: {text}", c.round),
+            ));
         }
         out
     }
@@ -245,7 +250,11 @@ impl SceneFold {
         let (x, y) = self.centre(goal);
         let m = self.picture.cell_m;
         let cube = json!({"pose": pose(x, y, 0.005 * m, 0.0), "size": {"x": 0.8 * m, "y": 0.8 * m, "z": 0.01 * m}, "color": rgba(0.2, 0.7, 0.3, 0.5)});
-        self.entity(t_ns, format!("goal/{i}"), json!({"cubes": [cube], "metadata": [kv("robot", i)]}))
+        self.entity(
+            t_ns,
+            format!("goal/{i}"),
+            json!({"cubes": [cube], "metadata": [kv("robot", i)]}),
+        )
     }
 
     fn robot(&self, t_ns: u64, i: usize, r: &Robot, p: &Pose) -> Value {
@@ -275,7 +284,11 @@ impl SceneFold {
             points.push(json!({"x": x, "y": y, "z": z}));
         }
         let line = json!({"type": 0, "pose": pose(0.0, 0.0, 0.0, 0.0), "thickness": 0.06 * self.picture.cell_m, "scale_invariant": false, "points": points, "color": rgba(0.2, 0.4, 0.9, 0.6)});
-        self.entity(t_ns, format!("route/{i}"), json!({"lines": [line], "metadata": [kv("robot", i)]}))
+        self.entity(
+            t_ns,
+            format!("route/{i}"),
+            json!({"lines": [line], "metadata": [kv("robot", i)]}),
+        )
     }
 
     fn conflict(&self, t_ns: u64, i: usize, kind: ConflictKind, c: u32) -> Value {
@@ -315,13 +328,29 @@ mod tests {
 
     fn fold() -> SceneFold {
         let grid = Grid::new(4, 2).unwrap();
-        SceneFold::new(Picture { grid, goals: vec![3, 7], cell_m: 0.5 })
+        SceneFold::new(Picture {
+            grid,
+            goals: vec![3, 7],
+            cell_m: 0.5,
+        })
     }
 
     fn truth(t_ns: u64, xs: [f64; 2]) -> Truth {
-        let mut t = Truth { sim_time_ns: t_ns, robots: 2, ..Truth::default() };
-        t.poses[0] = Pose { x_m: xs[0], y_m: 0.25, theta_rad: 0.0 };
-        t.poses[1] = Pose { x_m: xs[1], y_m: 0.75, theta_rad: 0.0 };
+        let mut t = Truth {
+            sim_time_ns: t_ns,
+            robots: 2,
+            ..Truth::default()
+        };
+        t.poses[0] = Pose {
+            x_m: xs[0],
+            y_m: 0.25,
+            theta_rad: 0.0,
+        };
+        t.poses[1] = Pose {
+            x_m: xs[1],
+            y_m: 0.75,
+            theta_rad: 0.0,
+        };
         t
     }
 
@@ -341,7 +370,10 @@ mod tests {
             .iter()
             .map(|e| e["id"].as_str().unwrap())
             .collect();
-        assert_eq!(ids, ["goal/0", "robot/0", "route/0", "goal/1", "robot/1", "route/1"]);
+        assert_eq!(
+            ids,
+            ["goal/0", "robot/0", "route/0", "goal/1", "robot/1", "route/1"]
+        );
         let robot = &out[0].body["entities"][1]["cubes"][0]["pose"]["position"];
         assert_eq!(robot["x"], 0.75);
     }
@@ -350,7 +382,11 @@ mod tests {
     fn a_conflict_is_drawn_and_logged_once_while_it_repeats() {
         let mut f = fold();
         f.truth(&truth(0, [0.25, 0.25]));
-        let mut c = Commit { round: 4, count: 1, ..Commit::default() };
+        let mut c = Commit {
+            round: 4,
+            count: 1,
+            ..Commit::default()
+        };
         c.decisions[0] = Decision {
             agent: 1,
             verdict: Verdict::Block as u8,
@@ -361,8 +397,15 @@ mod tests {
         let lines = f.commit(40, &c);
         assert_eq!(lines.len(), 1);
         assert_eq!(lines[0].body["name"], "agent-1");
-        assert!(lines[0].body["message"].as_str().unwrap().contains("block"), "{}", lines[0].body);
-        assert!(f.commit(50, &c).is_empty(), "the same block again is not logged again");
+        assert!(
+            lines[0].body["message"].as_str().unwrap().contains("block"),
+            "{}",
+            lines[0].body
+        );
+        assert!(
+            f.commit(50, &c).is_empty(),
+            "the same block again is not logged again"
+        );
         let scene = f.scene(60);
         let ids: Vec<&str> = scene.body["entities"]
             .as_array()
@@ -373,6 +416,8 @@ mod tests {
         assert!(ids.contains(&"conflict/1"), "{ids:?}");
         let down = f.lifecycle(70, Role::Agent as u8, 1, LifecycleEvent::Down as u8);
         assert_eq!(down.unwrap().body["level"], ERROR);
-        assert!(f.lifecycle(80, Role::Agent as u8, 1, LifecycleEvent::Up as u8).is_none());
+        assert!(f
+            .lifecycle(80, Role::Agent as u8, 1, LifecycleEvent::Up as u8)
+            .is_none());
     }
 }

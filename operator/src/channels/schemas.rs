@@ -95,9 +95,7 @@ fn vector3() -> Value {
 
 /// `foxglove.SceneEntity`, with the primitives HNAV draws (cubes, lines, texts).
 fn scene_entity() -> Value {
-    let array = |title: &str, properties: Value| {
-        json!({"type": "array", "items": {"title": title, "type": "object", "properties": properties}})
-    };
+    let array = |title: &str, properties: Value| json!({"type": "array", "items": {"title": title, "type": "object", "properties": properties}});
     json!({
         "title": "foxglove.SceneEntity",
         "type": "object",

@@ -39,16 +39,14 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{json, Value};
 
+use crate::channels::messages::{cell, decision_message, neural_map_message, pose_message, stamp};
+pub use crate::channels::schemas;
+pub use crate::channels::FRAME;
 use crate::invocation::Invocation;
 use crate::recording::{self, MapReader, PoseSource, RecordingError, TrajectoryReader};
 use hnav_runtime::consensus_log::{read_decided, LogError, Record, RunHeader};
 use hnav_runtime::msg::{LifecycleEvent, Role, Verdict, NO_CELL};
 use hnav_runtime::scenario::Scenario;
-use crate::channels::messages::{
-    cell, decision_message, neural_map_message, pose_message, stamp,
-};
-pub use crate::channels::schemas;
-pub use crate::channels::FRAME;
 
 /// The control period assumed when the run's scenario cannot be loaded (the default
 /// `[sim]`: 100 Hz odometry, 1 ms steps).
@@ -202,7 +200,7 @@ fn write_all(
             "/map",
             schemas::GRID,
             0,
-            &world::occupancy(&s.map.grid, 0, cell_m),
+            &crate::channels::messages::occupancy(&s.map.grid, 0, cell_m),
         )?;
         for (t, msg) in world::truth(s, cell_m) {
             w.message("/map", schemas::GRID, t, &msg)?;

@@ -134,10 +134,7 @@ fn put(w: &mut Mcap<impl Write + Seek>, m: &Message) -> Result<(), ExportError> 
 
 /// Registers every channel of [`channels::shown`] for `robots`, so an export lists what the
 /// live view advertises even where a channel got no message.
-pub(super) fn register(
-    w: &mut Mcap<impl Write + Seek>,
-    robots: usize,
-) -> Result<(), ExportError> {
+pub(super) fn register(w: &mut Mcap<impl Write + Seek>, robots: usize) -> Result<(), ExportError> {
     for c in channels::shown(robots) {
         w.channel(&c.topic, c.schema)?;
     }

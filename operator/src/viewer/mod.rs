@@ -1,6 +1,11 @@
-//! The live Foxglove view: a run served on the Foxglove WebSocket protocol
-//! (`foxglove.websocket.v1`, the `foxglove` crate's server), for Foxglove to connect to
-//! (`hnav run --foxglove [ADDR]`, `hnav view RUN --foxglove [ADDR]`).
+//! The live Foxglove view: a run served on the Foxglove WebSocket protocol (the `foxglove`
+//! crate's server), for Foxglove to connect to (`hnav run --foxglove [ADDR]`,
+//! `hnav view RUN --foxglove [ADDR]`).
+//!
+//! The crate negotiates the protocol under the subprotocol name `foxglove.sdk.v1` (or
+//! `foxglove.sdk.v1.1`), Foxglove's current name for the protocol first published as
+//! `foxglove.websocket.v1`, with the same messages and binary frames; a client that offers
+//! only the old name is refused with HTTP 400 (Foxglove's own app offers the new one).
 //!
 //! ```text
 //!   a Feed (live: the run's topics; playback: a run directory) ── Update ──> SceneFold ──> Server ──> clients
@@ -73,10 +78,12 @@ pub enum ViewerError {
 
 /// Parses `--foxglove`'s value.
 pub fn parse_addr(given: &str) -> Result<SocketAddr, ViewerError> {
-    given.parse().map_err(|e: std::net::AddrParseError| ViewerError::Address {
-        given: given.to_string(),
-        problem: e.to_string(),
-    })
+    given
+        .parse()
+        .map_err(|e: std::net::AddrParseError| ViewerError::Address {
+            given: given.to_string(),
+            problem: e.to_string(),
+        })
 }
 
 /// Set by a client's subscription: the map and the scene are due again.
@@ -246,7 +253,7 @@ pub fn show(
         let mut out: Vec<Message> = Vec::new();
         feed.pump(&mut |u| match u {
             Update::Truth(t) => {
-                latest.clone_from(t);
+                *latest = *t;
                 now_ns = now_ns.max(t.sim_time_ns);
                 fresh = true;
             }

@@ -92,7 +92,7 @@ pub struct RunArgs {
     /// The placement file for --host [default: hosts.toml beside the scenario].
     #[arg(long, value_name = "FILE", requires = "host")]
     pub hosts: Option<PathBuf>,
-    /// Serve the run live to Foxglove (WebSocket, foxglove.websocket.v1) on ADDR [default
+    /// Serve the run live to Foxglove (the Foxglove WebSocket protocol) on ADDR [default
     /// ADDR: 127.0.0.1:8765]; see docs/tutorials/watch-a-run-in-foxglove.md.
     #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = hnav_operator::viewer::DEFAULT_ADDR)]
     pub foxglove: Option<String>,
@@ -191,7 +191,11 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
         return ExitCode::from(2);
     };
     // Listening before anything is spawned: an address in use stops the run here.
-    let view = match a.foxglove.as_deref().map(|addr| crate::view_cmd::live(addr, &args)) {
+    let view = match a
+        .foxglove
+        .as_deref()
+        .map(|addr| crate::view_cmd::live(addr, &args))
+    {
         Some(Err(code)) => return code,
         Some(Ok(view)) => Some(view),
         None => None,

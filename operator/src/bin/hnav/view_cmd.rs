@@ -43,7 +43,7 @@ fn listen(addr: &str) -> Result<Server, ExitCode> {
     match parse_addr(addr).and_then(Server::bind) {
         Ok(server) => {
             hnav_runtime::errln!(
-                "foxglove  ws://{} (foxglove.websocket.v1)",
+                "foxglove  ws://{} (Foxglove WebSocket protocol, foxglove.sdk.v1)",
                 server.addr()
             );
             Ok(server)
@@ -80,7 +80,12 @@ pub fn run(a: ViewArgs) -> ExitCode {
         Ok(s) => s,
         Err(code) => return code,
     };
-    match show(feed.as_mut(), &mut server, a.exit_on_end, &AtomicBool::new(false)) {
+    match show(
+        feed.as_mut(),
+        &mut server,
+        a.exit_on_end,
+        &AtomicBool::new(false),
+    ) {
         Ok(_) => ExitCode::SUCCESS,
         Err(e) => {
             hnav_runtime::errln!("error: {e}");
