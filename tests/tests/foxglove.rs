@@ -22,6 +22,8 @@ use hnav_tests::TestRun;
 
 /// Bound on the whole live run (realtime, so the client has time to join).
 const RUN_TIMEOUT: Duration = Duration::from_secs(180);
+/// Bound on `hnav view` playing the run back at 10x.
+const VIEW_TIMEOUT: Duration = Duration::from_secs(120);
 /// How long the client reads, at most, before it checks what it got.
 const CLIENT_READS_S: u32 = 120;
 
@@ -104,6 +106,54 @@ fn a_foxglove_client_watches_a_live_run_and_its_export_holds_the_same_channels()
     assert!(
         said.contains("holds the 15 channels advertised live"),
         "{said}"
+    );
+    // The finished run served again by `hnav view`, played back: the same checks, the same
+    // channels advertised.
+    let addr = format!("127.0.0.1:{}", free_port());
+    let args: Vec<String> = [
+        "view",
+        &out.display().to_string(),
+        "--foxglove",
+        &addr,
+        "--speed",
+        "10",
+        "--exit-on-end",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let mut view = run
+        .spawn_exact_env(
+            &workspace_bin("hnav").display().to_string(),
+            &args,
+            &[("HNAV_RUNS_DIR", &tmp.path().join("runs"))],
+        )
+        .expect("hnav view starts");
+    let replayed = tmp.path().join("advertised-view.json");
+    let live = client(
+        &python,
+        &[
+            "live".into(),
+            format!("ws://{addr}"),
+            "--width=12".into(),
+            "--height=12".into(),
+            "--robots=6".into(),
+            format!("--advertised={}", replayed.display()),
+            format!("--timeout={CLIENT_READS_S}"),
+        ],
+    );
+    let said =
+        String::from_utf8_lossy(&live.stdout).into_owned() + &String::from_utf8_lossy(&live.stderr);
+    let status = view.wait_exit(VIEW_TIMEOUT).expect("hnav view ends");
+    assert!(
+        live.status.success(),
+        "the client of hnav view failed:\n{said}"
+    );
+    assert!(status.success(), "hnav view: {status}");
+    assert_eq!(
+        std::fs::read_to_string(&replayed).unwrap(),
+        std::fs::read_to_string(&advertised).unwrap(),
+        "hnav view advertised other channels than the live run"
     );
 }
 
