@@ -16,7 +16,7 @@ use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use hnav_runtime::transport::RunId;
+use hnav_runtime::transport::{run_iceoryx2_files, run_shm_files, RunId};
 use hnav_tests::swarm::{repo_root, venv_python, workspace_bin, SwarmRun};
 use hnav_tests::TestRun;
 
@@ -82,6 +82,12 @@ fn a_foxglove_client_watches_a_live_run_and_its_export_holds_the_same_channels()
         "the run, watched, did not end well ({status}):\n{}",
         swarm.log_tails()
     );
+    // The view's own node in the supervisor was gone before the supervisor purged the run.
+    let left: Vec<_> = run_shm_files(&run.run)
+        .into_iter()
+        .chain(run_iceoryx2_files(&run.run))
+        .collect();
+    assert!(left.is_empty(), "the run left {left:?}");
 
     let mcap = tmp.path().join("run.mcap");
     let export = Command::new(workspace_bin("hnav"))
