@@ -223,6 +223,12 @@ fn every_channel_reads_back_with_its_schema_and_count() {
     let pose = "foxglove.PoseInFrame";
     let expected: BTreeMap<&str, (&str, u64)> = [
         ("/map", ("foxglove.Grid", 1)),
+        // The live view's channels: a scene and a speed per sampling time (6), a log line
+        // per accepted move (agent 0, every round) and per process event (2).
+        ("/scene", ("foxglove.SceneUpdate", 6)),
+        ("/robots/0/stats", ("hnav.RobotStats", 6)),
+        ("/robots/1/stats", ("hnav.RobotStats", 6)),
+        ("/log", ("foxglove.Log", ROUNDS + 2)),
         ("/robots/0/truth", (pose, 6)),
         ("/robots/0/estimate", (pose, 6)),
         ("/robots/1/truth", (pose, 6)),

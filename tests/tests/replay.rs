@@ -275,6 +275,16 @@ fn the_demo_run_exports_to_mcap_with_every_channel() {
         .filter(|r| matches!(r, Record::Lifecycle(_)))
         .count() as u64;
     expected.insert("/lifecycle".into(), lifecycle);
+    // The live view's channels: a scene and each robot's speed per ground-truth sampling time.
+    let times: std::collections::BTreeSet<u64> = samples
+        .iter()
+        .filter(|s| s.source == PoseSource::Truth)
+        .map(|s| s.t_ns)
+        .collect();
+    expected.insert("/scene".into(), times.len() as u64);
+    for i in 0..6 {
+        expected.insert(format!("/robots/{i}/stats"), times.len() as u64);
+    }
 
     let out_file = tmp.path().join("demo.mcap");
     let out = std::process::Command::new(workspace_bin("hnav"))
@@ -299,6 +309,10 @@ fn the_demo_run_exports_to_mcap_with_every_channel() {
     for m in mcap::MessageStream::new(&bytes).unwrap() {
         *got.get_mut(&m.unwrap().channel.topic).unwrap() += 1;
     }
+    // `/log`: a line per decision worth one (the fold's rule, operator/src/channels/scene.rs's
+    // tests); here only that the demo's accepted moves gave some.
+    let log_lines = got.remove("/log").expect("a /log channel");
+    assert!(log_lines >= 6, "{log_lines} log lines");
     assert_eq!(got, expected);
     assert!(expected["/robots/0/truth"] > 0 && expected["/robots/0/neural_map"] > 0);
 }

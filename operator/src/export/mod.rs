@@ -1,7 +1,11 @@
 //! `hnav log export DIR --mcap out.mcap`: a run as an MCAP file that Foxglove Studio opens.
 //!
 //! Every channel's messages are JSON (message encoding `json`) with a JSON schema (schema
-//! encoding `jsonschema`, [`schemas`]). Log time is simulated time: `round x control
+//! encoding `jsonschema`, [`schemas`]). The channels the live Foxglove view shows
+//! ([`channels::shown`](crate::channels::shown): `/map`, `/scene`, `/robots/<i>/truth`,
+//! `/robots/<i>/stats`, `/log`) are written with the same schemas and from the same fold
+//! ([`SceneFold`](crate::channels::scene::SceneFold)), so a recorded run looks as a live one
+//! did; the others are the export's own. Log time is simulated time: `round x control
 //! period` for what comes from the consensus log (a lockstep round `r` is decided once `r`
 //! periods have been simulated), the samples' own `t_ns` for the recording.
 //!
@@ -9,7 +13,10 @@
 //! |---|---|---|---|
 //! | `/map` | `foxglove.Grid` | the scenario (`invocation.json`) | the run (field `occupied`, 1 = wall), and again at each close or open of its `[[events]]` |
 //! | `/map/shared` | `foxglove.Grid` | the scenario and `log/` (with `[sensing]`) | the coordinator's map at the start and after each map-change record |
+//! | `/scene` | `foxglove.SceneUpdate` | `recording/trajectories.bin` and `log/` | ground-truth sampling time: robots, goals, routes, conflicts |
 //! | `/robots/<i>/truth` | `foxglove.PoseInFrame` | `recording/trajectories.bin` | ground-truth sample of robot `i` |
+//! | `/robots/<i>/stats` | `hnav.RobotStats` | `recording/trajectories.bin` | ground-truth sampling time: robot `i`'s speed |
+//! | `/log` | `foxglove.Log` | `log/` | decision worth a line, process down, restarted or lost (as live) |
 //! | `/robots/<i>/estimate` | `foxglove.PoseInFrame` | `recording/trajectories.bin` | dead-reckoned sample of robot `i` |
 //! | `/robots/<i>/neural_map` | `foxglove.Grid` | `recording/maps.bin` | snapshot of agent `i` (fields `activation`, `log10_activation`) |
 //! | `/commits` | `hnav.CommittedCells` | `log/` | round: the cells its commit gave |
@@ -22,8 +29,7 @@
 //! recording file, or a scenario that cannot be loaded, leaves its channels out and is
 //! reported in [`ExportReport::notes`]; a damaged file is an error naming it and the offset.
 
-mod messages;
-pub mod schemas;
+mod scene;
 mod world;
 
 use std::collections::BTreeMap;
@@ -33,13 +39,14 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{json, Value};
 
+use crate::channels::messages::{cell, decision_message, neural_map_message, pose_message, stamp};
+pub use crate::channels::schemas;
+pub use crate::channels::FRAME;
 use crate::invocation::Invocation;
 use crate::recording::{self, MapReader, PoseSource, RecordingError, TrajectoryReader};
 use hnav_runtime::consensus_log::{read_decided, LogError, Record, RunHeader};
 use hnav_runtime::msg::{LifecycleEvent, Role, Verdict, NO_CELL};
 use hnav_runtime::scenario::Scenario;
-pub use messages::FRAME;
-use messages::{cell, decision_message, neural_map_message, pose_message, stamp};
 
 /// The control period assumed when the run's scenario cannot be loaded (the default
 /// `[sim]`: 100 Hz odometry, 1 ms steps).
@@ -178,7 +185,7 @@ fn write_all(
             "/map",
             schemas::GRID,
             0,
-            &world::occupancy(&s.map.grid, 0, cell_m),
+            &crate::channels::messages::occupancy(&s.map.grid, 0, cell_m),
         )?;
         for (t, msg) in world::truth(s, cell_m) {
             w.message("/map", schemas::GRID, t, &msg)?;
@@ -195,8 +202,8 @@ fn write_all(
     if trajectories.exists() {
         let mut r = TrajectoryReader::open(&trajectories)?;
         cell_size = f64::from(r.header().cell_size_m);
+        scene::register(w, usize::from(r.header().robots))?;
         for i in 0..r.header().robots {
-            w.channel(&format!("/robots/{i}/truth"), schemas::POSE_IN_FRAME)?;
             w.channel(&format!("/robots/{i}/estimate"), schemas::POSE_IN_FRAME)?;
         }
         for k in 0..r.header().movers {
@@ -217,9 +224,10 @@ fn write_all(
                 r.torn_tail()
             ));
         }
+        scene::write(w, &trajectories, records, info, cell_size)?;
     } else {
         notes.push(format!(
-            "{} missing: no /robots/<i>/truth and /robots/<i>/estimate channels",
+            "{} missing: no /scene, /robots/<i>/truth, /robots/<i>/stats, /robots/<i>/estimate and /log channels",
             trajectories.display()
         ));
     }

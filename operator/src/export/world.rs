@@ -9,14 +9,7 @@ use hnav_runtime::consensus_log::Record;
 use hnav_runtime::grid::Grid;
 use hnav_runtime::scenario::Scenario;
 
-use super::messages::{grid_message, NUMERIC_UINT8};
-
-/// `g` as a `foxglove.Grid` of field `occupied` (1 = blocked) at `t_ns`.
-pub(super) fn occupancy(g: &Grid, t_ns: u64, cell_m: f64) -> Value {
-    let occupied: Vec<u8> = g.blocked().iter().map(|&b| u8::from(b)).collect();
-    let fields = [("occupied", 0, NUMERIC_UINT8)];
-    grid_message(t_ns, (g.width(), cell_m), 1, &fields, &occupied)
-}
+use crate::channels::messages::occupancy;
 
 /// The true map after each close or open of `s`'s events, at its time (the sim applies an
 /// event at the first step at or after it, within a control period of this).

@@ -21,6 +21,7 @@ mod report_cmd;
 mod run_cmd;
 mod services_cmd;
 mod top;
+mod view_cmd;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -81,6 +82,9 @@ enum Command {
     Report(report_cmd::ReportArgs),
     /// Watch a live run in the terminal: its map, robots, agents' states and processes.
     Top(top::TopArgs),
+    /// Serve a live or finished run to Foxglove (WebSocket): map, robots, goals, routes,
+    /// conflicts, speeds, decisions.
+    View(view_cmd::ViewArgs),
     /// Inspect a run's consensus log, replay a lockstep run, export a run to MCAP.
     Log {
         #[command(subcommand)]
@@ -161,6 +165,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Command::Top(args) => top::run(args),
+        Command::View(args) => view_cmd::run(args),
     }
 }
 

@@ -1,6 +1,7 @@
 //! `hnav run SCENARIO [--agents N] [--mode lockstep|realtime] [--seed S] [--out DIR]
 //! [--run ID] [--replicas N] [--force] [--no-record] [--bin-dir DIR]
-//! [--kill|--term|--freeze TARGET@WHEN[+SECONDSs]]... [--host NAME [--hosts FILE]]`: the
+//! [--kill|--term|--freeze TARGET@WHEN[+SECONDSs]]... [--host NAME [--hosts FILE]]
+//! [--foxglove [ADDR]]`: the
 //! supervisor. The work
 //! is in `hnav_operator::supervisor::run`; the faults' syntax in
 //! `hnav_runtime::scenario::fault_arg`.
@@ -91,6 +92,10 @@ pub struct RunArgs {
     /// The placement file for --host [default: hosts.toml beside the scenario].
     #[arg(long, value_name = "FILE", requires = "host")]
     pub hosts: Option<PathBuf>,
+    /// Serve the run live to Foxglove (the Foxglove WebSocket protocol) on ADDR [default
+    /// ADDR: 127.0.0.1:8765]; see docs/tutorials/watch-a-run-in-foxglove.md.
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = hnav_operator::viewer::DEFAULT_ADDR)]
+    pub foxglove: Option<String>,
 }
 
 /// `--force`'s help: the outputs it removes, from the one list the refusal also names.
@@ -185,6 +190,16 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
     let Some(bin_dir) = bin_dir(a.bin_dir) else {
         return ExitCode::from(2);
     };
+    // Listening before anything is spawned: an address in use stops the run here.
+    let view = match a
+        .foxglove
+        .as_deref()
+        .map(|addr| crate::view_cmd::live(addr, &args))
+    {
+        Some(Err(code)) => return code,
+        Some(Ok(view)) => Some(view),
+        None => None,
+    };
     let dir = a.out.unwrap_or(name);
     args.dir = Some(dir.clone());
     let opts = RunOptions {
@@ -195,7 +210,9 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
         record: !a.no_record,
         host,
     };
-    match run(&opts) {
+    let result = run(&opts);
+    drop(view);
+    match result {
         Ok(summary) => {
             hnav_runtime::out!("{}", summary.render());
             hnav_runtime::outln!("summary   {}", dir.join("summary.json").display());

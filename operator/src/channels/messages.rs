@@ -1,4 +1,4 @@
-//! One JSON message per thing exported, in the shapes of [`super::schemas`]: poses and grids
+//! One JSON message per thing shown, in the shapes of [`super::schemas`]: poses and grids
 //! as Foxglove's well-known schemas, decisions with their verdicts and kinds by name, cells
 //! as `[x, y]` (`null` for none).
 
@@ -7,21 +7,22 @@ use serde_json::{json, Value};
 
 use crate::recording::{MapSnapshot, PoseSample};
 use hnav_runtime::consensus_log::LoggedDecision;
+use hnav_runtime::grid::Grid;
 use hnav_runtime::msg::{ConflictKind, Verdict, NO_CELL};
 
 /// The frame every pose and grid is in.
 pub const FRAME: &str = "map";
 /// `log10_activation` of a neuron at exactly 0 (below the smallest `f32`).
-const LOG10_OF_ZERO: f32 = -46.0;
-pub(super) const NUMERIC_UINT8: u8 = 1;
-const NUMERIC_FLOAT32: u8 = 7;
-const DIRECTIONS: [&str; 8] = ["N", "NE", "E", "SE", "S", "SW", "W", "NW"];
+pub(crate) const LOG10_OF_ZERO: f32 = -46.0;
+pub(crate) const NUMERIC_UINT8: u8 = 1;
+pub(crate) const NUMERIC_FLOAT32: u8 = 7;
+pub(crate) const DIRECTIONS: [&str; 8] = ["N", "NE", "E", "SE", "S", "SW", "W", "NW"];
 
-pub(super) fn stamp(t_ns: u64) -> Value {
+pub(crate) fn stamp(t_ns: u64) -> Value {
     json!({"sec": t_ns / 1_000_000_000, "nsec": t_ns % 1_000_000_000})
 }
 
-pub(super) fn cell(index: u32, width: u32) -> Value {
+pub(crate) fn cell(index: u32, width: u32) -> Value {
     if index == NO_CELL || width == 0 {
         Value::Null
     } else {
@@ -29,7 +30,7 @@ pub(super) fn cell(index: u32, width: u32) -> Value {
     }
 }
 
-pub(super) fn decision_message(t: u64, round: u64, d: &LoggedDecision, width: u32) -> Value {
+pub(crate) fn decision_message(t: u64, round: u64, d: &LoggedDecision, width: u32) -> Value {
     let name = |n: Option<&str>, code: u8| n.map_or_else(|| code.to_string(), str::to_string);
     json!({
         "timestamp": stamp(t),
@@ -43,21 +44,35 @@ pub(super) fn decision_message(t: u64, round: u64, d: &LoggedDecision, width: u3
     })
 }
 
-pub(super) fn pose_message(s: &PoseSample) -> Value {
-    let half = f64::from(s.theta_rad) / 2.0;
+pub(crate) fn pose_message(s: &PoseSample) -> Value {
+    let pose = pose(
+        f64::from(s.x_m),
+        f64::from(s.y_m),
+        0.0,
+        f64::from(s.theta_rad),
+    );
+    json!({"timestamp": stamp(s.t_ns), "frame_id": FRAME, "pose": pose})
+}
+
+/// A `foxglove.Pose` at `(x, y, z)` turned `theta` about z.
+pub(crate) fn pose(x: f64, y: f64, z: f64, theta: f64) -> Value {
+    let half = theta / 2.0;
     json!({
-        "timestamp": stamp(s.t_ns),
-        "frame_id": FRAME,
-        "pose": {
-            "position": {"x": f64::from(s.x_m), "y": f64::from(s.y_m), "z": 0.0},
-            "orientation": {"x": 0.0, "y": 0.0, "z": half.sin(), "w": half.cos()}
-        }
+        "position": {"x": x, "y": y, "z": z},
+        "orientation": {"x": 0.0, "y": 0.0, "z": half.sin(), "w": half.cos()}
     })
+}
+
+/// `g` as a `foxglove.Grid` of field `occupied` (1 = blocked) at `t_ns`.
+pub(crate) fn occupancy(g: &Grid, t_ns: u64, cell_m: f64) -> Value {
+    let occupied: Vec<u8> = g.blocked().iter().map(|&b| u8::from(b)).collect();
+    let fields = [("occupied", 0, NUMERIC_UINT8)];
+    grid_message(t_ns, (g.width(), cell_m), 1, &fields, &occupied)
 }
 
 /// A `foxglove.Grid` at the frame's origin: `columns` cells of `cell_m` a row, each
 /// `cell_stride` bytes of `data` holding `fields` (name, offset, numeric type).
-pub(super) fn grid_message(
+pub(crate) fn grid_message(
     t_ns: u64,
     (columns, cell_m): (u32, f64),
     cell_stride: u32,
@@ -82,7 +97,7 @@ pub(super) fn grid_message(
 
 /// A neural map as a grid of its activations and their log10, since the wave front decays
 /// geometrically and a linear colour scale shows only the cells next to the target.
-pub(super) fn neural_map_message(snap: &MapSnapshot, cell_m: f64) -> Value {
+pub(crate) fn neural_map_message(snap: &MapSnapshot, cell_m: f64) -> Value {
     let mut data = Vec::with_capacity(snap.values.len() * 8);
     for &v in &snap.values {
         let log = if v > 0.0 { v.log10() } else { LOG10_OF_ZERO };

@@ -1,9 +1,10 @@
-//! The JSON schemas of the exported channels (schema encoding `jsonschema`).
+//! The JSON schemas of the channels (schema encoding `jsonschema`), live and exported.
 //!
-//! Poses and grids use Foxglove's well-known schemas by name and shape
-//! (`foxglove.PoseInFrame`, `foxglove.Grid`, as in Foxglove's `schemas/jsonschema/`), so
-//! Foxglove Studio's 3D panel draws them without configuration; the log-derived channels
-//! have schemas of their own (`hnav.*`), which the Raw Messages and Plot panels read.
+//! Poses, grids, the scene and the log use Foxglove's well-known schemas by name and shape
+//! (`foxglove.PoseInFrame`, `foxglove.Grid`, `foxglove.SceneUpdate`, `foxglove.Log`: the
+//! fields HNAV fills, named as in Foxglove's JSON schemas), so Foxglove's 3D and Log panels
+//! show them without configuration; the rest have schemas of their own (`hnav.*`), which the
+//! Raw Messages and Plot panels read.
 
 use serde_json::{json, Value};
 
@@ -11,6 +12,12 @@ use serde_json::{json, Value};
 pub const POSE_IN_FRAME: &str = "foxglove.PoseInFrame";
 /// `foxglove.Grid`.
 pub const GRID: &str = "foxglove.Grid";
+/// `foxglove.SceneUpdate`: robots, goals, routes and conflicts.
+pub const SCENE_UPDATE: &str = "foxglove.SceneUpdate";
+/// `foxglove.Log`: decisions and process events as log lines.
+pub const LOG: &str = "foxglove.Log";
+/// One robot's speed (and energy, when a source has it) for the Plot panel.
+pub const ROBOT_STATS: &str = "hnav.RobotStats";
 /// One round's committed cells.
 pub const COMMITTED_CELLS: &str = "hnav.CommittedCells";
 /// One decision of one round.
@@ -66,9 +73,111 @@ fn cell() -> Value {
     })
 }
 
-/// The schema named `name`, as bytes for the MCAP schema record.
+fn color() -> Value {
+    let n = json!({"type": "number", "minimum": 0, "maximum": 1});
+    json!({
+        "title": "foxglove.Color",
+        "type": "object",
+        "properties": {"r": n, "g": n, "b": n, "a": n},
+        "required": ["r", "g", "b", "a"]
+    })
+}
+
+fn vector3() -> Value {
+    let number = json!({"type": "number"});
+    json!({
+        "title": "foxglove.Vector3",
+        "type": "object",
+        "properties": {"x": number, "y": number, "z": number},
+        "required": ["x", "y", "z"]
+    })
+}
+
+/// `foxglove.SceneEntity`, with the primitives HNAV draws (cubes, lines, texts).
+fn scene_entity() -> Value {
+    let array = |title: &str, properties: Value| json!({"type": "array", "items": {"title": title, "type": "object", "properties": properties}});
+    json!({
+        "title": "foxglove.SceneEntity",
+        "type": "object",
+        "properties": {
+            "timestamp": time(),
+            "frame_id": {"type": "string"},
+            "id": {"type": "string"},
+            "lifetime": {
+                "type": "object",
+                "title": "duration",
+                "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}
+            },
+            "frame_locked": {"type": "boolean"},
+            "metadata": array("foxglove.KeyValuePair", json!({"key": {"type": "string"}, "value": {"type": "string"}})),
+            "cubes": array("foxglove.CubePrimitive", json!({"pose": pose(), "size": vector3(), "color": color()})),
+            "lines": array("foxglove.LinePrimitive", json!({
+                "type": {"title": "foxglove.LineType", "type": "integer", "description": "0 line strip, 1 line loop, 2 line list"},
+                "pose": pose(),
+                "thickness": {"type": "number"},
+                "scale_invariant": {"type": "boolean"},
+                "points": {"type": "array", "items": vector3()},
+                "color": color()
+            })),
+            "texts": array("foxglove.TextPrimitive", json!({
+                "pose": pose(),
+                "billboard": {"type": "boolean"},
+                "font_size": {"type": "number"},
+                "scale_invariant": {"type": "boolean"},
+                "color": color(),
+                "text": {"type": "string"}
+            }))
+        }
+    })
+}
+
+/// The schema named `name`, as bytes for the MCAP schema record and the WebSocket advertise.
 pub fn schema(name: &str) -> Vec<u8> {
     let body = match name {
+        SCENE_UPDATE => json!({
+            "title": SCENE_UPDATE,
+            "description": "An update to the entities displayed in a 3D scene",
+            "type": "object",
+            "properties": {
+                "deletions": {
+                    "type": "array",
+                    "items": {
+                        "title": "foxglove.SceneEntityDeletion",
+                        "type": "object",
+                        "properties": {
+                            "timestamp": time(),
+                            "type": {"title": "foxglove.SceneEntityDeletionType", "type": "integer", "description": "0 matching id, 1 all"},
+                            "id": {"type": "string"}
+                        }
+                    }
+                },
+                "entities": {"type": "array", "items": scene_entity()}
+            }
+        }),
+        LOG => json!({
+            "title": LOG,
+            "description": "A log message",
+            "type": "object",
+            "properties": {
+                "timestamp": time(),
+                "level": {"title": "foxglove.LogLevel", "type": "integer", "description": "0 unknown, 1 debug, 2 info, 3 warning, 4 error, 5 fatal"},
+                "message": {"type": "string"},
+                "name": {"type": "string", "description": "the process or agent the line is about"},
+                "file": {"type": "string"},
+                "line": {"type": "integer", "minimum": 0}
+            }
+        }),
+        ROBOT_STATS => json!({
+            "title": ROBOT_STATS,
+            "description": "One robot's ground-truth speed, for the Plot panel",
+            "type": "object",
+            "properties": {
+                "timestamp": time(),
+                "robot": {"type": "integer"},
+                "speed_m_s": {"type": "number", "description": "ground-truth speed over the last sampling interval, m/s"},
+                "energy_j": {"type": ["number", "null"], "description": "motor energy so far, J; null where the source has none (no topic carries it live)"}
+            }
+        }),
         POSE_IN_FRAME => json!({
             "title": POSE_IN_FRAME,
             "description": "A timestamped pose for an object or reference frame in 3D space",
