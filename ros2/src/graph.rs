@@ -1,5 +1,5 @@
 //! rmw_zenoh's names for a ROS 2 graph, as `rmw_zenoh_cpp` (`liveliness_utils.cpp`,
-//! `attachment_helpers.cpp`, `docs/design.md` of ros2/rmw_zenoh) writes them:
+//! `attachment_helpers.cpp` and the design document of ros2/rmw_zenoh) writes them:
 //!
 //! - a topic's data key expression: `<domain>/<topic without its outer slashes>/<DDS type
 //!   name>/<type hash>`, e.g. `0/robot_0/odom/nav_msgs::msg::dds_::Odometry_/RIHS01_…`;

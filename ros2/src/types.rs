@@ -5,7 +5,7 @@
 //! The hashes were computed per REP-2011 from Jazzy's message definitions by PyPI `rosbags`
 //! 0.11.9 (`get_typestore(Stores.ROS2_JAZZY).hash_rihs01(name)`, the command in
 //! `docs/reference/ros2.md`), and that computation checked against two hashes published
-//! independently: `std_msgs/msg/String`'s in rmw_zenoh's `docs/design.md` and
+//! independently: `std_msgs/msg/String`'s in rmw_zenoh's design document and
 //! `nav_msgs/msg/Odometry`'s in ZettaScale's ros-z (computed from Jazzy's generated type
 //! descriptions). The Python test client decodes every topic with the same typestore, and
 //! checks the hash in each key expression against it.

@@ -13,6 +13,7 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 use hnav_runtime::transport::{run_iceoryx2_files, run_shm_files};
+use hnav_tests::python::python;
 use hnav_tests::swarm::{repo_root, workspace_bin, SwarmRun};
 use hnav_tests::TestRun;
 use nix::sys::signal::Signal;
@@ -23,33 +24,6 @@ const RUN_TIMEOUT: Duration = Duration::from_secs(120);
 const WATCH_TIMEOUT: Duration = Duration::from_secs(90);
 /// Commits the example is asked to print.
 const COMMITS: usize = 150;
-
-/// The virtual environment's Python, or `None` (with the reason printed) when the test
-/// should skip.
-fn python() -> Option<PathBuf> {
-    let explicit = std::env::var_os("HNAV_PYTHON").map(PathBuf::from);
-    let path = explicit
-        .clone()
-        .unwrap_or_else(|| repo_root().join("target/py-venv/bin/python"));
-    if path.exists() {
-        return Some(path);
-    }
-    let why = format!(
-        "no Python virtual environment at {} ({}); make it with `python3 -m venv target/py-venv \
-         && target/py-venv/bin/pip install -r clients/python/requirements.txt`",
-        path.display(),
-        if explicit.is_some() {
-            "$HNAV_PYTHON"
-        } else {
-            "the default; or set $HNAV_PYTHON"
-        }
-    );
-    if std::env::var_os("HNAV_REQUIRE_PYTHON").is_some() {
-        panic!("HNAV_REQUIRE_PYTHON is set but there is {why}");
-    }
-    eprintln!("SKIPPED: {why}");
-    None
-}
 
 /// Runs the Python example `args` against `swarm`'s run until it exits, then stops the run
 /// (the rest of it is not the test's business, and takes minutes on a loaded machine); the
