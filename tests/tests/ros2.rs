@@ -1,6 +1,7 @@
-//! `hnav run --ros2` seen from a ROS 2 client that shares no code with HNAV
-//! (`clients/python/examples/ros2_check.py`: PyPI `eclipse-zenoh` 1.10.2 for the network,
-//! `rosbags` for ROS 2 Jazzy's message definitions, type hashes and CDR).
+//! `hnav run --ros2` seen from a ROS 2 client that shares no code with HNAV.
+//!
+//! The client, `clients/python/examples/ros2_check.py`, has PyPI `eclipse-zenoh` 1.10.2 for
+//! the network and `rosbags` for ROS 2 Jazzy's message definitions, type hashes and CDR.
 //!
 //! The client is the Zenoh router of the graph, on a free port of this test's; the lockstep
 //! demo run joins it (`--ros2-router`). The client finds the liveliness tokens rmw_zenoh
