@@ -68,11 +68,7 @@ impl Scene {
         changes.reverse();
         Scene {
             grid: scenario.map.grid.clone(),
-            corners: if scenario.map.corner_cutting {
-                CornerCutting::Allowed
-            } else {
-                CornerCutting::Forbidden
-            },
+            corners: scenario.map.corner_cutting,
             cell_m: scenario.robot.cell_size_m,
             wheel_radius_m: scenario.robot.wheel_radius_m,
             axle_m: scenario.robot.axle_track_m,
