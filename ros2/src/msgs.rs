@@ -362,9 +362,11 @@ mod tests {
             ..Odometry::default()
         };
         encode(&odom, &mut out).unwrap();
-        // header 4 + time 8 + "ab" 4+3 = 19, child_frame_id at 20 (len 1: "") = 25, pose at 32.
-        assert_eq!(&out[4 + 20..4 + 25], &[1, 0, 0, 0, 0]);
-        assert_eq!(out.len(), 4 + 32 + (7 + 36) * 8 + (6 + 36) * 8);
+        // After the 4-byte header: time 8, "ab" 4 + 3 = 15, child_frame_id aligned to 16
+        // (length 1: "") = 21, the pose's first float64 aligned to 24.
+        assert_eq!(&out[4 + 16..4 + 21], &[1, 0, 0, 0, 0]);
+        assert_eq!(&out[4 + 21..4 + 24], &[0, 0, 0]);
+        assert_eq!(out.len(), 4 + 24 + (7 + 36) * 8 + (6 + 36) * 8);
     }
 
     #[test]

@@ -368,12 +368,13 @@ mod tests {
         let s = scenario();
         let mut scene = Scene::new(&s);
         let grid = s.map.grid.clone();
-        // Activation: minus the steps to the goal (3, 2), so the ascent walks there.
+        // Activation: minus the Manhattan distance to the goal (3, 2), so the ascent walks
+        // there.
         let goal = Cell::new(3, 2);
         let values: Vec<f32> = (0..grid.len())
             .map(|i| {
                 let c = grid.cell_at(i).unwrap();
-                -((c.x.abs_diff(goal.x)).max(c.y.abs_diff(goal.y)) as f32)
+                -((c.x.abs_diff(goal.x) + c.y.abs_diff(goal.y)) as f32)
             })
             .collect();
         let header = MapHeader {

@@ -105,11 +105,11 @@ pub struct RunArgs {
 /// How `hnav-ros2` joins the ROS 2 graph, if the run is published (`--ros2`,
 /// `--ros2-router` or `[ros2]`). With rmw_zenoh's default router and none answering there,
 /// `hnav-ros2` is the router, and stderr says so.
-fn ros2_options(a: &RunArgs, s: &Scenario) -> Option<Ros2Options> {
-    if !a.ros2 && a.ros2_router.is_none() && s.ros2.is_none() {
+fn ros2_options(ros2: bool, router: Option<&str>, s: &Scenario) -> Option<Ros2Options> {
+    if !ros2 && router.is_none() && s.ros2.is_none() {
         return None;
     }
-    let router = (a.ros2_router.clone()).or_else(|| s.ros2.as_ref()?.router.clone());
+    let router = (router.map(String::from)).or_else(|| s.ros2.as_ref()?.router.clone());
     let tcp = |addr: &str| {
         use std::net::ToSocketAddrs;
         let timeout = std::time::Duration::from_millis(500);
@@ -222,7 +222,7 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
     });
     let (name, faults, host, ros2) = match placed {
         Ok((s, faults, host)) => {
-            let ros2 = ros2_options(&a, &s);
+            let ros2 = ros2_options(a.ros2, a.ros2_router.as_deref(), &s);
             (default_run_dir(&s, a.host.as_deref()), faults, host, ros2)
         }
         Err(e) => {
