@@ -67,6 +67,7 @@ fn a_ros2_client_without_ros_sees_the_demo_run_and_its_robots_at_their_goals() {
         .expect("the client exits");
     let run_status = swarm.finish(Duration::from_secs(30));
     let text = lines.join("\n");
+    eprintln!("{text}");
     let ros2_log = std::fs::read_to_string(out.join("logs/ros2.log")).unwrap_or_default();
     assert!(
         status.success(),
