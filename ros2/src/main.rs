@@ -65,7 +65,12 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let mut topics = Topics::declare(session, scenario.agents.len(), &opts)?;
     tracing::info!(?role, node = topics.node.token(), "ros2 node up");
     for p in topics.publishers() {
-        tracing::debug!(topic = p.topic(), key = p.key(), token = p.token(), "publisher");
+        tracing::debug!(
+            topic = p.topic(),
+            key = p.key(),
+            token = p.token(),
+            "publisher"
+        );
     }
     let counts = relay(&run, &scenario, &mut topics, &opts)?;
     hnav_runtime::outln!("{counts}");

@@ -341,10 +341,7 @@ mod tests {
     fn a_header_is_the_encapsulation_then_aligned_fields() {
         let mut out = Vec::new();
         let h = Header {
-            stamp: Time {
-                sec: 1,
-                nanosec: 2,
-            },
+            stamp: Time { sec: 1, nanosec: 2 },
             frame_id: "map".into(),
         };
         encode(&h, &mut out).unwrap();

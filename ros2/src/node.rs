@@ -118,7 +118,9 @@ impl Node {
         } else {
             builder.advanced().wait()
         }
-        .map_err(zenoh_err(format!("declare the publisher of {topic} on {key}")))?;
+        .map_err(zenoh_err(format!(
+            "declare the publisher of {topic} on {key}"
+        )))?;
         let live = (self.session.liveliness().declare_token(&token).wait())
             .map_err(zenoh_err(format!("declare the publisher's token {token}")))?;
         Ok(Publisher {

@@ -11,16 +11,16 @@
 
 use std::time::{Duration, Instant};
 
-use hnav_runtime::msg::{Commit, Estimate, Lifecycle, LifecycleEvent, MapHeader, Truth, WheelCommand};
+use hnav_runtime::msg::{
+    Commit, Estimate, Lifecycle, LifecycleEvent, MapHeader, Truth, WheelCommand,
+};
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::topics;
-use hnav_runtime::transport::{
-    Receiver, RunId, SliceReceiver, Transport, TransportError, Wake,
-};
+use hnav_runtime::transport::{Receiver, RunId, SliceReceiver, Transport, TransportError, Wake};
 use zenoh::Session;
 
 use crate::graph::Qos;
-use crate::msgs::{MarkerArray, OccupancyGrid, Odometry, Path, TfMessage, Text};
+use crate::msgs::{MarkerArray, OccupancyGrid, Odometry, Path, Text, TfMessage};
 use crate::node::{Node, NodeError, Publisher};
 use crate::scene::Scene;
 use crate::types;
@@ -64,6 +64,8 @@ impl std::fmt::Display for Counts {
 
 /// One robot's publishers.
 struct RobotTopics {
+    /// `robot_<i>/odom`, made once.
+    odom_frame: String,
     odom: Publisher,
     ground_truth: Publisher,
     plan: Publisher,
@@ -83,15 +85,24 @@ pub struct Topics {
 
 impl Topics {
     /// Declares node `hnav` and its publishers for `agents` robots.
-    pub fn declare(session: Session, agents: usize, opts: &RelayOptions) -> Result<Topics, NodeError> {
+    pub fn declare(
+        session: Session,
+        agents: usize,
+        opts: &RelayOptions,
+    ) -> Result<Topics, NodeError> {
         let mut node = Node::declare(session, opts.domain, "/", "hnav")?;
         let ns = opts.namespace.trim_end_matches('/');
         let mut robots = Vec::with_capacity(agents);
         for i in 0..agents {
             let name = |t: &str| format!("{ns}/robot_{i}/{t}");
             robots.push(RobotTopics {
+                odom_frame: format!("robot_{i}/odom"),
                 odom: node.publisher(&name("odom"), &types::ODOMETRY, Qos::DEFAULT)?,
-                ground_truth: node.publisher(&name("ground_truth"), &types::ODOMETRY, Qos::DEFAULT)?,
+                ground_truth: node.publisher(
+                    &name("ground_truth"),
+                    &types::ODOMETRY,
+                    Qos::DEFAULT,
+                )?,
                 plan: node.publisher(&name("plan"), &types::PATH, Qos::DEFAULT)?,
                 cmd_vel: node.publisher(&name("cmd_vel"), &types::TWIST, Qos::DEFAULT)?,
             });
@@ -177,7 +188,9 @@ pub fn relay(
     loop {
         let wake = waiter.wait(Some(next))?;
         let mut stop = wake == Wake::Stop || std::os::unix::process::parent_id() != parent;
-        inputs.life.drain(|l| stop |= l.event == LifecycleEvent::Stop as u8)?;
+        inputs
+            .life
+            .drain(|l| stop |= l.event == LifecycleEvent::Stop as u8)?;
         read(&inputs, &mut scene, topics, &mut s, &mut out)?;
         if stop || Instant::now() >= next {
             publish_state(&mut scene, topics, &mut s, &mut out);
@@ -227,7 +240,7 @@ fn read(
 fn publish_state(scene: &mut Scene, topics: &mut Topics, s: &mut Scratch, out: &mut Out) {
     for (i, t) in topics.robots.iter_mut().enumerate() {
         if let Some((ns, pose)) = scene.robots[i].estimate {
-            scene.odometry(i, ns, &pose, &format!("robot_{i}/odom"), &mut s.odom);
+            scene.odometry(i, ns, &pose, &t.odom_frame, &mut s.odom);
             out.put(&mut t.odom, &s.odom);
         }
         if let Some(pose) = scene.true_pose(i) {

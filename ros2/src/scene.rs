@@ -102,8 +102,12 @@ impl Scene {
         self.conflicts.clear();
         let n = (c.count as usize).min(c.decisions.len());
         for d in &c.decisions[..n] {
-            let conflict = ConflictKind::from_u8(d.kind)
-                .is_some_and(|k| !matches!(k, ConflictKind::None | ConflictKind::Pushed | ConflictKind::Redirected));
+            let conflict = ConflictKind::from_u8(d.kind).is_some_and(|k| {
+                !matches!(
+                    k,
+                    ConflictKind::None | ConflictKind::Pushed | ConflictKind::Redirected
+                )
+            });
             if conflict {
                 if let Some(cell) = self.cell_of_index(d.cell) {
                     self.conflicts.push(cell);
@@ -113,7 +117,9 @@ impl Scene {
     }
 
     fn cell_of_index(&self, i: u32) -> Option<Cell> {
-        (i != msg::NO_CELL).then(|| self.grid.cell_at(i as usize)).flatten()
+        (i != msg::NO_CELL)
+            .then(|| self.grid.cell_at(i as usize))
+            .flatten()
     }
 
     /// The sim time of the last ground truth, ns.
@@ -225,23 +231,23 @@ impl Scene {
                 continue;
             };
             let p = ros_pose(&pose);
-            for (parent, child, transform) in [
-                (format!("map"), format!("robot_{i}/odom"), Transform::default()),
-                (
-                    format!("robot_{i}/odom"),
-                    format!("robot_{i}/base_link"),
-                    Transform {
-                        translation: p.position,
-                        rotation: p.orientation,
-                    },
-                ),
-            ] {
+            let base = Transform {
+                translation: p.position,
+                rotation: p.orientation,
+            };
+            for (k, transform) in [Transform::default(), base].into_iter().enumerate() {
                 if out.transforms.len() <= n {
                     out.transforms.push(TransformStamped::default());
                 }
                 let ts = &mut out.transforms[n];
-                set_header(&mut ts.header, t_ns, &parent);
-                set_string(&mut ts.child_frame_id, format_args!("{child}"));
+                ts.header.stamp = Time::from_ns(t_ns);
+                if k == 0 {
+                    set_string(&mut ts.header.frame_id, format_args!("map"));
+                    set_string(&mut ts.child_frame_id, format_args!("robot_{i}/odom"));
+                } else {
+                    set_string(&mut ts.header.frame_id, format_args!("robot_{i}/odom"));
+                    set_string(&mut ts.child_frame_id, format_args!("robot_{i}/base_link"));
+                }
                 ts.transform = transform;
                 n += 1;
             }
@@ -276,19 +282,59 @@ impl Scene {
         };
         let flat = |s: f64, h: f64| Vec3 { x: s, y: s, z: h };
         for (i, g) in self.goals.iter().enumerate() {
-            let green = Color { r: 0.1, g: 0.8, b: 0.2, a: 0.6 };
-            add("goals", i, Marker::CUBE, self.centre(*g), flat(cell * 0.5, 0.02), green);
+            let green = Color {
+                r: 0.1,
+                g: 0.8,
+                b: 0.2,
+                a: 0.6,
+            };
+            add(
+                "goals",
+                i,
+                Marker::CUBE,
+                self.centre(*g),
+                flat(cell * 0.5, 0.02),
+                green,
+            );
         }
         for i in 0..self.robots.len() {
             if let Some(p) = self.true_pose(i) {
-                let blue = Color { r: 0.2, g: 0.4, b: 1.0, a: 1.0 };
-                let at = Vec3 { x: p.x_m, y: p.y_m, z: 0.0 };
-                add("robots", i, Marker::CYLINDER, at, flat(cell * 0.7, 0.05), blue);
+                let blue = Color {
+                    r: 0.2,
+                    g: 0.4,
+                    b: 1.0,
+                    a: 1.0,
+                };
+                let at = Vec3 {
+                    x: p.x_m,
+                    y: p.y_m,
+                    z: 0.0,
+                };
+                add(
+                    "robots",
+                    i,
+                    Marker::CYLINDER,
+                    at,
+                    flat(cell * 0.7, 0.05),
+                    blue,
+                );
             }
         }
         for (k, c) in self.conflicts.iter().enumerate() {
-            let red = Color { r: 1.0, g: 0.1, b: 0.1, a: 0.8 };
-            add("conflicts", k, Marker::SPHERE, self.centre(*c), flat(cell * 0.4, cell * 0.4), red);
+            let red = Color {
+                r: 1.0,
+                g: 0.1,
+                b: 0.1,
+                a: 0.8,
+            };
+            add(
+                "conflicts",
+                k,
+                Marker::SPHERE,
+                self.centre(*c),
+                flat(cell * 0.4, cell * 0.4),
+                red,
+            );
         }
     }
 
@@ -297,7 +343,11 @@ impl Scene {
     /// "refused":BITS}]}`.
     pub fn decisions_json(&self, c: &Commit, out: &mut String) {
         out.clear();
-        let _ = write!(out, "{{\"round\":{},\"term\":{},\"decisions\":[", c.round, c.term);
+        let _ = write!(
+            out,
+            "{{\"round\":{},\"term\":{},\"decisions\":[",
+            c.round, c.term
+        );
         let n = (c.count as usize).min(c.decisions.len());
         for (k, d) in c.decisions[..n].iter().enumerate() {
             let verdict = Verdict::from_u8(d.verdict).map_or("unknown", Verdict::name);
@@ -382,8 +432,10 @@ mod tests {
             ..MapHeader::default()
         };
         scene.robots[0].map = Some((header, values));
-        let mut truth = Truth::default();
-        truth.robots = 1;
+        let mut truth = Truth {
+            robots: 1,
+            ..Truth::default()
+        };
         truth.poses[0] = Pose {
             x_m: 0.08,
             y_m: 0.08,
@@ -393,7 +445,12 @@ mod tests {
         let mut path = msgs::Path::default();
         scene.plan(0, &mut path);
         let cells: Vec<(f64, f64)> = (path.poses.iter())
-            .map(|p| (p.pose.position.x / 0.16 - 0.5, p.pose.position.y / 0.16 - 0.5))
+            .map(|p| {
+                (
+                    p.pose.position.x / 0.16 - 0.5,
+                    p.pose.position.y / 0.16 - 0.5,
+                )
+            })
             .map(|(x, y)| (x.round(), y.round()))
             .collect();
         // (1, 1) is blocked and no corner is cut: along the top row, then down.
@@ -407,8 +464,10 @@ mod tests {
     fn a_close_applies_once_truth_passes_its_time() {
         let mut scene = Scene::new(&scenario());
         let mut grid = OccupancyGrid::default();
-        let mut truth = Truth::default();
-        truth.sim_time_ns = 999_999_999;
+        let mut truth = Truth {
+            sim_time_ns: 999_999_999,
+            ..Truth::default()
+        };
         scene.truth(&truth);
         scene.occupancy(&mut grid);
         assert_eq!(grid.data[3], 0);
@@ -425,9 +484,11 @@ mod tests {
     #[test]
     fn decisions_are_one_json_object_per_commit() {
         let scene = Scene::new(&scenario());
-        let mut c = Commit::default();
-        c.round = 7;
-        c.count = 1;
+        let mut c = Commit {
+            round: 7,
+            count: 1,
+            ..Commit::default()
+        };
         c.decisions[0].verdict = Verdict::Accept as u8;
         c.decisions[0].cell = 1;
         let mut out = String::new();

@@ -117,6 +117,9 @@ mod tests {
             &format!("tcp/127.0.0.1:{port}"),
             Duration::from_millis(200)
         ));
-        assert!(!answers("tcp/no-such-host.invalid:1", Duration::from_millis(200)));
+        assert!(!answers(
+            "tcp/no-such-host.invalid:1",
+            Duration::from_millis(200)
+        ));
     }
 }

@@ -92,7 +92,9 @@ mod tests {
             assert_eq!(t.dds, format!("{pkg}::msg::dds_::{rest}_"));
             let hex = t.hash.strip_prefix("RIHS01_").unwrap();
             assert_eq!(hex.len(), 64);
-            assert!(hex.bytes().all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b)));
+            assert!(hex
+                .bytes()
+                .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b)));
         }
     }
 }

@@ -73,7 +73,10 @@ fn a_ros2_client_without_ros_sees_the_demo_run_and_its_robots_at_their_goals() {
         status.success(),
         "the client failed ({status}):\n{text}\n--- ros2.log:\n{ros2_log}"
     );
-    assert!(run_status.as_ref().is_ok_and(|s| s.success()), "{run_status:?}");
+    assert!(
+        run_status.as_ref().is_ok_and(|s| s.success()),
+        "{run_status:?}"
+    );
     assert_eq!(lines.last().map(String::as_str), Some("OK"), "{text}");
     let at_goal = lines
         .iter()

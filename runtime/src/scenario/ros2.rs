@@ -148,10 +148,21 @@ mod tests {
         let e = parse("domain_id = 300").unwrap_err().to_string();
         assert_eq!(e, "r.toml:8: ros2.domain_id must be in [0, 232], got 300");
         let e = parse("\nnamespace = \"9lives\"").unwrap_err().to_string();
-        assert!(e.starts_with("r.toml:9: ros2.namespace must be ROS name tokens"), "{e}");
-        let e = parse("router = \"localhost:7447\"").unwrap_err().to_string();
-        assert!(e.starts_with("r.toml:8: ros2.router must be a Zenoh endpoint"), "{e}");
-        assert!(parse("domain = 3").unwrap_err().to_string().contains("domain"));
+        assert!(
+            e.starts_with("r.toml:9: ros2.namespace must be ROS name tokens"),
+            "{e}"
+        );
+        let e = parse("router = \"localhost:7447\"")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("r.toml:8: ros2.router must be a Zenoh endpoint"),
+            "{e}"
+        );
+        assert!(parse("domain = 3")
+            .unwrap_err()
+            .to_string()
+            .contains("domain"));
     }
 
     #[test]
