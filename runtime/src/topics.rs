@@ -6,7 +6,7 @@
 //! | `wheels/<i>` | [`WheelCommand`](crate::msg::WheelCommand) | agent i -> sim | latest |
 //! | `odom/<i>` | [`Odometry`](crate::msg::Odometry) | sim -> agent i | latest |
 //! | `truth` | [`Truth`](crate::msg::Truth) | sim -> supervisor, recorder, viewers | latest, deep buffer ([`truth_qos`]) |
-//! | `estimate` | [`Estimate`](crate::msg::Estimate) | every agent -> recorder, viewers | latest, depth 1, not notified ([`estimate_qos`]) |
+//! | `estimate` | [`Estimate`](crate::msg::Estimate) | every agent -> recorder, `hnav-ros2`, viewers | latest, depth 1, not notified ([`estimate_qos`]) |
 //! | `candidates` | [`Candidate`](crate::msg::Candidate) | agents -> coordinator | reliable |
 //! | `commit` | [`Commit`](crate::msg::Commit) | coordinator -> agents | latest, deep buffer |
 //! | `map/<i>` | `[f32]` + [`MapHeader`](crate::msg::MapHeader) | agent i -> viewers (`hnav services` lists who) | latest |
@@ -144,9 +144,13 @@ pub fn truth_qos() -> Qos {
 
 /// QoS of the `estimate` topic of a swarm of `agents`: like [`heartbeat_qos`], every agent
 /// (twice, while a restarted one replaces a dead one) publishes and only each one's latest
-/// pose matters; the recorder and a viewer read at a pace of their own.
+/// pose matters; the recorder, `hnav-ros2`, a live view and one more viewer read at a pace
+/// of their own.
 pub fn estimate_qos(agents: usize) -> Qos {
-    heartbeat_qos(agents)
+    Qos {
+        max_subscribers: 4,
+        ..heartbeat_qos(agents)
+    }
 }
 
 /// QoS of the candidate stream of a swarm of `agents`.

@@ -28,6 +28,7 @@
 //! | [`house`] | the workspace's import rules checked over its sources: rings of files, imports back up a `lib.rs` table |
 //! | [`docs`] | what `tests/docs.rs` checks in the markdown: commands against `--help`, links, paths |
 //! | [`across`] | one run across hosts in network namespaces: a supervisor per host, their domains purged |
+//! | [`python`] | the Python of the client tests, or why they skip |
 //! | [`swarm`] | one `hnav run` of a test: its scenario, its run directory, its log's digest |
 //! | [`rogue`] | the hostile candidates `hnav-rogue` forges |
 //! | [`lost_wakeup`] | both halves of the lost-wake-up reproducer |
@@ -44,6 +45,7 @@ pub mod house;
 pub mod lost_wakeup;
 pub mod netns;
 pub mod pattern;
+pub mod python;
 pub mod rogue;
 pub mod swarm;
 pub mod tmux;

@@ -338,30 +338,3 @@ pub fn lifecycle_records(
         .collect()
 }
 
-/// The virtual environment's Python for the tests of the Python clients: `$HNAV_PYTHON`, else
-/// `target/py-venv/bin/python`; `None` (with the reason printed) when the test should skip,
-/// a panic instead when `HNAV_REQUIRE_PYTHON` is set (CI sets it).
-pub fn venv_python() -> Option<PathBuf> {
-    let explicit = std::env::var_os("HNAV_PYTHON").map(PathBuf::from);
-    let path = explicit
-        .clone()
-        .unwrap_or_else(|| repo_root().join("target/py-venv/bin/python"));
-    if path.exists() {
-        return Some(path);
-    }
-    let why = format!(
-        "no Python virtual environment at {} ({}); make it with `python3 -m venv target/py-venv \
-         && target/py-venv/bin/pip install -r clients/python/requirements.txt`",
-        path.display(),
-        if explicit.is_some() {
-            "$HNAV_PYTHON"
-        } else {
-            "the default; or set $HNAV_PYTHON"
-        }
-    );
-    if std::env::var_os("HNAV_REQUIRE_PYTHON").is_some() {
-        panic!("HNAV_REQUIRE_PYTHON is set but there is {why}");
-    }
-    eprintln!("SKIPPED: {why}");
-    None
-}

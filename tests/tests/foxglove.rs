@@ -8,7 +8,7 @@
 //! advertised live, with the same schemas. And `--foxglove` with an address in use or one
 //! that does not parse stops `hnav run` before anything is spawned.
 //!
-//! The Python is the virtual environment's (`swarm::venv_python`): skipped without one,
+//! The Python is the virtual environment's (`hnav_tests::python::python`): skipped without one,
 //! unless `HNAV_REQUIRE_PYTHON` is set (CI sets it).
 
 use std::net::TcpListener;
@@ -17,7 +17,8 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 use hnav_runtime::transport::{run_iceoryx2_files, run_shm_files, RunId};
-use hnav_tests::swarm::{repo_root, venv_python, workspace_bin, SwarmRun};
+use hnav_tests::python::python as venv_python;
+use hnav_tests::swarm::{repo_root, workspace_bin, SwarmRun};
 use hnav_tests::TestRun;
 
 /// Bound on the whole live run (realtime, so the client has time to join).

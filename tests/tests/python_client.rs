@@ -13,7 +13,8 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 use hnav_runtime::transport::{run_iceoryx2_files, run_shm_files};
-use hnav_tests::swarm::{repo_root, venv_python as python, workspace_bin, SwarmRun};
+use hnav_tests::python::python;
+use hnav_tests::swarm::{repo_root, workspace_bin, SwarmRun};
 use hnav_tests::TestRun;
 use nix::sys::signal::Signal;
 

@@ -163,6 +163,7 @@ pub fn replay(opts: &ReplayOptions) -> Result<Replayed, ReplayError> {
         // The comparison reads the log only; a recording would cost the replay time.
         record: false,
         host: None,
+        ros2: None,
     })?;
     let replayed = read_decided(tmp.0.join("log"))?;
     // Compacted logs (replicas' snapshots) are compared from where both hold their records.

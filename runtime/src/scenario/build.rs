@@ -32,6 +32,7 @@ pub(super) fn parse(
     let health = super::health::build_health(raw.health, &lines)?;
     let record = super::record::build_record(raw.record, &lines)?;
     let sensing = super::sensing::build_sensing(raw.sensing, &lines)?;
+    let ros2 = super::ros2::build_ros2(raw.ros2, &lines)?;
     let localisation =
         super::localisation::build_localisation(raw.localisation, sim.odometry_hz, &lines)?;
     if raw.agents.is_empty() {
@@ -89,6 +90,7 @@ pub(super) fn parse(
         tasks,
         events,
         sensing,
+        ros2,
     })
 }
 

@@ -126,6 +126,11 @@
 //! known_map = true                     # false: only the walls seen so far are known
 //! repair = "auto"                      # neural-map repair: "auto", "partial", "rebuild"
 //! all_knowing = false                  # true: also told every close/open as it happens
+//!
+//! [ros2]                               # optional: the run as ROS 2 topics over rmw_zenoh
+//! domain_id = 0                        # ([`ros2`], docs/reference/ros2.md), as with `hnav
+//! namespace = "fleet"                  # run --ros2`; the robots' topics' prefix; the Zenoh
+//! router = "tcp/localhost:7447"        # router (started by `hnav run` if none answers)
 //! ```
 //!
 //! Unknown keys are errors (a typo must not silently fall back to a default). Every semantic
@@ -180,6 +185,7 @@ pub mod params;
 mod raw;
 pub mod record;
 pub mod report;
+pub mod ros2;
 pub mod sensing;
 pub mod tasks;
 mod validate;
@@ -200,6 +206,7 @@ pub use params::{
 pub use raw::KEYS;
 pub use record::RecordParams;
 pub use report::{default_out_dir, ScenarioReport};
+pub use ros2::Ros2Params;
 pub use sensing::{RepairRule, SensingParams};
 pub use tasks::{StreamKind, TaskStream, TasksSpec};
 
@@ -368,6 +375,9 @@ pub struct Scenario {
     /// What the robots sense of the world after `Start` (`[sensing]`); `None`: nothing, they
     /// plan on the scenario's map.
     pub sensing: Option<SensingParams>,
+    /// How the run is published as ROS 2 topics (`[ros2]`); `None`: only with `hnav run
+    /// --ros2`, with the defaults.
+    pub ros2: Option<Ros2Params>,
 }
 
 impl Scenario {

@@ -35,6 +35,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
             "tasks",
             "events",
             "sensing",
+            "ros2",
         ],
     ),
     ("map", &["file", "rows", "corner_cutting"]),
@@ -114,6 +115,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
     ("tasks", &["stream", "seed", "goals"]),
     ("tasks.goals", &["agent", "cells"]),
     ("sensing", &["range", "known_map", "repair", "all_knowing"]),
+    ("ros2", &["domain_id", "namespace", "router"]),
     (
         "events",
         &[
@@ -155,6 +157,7 @@ pub(super) struct RawScenario {
     #[serde(default)]
     pub events: Vec<Spanned<super::events::RawEvent>>,
     pub sensing: Option<super::sensing::RawSensing>,
+    pub ros2: Option<super::ros2::RawRos2>,
 }
 
 /// `[map]`.

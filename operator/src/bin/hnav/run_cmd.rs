@@ -1,7 +1,7 @@
 //! `hnav run SCENARIO [--agents N] [--mode lockstep|realtime] [--seed S] [--out DIR]
 //! [--run ID] [--replicas N] [--force] [--no-record] [--bin-dir DIR]
 //! [--kill|--term|--freeze TARGET@WHEN[+SECONDSs]]... [--host NAME [--hosts FILE]]
-//! [--foxglove [ADDR]]`: the
+//! [--foxglove [ADDR]] [--ros2 [--ros2-router ENDPOINT]]`: the
 //! supervisor. The work
 //! is in `hnav_operator::supervisor::run`; the faults' syntax in
 //! `hnav_runtime::scenario::fault_arg`.
@@ -21,7 +21,7 @@ use std::process::ExitCode;
 
 use clap::ArgMatches;
 use hnav_operator::supervisor::run::{
-    default_run_dir, new_run_id, run, HostPart, RunError, RunOptions,
+    default_run_dir, new_run_id, run, HostPart, Ros2Options, RunError, RunOptions,
 };
 use hnav_operator::supervisor::run_dir::RUN_OUTPUTS;
 use hnav_runtime::launch::ProcessArgs;
@@ -96,6 +96,52 @@ pub struct RunArgs {
     /// ADDR: 127.0.0.1:8765]; see docs/tutorials/watch-a-run-in-foxglove.md.
     #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = hnav_operator::viewer::DEFAULT_ADDR)]
     pub foxglove: Option<String>,
+    /// Publish the run as ROS 2 topics over rmw_zenoh (`hnav-ros2`; docs/reference/ros2.md),
+    /// as a scenario's `[ros2]` does. Without a router at tcp/localhost:7447 (and no
+    /// --ros2-router), one is started there for the run.
+    #[arg(long)]
+    pub ros2: bool,
+    /// The Zenoh router of the ROS 2 graph (implies --ros2) [default: the scenario's `[ros2]
+    /// router`, else tcp/localhost:7447].
+    #[arg(long, value_name = "ENDPOINT")]
+    pub ros2_router: Option<String>,
+}
+
+/// How `hnav-ros2` joins the ROS 2 graph, if the run is published (`--ros2`,
+/// `--ros2-router` or `[ros2]`). With rmw_zenoh's default router and none answering there,
+/// `hnav-ros2` is the router, and stderr says so.
+fn ros2_options(ros2: bool, router: Option<&str>, s: &Scenario) -> Option<Ros2Options> {
+    if !ros2 && router.is_none() && s.ros2.is_none() {
+        return None;
+    }
+    let router = (router.map(String::from)).or_else(|| s.ros2.as_ref()?.router.clone());
+    let tcp = |addr: &str| {
+        use std::net::ToSocketAddrs;
+        let timeout = std::time::Duration::from_millis(500);
+        (addr.to_socket_addrs().into_iter().flatten())
+            .any(|sa| std::net::TcpStream::connect_timeout(&sa, timeout).is_ok())
+    };
+    match &router {
+        None if !tcp("localhost:7447") => {
+            hnav_runtime::errln!(
+                "ros2: no Zenoh router answers at tcp/localhost:7447: hnav-ros2 starts one there for this run (it ends with the run)"
+            );
+            return Some(Ros2Options {
+                router: None,
+                start_router: true,
+            });
+        }
+        Some(r) if r.strip_prefix("tcp/").is_some_and(|addr| !tcp(addr)) => {
+            hnav_runtime::errln!(
+                "ros2: no Zenoh router answers at {r} yet: hnav-ros2 keeps trying to join it"
+            );
+        }
+        _ => {}
+    }
+    Some(Ros2Options {
+        router,
+        start_router: false,
+    })
 }
 
 /// `--force`'s help: the outputs it removes, from the one list the refusal also names.
@@ -179,8 +225,11 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
         };
         Ok((s, faults, host))
     });
-    let (name, faults, host) = match placed {
-        Ok((s, faults, host)) => (default_run_dir(&s, a.host.as_deref()), faults, host),
+    let (name, faults, host, ros2) = match placed {
+        Ok((s, faults, host)) => {
+            let ros2 = ros2_options(a.ros2, a.ros2_router.as_deref(), &s);
+            (default_run_dir(&s, a.host.as_deref()), faults, host, ros2)
+        }
         Err(e) => {
             hnav_runtime::errln!("error: {e}");
             return ExitCode::from(2);
@@ -209,6 +258,7 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
         force: a.force,
         record: !a.no_record,
         host,
+        ros2,
     };
     let result = run(&opts);
     drop(view);

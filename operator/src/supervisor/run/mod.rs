@@ -47,6 +47,7 @@
 // | `dying` | processes the supervisor SIGKILLed, told `Down` once they can no longer act, before the kernel has torn them down |
 // | `slots` | the run's processes: spawn, reap, restart under their policy, `Up`s announced |
 // | `sweeper` | dead nodes' shared memory removed on a thread of its own, so that it never delays a reap |
+// | `ros2` | `hnav-ros2`, the run's ROS 2 publisher: a process beside the roster |
 // | `host` | this host's part of a run across hosts; the list of a run's processes |
 // | `action` | what the watch's parts want done: signals, journal lines, lifecycle messages, respawns |
 // | `error` | [`RunError`] |
@@ -60,6 +61,8 @@ mod dying;
 
 mod slots;
 mod sweeper;
+
+mod ros2;
 
 mod host;
 
@@ -95,6 +98,7 @@ use watch::{End, Ports, Seen, Watch};
 
 pub use error::RunError;
 pub use host::HostPart;
+pub use ros2::Ros2Options;
 
 /// How long a child gets after `Stop`, and again after SIGTERM.
 pub const STOP_GRACE: Duration = Duration::from_secs(3);
@@ -116,6 +120,9 @@ pub struct RunOptions {
     /// In a run across hosts, this host's part (`--host NAME`): only its processes and its
     /// bridge are started here.
     pub host: Option<HostPart>,
+    /// Publish the run as ROS 2 topics (`--ros2`, or the scenario's `[ros2]`): how
+    /// `hnav-ros2` joins the graph.
+    pub ros2: Option<Ros2Options>,
 }
 
 /// Runs the scenario to its end and returns the summary (also written to `DIR/summary.json`).
@@ -164,6 +171,7 @@ fn run_owned(
     let ports = Ports::open(&run, scenario.agents.len(), opts.host.is_some())?;
     // Started before any process, so the recording begins with the first truth message.
     let recorder = start_recorder(opts, &run, &scenario, &dir);
+    let ros2 = start_ros2(opts, &dir, run.domain());
     let mut record = registry.new_record(&run, &dir);
     record.set_process_args(&opts.args);
     let started = Instant::now();
@@ -199,6 +207,9 @@ fn run_owned(
         Ok(End::TimeLimit) => StopReason::TimeLimit,
         _ => StopReason::Requested,
     };
+    if let Some(p) = ros2 {
+        p.stop(STOP_GRACE);
+    }
     stop_run(ports, &slots, reason, &run, &record);
     let ended = Ended {
         end: result?,
@@ -229,6 +240,21 @@ fn start_recorder(
             ..RecordingSummary::default()
         }
     }))
+}
+
+/// Starts `hnav-ros2` when asked; one that cannot start is a warning, the run goes on.
+fn start_ros2(opts: &RunOptions, dir: &Path, domain: Option<&str>) -> Option<ros2::Ros2Process> {
+    let r = opts.ros2.as_ref()?;
+    match ros2::Ros2Process::start(r, &opts.args, &opts.bin_dir, dir, domain) {
+        Ok(p) => {
+            tracing::info!("hnav-ros2 started, its log {}", p.log().display());
+            Some(p)
+        }
+        Err(e) => {
+            tracing::warn!("hnav-ros2 did not start: {e}; the run goes on without ROS 2");
+            None
+        }
+    }
 }
 
 /// The commit bell, kept open for the whole run: restarted processes inherit it too.
