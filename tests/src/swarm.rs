@@ -337,4 +337,3 @@ pub fn lifecycle_records(
         })
         .collect()
 }
-

@@ -12,6 +12,7 @@
 //! | `goal/<i>` | a flat green square on the goal cell | the run's goals |
 //! | `route/<i>` | a line: the robot, the cell last committed to it, the waypoint of its last replan, its goal | the decisions |
 //! | `conflict/<i>` | a flat red square on the cell refused or held, with the conflict's kind | a block or a hold for a conflict in its last decision |
+//! | `mover/<k>` | a tall red-brown box with `mover k` above it | a mover on the floor (`[[events]]` movers: the sim's `movers` topic, the recording's mover samples) |
 //!
 //! The route is what the swarm decided for the robot, then a straight line to its goal: an
 //! agent's own path (its neural map's gradient) is on no topic.
@@ -22,7 +23,7 @@ use super::messages::{cell, occupancy, pose, stamp, FRAME};
 use super::{schemas, Message, LOG, MAP, SCENE};
 use hnav_runtime::grid::Grid;
 use hnav_runtime::msg::{
-    Commit, ConflictKind, LifecycleEvent, Pose, Role, Truth, Verdict, NO_CELL,
+    Commit, ConflictKind, LifecycleEvent, MoverPlace, Pose, Role, Truth, Verdict, NO_CELL,
 };
 
 /// `foxglove.Log` levels.
@@ -62,13 +63,25 @@ struct Robot {
 pub struct SceneFold {
     picture: Picture,
     robots: Vec<Robot>,
+    /// The movers on the floor, as last told.
+    movers: Vec<MoverPlace>,
 }
 
 impl SceneFold {
     /// A fold of a run of `picture`, before any message.
     pub fn new(picture: Picture) -> Self {
         let robots = vec![Robot::default(); picture.goals.len()];
-        SceneFold { picture, robots }
+        SceneFold {
+            picture,
+            robots,
+            movers: Vec::new(),
+        }
+    }
+
+    /// The movers on the floor now: the next scene draws these.
+    pub fn movers(&mut self, places: &[MoverPlace]) {
+        self.movers.clear();
+        self.movers.extend_from_slice(places);
     }
 
     /// The run's static picture.
@@ -208,6 +221,9 @@ impl SceneFold {
                 entities.push(self.conflict(t_ns, i, kind, c));
             }
         }
+        for m in &self.movers {
+            entities.push(self.mover(t_ns, m));
+        }
         Message {
             topic: SCENE.into(),
             schema: schemas::SCENE_UPDATE,
@@ -288,6 +304,17 @@ impl SceneFold {
             t_ns,
             format!("route/{i}"),
             json!({"lines": [line], "metadata": [kv("robot", i)]}),
+        )
+    }
+
+    fn mover(&self, t_ns: u64, m: &MoverPlace) -> Value {
+        let (cell, p) = (self.picture.cell_m, &m.pose);
+        let cube = json!({"pose": pose(p.x_m, p.y_m, 0.4 * cell, p.theta_rad), "size": {"x": 0.5 * cell, "y": 0.5 * cell, "z": 0.8 * cell}, "color": rgba(0.47, 0.16, 0.08, 1.0)});
+        let text = json!({"pose": pose(p.x_m, p.y_m, 1.0 * cell, 0.0), "billboard": true, "font_size": 12.0, "scale_invariant": true, "color": rgba(1.0, 0.8, 0.7, 1.0), "text": format!("mover {}", m.mover)});
+        self.entity(
+            t_ns,
+            format!("mover/{}", m.mover),
+            json!({"cubes": [cube], "texts": [text], "metadata": [kv("mover", m.mover)]}),
         )
     }
 

@@ -13,6 +13,8 @@
 //! |---|---|---|---|
 //! | `/map` | `foxglove.Grid` | the scenario (`invocation.json`) | the run (field `occupied`, 1 = wall), and again at each close or open of its `[[events]]` |
 //! | `/map/shared` | `foxglove.Grid` | the scenario and `log/` (with `[sensing]`) | the coordinator's map at the start and after each map-change record |
+//! | `/map/sensed` | `foxglove.Grid` | the scenario and the trajectories (with `[sensing]`) | the floor the robots' sensors see (`occupied` 1), once a second of sim time |
+//! | `/movers/<k>` | `foxglove.PoseInFrame` | the trajectories (a run with movers) | mover `k`'s place at each sampling time |
 //! | `/scene` | `foxglove.SceneUpdate` | `recording/trajectories.bin` and `log/` | ground-truth sampling time: robots, goals, routes, conflicts |
 //! | `/robots/<i>/truth` | `foxglove.PoseInFrame` | `recording/trajectories.bin` | ground-truth sample of robot `i` |
 //! | `/robots/<i>/stats` | `hnav.RobotStats` | `recording/trajectories.bin` | ground-truth sampling time: robot `i`'s speed |
@@ -225,6 +227,12 @@ fn write_all(
             ));
         }
         scene::write(w, &trajectories, records, info, cell_size)?;
+        if let Some((s, range)) = (info.scenario.as_ref()).and_then(|s| Some((s, s.sensing?.range)))
+        {
+            for (t, msg) in world::sensed(s, range, &trajectories, cell_size)? {
+                w.message("/map/sensed", schemas::GRID, t, &msg)?;
+            }
+        }
     } else {
         notes.push(format!(
             "{} missing: no /scene, /robots/<i>/truth, /robots/<i>/stats, /robots/<i>/estimate and /log channels",

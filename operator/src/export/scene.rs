@@ -10,10 +10,11 @@ use std::path::Path;
 use super::{ExportError, Mcap, RunInfo};
 use crate::channels::scene::{Picture, SceneFold};
 use crate::channels::{self, Message};
+use crate::recording::world::RecordedWorld;
 use crate::recording::{PoseSource, TrajectoryReader};
 use hnav_runtime::consensus_log::Record;
 use hnav_runtime::grid::Grid;
-use hnav_runtime::msg::{Commit, Pose, Truth, MAX_AGENTS};
+use hnav_runtime::msg::{Commit, Truth, MAX_AGENTS};
 
 /// Writes the channels [`channels::shown`] lists that come from the fold, from the
 /// trajectories at `path` and `records`.
@@ -48,7 +49,14 @@ pub(super) fn write(
     let mut truth = Box::<Truth>::default();
     truth.robots = u32::from(r.header().robots).min(MAX_AGENTS as u32);
     let mut at: Option<u64> = None;
+    // The recorder writes a time's movers after its truth: they are in before it is folded.
+    let mut world = RecordedWorld::new(folding.fold.picture().grid.clone(), Vec::new(), cell_m);
     while let Some(s) = r.next_sample()? {
+        if s.source == PoseSource::Mover {
+            world.place_mover(u32::from(s.robot), s.pose());
+            folding.fold.movers(world.movers());
+            continue;
+        }
         if s.source != PoseSource::Truth {
             continue;
         }
@@ -58,11 +66,7 @@ pub(super) fn write(
         at = Some(s.t_ns);
         truth.sim_time_ns = s.t_ns;
         if let Some(p) = truth.poses.get_mut(usize::from(s.robot)) {
-            *p = Pose {
-                x_m: f64::from(s.x_m),
-                y_m: f64::from(s.y_m),
-                theta_rad: f64::from(s.theta_rad),
-            };
+            *p = s.pose();
         }
     }
     if at.is_some() {

@@ -161,7 +161,7 @@ impl PlaybackFeed {
                 // The recorder writes a time's movers after its truth, so they are read
                 // here, ahead of the next time's truth, and shown with their own time's.
                 Some(s) if s.source == PoseSource::Mover => {
-                    self.world.place_mover(u32::from(s.robot), pose_of(&s));
+                    self.world.place_mover(u32::from(s.robot), s.pose());
                 }
                 Some(_) => {}
                 None => return Ok(None),
@@ -194,7 +194,7 @@ impl PlaybackFeed {
     fn emit_truth(&mut self, t: u64, apply: &mut dyn FnMut(Update<'_>)) -> Result<(), FeedError> {
         while let Some(s) = self.pending.filter(|s| s.t_ns == t) {
             if let Some(p) = self.truth.poses.get_mut(usize::from(s.robot)) {
-                *p = pose_of(&s);
+                *p = s.pose();
             }
             self.pending = None;
             self.next_truth_time()?;
@@ -394,15 +394,6 @@ fn run_info(
         changes,
         sensor_range: scenario.and_then(|s| s.sensing.map(|s| s.range)),
     })
-}
-
-/// A sample's pose.
-fn pose_of(s: &PoseSample) -> Pose {
-    Pose {
-        x_m: f64::from(s.x_m),
-        y_m: f64::from(s.y_m),
-        theta_rad: f64::from(s.theta_rad),
-    }
 }
 
 /// The centre of row-major cell `c`, where a robot stands before its first sample.

@@ -169,6 +169,15 @@ pub struct PoseSample {
 }
 
 impl PoseSample {
+    /// The sample's pose, in the messages' type.
+    pub fn pose(&self) -> hnav_runtime::msg::Pose {
+        hnav_runtime::msg::Pose {
+            x_m: f64::from(self.x_m),
+            y_m: f64::from(self.y_m),
+            theta_rad: f64::from(self.theta_rad),
+        }
+    }
+
     fn encode(&self) -> [u8; SAMPLE_LEN] {
         let mut b = [0u8; SAMPLE_LEN];
         b[..8].copy_from_slice(&self.t_ns.to_le_bytes());

@@ -259,6 +259,7 @@ pub fn show(
             }
             Update::Commit(c) => out.extend(fold.commit(now_ns, c)),
             Update::Lifecycle(l) => out.extend(fold.lifecycle(now_ns, l.role, l.index, l.event)),
+            Update::Movers(m) => fold.movers(m),
             Update::Ended(why) => ended = Some(why),
             _ => {}
         })?;

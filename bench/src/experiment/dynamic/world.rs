@@ -5,7 +5,7 @@
 //! below), never a robot's start or goal and never on a walker's row, so closing it cuts an
 //! aisle without trapping anybody for good. Door `i` closes at `DOOR_FIRST_S + i *
 //! DOOR_EVERY_S` and opens again `DOOR_SHUT_S` later. A walker goes back and forth along the
-//! longest free stretch of a random row that no robot starts on, from `WALKERS_AT_S`.
+//! longest free stretch of a random row without a robot's start or goal, from `WALKERS_AT_S`.
 
 use std::fmt::Write as _;
 
@@ -67,7 +67,11 @@ pub fn draw(grid: &Grid, shape: Shape, rng: &mut ChaCha8Rng) -> Result<World> {
         if walker_rows.len() == shape.walkers {
             break;
         }
-        let stretch = longest_free_stretch(grid, y, &|c| robots.iter().any(|(s, _)| *s == c));
+        // Neither a start nor a goal on a walker's way: a robot parked at its goal there
+        // would hold a yielding walker for good (the first full run: walker 0 waited 900 s
+        // at its end for robot 38 at its goal next to it, and robot 6 for the walker).
+        let on_way = |c: Cell| robots.iter().any(|(s, g)| *s == c || *g == c);
+        let stretch = longest_free_stretch(grid, y, &on_way);
         if let Some((x0, x1)) = stretch.filter(|(a, b)| b - a + 1 >= WALKER_MIN_CELLS) {
             let name = format!("walker-{}", walker_rows.len());
             let text = format!(

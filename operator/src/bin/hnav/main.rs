@@ -69,7 +69,7 @@ enum Command {
         command: MapCommand,
     },
     /// Run a scenario end to end: sim, coordinator and one agent process per robot.
-    Run(run_cmd::RunArgs),
+    Run(Box<run_cmd::RunArgs>),
     /// List the live runs on this machine and their processes.
     Ps(ps_cmd::PsArgs),
     /// Send a signal to one process of a live run (agent:N, coordinator, coordinator:ID or sim).
@@ -148,7 +148,7 @@ fn main() -> ExitCode {
         Command::Map {
             command: MapCommand::Scen { map, agents, seed },
         } => map_scen(map, agents, seed),
-        Command::Run(args) => run_cmd::run_command(args, matches.subcommand_matches("run")),
+        Command::Run(args) => run_cmd::run_command(*args, matches.subcommand_matches("run")),
         Command::Kill(args) => kill_cmd::run(args),
         Command::Ps(args) => ps_cmd::run(args),
         Command::Clean(args) => clean_cmd::run(args),

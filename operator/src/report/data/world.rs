@@ -12,7 +12,7 @@
 use std::path::Path;
 
 use hnav_runtime::grid::Grid;
-use hnav_runtime::msg::{Pose, View};
+use hnav_runtime::msg::View;
 
 use super::RunData;
 use crate::invocation::Invocation;
@@ -56,11 +56,7 @@ impl RunData {
         let mut last: Vec<Option<(u32, u32, u64)>> = vec![None; self.starts.len()];
         let (mut epoch, mut view) = (0u64, View::default());
         while let Some(s) = r.next_sample()? {
-            let pose = Pose {
-                x_m: f64::from(s.x_m),
-                y_m: f64::from(s.y_m),
-                theta_rad: f64::from(s.theta_rad),
-            };
+            let pose = s.pose();
             match s.source {
                 PoseSource::Mover => {
                     if let Some(track) = self.movers.get_mut(usize::from(s.robot)) {
