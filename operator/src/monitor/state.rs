@@ -29,6 +29,7 @@ use std::time::{Duration, Instant};
 
 use super::feed::{RunEnd, RunInfo, Update};
 use super::health::HealthRow;
+use crate::recording::world::apply_due;
 use hnav_runtime::msg::{
     Commit, ConflictKind, Decision, Lifecycle, LifecycleEvent, MoverPlace, Pose, Progress, Role,
     RosterState, Truth, Verdict, View,
@@ -377,17 +378,13 @@ impl ViewState {
         self.truth_period = Some(t.period);
         self.collisions = t.collisions;
         // The world's changes the sim has made by now: closed cells are walls on screen.
-        while let Some(step) = self.info.changes.get(self.changed) {
-            if step.at_ns > t.sim_time_ns {
-                break;
-            }
-            for &c in &step.cells {
-                if let Some(cell) = self.info.grid.cell_at(c as usize) {
-                    self.info.grid.set_blocked(cell, step.closed);
-                }
-            }
-            self.changed += 1;
-        }
+        let info = &mut self.info;
+        apply_due(
+            &mut info.grid,
+            &info.changes,
+            &mut self.changed,
+            t.sim_time_ns,
+        );
         for (agent, pose) in self.agents.iter_mut().zip(t.poses()) {
             let cell = self.info.cell_of(pose);
             agent.place(cell, *pose);

@@ -43,6 +43,22 @@ pub fn world_steps(scenario: &Scenario, grid: &Grid) -> Vec<WorldStep> {
         .collect()
 }
 
+/// Applies to `grid` the steps of `steps` from index `*applied` on that are due by `t_ns`,
+/// moving `*applied` past them; whether any was. The one way a reader (the view's state, the
+/// live Foxglove view, [`RecordedWorld`]) follows the scenario's closes and opens.
+pub fn apply_due(grid: &mut Grid, steps: &[WorldStep], applied: &mut usize, t_ns: u64) -> bool {
+    let before = *applied;
+    while let Some(step) = steps.get(*applied).filter(|s| s.at_ns <= t_ns) {
+        for &c in &step.cells {
+            if let Some(cell) = grid.cell_at(c as usize) {
+                grid.set_blocked(cell, step.closed);
+            }
+        }
+        *applied += 1;
+    }
+    *applied != before
+}
+
 /// The world of a recorded run, moved forward in time by its reader.
 #[derive(Debug, Clone)]
 pub struct RecordedWorld {
@@ -70,16 +86,7 @@ impl RecordedWorld {
 
     /// Applies the closes and opens due by `t_ns`; whether any was.
     pub fn advance(&mut self, t_ns: u64) -> bool {
-        let before = self.applied;
-        while let Some(step) = self.steps.get(self.applied).filter(|s| s.at_ns <= t_ns) {
-            for &c in &step.cells {
-                if let Some(cell) = self.grid.cell_at(c as usize) {
-                    self.grid.set_blocked(cell, step.closed);
-                }
-            }
-            self.applied += 1;
-        }
-        self.applied != before
+        apply_due(&mut self.grid, &self.steps, &mut self.applied, t_ns)
     }
 
     /// Mover `k` (in the order they appeared) is at `pose` now: it is on the floor.

@@ -48,6 +48,7 @@ use iceoryx2_bb_posix::signal::SignalHandler;
 use crate::channels::scene::{Picture, SceneFold};
 use crate::channels::{self, Message};
 use crate::monitor::feed::{Feed, FeedError, RunEnd, Update, Waited};
+use crate::recording::world::apply_due;
 use hnav_runtime::msg::Truth;
 
 /// Where the view listens without an address given.
@@ -232,7 +233,7 @@ pub fn show(
     let robots = info.goals.len();
     server.advertise(&channels::shown(robots));
     let mut world = info.grid.clone();
-    let mut changes = info.changes.iter().peekable();
+    let mut applied = 0;
     let mut latest = Box::<Truth>::default();
     let mut now_ns = 0;
     let mut ended = None;
@@ -263,15 +264,8 @@ pub fn show(
             Update::Ended(why) => ended = Some(why),
             _ => {}
         })?;
-        let mut map_due = server.take_subscribed();
-        while let Some(step) = changes.next_if(|s| s.at_ns <= now_ns) {
-            for &c in &step.cells {
-                if let Some(cell) = world.cell_at(c as usize) {
-                    world.set_blocked(cell, step.closed);
-                }
-            }
-            map_due = true;
-        }
+        let changed = apply_due(&mut world, &info.changes, &mut applied, now_ns);
+        let map_due = server.take_subscribed() | changed;
         if map_due {
             server.publish(&fold.map(&world, now_ns));
             if !fresh {
