@@ -5,7 +5,7 @@
 //!   name>/<type hash>`, e.g. `0/robot_0/odom/nav_msgs::msg::dds_::Odometry_/RIHS01_…`;
 //! - a liveliness token per entity under the hermetic chunk `@ros2_lv`:
 //!   `@ros2_lv/<domain>/<zid>/<nid>/<eid>/<kind>/<enclave>/<namespace>/<node>` for a node
-//!   (`eid` = `nid`, kind `NN`), and for a publisher (`MP`) also
+//!   (`eid` = `nid`, kind `NN`), and for a publisher (`MP`) or a subscription (`MS`) also
 //!   `/<topic>/<DDS type name>/<type hash>/<qos>`; every name "mangled" (each `/` as `%`), so
 //!   the default enclave and namespace `/` are `%`;
 //! - the QoS in the token, each field empty where it equals rmw_zenoh's default (reliable,
@@ -102,8 +102,17 @@ impl NodeName {
 
     /// The liveliness token of its publisher `eid` of `topic` (a fully qualified name).
     pub fn publisher_token(&self, eid: u32, topic: &str, ty: &TypeInfo, qos: Qos) -> String {
+        self.entity_token("MP", eid, topic, ty, qos)
+    }
+
+    /// The liveliness token of its subscription `eid` of `topic` (a fully qualified name).
+    pub fn subscription_token(&self, eid: u32, topic: &str, ty: &TypeInfo, qos: Qos) -> String {
+        self.entity_token("MS", eid, topic, ty, qos)
+    }
+
+    fn entity_token(&self, kind: &str, eid: u32, topic: &str, ty: &TypeInfo, qos: Qos) -> String {
         format!(
-            "{ADMIN_SPACE}/{}/{}/{}/{eid}/MP/%/{}/{}/{}/{}/{}/{}",
+            "{ADMIN_SPACE}/{}/{}/{}/{eid}/{kind}/%/{}/{}/{}/{}/{}/{}",
             self.domain,
             self.zid,
             self.nid,
@@ -171,6 +180,10 @@ mod tests {
         assert_eq!(
             node().publisher_token(10, "/chatter", &string, pubq),
             "@ros2_lv/2/8b20917502ee955ac4476e0266340d5c/0/10/MP/%/%/talker/%chatter/std_msgs::msg::dds_::String_/RIHS01_df668c740482bbd48fb39d76a70dfd4bd59db1288021743503259e948f6b1a18/::,7:,:,:,,"
+        );
+        assert_eq!(
+            node().subscription_token(11, "/chatter", &string, pubq),
+            "@ros2_lv/2/8b20917502ee955ac4476e0266340d5c/0/11/MS/%/%/talker/%chatter/std_msgs::msg::dds_::String_/RIHS01_df668c740482bbd48fb39d76a70dfd4bd59db1288021743503259e948f6b1a18/::,7:,:,:,,"
         );
         let listener = NodeName {
             zid: "aac3178e146ba6f1fc6e6a4085e77f21".into(),

@@ -15,17 +15,19 @@
 //!
 //! | module | what it holds |
 //! |---|---|
+//! | [`outside`] | `--robots`: robots outside HNAV in the sim's place (wheel commands out as `cmd_vel`, `joint_states` or `odom` in as odometry, their ground truth as the run's) |
 //! | [`relay`] | the loop: the run's iceoryx2 topics in, ROS 2 messages out; the node's publishers |
 //! | [`scene`] | what is known of the run, and the ROS 2 messages made of it (frames, plans, markers, decisions) |
-//! | [`node`] | one ROS 2 node on Zenoh: liveliness tokens, publishers, attachments, transient local |
+//! | [`node`] | one ROS 2 node on Zenoh: liveliness tokens, publishers and subscriptions, attachments, transient local |
 //! | [`session`] | the Zenoh session: a peer of the router, or the router itself |
 //! | [`graph`] | rmw_zenoh's names: key expressions, liveliness tokens, QoS strings, GIDs, attachments |
 //! | [`types`] | the message types: ROS and DDS names, RIHS01 hashes (Jazzy) |
-//! | [`msgs`] | the messages as serde structs, and their CDR encoding |
+//! | [`msgs`] | the messages as serde structs, and their CDR encoding and decoding |
 
 pub mod graph;
 pub mod msgs;
 pub mod node;
+pub mod outside;
 pub mod relay;
 pub mod scene;
 pub mod session;

@@ -1,15 +1,18 @@
 //! `hnav-ros2 --run ID --scenario FILE [--agents N] [--seed S] [--mode M] [--domain-id D]
-//! [--namespace NS] [--router ENDPOINT | --start-router] [--rate-hz HZ]`: publishes run ID as
-//! ROS 2 topics on rmw_zenoh's wire contract until the run stops (the supervisor's `Stop`,
-//! SIGTERM/SIGINT, or its parent gone); then prints what it sent. Started by
-//! `hnav run --ros2`; see `hnav_ros2`.
+//! [--namespace NS] [--router ENDPOINT | --start-router] [--rate-hz HZ] [--robots]`: publishes
+//! run ID as ROS 2 topics on rmw_zenoh's wire contract until the run stops (the supervisor's
+//! `Stop`, SIGTERM/SIGINT, or its parent gone); then prints what it sent. Started by
+//! `hnav run --ros2`; with `--robots` (a scenario of `[sim] kind = "ros2"`), it is the run's
+//! sim instead, driving robots outside HNAV. See `hnav_ros2`.
 
 use std::process::ExitCode;
 
 use clap::Parser;
+use hnav_ros2::outside::{drive, OutsideOptions};
 use hnav_ros2::relay::{relay, RelayOptions, Topics};
 use hnav_ros2::session::{self, Role, DEFAULT_ROUTER, OWN_ROUTER_LISTEN};
 use hnav_runtime::launch::{process_main, ProcessArgs};
+use hnav_runtime::scenario::SimKind;
 
 #[derive(Parser)]
 #[command(about = "HNAV's run as ROS 2 topics over rmw_zenoh's wire contract")]
@@ -35,6 +38,10 @@ struct Args {
     /// wall clock.
     #[arg(long, value_name = "HZ", default_value_t = 20.0)]
     rate_hz: f64,
+    /// Stand in for the sim: drive the scenario's robots outside HNAV through ROS 2
+    /// (`[sim] kind = "ros2"`; the supervisor starts it so in the sim's slot).
+    #[arg(long)]
+    robots: bool,
 }
 
 fn main() -> ExitCode {
@@ -61,8 +68,19 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             .unwrap_or_else(|| DEFAULT_ROUTER.to_string());
         Role::Peer(router)
     };
+    if args.robots && scenario.sim.kind != SimKind::Ros2 {
+        return Err(format!(
+            "--robots: the scenario's [sim] kind is {:?}, not \"ros2\"",
+            scenario.sim.kind.name()
+        )
+        .into());
+    }
+    let outside = args
+        .robots
+        .then(|| scenario.ros2.clone().unwrap_or_default());
     let session = session::open(&role)?;
-    let mut topics = Topics::declare(session, scenario.agents.len(), &opts)?;
+    let source = outside.as_ref().map(|o| o.odometry);
+    let mut topics = Topics::declare(session, scenario.agents.len(), &opts, source)?;
     tracing::info!(?role, node = topics.node.token(), "ros2 node up");
     for p in topics.publishers() {
         tracing::debug!(
@@ -71,6 +89,17 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             token = p.token(),
             "publisher"
         );
+    }
+    if let Some(ros2) = outside {
+        let o = OutsideOptions {
+            relay: opts,
+            ros2,
+            resume: args.common.resume,
+            dir: args.common.dir.clone(),
+        };
+        let counts = drive(&run, &scenario, &mut topics, &o)?;
+        hnav_runtime::outln!("{counts}");
+        return Ok(());
     }
     let counts = relay(&run, &scenario, &mut topics, &opts)?;
     hnav_runtime::outln!("{counts}");

@@ -6,11 +6,16 @@
 //! header; strings are a `u32` length (with the NUL) and the NUL-terminated bytes; a sequence
 //! (`T[]`) is a `u32` count and the elements; a fixed array (`float64[36]`) its elements only.
 //! The covariances are the one array longer than serde's 32, hence [`Cov`].
+//!
+//! What robots outside HNAV send (`[sim] kind = "ros2"`: [`JointState`], and [`Odometry`]
+//! as `odom` or `ground_truth`) is decoded the same way ([`decode`]); a sample that does not
+//! decode is an error, never a panic.
 
+use serde::de::{Deserialize, Deserializer, SeqAccess, Visitor};
 use serde::ser::{Serialize, SerializeTuple, Serializer};
 
 /// `builtin_interfaces/msg/Time` (and `Duration`, the same two fields).
-#[derive(serde::Serialize, Debug, Clone, Copy, Default, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, Default, PartialEq)]
 pub struct Time {
     /// Seconds.
     pub sec: i32,
@@ -29,16 +34,17 @@ impl Time {
 }
 
 /// `std_msgs/msg/Header`.
-#[derive(serde::Serialize, Debug, Clone, Default, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Default, PartialEq)]
 pub struct Header {
     /// When.
     pub stamp: Time,
     /// The frame the data is in.
+    #[serde(deserialize_with = "string")]
     pub frame_id: String,
 }
 
 /// `geometry_msgs/msg/Point` and `Vector3` (the same three `float64`).
-#[derive(serde::Serialize, Debug, Clone, Copy, Default, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, Default, PartialEq)]
 pub struct Vec3 {
     /// x.
     pub x: f64,
@@ -49,7 +55,7 @@ pub struct Vec3 {
 }
 
 /// `geometry_msgs/msg/Quaternion`.
-#[derive(serde::Serialize, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
 pub struct Quaternion {
     /// x.
     pub x: f64,
@@ -68,6 +74,13 @@ impl Default for Quaternion {
 }
 
 impl Quaternion {
+    /// The rotation about +z (yaw) of this orientation, radians in [-pi, pi]; a planar
+    /// robot's heading.
+    pub fn yaw_angle(&self) -> f64 {
+        let (x, y, z, w) = (self.x, self.y, self.z, self.w);
+        (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z))
+    }
+
     /// A rotation by `theta` radians about +z.
     pub fn yaw(theta: f64) -> Quaternion {
         let (s, c) = (theta / 2.0).sin_cos();
@@ -81,7 +94,7 @@ impl Quaternion {
 }
 
 /// `geometry_msgs/msg/Pose`.
-#[derive(serde::Serialize, Debug, Clone, Copy, Default, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, Default, PartialEq)]
 pub struct Pose {
     /// Position (a `Point`).
     pub position: Vec3,
@@ -103,8 +116,29 @@ impl Serialize for Cov {
     }
 }
 
+impl<'de> Deserialize<'de> for Cov {
+    /// Reads the 36 values and keeps none: HNAV has no use for an outside covariance.
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Skip36;
+        impl<'de> Visitor<'de> for Skip36 {
+            type Value = Cov;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("36 float64")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Cov, A::Error> {
+                for i in 0..36 {
+                    seq.next_element::<f64>()?
+                        .ok_or_else(|| serde::de::Error::invalid_length(i, &self))?;
+                }
+                Ok(Cov)
+            }
+        }
+        d.deserialize_tuple(36, Skip36)
+    }
+}
+
 /// `geometry_msgs/msg/PoseWithCovariance`.
-#[derive(serde::Serialize, Debug, Clone, Copy, Default, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, Default, PartialEq)]
 pub struct PoseWithCovariance {
     /// The pose.
     pub pose: Pose,
@@ -113,7 +147,7 @@ pub struct PoseWithCovariance {
 }
 
 /// `geometry_msgs/msg/Twist`.
-#[derive(serde::Serialize, Debug, Clone, Copy, Default, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, Default, PartialEq)]
 pub struct Twist {
     /// m/s (a `Vector3`).
     pub linear: Vec3,
@@ -122,7 +156,7 @@ pub struct Twist {
 }
 
 /// `geometry_msgs/msg/TwistWithCovariance`.
-#[derive(serde::Serialize, Debug, Clone, Copy, Default, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, Default, PartialEq)]
 pub struct TwistWithCovariance {
     /// The twist.
     pub twist: Twist,
@@ -131,11 +165,12 @@ pub struct TwistWithCovariance {
 }
 
 /// `nav_msgs/msg/Odometry`.
-#[derive(serde::Serialize, Debug, Clone, Default, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Default, PartialEq)]
 pub struct Odometry {
     /// Stamp and the pose's frame.
     pub header: Header,
     /// The body frame.
+    #[serde(deserialize_with = "string")]
     pub child_frame_id: String,
     /// Pose in `header.frame_id`.
     pub pose: PoseWithCovariance,
@@ -319,6 +354,22 @@ pub struct MarkerArray {
     pub markers: Vec<Marker>,
 }
 
+/// `sensor_msgs/msg/JointState`: what a robot outside HNAV says of its wheels.
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Default, PartialEq)]
+pub struct JointState {
+    /// Stamp and frame (unused).
+    pub header: Header,
+    /// The joints' names.
+    #[serde(deserialize_with = "strings")]
+    pub name: Vec<String>,
+    /// Positions, rad for a wheel (as many as `name`, or none).
+    pub position: Vec<f64>,
+    /// Velocities, rad/s (as many as `name`, or none).
+    pub velocity: Vec<f64>,
+    /// Efforts (as many as `name`, or none).
+    pub effort: Vec<f64>,
+}
+
 /// `std_msgs/msg/String`.
 #[derive(serde::Serialize, Debug, Clone, Default, PartialEq)]
 pub struct Text {
@@ -331,6 +382,61 @@ pub struct Text {
 pub fn encode<T: Serialize>(msg: &T, out: &mut Vec<u8>) -> Result<(), cdr::Error> {
     out.clear();
     cdr::serialize_into::<_, _, _, cdr::CdrLe>(&mut *out, msg, cdr::Infinite)
+}
+
+/// A CDR string read as what it is on the wire, a `u32` count and that many bytes (the last
+/// a NUL), one byte at a time: the `cdr` crate's own string reader allocates the count it
+/// reads before it checks the payload holds it, so a malformed sample could ask for 4 GiB.
+/// Here a count beyond the payload ends in an error once the payload runs out.
+fn string<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+    struct Bytes;
+    impl<'de> Visitor<'de> for Bytes {
+        type Value = String;
+        fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.write_str("a NUL-terminated UTF-8 string")
+        }
+        fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<String, A::Error> {
+            let mut v = Vec::new();
+            while let Some(b) = seq.next_element::<u8>()? {
+                v.push(b);
+            }
+            if v.pop() != Some(0) {
+                return Err(serde::de::Error::custom("a string without its NUL"));
+            }
+            String::from_utf8(v).map_err(serde::de::Error::custom)
+        }
+    }
+    d.deserialize_seq(Bytes)
+}
+
+/// A `string[]` whose strings are read as [`string`] reads one.
+fn strings<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<String>, D::Error> {
+    struct One(String);
+    impl<'de> Deserialize<'de> for One {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            string(d).map(One)
+        }
+    }
+    struct Many;
+    impl<'de> Visitor<'de> for Many {
+        type Value = Vec<String>;
+        fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.write_str("a sequence of strings")
+        }
+        fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Vec<String>, A::Error> {
+            let mut v = Vec::new();
+            while let Some(One(s)) = seq.next_element()? {
+                v.push(s);
+            }
+            Ok(v)
+        }
+    }
+    d.deserialize_seq(Many)
+}
+
+/// Decodes a CDR payload (either byte order, as its encapsulation header says) into `T`.
+pub fn decode<T: serde::de::DeserializeOwned>(payload: &[u8]) -> Result<T, cdr::Error> {
+    cdr::deserialize::<T>(payload)
 }
 
 #[cfg(test)]
@@ -364,6 +470,40 @@ mod tests {
         assert_eq!(&out[4 + 16..4 + 21], &[1, 0, 0, 0, 0]);
         assert_eq!(&out[4 + 21..4 + 24], &[0, 0, 0]);
         assert_eq!(out.len(), 4 + 24 + (7 + 36) * 8 + (6 + 36) * 8);
+    }
+
+    #[test]
+    fn what_is_encoded_decodes_and_garbage_is_an_error() {
+        let mut out = Vec::new();
+        let js = JointState {
+            name: vec!["left_wheel_joint".into(), "right_wheel_joint".into()],
+            position: vec![1.5, -2.25],
+            ..JointState::default()
+        };
+        encode(&js, &mut out).unwrap();
+        assert_eq!(decode::<JointState>(&out).unwrap(), js);
+        let odom = Odometry {
+            child_frame_id: "base_link".into(),
+            ..Odometry::default()
+        };
+        encode(&odom, &mut out).unwrap();
+        assert_eq!(decode::<Odometry>(&out).unwrap(), odom);
+        // Cut short, a wrong header, a sequence longer than the payload.
+        assert!(decode::<Odometry>(&out[..out.len() - 3]).is_err());
+        assert!(decode::<JointState>(&[0xde, 0xad, 0xbe, 0xef, 1, 2, 3]).is_err());
+        let mut long = vec![0, 1, 0, 0];
+        long.extend_from_slice(&[0; 8]);
+        long.extend_from_slice(&[1, 0, 0, 0]);
+        long.extend_from_slice(&0xffff_fff0u32.to_le_bytes());
+        assert!(decode::<JointState>(&long).is_err());
+        // A frame id that claims 4 GiB: an error once the payload runs out, not an
+        // allocation of the claim.
+        let mut huge = vec![0, 1, 0, 0];
+        huge.extend_from_slice(&[0; 8]);
+        huge.extend_from_slice(&0xffff_fff0u32.to_le_bytes());
+        huge.extend_from_slice(b"map\0");
+        assert!(decode::<Odometry>(&huge).is_err());
+        assert!(decode::<JointState>(&huge).is_err());
     }
 
     #[test]

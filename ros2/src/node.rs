@@ -1,6 +1,6 @@
 //! One ROS 2 node on Zenoh, declared as `rmw_zenoh_cpp` declares one: a liveliness token for
-//! the node, and per publisher a Zenoh advanced publisher on the topic's key expression and a
-//! liveliness token. Each sample carries rmw_zenoh's attachment (sequence number from 1,
+//! the node, per publisher a Zenoh advanced publisher on the topic's key expression and a
+//! liveliness token, per subscription a Zenoh subscriber on it and a token. Each sample carries rmw_zenoh's attachment (sequence number from 1,
 //! source time, the publisher's GID). A transient-local publisher keeps a cache of its last
 //! `depth` samples that late subscribers query (rmw_zenoh's `AdvancedPublisher` options:
 //! cache, publisher detection, sporadic heartbeat every 500 ms), which is how a
@@ -10,8 +10,11 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use serde::Serialize;
 use zenoh::bytes::ZBytes;
+use zenoh::handlers::{RingChannel, RingChannelHandler};
 use zenoh::liveliness::LivelinessToken;
+use zenoh::pubsub::Subscriber;
 use zenoh::qos::{CongestionControl, Reliability};
+use zenoh::sample::{Locality, Sample};
 use zenoh::{Session, Wait};
 use zenoh_ext::{AdvancedPublisher, AdvancedPublisherBuilderExt, CacheConfig, MissDetectionConfig};
 
@@ -133,6 +136,69 @@ impl Node {
             publisher,
             _token: live,
         })
+    }
+
+    /// Declares a subscription of `ty` on `topic` (a fully qualified name) with `qos`.
+    pub fn subscription(
+        &mut self,
+        topic: &str,
+        ty: &TypeInfo,
+        qos: Qos,
+    ) -> Result<Subscription, NodeError> {
+        let eid = self.next_eid;
+        self.next_eid += 1;
+        let key = self.name.topic_key(topic, ty);
+        let token = self.name.subscription_token(eid, topic, ty, qos);
+        // Only other sessions' samples: the node may publish on the same topic name (its
+        // `odom`), and must not read its own.
+        let subscriber = (self.session.declare_subscriber(key.clone()))
+            .allowed_origin(Locality::Remote)
+            .with(RingChannel::new(SUBSCRIPTION_RING))
+            .wait()
+            .map_err(zenoh_err(format!(
+                "declare the subscription of {topic} on {key}"
+            )))?;
+        let live = (self.session.liveliness().declare_token(&token).wait()).map_err(zenoh_err(
+            format!("declare the subscription's token {token}"),
+        ))?;
+        Ok(Subscription {
+            topic: topic.to_string(),
+            key,
+            subscriber,
+            _token: live,
+        })
+    }
+}
+
+/// The samples a subscription holds before the oldest is dropped: the loop takes them every
+/// control period, so a robot's 10 ms of messages fit many times over.
+const SUBSCRIPTION_RING: usize = 64;
+
+/// One topic's subscription: Zenoh puts its samples into a ring (the oldest dropped when
+/// full, so a flood from outside never blocks Zenoh's threads), and the loop takes them.
+pub struct Subscription {
+    topic: String,
+    key: String,
+    subscriber: Subscriber<RingChannelHandler<Sample>>,
+    _token: LivelinessToken,
+}
+
+impl Subscription {
+    /// The topic's fully qualified name.
+    pub fn topic(&self) -> &str {
+        &self.topic
+    }
+
+    /// The data key expression.
+    pub fn key(&self) -> &str {
+        &self.key
+    }
+
+    /// Hands every payload received since the last call to `f`, oldest first.
+    pub fn drain(&self, mut f: impl FnMut(&[u8])) {
+        while let Ok(Some(sample)) = self.subscriber.handler().try_recv() {
+            f(&sample.payload().to_bytes());
+        }
     }
 }
 

@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use hnav_runtime::msg::{
     Commit, Estimate, Lifecycle, LifecycleEvent, MapHeader, Truth, WheelCommand,
 };
-use hnav_runtime::scenario::Scenario;
+use hnav_runtime::scenario::{OdometrySource, Scenario};
 use hnav_runtime::topics;
 use hnav_runtime::transport::{Receiver, RunId, SliceReceiver, Transport, TransportError, Wake};
 use zenoh::Session;
@@ -63,20 +63,25 @@ impl std::fmt::Display for Counts {
 }
 
 /// One robot's publishers.
-struct RobotTopics {
+pub(crate) struct RobotTopics {
     /// `robot_<i>/odom`, made once.
     odom_frame: String,
-    odom: Publisher,
-    ground_truth: Publisher,
+    /// `None` when the robot outside HNAV publishes its own `odom` (and HNAV reads it).
+    odom: Option<Publisher>,
+    /// `None` when the robot is outside HNAV: its ground truth is the outside world's.
+    ground_truth: Option<Publisher>,
     plan: Publisher,
-    cmd_vel: Publisher,
+    pub(crate) cmd_vel: Publisher,
 }
 
 /// The node and its publishers.
 pub struct Topics {
     /// The node.
     pub node: Node,
-    robots: Vec<RobotTopics>,
+    pub(crate) robots: Vec<RobotTopics>,
+    /// Robots outside HNAV: `cmd_vel` is theirs to obey, sent only by `outside` (as commands
+    /// come, and the stops), never repeated with the state.
+    outside: bool,
     map: Publisher,
     tf: Publisher,
     markers: Publisher,
@@ -84,11 +89,14 @@ pub struct Topics {
 }
 
 impl Topics {
-    /// Declares node `hnav` and its publishers for `agents` robots.
+    /// Declares node `hnav` and its publishers for `agents` robots. Robots `outside` HNAV
+    /// (`Some`: where their motion comes from) get no `ground_truth` publisher, theirs
+    /// being the outside world's, nor an `odom` one when they publish their own.
     pub fn declare(
         session: Session,
         agents: usize,
         opts: &RelayOptions,
+        outside: Option<OdometrySource>,
     ) -> Result<Topics, NodeError> {
         let mut node = Node::declare(session, opts.domain, "/", "hnav")?;
         let ns = opts.namespace.trim_end_matches('/');
@@ -97,12 +105,13 @@ impl Topics {
             let name = |t: &str| format!("{ns}/robot_{i}/{t}");
             robots.push(RobotTopics {
                 odom_frame: format!("robot_{i}/odom"),
-                odom: node.publisher(&name("odom"), &types::ODOMETRY, Qos::DEFAULT)?,
-                ground_truth: node.publisher(
-                    &name("ground_truth"),
-                    &types::ODOMETRY,
-                    Qos::DEFAULT,
-                )?,
+                odom: (outside != Some(OdometrySource::Odom))
+                    .then(|| node.publisher(&name("odom"), &types::ODOMETRY, Qos::DEFAULT))
+                    .transpose()?,
+                ground_truth: outside
+                    .is_none()
+                    .then(|| node.publisher(&name("ground_truth"), &types::ODOMETRY, Qos::DEFAULT))
+                    .transpose()?,
                 plan: node.publisher(&name("plan"), &types::PATH, Qos::DEFAULT)?,
                 cmd_vel: node.publisher(&name("cmd_vel"), &types::TWIST, Qos::DEFAULT)?,
             });
@@ -117,6 +126,7 @@ impl Topics {
             markers: node.publisher("/hnav/markers", &types::MARKER_ARRAY, Qos::DEFAULT)?,
             decisions: node.publisher("/hnav/decisions", &types::STRING, Qos::DEFAULT)?,
             robots,
+            outside: outside.is_some(),
             node,
         })
     }
@@ -124,28 +134,39 @@ impl Topics {
     /// Every publisher.
     pub fn publishers(&self) -> impl Iterator<Item = &Publisher> {
         (self.robots.iter())
-            .flat_map(|r| [&r.odom, &r.ground_truth, &r.plan, &r.cmd_vel])
+            .flat_map(|r| {
+                [
+                    r.odom.as_ref(),
+                    r.ground_truth.as_ref(),
+                    Some(&r.plan),
+                    Some(&r.cmd_vel),
+                ]
+            })
+            .flatten()
             .chain([&self.map, &self.tf, &self.markers, &self.decisions])
     }
 }
 
 /// The run's topics this relay reads.
-struct Inputs {
-    truth: Receiver<Truth>,
+pub(crate) struct Inputs {
+    /// `None` when this process sends the ground truth itself (robots outside HNAV).
+    truth: Option<Receiver<Truth>>,
     estimate: Receiver<Estimate>,
     commit: Receiver<Commit>,
-    life: Receiver<Lifecycle>,
-    wheels: Vec<Receiver<WheelCommand>>,
+    pub(crate) wheels: Vec<Receiver<WheelCommand>>,
     maps: Vec<SliceReceiver<f32, MapHeader>>,
 }
 
 impl Inputs {
-    fn open(t: &Transport, n: usize) -> Result<Inputs, TransportError> {
+    /// Opens the topics of a run of `n` robots; the ground truth's only for an `observer`
+    /// (the relay beside the roster, not the sim's stand-in in it, which sends it).
+    pub(crate) fn open(t: &Transport, n: usize, observer: bool) -> Result<Inputs, TransportError> {
         Ok(Inputs {
-            truth: t.receiver(topics::TRUTH, topics::truth_qos())?,
+            truth: observer
+                .then(|| t.receiver(topics::TRUTH, topics::truth_qos()))
+                .transpose()?,
             estimate: t.receiver(topics::ESTIMATE, topics::estimate_qos(n))?,
             commit: t.receiver(topics::COMMIT, topics::commit_qos(n))?,
-            life: t.receiver(topics::LIFECYCLE, topics::lifecycle_qos(n))?,
             wheels: (0..n)
                 .map(|i| t.receiver(&topics::wheels(i), topics::state_qos()))
                 .collect::<Result<_, _>>()?,
@@ -158,7 +179,7 @@ impl Inputs {
 
 /// Reusable messages: each is filled in place, so a tick allocates only what Zenoh copies.
 #[derive(Default)]
-struct Scratch {
+pub(crate) struct Scratch {
     odom: Odometry,
     path: Path,
     grid: OccupancyGrid,
@@ -176,9 +197,11 @@ pub fn relay(
 ) -> Result<Counts, RelayError> {
     let n = scenario.agents.len();
     let transport = Transport::builder(run).node_name("ros2").create()?;
-    let inputs = Inputs::open(&transport, n)?;
+    let inputs = Inputs::open(&transport, n, true)?;
+    let life: Receiver<Lifecycle> =
+        transport.receiver(topics::LIFECYCLE, topics::lifecycle_qos(n))?;
     let waiter = transport.waiter()?;
-    let _life = waiter.attach(&inputs.life)?;
+    let _life = waiter.attach(&life)?;
     let period = Duration::from_secs_f64(1.0 / opts.rate_hz.clamp(0.1, 1000.0));
     let parent = std::os::unix::process::parent_id();
     let mut out = Out::default();
@@ -188,9 +211,7 @@ pub fn relay(
     loop {
         let wake = waiter.wait(Some(next))?;
         let mut stop = wake == Wake::Stop || std::os::unix::process::parent_id() != parent;
-        inputs
-            .life
-            .drain(|l| stop |= l.event == LifecycleEvent::Stop as u8)?;
+        life.drain(|l| stop |= l.event == LifecycleEvent::Stop as u8)?;
         read(&inputs, &mut scene, topics, &mut s, &mut out)?;
         if stop || Instant::now() >= next {
             publish_state(&mut scene, topics, &mut s, &mut out);
@@ -203,14 +224,16 @@ pub fn relay(
 }
 
 /// Takes in what the run's topics hold; each commit goes out on `/hnav/decisions` at once.
-fn read(
+pub(crate) fn read(
     inputs: &Inputs,
     scene: &mut Scene,
     topics: &mut Topics,
     s: &mut Scratch,
     out: &mut Out,
 ) -> Result<(), TransportError> {
-    inputs.truth.drain(|t| scene.truth(t))?;
+    if let Some(truth) = &inputs.truth {
+        truth.drain(|t| scene.truth(t))?;
+    }
     inputs.estimate.drain(|e| {
         if let Some(r) = scene.robots.get_mut(e.agent as usize) {
             r.estimate = Some((e.sim_time_ns, e.pose));
@@ -237,19 +260,27 @@ fn read(
 
 /// Sends the state: per robot its odometry, ground truth, plan and command, then `/tf`,
 /// the markers, and `/map` if it changed.
-fn publish_state(scene: &mut Scene, topics: &mut Topics, s: &mut Scratch, out: &mut Out) {
+pub(crate) fn publish_state(
+    scene: &mut Scene,
+    topics: &mut Topics,
+    s: &mut Scratch,
+    out: &mut Out,
+) {
+    let outside = topics.outside;
     for (i, t) in topics.robots.iter_mut().enumerate() {
-        if let Some((ns, pose)) = scene.robots[i].estimate {
+        if let (Some((ns, pose)), Some(odom)) = (scene.robots[i].estimate, &mut t.odom) {
             scene.odometry(i, ns, &pose, &t.odom_frame, &mut s.odom);
-            out.put(&mut t.odom, &s.odom);
+            out.put(odom, &s.odom);
         }
         if let Some(pose) = scene.true_pose(i) {
-            scene.odometry(i, scene.now_ns(), &pose, "map", &mut s.odom);
-            out.put(&mut t.ground_truth, &s.odom);
+            if let Some(gt) = &mut t.ground_truth {
+                scene.odometry(i, scene.now_ns(), &pose, "map", &mut s.odom);
+                out.put(gt, &s.odom);
+            }
             scene.plan(i, &mut s.path);
             out.put(&mut t.plan, &s.path);
         }
-        if scene.robots[i].wheels.is_some() {
+        if scene.robots[i].wheels.is_some() && !outside {
             out.put(&mut t.cmd_vel, &scene.twist(i));
         }
     }
@@ -269,14 +300,14 @@ fn publish_state(scene: &mut Scene, topics: &mut Topics, s: &mut Scratch, out: &
 
 /// The counts, and the topics whose failure was already said.
 #[derive(Default)]
-struct Out {
-    counts: Counts,
+pub(crate) struct Out {
+    pub(crate) counts: Counts,
     said: Vec<String>,
 }
 
 impl Out {
     /// Publishes `msg` on `p`; a failure is counted, and logged the first time per topic.
-    fn put<T: serde::Serialize>(&mut self, p: &mut Publisher, msg: &T) -> bool {
+    pub(crate) fn put<T: serde::Serialize>(&mut self, p: &mut Publisher, msg: &T) -> bool {
         match p.publish(msg) {
             Ok(()) => {
                 self.counts.sent += 1;

@@ -1,4 +1,4 @@
-//! The ROS 2 message types HNAV publishes, for ROS 2 Jazzy Jalisco: the name, the DDS type
+//! The ROS 2 message types HNAV publishes (and, from robots outside HNAV, reads), for ROS 2 Jazzy Jalisco: the name, the DDS type
 //! name rmw_zenoh puts in key expressions and tokens, and the type hash (REP-2011's
 //! `RIHS01_<sha256 of the type description>`).
 //!
@@ -70,8 +70,16 @@ pub const STRING: TypeInfo = TypeInfo {
     hash: "RIHS01_df668c740482bbd48fb39d76a70dfd4bd59db1288021743503259e948f6b1a18",
 };
 
+/// `sensor_msgs/msg/JointState`: what robots outside HNAV publish of their wheels.
+pub const JOINT_STATE: TypeInfo = TypeInfo {
+    name: "sensor_msgs/msg/JointState",
+    dds: "sensor_msgs::msg::dds_::JointState_",
+    hash: "RIHS01_a13ee3a330e346c9d87b5aa18d24e11690752bd33a0350f11c5882bc9179260e",
+};
+
 /// Every type above.
-pub const ALL: [TypeInfo; 7] = [
+pub const ALL: [TypeInfo; 8] = [
+    JOINT_STATE,
     ODOMETRY,
     PATH,
     TWIST,

@@ -35,7 +35,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use crate::msg::{Lifecycle, LifecycleEvent, Role, StartupPhase, StopReason};
-use crate::scenario::params::CoordinatorParams;
+use crate::scenario::params::{CoordinatorParams, SimKind};
 use crate::scenario::{fault_arg, ClockMode, FaultSpec, FaultTarget, Loc, Scenario, ScenarioError};
 use crate::topics;
 use crate::transport::{Receiver, RunId, Sender, Transport, TransportError, Wake};
@@ -106,6 +106,14 @@ impl ProcessArgs {
             }
         }
         if let Some(m) = self.mode {
+            if m == ClockMode::Lockstep && s.sim.kind == SimKind::Ros2 {
+                return Err(ScenarioError::InvalidParameter {
+                    at: Loc::new("the command line", 0),
+                    key: "--mode".into(),
+                    problem: "lockstep: the scenario's [sim] kind = \"ros2\" runs in realtime only"
+                        .into(),
+                });
+            }
             s.sim.clock = m;
         }
         if let Some(r) = self.replicas {

@@ -9,6 +9,7 @@ use toml::Spanned;
 use super::build_params::{build_coordinator, build_restart, build_robot, build_run, build_sim};
 use super::error::{Loc, ScenarioError};
 use super::lines::{toml_error, Lines};
+use super::params::SimKind;
 use super::raw::{RawMap, RawScenario};
 use super::validate::{build_agent, build_fault, check_agent, check_reachable, Seen};
 use super::{MapSpec, Scenario};
@@ -25,6 +26,10 @@ pub(super) fn parse(
     let raw: RawScenario = toml::from_str(text).map_err(|e| toml_error(&e, &lines))?;
     let map = build_map(&raw.map, &lines, base_dir)?;
     let robot = build_robot(raw.robot, &lines)?;
+    let outside = (raw.sim.as_ref())
+        .and_then(|s| s.kind.as_ref())
+        .filter(|k| *k.get_ref() == SimKind::Ros2)
+        .map(|k| lines.at(k));
     let sim = build_sim(raw.sim, &lines)?;
     let coordinator = build_coordinator(raw.coordinator, &lines)?;
     let restart = build_restart(raw.restart);
@@ -71,6 +76,23 @@ pub(super) fn parse(
         (&map.grid, map.corner_cutting),
         &lines,
     )?;
+    if let Some(at) = outside {
+        // The world of robots outside HNAV is theirs: HNAV can neither close its doors nor
+        // see for its robots.
+        let what = [
+            (!raw.events.is_empty(), "[[events]]"),
+            (sensing.is_some(), "[sensing]"),
+        ];
+        if let Some((_, what)) = what.iter().find(|w| w.0) {
+            return Err(ScenarioError::InvalidParameter {
+                at,
+                key: "sim.kind".into(),
+                problem: format!(
+                    "\"ros2\" drives robots outside HNAV, whose world HNAV does not simulate: {what} needs kind = \"hnav\""
+                ),
+            });
+        }
+    }
     let events = super::events::build_events(raw.events, &map.grid, &agents, &sim, &lines)?;
     Ok(Scenario {
         name: raw.name.into_inner(),

@@ -7,7 +7,8 @@ use toml::Spanned;
 use super::error::{Loc, ScenarioError};
 use super::lines::Lines;
 use super::params::{
-    CoordinatorParams, RestartConfig, RestartRule, RobotParams, RunParams, SimParams,
+    ClockMode, CoordinatorParams, RestartConfig, RestartRule, RobotParams, RunParams, SimKind,
+    SimParams,
 };
 use super::raw::{RawCoordinator, RawRestart, RawRestartRule, RawRobot, RawRun, RawSim};
 
@@ -135,7 +136,7 @@ pub(super) fn build_sim(
     let d = SimParams::default();
     let Some(s) = raw else { return Ok(d) };
     let none = Loc::new(lines.source_name, 0);
-    let p = SimParams {
+    let mut p = SimParams {
         step_ms: count(&s.step_ms, d.step_ms, "sim.step_ms", lines)?,
         odometry_hz: count(&s.odometry_hz, d.odometry_hz, "sim.odometry_hz", lines)?,
         clock: s.clock.unwrap_or(d.clock),
@@ -153,7 +154,23 @@ pub(super) fn build_sim(
         // Any u32 (0 = no deadline); a negative or fractional value fails in serde, with its
         // line.
         lockstep_deadline_ms: s.lockstep_deadline_ms.unwrap_or(d.lockstep_deadline_ms),
+        kind: s.kind.as_ref().map_or(d.kind, |k| *k.get_ref()),
     };
+    // Robots outside HNAV keep their own time: such a run follows the wall clock, which is
+    // also what it defaults to.
+    if let Some(k) = s.kind.as_ref().filter(|k| *k.get_ref() == SimKind::Ros2) {
+        match s.clock {
+            Some(ClockMode::Lockstep) => {
+                return Err(ScenarioError::InvalidParameter {
+                    at: lines.at(k),
+                    key: "sim.kind".into(),
+                    problem: "\"ros2\" runs in realtime only (robots outside HNAV do not wait for a lockstep round); drop clock = \"lockstep\"".into(),
+                })
+            }
+            Some(ClockMode::Realtime) => {}
+            None => p.clock = ClockMode::Realtime,
+        }
+    }
     // Odometry is sampled on physics steps, so it cannot be faster than one message per step.
     if u64::from(p.odometry_hz) * u64::from(p.step_ms) > 1000 {
         let at = lines.at_opt(&s.odometry_hz, &lines.at_opt(&s.step_ms, &none));

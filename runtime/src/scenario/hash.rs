@@ -33,7 +33,7 @@
 
 use super::localisation::LocalisationParams;
 use super::params::{
-    ClockMode, FsyncPolicy, GiveUpAction, Planner, RestartPolicy, RestartRule, Rules,
+    ClockMode, FsyncPolicy, GiveUpAction, Planner, RestartPolicy, RestartRule, Rules, SimKind,
 };
 use super::tasks::StreamKind;
 use super::{EventSpec, RepairRule, WorldChange};
@@ -142,6 +142,10 @@ pub(super) fn scenario_hash(s: &Scenario) -> u64 {
         .u64(sim.watchdog_ms.into())
         .f64(sim.slip_hold_s)
         .u64(sim.lockstep_deadline_ms.into());
+    // Only when not the default, so that every scenario before the key keeps its hash.
+    if sim.kind != SimKind::Hnav {
+        h.bytes(b"sim.kind=ros2");
+    }
 
     let c = &s.coordinator;
     h.u64(c.round_deadline_ms.into());

@@ -201,12 +201,12 @@ pub use localisation::LocalisationParams;
 pub use params::{
     default_startup_timeout_s, ClockMode, ClockModeError, CoordinatorParams, FsyncPolicy,
     GiveUpAction, Planner, RestartConfig, RestartPolicy, RestartRule, RobotParams, Rules,
-    RunParams, SimParams,
+    RunParams, SimKind, SimParams,
 };
 pub use raw::KEYS;
 pub use record::RecordParams;
 pub use report::{default_out_dir, ScenarioReport};
-pub use ros2::Ros2Params;
+pub use ros2::{OdometrySource, Ros2Params};
 pub use sensing::{RepairRule, SensingParams};
 pub use tasks::{StreamKind, TaskStream, TasksSpec};
 

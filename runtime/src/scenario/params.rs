@@ -135,6 +135,33 @@ pub struct SimParams {
     /// indefinitely; a robot is then counted down only when its agent's process dies or
     /// leaves (peer-death events), and a positive value is a fallback for agents that hang.
     pub lockstep_deadline_ms: u32,
+    /// What moves the robots: HNAV's own physics stepper, or robots outside HNAV reached
+    /// through ROS 2.
+    pub kind: SimKind,
+}
+
+/// What moves a run's robots (`[sim] kind`).
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SimKind {
+    /// `hnav-sim`: HNAV's differential-drive physics, Hall ticks and ground truth.
+    #[default]
+    Hnav,
+    /// Robots outside HNAV (Gazebo, Webots, real robots) through ROS 2: `hnav-ros2 --robots`
+    /// takes the sim's place, sends each agent's wheel commands out as `cmd_vel` and turns
+    /// the robots' `joint_states` (or `odom`) into odometry. Realtime only; the world is the
+    /// outside's, so no `[sensing]` and no `[[events]]`.
+    Ros2,
+}
+
+impl SimKind {
+    /// The name in scenario files: `"hnav"` or `"ros2"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SimKind::Hnav => "hnav",
+            SimKind::Ros2 => "ros2",
+        }
+    }
 }
 
 impl Default for SimParams {
@@ -148,6 +175,7 @@ impl Default for SimParams {
             watchdog_ms: 100,
             slip_hold_s: 0.010,
             lockstep_deadline_ms: 0,
+            kind: SimKind::Hnav,
         }
     }
 }

@@ -9,7 +9,7 @@
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::params::{ClockMode, FsyncPolicy, GiveUpAction, Planner, RestartPolicy, Rules};
+use super::params::{ClockMode, FsyncPolicy, GiveUpAction, Planner, RestartPolicy, Rules, SimKind};
 
 /// Every key of the format, table by table as the structs below (and `health`'s and
 /// `record`'s) take them: `""` is the top level, `restart.ROLE` each role's rule, `agents`,
@@ -65,6 +65,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
             "watchdog_ms",
             "slip_hold_s",
             "lockstep_deadline_ms",
+            "kind",
         ],
     ),
     (
@@ -115,7 +116,17 @@ pub const KEYS: &[(&str, &[&str])] = &[
     ("tasks", &["stream", "seed", "goals"]),
     ("tasks.goals", &["agent", "cells"]),
     ("sensing", &["range", "known_map", "repair", "all_knowing"]),
-    ("ros2", &["domain_id", "namespace", "router"]),
+    (
+        "ros2",
+        &[
+            "domain_id",
+            "namespace",
+            "router",
+            "odometry",
+            "wheel_joints",
+            "silence_s",
+        ],
+    ),
     (
         "events",
         &[
@@ -197,6 +208,7 @@ pub(super) struct RawSim {
     pub watchdog_ms: Option<Spanned<u32>>,
     pub slip_hold_s: Option<Spanned<f64>>,
     pub lockstep_deadline_ms: Option<u32>,
+    pub kind: Option<Spanned<SimKind>>,
 }
 
 /// `[coordinator]`.

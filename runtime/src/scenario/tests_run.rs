@@ -68,3 +68,50 @@ fn huge_and_tiny_numbers_print_in_scientific_notation() {
         assert_eq!(error::number(x).to_string(), shown);
     }
 }
+
+#[test]
+fn robots_outside_hnav_run_in_realtime_in_a_world_hnav_does_not_simulate() {
+    let s = parse(&format!("{BASE}[sim]\nkind = \"ros2\"\n")).unwrap();
+    assert_eq!(s.sim.kind, SimKind::Ros2);
+    assert_eq!(
+        s.sim.clock,
+        ClockMode::Realtime,
+        "ros2 defaults to realtime"
+    );
+    let realtime = parse(&format!("{BASE}[sim]\nclock = \"realtime\"\n")).unwrap();
+    assert_ne!(s.scenario_hash(), realtime.scenario_hash());
+    // The default keeps every older scenario's hash.
+    let hnav = parse(&format!(
+        "{BASE}[sim]\nclock = \"realtime\"\nkind = \"hnav\"\n"
+    ))
+    .unwrap();
+    assert_eq!(hnav.scenario_hash(), realtime.scenario_hash());
+
+    let e = parse(&format!(
+        "{BASE}[sim]\nclock = \"lockstep\"\nkind = \"ros2\"\n"
+    ))
+    .unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("t.toml:18: sim.kind \"ros2\" runs in realtime only"),
+        "{e}"
+    );
+    let e = parse(&format!(
+        "{BASE}[sim]\nkind = \"ros2\"\n[sensing]\nrange = 3\n"
+    ))
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("[sensing] needs kind = \"hnav\""),
+        "{e}"
+    );
+    assert!(e.to_string().starts_with("t.toml:17:"), "{e}");
+    let e = parse(&format!(
+        "{BASE}[sim]\nkind = \"ros2\"\n[[events]]\nat_s = 1.0\nclose = [[2, 2]]\n"
+    ))
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("[[events]] needs kind = \"hnav\""),
+        "{e}"
+    );
+    assert!(parse(&format!("{BASE}[sim]\nkind = \"gazebo\"\n")).is_err());
+}

@@ -26,7 +26,7 @@ use hnav_operator::supervisor::run::{
 use hnav_operator::supervisor::run_dir::RUN_OUTPUTS;
 use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::scenario::fault_arg::{self, FaultArgError, FaultFlag};
-use hnav_runtime::scenario::{ClockMode, FaultSpec, Scenario};
+use hnav_runtime::scenario::{ClockMode, FaultSpec, Scenario, SimKind};
 
 /// The exit code of a run that started but could not go on (a process stopped on a full
 /// disk): neither a finished run (0, 1) nor one that never started (2).
@@ -227,7 +227,9 @@ pub fn run_command(a: RunArgs, matches: Option<&ArgMatches>) -> ExitCode {
     });
     let (name, faults, host, ros2) = match placed {
         Ok((s, faults, host)) => {
-            let ros2 = ros2_options(a.ros2, a.ros2_router.as_deref(), &s);
+            // Robots outside HNAV are reached through the ROS 2 graph whatever the flags.
+            let outside = s.sim.kind == SimKind::Ros2;
+            let ros2 = ros2_options(a.ros2 || outside, a.ros2_router.as_deref(), &s);
             (default_run_dir(&s, a.host.as_deref()), faults, host, ros2)
         }
         Err(e) => {

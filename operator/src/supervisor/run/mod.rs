@@ -91,7 +91,7 @@ use hang::HangWatch;
 use hnav_runtime::consensus_log::EndReason;
 use hnav_runtime::launch::ProcessArgs;
 use hnav_runtime::msg::{Lifecycle, Role, StopReason};
-use hnav_runtime::scenario::Scenario;
+use hnav_runtime::scenario::{Scenario, SimKind};
 use hnav_runtime::transport::{purge_run, Bell, RunId};
 use slots::Slots;
 use watch::{End, Ports, Seen, Watch};
@@ -171,7 +171,10 @@ fn run_owned(
     let ports = Ports::open(&run, scenario.agents.len(), opts.host.is_some())?;
     // Started before any process, so the recording begins with the first truth message.
     let recorder = start_recorder(opts, &run, &scenario, &dir);
-    let ros2 = start_ros2(opts, &dir, run.domain());
+    let outside = scenario.sim.kind == SimKind::Ros2;
+    let ros2 = (!outside)
+        .then(|| start_ros2(opts, &dir, run.domain()))
+        .flatten();
     let mut record = registry.new_record(&run, &dir);
     record.set_process_args(&opts.args);
     let started = Instant::now();
@@ -186,6 +189,9 @@ fn run_owned(
         host,
         run.domain(),
     );
+    if let (true, Some(r)) = (outside, &opts.ros2) {
+        slots = slots.with_outside_robots(&opts.bin_dir, r);
+    }
     let journal = RunEvents::create(&dir);
     // The last ground truth seen: a sample does not outlive its publisher, so a sim that is
     // down at the end (or gone for good) leaves only what was taken while it ran.

@@ -1,6 +1,9 @@
 //! `hnav run --ros2` (or a scenario's `[ros2]`): the run's ROS 2 publisher, `hnav-ros2`.
 //!
-//! One more process of the run, beside the roster rather than in it: started once the run's
+//! With robots outside HNAV (`[sim] kind = "ros2"`), `hnav-ros2 --robots` is the run's sim
+//! instead, in the roster (`Slots::with_outside_robots`), and this one is not started.
+//!
+//! Otherwise it is one more process of the run, beside the roster rather than in it: started once the run's
 //! services exist (with the recorder, before the sim) so that it hears the run from its first
 //! sample; not waited for, given no hang deadline, not restarted. It only observes, so a
 //! failure there (a router that never answers, a crash) is its log's business,
@@ -27,6 +30,20 @@ pub struct Ros2Options {
     pub start_router: bool,
 }
 
+impl Ros2Options {
+    /// Its `hnav-ros2` arguments: `--router ENDPOINT`, `--start-router`, or none.
+    pub fn args(&self) -> Vec<String> {
+        let mut a = Vec::new();
+        if let Some(r) = &self.router {
+            a.extend(["--router".to_string(), r.clone()]);
+        }
+        if self.start_router {
+            a.push("--start-router".into());
+        }
+        a
+    }
+}
+
 /// The running `hnav-ros2`.
 pub struct Ros2Process {
     child: Child,
@@ -49,13 +66,7 @@ impl Ros2Process {
         }
         let out = OpenOptions::new().create(true).append(true).open(&log)?;
         let mut cmd = Command::new(bin_dir.join("hnav-ros2"));
-        cmd.args(args.to_args());
-        if let Some(r) = &opts.router {
-            cmd.arg("--router").arg(r);
-        }
-        if opts.start_router {
-            cmd.arg("--start-router");
-        }
+        cmd.args(args.to_args()).args(opts.args());
         if let Some(d) = domain {
             cmd.env(DOMAIN_ENV, d);
         }

@@ -14,6 +14,7 @@ use gone::{not_restarted, role_writes, Gone};
 use super::action::{Action, Incarnation};
 use super::error::RunError;
 use super::host::{processes_of, HostPart};
+use super::ros2::Ros2Options;
 use crate::supervisor::child::{Child, ChildError, ChildSpec, ExitInfo};
 use crate::supervisor::events::RunEvent;
 use crate::supervisor::exit_fd::ExitFd;
@@ -132,6 +133,20 @@ impl Slots {
             on_give_up: scenario.restart.on_give_up,
             host: host.cloned(),
         }
+    }
+
+    /// Robots outside HNAV (`[sim] kind = "ros2"`): the sim's slot runs
+    /// `bin_dir/hnav-ros2 --robots` instead of `hnav-sim`, joining the ROS 2 graph as `ros2`
+    /// says; as the sim it keeps its role, log, restarts and faults.
+    pub(super) fn with_outside_robots(mut self, bin_dir: &Path, ros2: &Ros2Options) -> Self {
+        for slot in self.slots.iter_mut().filter(|s| s.spec.role == Role::Sim) {
+            slot.spec.program = bin_dir.join("hnav-ros2");
+            slot.spec.args.push("--robots".into());
+            slot.spec
+                .args
+                .extend(ros2.args().into_iter().map(Into::into));
+        }
+        self
     }
 
     /// In a run across hosts, this host's part.
