@@ -1,5 +1,6 @@
 //! `hnav-ros2 --run ID --scenario FILE [--agents N] [--seed S] [--mode M] [--domain-id D]
-//! [--namespace NS] [--router ENDPOINT | --start-router] [--rate-hz HZ] [--robots]`: publishes
+//! [--namespace NS] [--router ENDPOINT | --start-router | --listen ENDPOINT] [--rate-hz HZ]
+//! [--robots]`: publishes
 //! run ID as ROS 2 topics on rmw_zenoh's wire contract until the run stops (the supervisor's
 //! `Stop`, SIGTERM/SIGINT, or its parent gone); then prints what it sent. Started by
 //! `hnav run --ros2`; with `--robots` (a scenario of `[sim] kind = "ros2"`), it is the run's
@@ -32,8 +33,11 @@ struct Args {
     router: Option<String>,
     /// Be the router, listening on tcp/127.0.0.1:7447 (what `hnav run --ros2` asks for when
     /// no router answers there).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "listen")]
     start_router: bool,
+    /// Be the router, listening on ENDPOINT (`hnav-bench round --observers`: a free port).
+    #[arg(long, value_name = "ENDPOINT", conflicts_with = "router")]
+    listen: Option<String>,
     /// State messages (odometry, ground truth, plans, commands, /tf, markers) per second of
     /// wall clock.
     #[arg(long, value_name = "HZ", default_value_t = 20.0)]
@@ -60,7 +64,9 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         namespace: normalise_namespace(args.namespace.as_deref().unwrap_or(&ros2.namespace)),
         rate_hz: args.rate_hz,
     };
-    let role = if args.start_router {
+    let role = if let Some(listen) = &args.listen {
+        Role::Router(listen.clone())
+    } else if args.start_router {
         Role::Router(OWN_ROUTER_LISTEN.to_string())
     } else {
         let router = (args.router.clone())

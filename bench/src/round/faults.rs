@@ -37,6 +37,7 @@ use hnav_runtime::scenario::FsyncPolicy;
 use hnav_runtime::topics;
 use hnav_runtime::transport::{purge_run, RunId, Sender, Transport, Wake};
 
+use super::observers::Observers;
 use super::report::{Dist, FaultPoint};
 use super::session::{with_coordinator, CoordinatorSetup};
 use super::swarm::keep_going;
@@ -292,7 +293,11 @@ fn kill_once(
 /// the latencies, how many trials needed more than one round, and how many were left out
 /// because a round stalled.
 fn rejoin(program: &Path, fsync: FsyncPolicy, trials: usize) -> Result<(Vec<u64>, usize, usize)> {
-    let setup = CoordinatorSetup { fsync, replicas: 1 };
+    let setup = CoordinatorSetup {
+        fsync,
+        replicas: 1,
+        observers: Observers::default(),
+    };
     with_coordinator(program, REJOIN_AGENTS, setup, |session, swarm| {
         if let Some(t) = session.startup() {
             hnav_runtime::errln!(

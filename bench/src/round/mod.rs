@@ -34,6 +34,7 @@
 
 mod faults;
 mod layout;
+mod observers;
 mod report;
 mod session;
 mod swarm;
@@ -45,6 +46,7 @@ use clap::Args;
 
 use hnav_runtime::scenario::FsyncPolicy;
 
+use observers::Observers;
 use report::{Dist, RoundPoint};
 use session::CoordinatorSetup;
 use swarm::keep_going;
@@ -86,6 +88,12 @@ pub struct RoundArgs {
     #[arg(long, value_delimiter = ',', value_name = "N", default_values_t = [1u32],
           value_parser = parse_replicas, conflicts_with = "faults")]
     pub replicas: Vec<u32>,
+    /// The observers each point runs with, one row each (comma-separated): none, ros2 (the
+    /// `hnav run --ros2` publisher beside the run), foxglove (the `--foxglove` live view),
+    /// ros2+foxglove. `none,ros2+foxglove` measures what both add, in one run.
+    #[arg(long, value_delimiter = ',', value_name = "SET", default_values = ["none"],
+          value_parser = Observers::parse, conflicts_with = "faults")]
+    pub observers: Vec<Observers>,
     /// One JSON object per line instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -129,6 +137,9 @@ pub fn main(args: RoundArgs) -> Result<()> {
     }
     if args.fsync.is_empty() {
         bail!("--fsync needs at least one policy");
+    }
+    if args.observers.is_empty() {
+        bail!("--observers needs at least one set");
     }
     if args.replicas.is_empty() {
         bail!("--replicas needs at least one cluster size");
@@ -191,14 +202,21 @@ fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
     let mut points = Vec::new();
     for &agents in &args.agents {
         for &fsync in &args.fsync {
-            for &replicas in &args.replicas {
+            for (&replicas, &observers) in
+                (args.replicas.iter()).flat_map(|r| args.observers.iter().map(move |o| (r, o)))
+            {
                 hnav_runtime::errln!(
-                    "round: {agents} agents, fsync {}, {replicas} coordinator(s): {} warm-up \
-                     + {rounds} measured rounds",
+                    "round: {agents} agents, fsync {}, {replicas} coordinator(s), observers {}: \
+                     {} warm-up + {rounds} measured rounds",
                     layout::fsync_name(fsync),
+                    observers.name(),
                     args.warmup
                 );
-                let setup = CoordinatorSetup { fsync, replicas };
+                let setup = CoordinatorSetup {
+                    fsync,
+                    replicas,
+                    observers,
+                };
                 let point = measure_point(program, agents, setup, args.warmup, rounds)?;
                 if args.json {
                     hnav_runtime::outln!("{}", point.json());
@@ -296,6 +314,7 @@ fn measure_point(
         agents,
         fsync: setup.fsync,
         replicas: setup.replicas,
+        observers: setup.observers,
         dist: Dist::from_ns(&all)?,
         first: Dist::from_ns(&first)?,
         stalled,

@@ -8,6 +8,7 @@ use hnav_runtime::scenario::FsyncPolicy;
 use serde_json::json;
 
 use super::layout::fsync_name;
+use super::observers::Observers;
 
 /// The distribution of one series of latencies (ns): the same summary `hnav-bench latency`
 /// reports.
@@ -31,6 +32,8 @@ pub struct RoundPoint {
     pub fsync: FsyncPolicy,
     /// Coordinator processes: 1, or 3 or 5 Raft replicas.
     pub replicas: u32,
+    /// The observers beside the run.
+    pub observers: Observers,
     /// Round latencies (to the last agent's commit).
     pub dist: Dist,
     /// Latencies to the first agent's commit.
@@ -42,10 +45,11 @@ pub struct RoundPoint {
 /// The table header of the round benchmark.
 pub fn round_header() -> String {
     format!(
-        "{:>7}  {:<13} {:>8} {:>7} {:>10} {:>10} {:>10} | {:>10} {:>10} | {:>7}",
+        "{:>7}  {:<13} {:>8} {:<14} {:>7} {:>10} {:>10} {:>10} | {:>10} {:>10} | {:>7}",
         "agents",
         "fsync",
         "replicas",
+        "observers",
         "rounds",
         "p50 µs",
         "p99 µs",
@@ -61,10 +65,11 @@ impl RoundPoint {
     pub fn row(&self) -> String {
         let d = &self.dist;
         format!(
-            "{:>7}  {:<13} {:>8} {:>7} {:>10.1} {:>10.1} {:>10.1} | {:>10.1} {:>10.1} | {:>7}",
+            "{:>7}  {:<13} {:>8} {:<14} {:>7} {:>10.1} {:>10.1} {:>10.1} | {:>10.1} {:>10.1} | {:>7}",
             self.agents,
             fsync_name(self.fsync),
             self.replicas,
+            self.observers.name(),
             d.n,
             us(d.p50_ns),
             us(d.p99_ns),
@@ -83,6 +88,7 @@ impl RoundPoint {
             "agents": self.agents,
             "fsync": fsync_name(self.fsync),
             "replicas": self.replicas,
+            "observers": self.observers.name(),
             "p50_us": us1(d.p50_ns),
             "p99_us": us1(d.p99_ns),
             "max_us": us1(d.max_ns),
@@ -187,11 +193,16 @@ pub fn write_round_csv(dir: &Path, points: &[RoundPoint]) -> Result<std::path::P
     let info = crate::latency::RunInfo::now();
     let rows = points.iter().flat_map(|p| {
         let c = Some((p.agents, p.fsync, p.replicas));
+        // The measure names the observers when there are any, so the file's columns stay.
+        let with = match p.observers.name() {
+            "none" => String::new(),
+            o => format!("_with_{o}"),
+        };
         [
             csv_row(
                 &info,
                 "round",
-                "last_candidate_to_all_commits",
+                &format!("last_candidate_to_all_commits{with}"),
                 c,
                 &p.dist,
                 p.stalled,
@@ -199,7 +210,7 @@ pub fn write_round_csv(dir: &Path, points: &[RoundPoint]) -> Result<std::path::P
             csv_row(
                 &info,
                 "round",
-                "last_candidate_to_first_commit",
+                &format!("last_candidate_to_first_commit{with}"),
                 c,
                 &p.first,
                 p.stalled,
@@ -264,6 +275,10 @@ mod tests {
             agents: 8,
             fsync: FsyncPolicy::None,
             replicas: 3,
+            observers: Observers {
+                ros2: true,
+                foxglove: true,
+            },
             dist: d,
             first: d,
             stalled: 0,
@@ -273,6 +288,7 @@ mod tests {
         assert_eq!(v["agents"], 8);
         assert_eq!(v["fsync"], "none");
         assert_eq!(v["replicas"], 3);
+        assert_eq!(v["observers"], "ros2+foxglove");
         assert_eq!(v["rounds"], 3);
         assert_eq!(v["max_us"], 30.0);
         for k in ["p50_us", "p99_us", "first_p50_us", "first_p99_us"] {

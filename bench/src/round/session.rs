@@ -17,6 +17,7 @@ use hnav_runtime::scenario::FsyncPolicy;
 use hnav_runtime::transport::{purge_run, Bell, RunId, Transport, BELL_ENV};
 
 use super::layout::Layout;
+use super::observers::{Observers, Running};
 use super::swarm::Swarm;
 
 /// How long the coordinator gets to announce itself.
@@ -137,6 +138,8 @@ pub struct CoordinatorSetup {
     pub fsync: FsyncPolicy,
     /// 1 (one coordinator, today's behaviour), 3 or 5 Raft replicas.
     pub replicas: u32,
+    /// The observers running beside it (`--observers`).
+    pub observers: Observers,
 }
 
 /// Starts the coordinator (or its replicas) for `agents` agents, hands the session and the
@@ -237,9 +240,16 @@ fn session<T>(
         life,
         transport,
     };
+    let bin_dir = program.parent().unwrap_or(Path::new("."));
     let out = match spawn_failed {
         Some(e) => Err(e),
-        None => session.handshake().and_then(|()| f(&session, &mut swarm)),
+        None => session.handshake().and_then(|()| {
+            // Started once the coordinator's ports exist; stopped before it is.
+            let observers = Running::start(setup.observers, run, &args, dir, bin_dir)?;
+            let out = f(&session, &mut swarm);
+            observers.stop();
+            out
+        }),
     };
     let stopped = session.stop();
     drop(swarm);

@@ -29,13 +29,21 @@ pub struct LiveView {
 
 impl LiveView {
     /// Serves run `run_id` on `server` from a thread of its own.
-    pub fn start(mut server: Server, run_id: String) -> std::io::Result<LiveView> {
+    pub fn start(server: Server, run_id: String) -> std::io::Result<LiveView> {
+        Self::start_in(RunRegistry::default_location(), server, run_id)
+    }
+
+    /// [`LiveView::start`], with the run looked up in `registry`.
+    pub fn start_in(
+        registry: RunRegistry,
+        mut server: Server,
+        run_id: String,
+    ) -> std::io::Result<LiveView> {
         let stop = Arc::new(AtomicBool::new(false));
         let flag = stop.clone();
         let thread = std::thread::Builder::new()
             .name("hnav-foxglove".into())
             .spawn(move || {
-                let registry = RunRegistry::default_location();
                 let mut feed = loop {
                     if flag.load(Ordering::Relaxed) {
                         return;
