@@ -7,6 +7,10 @@
 //! side: the messages are CDR-encoded by serde ([`msgs`]), the names, tokens and attachments
 //! are rmw_zenoh's ([`graph`]), and Zenoh carries them.
 //!
+//! With `[sim] kind = "ros2"` the same node also drives robots outside HNAV, in the sim's
+//! place ([`outside`]): wheel commands out as `cmd_vel`, `joint_states` (or `odom`) and
+//! `ground_truth` in, decoded from CDR the same way.
+//!
 //! **Must not depend on**: any HNAV crate but `hnav-runtime` (the run is reached only through
 //! its topics), nor on the operator's libraries.
 //!

@@ -90,3 +90,28 @@ fn a_ros2_client_without_ros_sees_the_demo_run_and_its_robots_at_their_goals() {
     // The publisher said what it sent when the run stopped it.
     assert!(ros2_log.contains("sent="), "{ros2_log}");
 }
+
+/// The RViz config the tutorial ships subscribes only to what `/hnav` publishes for the
+/// demo, in the frame it publishes in.
+#[test]
+fn the_shipped_rviz_config_shows_the_demos_topics_in_the_map_frame() {
+    let text = std::fs::read_to_string(repo_root().join("docs/ros2/hnav.rviz")).unwrap();
+    let mut published: Vec<String> = vec!["/map".into(), "/hnav/markers".into()];
+    published.extend((0..6).map(|i| format!("/robot_{i}/plan")));
+    let topics: Vec<&str> = (text.lines())
+        .filter_map(|l| l.trim().strip_prefix("Value: /"))
+        .collect();
+    for t in &topics {
+        // RViz's map display also listens for partial updates; HNAV sends whole maps.
+        let t = format!("/{t}");
+        assert!(
+            published.contains(&t) || t == "/map_updates",
+            "{t} is not a topic of /hnav"
+        );
+    }
+    for p in &published {
+        assert!(topics.contains(&&p[1..]), "the config does not show {p}");
+    }
+    assert!(text.contains("Fixed Frame: map"));
+    assert!(text.contains("Durability Policy: Transient Local"));
+}

@@ -21,11 +21,12 @@
 //! truth's count stays 0. A message that does not decode, or lacks the wheel joints, is
 //! counted and dropped (said once per topic).
 
+pub mod origin;
 pub mod robot;
 pub mod wheels;
 
-use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 use hnav_runtime::grid::geometry::cell_centre_pose;
 use hnav_runtime::health::Heartbeat;
@@ -41,11 +42,9 @@ use crate::node::{NodeError, Subscription};
 use crate::relay::{publish_state, read, Counts, Inputs, Out, RelayOptions, Scratch, Topics};
 use crate::scene::Scene;
 use crate::types;
+use origin::origin;
 use robot::{Liveness, OutsideRobot};
 use wheels::{ticks, wheel_positions, Malformed};
-
-/// The file in the run directory that holds the run's start, ns since the Unix epoch.
-pub const ORIGIN_FILE: &str = "outside.origin";
 
 /// What the process is told.
 #[derive(Debug, Clone)]
@@ -56,7 +55,7 @@ pub struct OutsideOptions {
     pub ros2: Ros2Params,
     /// Restarted by the supervisor (`--resume`): announce, do not wait for `Start`.
     pub resume: bool,
-    /// The run directory (for [`ORIGIN_FILE`]).
+    /// The run directory (for [`origin::ORIGIN_FILE`]).
     pub dir: Option<PathBuf>,
 }
 
@@ -69,14 +68,9 @@ pub enum OutsideError {
     /// A ROS 2 declaration.
     #[error(transparent)]
     Node(#[from] NodeError),
-    /// The run's start could not be kept or read back.
-    #[error("{path}: {source}")]
-    Origin {
-        /// The file.
-        path: PathBuf,
-        /// What failed.
-        source: std::io::Error,
-    },
+    /// The run's start could not be kept.
+    #[error(transparent)]
+    Origin(#[from] origin::OriginError),
 }
 
 /// What it did.
@@ -465,37 +459,4 @@ impl Loop {
         self.k += 1;
         Ok(())
     }
-}
-
-/// The run's start: now, kept in `dir/outside.origin`; or, resuming, the one kept there.
-fn origin(dir: Option<&Path>, resume: bool) -> Result<Instant, OutsideError> {
-    let now = Instant::now();
-    let wall = SystemTime::now();
-    let Some(dir) = dir else { return Ok(now) };
-    let path = dir.join(ORIGIN_FILE);
-    let err = |source| OutsideError::Origin {
-        path: path.clone(),
-        source,
-    };
-    if resume {
-        if let Ok(text) = std::fs::read_to_string(&path) {
-            if let Ok(ns) = text.trim().parse::<u64>() {
-                let then = UNIX_EPOCH + Duration::from_nanos(ns);
-                let ago = wall.duration_since(then).unwrap_or_default();
-                return Ok(now.checked_sub(ago).unwrap_or(now));
-            }
-        }
-        tracing::warn!(
-            "{}: no usable start kept; counting from now",
-            path.display()
-        );
-    }
-    let ns = wall
-        .duration_since(UNIX_EPOCH)
-        .unwrap_or_default()
-        .as_nanos();
-    let tmp = dir.join(format!("{ORIGIN_FILE}.tmp"));
-    std::fs::write(&tmp, format!("{ns}\n")).map_err(err)?;
-    std::fs::rename(&tmp, &path).map_err(err)?;
-    Ok(now)
 }

@@ -40,6 +40,7 @@
 //!                                      # before that robot counts as down and brakes;
 //!                                      # 0 = wait indefinitely (down only when its agent
 //!                                      # process dies or leaves), > 0 = fallback for hung agents
+//! kind = "hnav"                        # or "ros2": robots outside HNAV, through ROS 2
 //!
 //! [coordinator]
 //! round_deadline_ms = 50
@@ -131,6 +132,9 @@
 //! domain_id = 0                        # ([`ros2`], docs/reference/ros2.md), as with `hnav
 //! namespace = "fleet"                  # run --ros2`; the robots' topics' prefix; the Zenoh
 //! router = "tcp/localhost:7447"        # router (started by `hnav run` if none answers)
+//! odometry = "joint_states"            # kind = "ros2": or "odom", the robots' motion
+//! wheel_joints = ["left_wheel_joint", "right_wheel_joint"]  # kind = "ros2"
+//! silence_s = 1.0                      # kind = "ros2": a robot not heard this long is down
 //! ```
 //!
 //! Unknown keys are errors (a typo must not silently fall back to a default). Every semantic
