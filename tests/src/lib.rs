@@ -199,3 +199,10 @@ impl Drop for TestRun {
         }
     }
 }
+
+/// A loopback TCP port nothing listens on now (the kernel's choice), so that tests running
+/// in parallel do not collide; whoever binds it next should do so soon.
+pub fn free_port() -> u16 {
+    let l = std::net::TcpListener::bind("127.0.0.1:0").expect("a free loopback port");
+    l.local_addr().expect("a bound listener's address").port()
+}

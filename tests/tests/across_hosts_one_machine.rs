@@ -10,13 +10,12 @@
 //! for the counts that only the coordinator's log has. While they run, `hnav ps` lists one
 //! entry per host, and `hnav kill` finds each target in the entry of the host that runs it.
 
-use std::net::{Ipv4Addr, TcpListener};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use hnav_runtime::transport::{purge_run, RunId};
 use hnav_tests::swarm::{hnav_output, repo_root, workspace_bin};
-use hnav_tests::{Peer, TestRun};
+use hnav_tests::{free_port, Peer, TestRun};
 
 /// Generous: a debug build of ten processes and two bridges on a 2-core machine.
 const RUN_TIMEOUT: Duration = Duration::from_secs(600);
@@ -37,11 +36,6 @@ impl Drop for DomainPurge {
             }
         }
     }
-}
-
-fn free_port() -> u16 {
-    let l = TcpListener::bind((Ipv4Addr::LOCALHOST, 0)).unwrap();
-    l.local_addr().unwrap().port()
 }
 
 /// The tutorial's block: the placement file's text and each `hnav run` line's words.

@@ -19,7 +19,7 @@ use std::time::{Duration, Instant};
 use hnav_runtime::transport::{run_iceoryx2_files, run_shm_files, RunId};
 use hnav_tests::python::python as venv_python;
 use hnav_tests::swarm::{repo_root, workspace_bin, SwarmRun};
-use hnav_tests::TestRun;
+use hnav_tests::{free_port, TestRun};
 
 /// Bound on the whole live run (realtime, so the client has time to join).
 const RUN_TIMEOUT: Duration = Duration::from_secs(180);
@@ -27,12 +27,6 @@ const RUN_TIMEOUT: Duration = Duration::from_secs(180);
 const VIEW_TIMEOUT: Duration = Duration::from_secs(120);
 /// How long the client reads, at most, before it checks what it got.
 const CLIENT_READS_S: u32 = 120;
-
-/// A port nobody listens on now (the kernel's choice), so parallel tests do not collide.
-fn free_port() -> u16 {
-    let l = TcpListener::bind("127.0.0.1:0").unwrap();
-    l.local_addr().unwrap().port()
-}
 
 fn client(python: &Path, args: &[String]) -> std::process::Output {
     let script = repo_root().join("clients/python/examples/foxglove_client.py");

@@ -17,18 +17,12 @@ use std::time::{Duration, Instant};
 
 use hnav_tests::python::python;
 use hnav_tests::swarm::{repo_root, SwarmRun};
-use hnav_tests::TestRun;
+use hnav_tests::{free_port, TestRun};
 
 /// Bound on the client's router coming up.
 const ROUTER_TIMEOUT: Duration = Duration::from_secs(30);
 /// Bound on the run and the client's checks.
 const RUN_TIMEOUT: Duration = Duration::from_secs(180);
-
-/// A TCP port nothing listens on now (the client's router binds it next).
-fn free_port() -> u16 {
-    let l = std::net::TcpListener::bind("127.0.0.1:0").expect("a free port");
-    l.local_addr().unwrap().port()
-}
 
 #[test]
 fn a_ros2_client_without_ros_sees_the_demo_run_and_its_robots_at_their_goals() {

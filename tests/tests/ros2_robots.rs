@@ -16,18 +16,12 @@ use std::time::{Duration, Instant};
 use hnav_runtime::scenario::RobotParams;
 use hnav_tests::python::python;
 use hnav_tests::swarm::{hnav_output, repo_root, SwarmRun};
-use hnav_tests::TestRun;
+use hnav_tests::{free_port, TestRun};
 
 /// Bound on the stand-in's router coming up.
 const ROUTER_TIMEOUT: Duration = Duration::from_secs(30);
 /// Bound on a run and the stand-in's checks.
 const RUN_TIMEOUT: Duration = Duration::from_secs(150);
-
-/// A TCP port nothing listens on now.
-fn free_port() -> u16 {
-    let l = std::net::TcpListener::bind("127.0.0.1:0").expect("a free port");
-    l.local_addr().unwrap().port()
-}
 
 /// The demo with its robots outside HNAV: `clock = "lockstep"` becomes `kind = "ros2"`
 /// (which runs in realtime).
@@ -112,27 +106,66 @@ fn until_exit(peer: &mut hnav_tests::Peer) -> (Vec<String>, Option<std::process:
     (lines, status)
 }
 
-#[test]
-fn a_ros2_stand_in_drives_the_demos_six_robots_to_their_goals_through_malformed_samples() {
-    let Some(python) = python() else { return };
-    let tmp = tempfile::tempdir().unwrap();
-    let scenario = demo_outside(tmp.path());
-    let mut run = TestRun::new("ros2-robots");
-    let (mut robots, endpoint) = stand_in(&mut run, &python, &scenario, &["--malformed", "0"]);
-    let out = tmp.path().join("out");
+/// What a run with the stand-in left.
+struct Driven {
+    /// The stand-in's lines, and how it exited.
+    lines: Vec<String>,
+    status: Option<std::process::ExitStatus>,
+    /// How `hnav run` exited.
+    run_status: Result<std::process::ExitStatus, String>,
+    /// `DIR/logs/sim.log`: `hnav-ros2 --robots`'s log.
+    sim_log: String,
+    swarm: SwarmRun,
+    _run: TestRun,
+}
+
+/// Runs `scenario` (in `tmp`) with the stand-in given `extra`, until both have ended.
+fn drive(tag: &str, python: &Path, tmp: &Path, scenario: &Path, extra: &[&str]) -> Driven {
+    let mut run = TestRun::new(tag);
+    let (mut robots, endpoint) = stand_in(&mut run, python, scenario, extra);
+    let out = tmp.join("out");
     let mut swarm = SwarmRun::start(
         &mut run,
-        &scenario,
+        scenario,
         &out,
-        &tmp.path().join("runs"),
+        &tmp.join("runs"),
         &["--ros2-router", &endpoint],
     )
     .expect("hnav run starts");
     let (lines, status) = until_exit(&mut robots);
     let run_status = swarm.finish(Duration::from_secs(30));
+    eprintln!("{}", lines.join("\n"));
+    Driven {
+        lines,
+        status,
+        run_status,
+        sim_log: std::fs::read_to_string(out.join("logs/sim.log")).unwrap_or_default(),
+        swarm,
+        _run: run,
+    }
+}
+
+#[test]
+fn a_ros2_stand_in_drives_the_demos_six_robots_to_their_goals_through_malformed_samples() {
+    let Some(python) = python() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = demo_outside(tmp.path());
+    let d = drive(
+        "ros2-robots",
+        &python,
+        tmp.path(),
+        &scenario,
+        &["--malformed", "0"],
+    );
+    let Driven {
+        lines,
+        status,
+        run_status,
+        sim_log,
+        swarm,
+        ..
+    } = &d;
     let text = lines.join("\n");
-    eprintln!("{text}");
-    let sim_log = std::fs::read_to_string(out.join("logs/sim.log")).unwrap_or_default();
     assert!(
         status.is_some_and(|s| s.success()),
         "the stand-in's checks ({status:?}):\n{text}\n--- sim.log:\n{sim_log}\n{}",
@@ -177,21 +210,22 @@ fn a_robot_that_never_publishes_joint_states_is_down_and_the_run_ends_by_its_tim
     let tmp = tempfile::tempdir().unwrap();
     let scenario = tmp.path().join("two-lanes.toml");
     std::fs::write(&scenario, TWO_LANES).unwrap();
-    let mut run = TestRun::new("ros2-silent");
-    let (mut robots, endpoint) = stand_in(&mut run, &python, &scenario, &["--silent", "1"]);
-    let out = tmp.path().join("out");
-    let mut swarm = SwarmRun::start(
-        &mut run,
+    let d = drive(
+        "ros2-silent",
+        &python,
+        tmp.path(),
         &scenario,
-        &out,
-        &tmp.path().join("runs"),
-        &["--ros2-router", &endpoint],
-    )
-    .expect("hnav run starts");
-    let (lines, status) = until_exit(&mut robots);
-    let run_status = swarm.finish(Duration::from_secs(30));
+        &["--silent", "1"],
+    );
+    let Driven {
+        lines,
+        status,
+        run_status,
+        sim_log,
+        swarm,
+        ..
+    } = &d;
     let text = lines.join("\n");
-    let sim_log = std::fs::read_to_string(out.join("logs/sim.log")).unwrap_or_default();
     // Robot 0 went home; the stand-in leaves the silent robot out of its goal check.
     assert!(
         status.is_some_and(|s| s.success()),
