@@ -177,8 +177,8 @@ pub fn relay(
     let n = scenario.agents.len();
     let transport = Transport::builder(run).node_name("ros2").create()?;
     let inputs = Inputs::open(&transport, n)?;
-    let waiter = transport.waiter()?;
-    let _life = waiter.attach(&inputs.life)?;
+    // The lifecycle is the one source the relay sleeps on; the rest is read at its rate.
+    let waiter = transport.single_waiter(&inputs.life);
     let period = Duration::from_secs_f64(1.0 / opts.rate_hz.clamp(0.1, 1000.0));
     let parent = std::os::unix::process::parent_id();
     let mut out = Out::default();
@@ -188,9 +188,11 @@ pub fn relay(
     loop {
         let wake = waiter.wait(Some(next))?;
         let mut stop = wake == Wake::Stop || std::os::unix::process::parent_id() != parent;
+        // Consumes the listener's events too: an event left pending would end every later
+        // wait at once.
         inputs
             .life
-            .drain(|l| stop |= l.event == LifecycleEvent::Stop as u8)?;
+            .drain_pending(|l| stop |= l.event == LifecycleEvent::Stop as u8)?;
         read(&inputs, &mut scene, topics, &mut s, &mut out)?;
         if stop || Instant::now() >= next {
             publish_state(&mut scene, topics, &mut s, &mut out);
