@@ -7,8 +7,9 @@
 //! (every one keeps room for observers, see `topics`) and never publishes. It reads with
 //! non-blocking receives when the viewer asks ([`Feed::pump`]): the topics are "latest"
 //! services without back-pressure, so a slow viewer loses the oldest samples and never
-//! holds up a publisher. Between pumps it sleeps in a [`Waiter`] with a deadline, woken early
-//! only by a lifecycle event (a death, a restart, `Stop`) or a termination signal.
+//! holds up a publisher. Between pumps it sleeps on its lifecycle receiver with a deadline
+//! ([`SingleWaiter`](hnav_runtime::transport::SingleWaiter)), woken early only by a lifecycle
+//! event (a death, a restart, `Stop`) or a termination signal.
 //!
 //! Progress and lifecycle are drained before ground truth and commits: a `done` or a `Stop`
 //! seen in a pump then comes with every pose the sim published before it. The registry is

@@ -14,7 +14,7 @@
 //!   interval and a deadline; it guarantees the drain order, tells a paused process from a
 //!   stopped one and bounds iceoryx2's lost wake-up. A loop with exactly one receiver waits
 //!   on that receiver's own descriptor instead ([`SingleWaiter`]), with the same [`Wake`]s
-//!   and two system calls fewer per wake-up.
+//!   and one system call fewer per wake-up.
 //! - **One wake-up for the whole swarm** ([`Bell`]): the coordinator wakes every agent with one
 //!   eventfd write instead of one datagram per agent.
 //! - **In-place slices** ([`SliceSender`], [`SliceReceiver`]): the neural-map snapshot is loaned

@@ -7,18 +7,20 @@
 //! every wake-up iceoryx2 0.10 makes an `epoll_wait`, an `fcntl(F_GETFD)` for each ready
 //! descriptor (`iceoryx2-bb-posix` checks that it is still valid before the callback) and a
 //! heap allocation (the list of ready descriptors). A loop that waits on exactly one receiver
-//! has nothing to multiplex, and on a ping-pong those costs were half of the distance between
-//! an HNAV event and a Unix-socket ping (`docs/explanation/performance.md`, *the wake-up*).
+//! has nothing to multiplex: on a ping-pong a message cost four system calls where a
+//! Unix-socket ping costs two (`docs/explanation/performance.md`, *the wake-up*).
 //!
 //! iceoryx2's own direct waits on a listener (`Listener::timed_wait`, `blocking_wait`) are no
 //! cheaper: each one switches the listener's socket to blocking (`fcntl` `F_GETFL` and
 //! `F_SETFL`), sets `SO_RCVTIMEO` (`setsockopt`) and receives, and the non-blocking read of
-//! the drain that follows switches it back (two more `fcntl`): six or seven system calls where
-//! the `WaitSet` makes three (`iceoryx2-bb-posix` 0.10.0, `UnixDatagramReceiver::
-//! timed_receive` and `try_receive`).
+//! the drain that follows switches it back (two more `fcntl`) before it finds the socket empty:
+//! seven system calls on the receiving side where the `WaitSet` makes three (read from
+//! `iceoryx2-bb-posix` 0.10.0, `UnixDatagramReceiver::timed_receive` and `try_receive`, and
+//! `iceoryx2-cal`'s `Waiter::drain_events`; not measured).
 //!
-//! So the single wait is `ppoll(2)` on the listener's descriptor: one system call to sleep,
-//! and the loop's drain ([`Receiver::drain_pending`](super::Receiver::drain_pending)) reads the
+//! So the single wait is `ppoll(2)` on the listener's descriptor: one system call to sleep
+//! (three a message with the notifier's `sendto`, measured with `perf stat`), and the loop's
+//! drain ([`Receiver::drain_pending`](super::Receiver::drain_pending)) reads the
 //! datagram with one `recvfrom` on a socket iceoryx2 already left non-blocking. It keeps
 //! everything else a [`Waiter`](super::Waiter) promises: the same [`Wake`] for the same
 //! reasons, the same drain order after [`Wake::Data`], the same lost-wake-up re-check
@@ -33,8 +35,9 @@
 //! ## Signals
 //!
 //! As in the `Waiter`: `ppoll` returns `EINTR` for any signal the process handles (it is
-//! never restarted, whatever the handler's `SA_RESTART`, see `signal(7)`), which is [`Wake::Data`] unless it was SIGINT or SIGTERM and the transport
-//! handles signals, which is [`Wake::Stop`], sticky ([`stop_requested`](super::stop_requested)).
+//! never restarted, whatever the handler's `SA_RESTART`, see `signal(7)`), which is
+//! [`Wake::Data`] unless it was SIGINT or SIGTERM and the transport handles signals, which is
+//! [`Wake::Stop`], sticky ([`stop_requested`](super::stop_requested)).
 //! A request that lands after the wait looked for one and before it sleeps does not interrupt
 //! the sleep; the wait then sees it when the re-check ends that sleep, so a stop ends the
 //! wait within [`Waiter::LOST_WAKEUP_RECHECK`]: the same window as the `WaitSet`'s.
@@ -180,13 +183,18 @@ mod tests {
     /// A bound on every wait that should end at once: long, so a slow machine does not fail.
     const LONG: Duration = Duration::from_secs(30);
 
+    /// A transport of `run` that leaves signals to the test harness.
+    fn transport(run: &PurgeOnDrop) -> Transport {
+        Transport::builder(&run.0)
+            .handle_signals(false)
+            .create()
+            .unwrap()
+    }
+
     #[test]
     fn a_notification_is_data_and_a_quiet_receiver_times_out_at_the_deadline() {
         let run = PurgeOnDrop(RunId::unique("single"));
-        let t = Transport::builder(&run.0)
-            .handle_signals(false)
-            .create()
-            .unwrap();
+        let t = transport(&run);
         let rx = t.receiver::<Lifecycle>("life", Qos::reliable(4)).unwrap();
         let tx = t.sender::<Lifecycle>("life", Qos::reliable(4)).unwrap();
         let waiter = t.single_waiter(&rx).with_recheck(None);
@@ -214,10 +222,7 @@ mod tests {
     #[test]
     fn the_recheck_ends_a_quiet_wait_as_data() {
         let run = PurgeOnDrop(RunId::unique("singlerecheck"));
-        let t = Transport::builder(&run.0)
-            .handle_signals(false)
-            .create()
-            .unwrap();
+        let t = transport(&run);
         let rx = t.receiver::<Lifecycle>("life", Qos::reliable(4)).unwrap();
         let waiter = t
             .single_waiter(&rx)
