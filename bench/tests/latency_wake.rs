@@ -5,10 +5,8 @@
 
 use std::time::Duration;
 
-use hnav_bench::latency::csv;
-
 mod common;
-use common::bench_within;
+use common::latency_csv;
 
 /// Seconds on a quiet machine; past this it hangs.
 const LIMIT: Duration = Duration::from_secs(180);
@@ -29,17 +27,10 @@ fn the_wait_rows_and_the_datagram_floor_join_the_latency_table() {
         "--out",
         &out,
     ];
-    let run = bench_within(&args, LIMIT);
-    assert!(
-        run.status.success(),
-        "{}\n{}",
-        String::from_utf8_lossy(&run.stdout),
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let text = std::fs::read_to_string(dir.path().join("latency.csv")).unwrap();
-    let mut lines = text.lines();
-    assert_eq!(lines.next(), Some(csv::HEADER));
-    let mut rows: Vec<(String, usize)> = lines
+    let text = latency_csv(&args, dir.path(), LIMIT);
+    let mut rows: Vec<(String, usize)> = text
+        .lines()
+        .skip(1)
         .map(|line| {
             let cols: Vec<&str> = line.split(',').collect();
             (cols[3].to_string(), cols[4].parse().unwrap())

@@ -147,7 +147,7 @@ pub(super) fn slept(ticked: bool, deadline: Option<Instant>) -> Wake {
     }
 }
 
-/// Why [`Waiter::wait`] returned.
+/// Why [`Waiter::wait`] (or [`SingleWaiter::wait`](super::SingleWaiter::wait)) returned.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Wake {
     /// Go and drain every attached receiver; there may be nothing there. Returned when
