@@ -409,7 +409,7 @@ struct LatencyArgs {
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
     /// Measure only these transports (iceoryx2, hnav, uds, tcp, crossbeam, futex, and
-    /// hnav-bridge, which is measured only when named here;
+    /// hnav-bridge, hnav-waitset and uds-dgram, which are measured only when named here;
     /// comma-separated).
     #[arg(long, value_delimiter = ',', value_name = "TRANSPORT")]
     only: Vec<TransportKind>,

@@ -5,10 +5,10 @@
 
 use std::time::Duration;
 
-use hnav_bench::latency::{csv, Options};
+use hnav_bench::latency::Options;
 
 mod common;
-use common::bench_within;
+use common::latency_csv;
 
 /// Seconds on a quiet machine; past this it hangs.
 const LIMIT: Duration = Duration::from_secs(180);
@@ -17,7 +17,7 @@ const LIMIT: Duration = Duration::from_secs(180);
 fn the_bridge_rows_join_the_latency_table() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().display().to_string();
-    let run = bench_within(
+    let text = latency_csv(
         &[
             "latency",
             "--quick",
@@ -28,20 +28,12 @@ fn the_bridge_rows_join_the_latency_table() {
             "--out",
             &out,
         ],
+        dir.path(),
         LIMIT,
     );
-    assert!(
-        run.status.success(),
-        "{}\n{}",
-        String::from_utf8_lossy(&run.stdout),
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let text = std::fs::read_to_string(dir.path().join("latency.csv")).unwrap();
-    let mut lines = text.lines();
-    assert_eq!(lines.next(), Some(csv::HEADER));
     let opts = Options::new(true, dir.path().to_path_buf());
     let mut rows: Vec<(String, usize)> = Vec::new();
-    for line in lines {
+    for line in text.lines().skip(1) {
         let cols: Vec<&str> = line.split(',').collect();
         let size: usize = cols[4].parse().unwrap();
         assert_eq!(

@@ -200,8 +200,8 @@ pub fn relay(
     let inputs = Inputs::open(&transport, n, true)?;
     let life: Receiver<Lifecycle> =
         transport.receiver(topics::LIFECYCLE, topics::lifecycle_qos(n))?;
-    let waiter = transport.waiter()?;
-    let _life = waiter.attach(&life)?;
+    // The lifecycle is the one source the relay sleeps on; the rest is read at its rate.
+    let waiter = transport.single_waiter(&life);
     let period = Duration::from_secs_f64(1.0 / opts.rate_hz.clamp(0.1, 1000.0));
     let parent = std::os::unix::process::parent_id();
     let mut out = Out::default();
@@ -211,7 +211,9 @@ pub fn relay(
     loop {
         let wake = waiter.wait(Some(next))?;
         let mut stop = wake == Wake::Stop || std::os::unix::process::parent_id() != parent;
-        life.drain(|l| stop |= l.event == LifecycleEvent::Stop as u8)?;
+        // Consumes the listener's events too: an event left pending would end every later
+        // wait at once.
+        life.drain_pending(|l| stop |= l.event == LifecycleEvent::Stop as u8)?;
         read(&inputs, &mut scene, topics, &mut s, &mut out)?;
         if stop || Instant::now() >= next {
             publish_state(&mut scene, topics, &mut s, &mut out);

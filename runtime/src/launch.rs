@@ -312,8 +312,8 @@ impl LifecyclePorts {
         if resume {
             return Ok(StartOutcome::Started);
         }
-        let waiter = transport.waiter()?;
-        let _attached = waiter.attach(&self.events)?;
+        // The supervisor's events are the only source here: no `WaitSet` needed.
+        let waiter = transport.single_waiter(&self.events);
         let deadline = Instant::now() + timeout;
         loop {
             let mut started = false;

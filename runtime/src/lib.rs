@@ -28,7 +28,7 @@
 //! | [`rejected`] | the classes of hostile or malformed messages a receiver drops, and their counts for the run summary |
 //! | [`layout`] | the table of every payload's size, alignment and field offsets, and of the topic that carries it, for clients in other languages (`hnav layout --json`) |
 //! | [`topics`] | the run's service names and their QoS, defined once for every process |
-//! | [`transport`] | run-scoped iceoryx2 services: publisher+notifier, subscriber+listener, the one [`Waiter`](transport::Waiter) every process blocks in |
+//! | [`transport`] | run-scoped iceoryx2 services: publisher+notifier, subscriber+listener, the [`Waiter`](transport::Waiter) every process blocks in (or, with one source, the [`SingleWaiter`](transport::SingleWaiter)) |
 //! | [`plan`] | [`PlanResult`](plan::PlanResult), the answer to one planning query, whichever planner gave it |
 //! | [`grid`] | occupancy grids, terrain, coordinates, octile neighbours, MovingAI `.map`/`.scen` files |
 //! | [`msg`] | `#[repr(C)]` zero-copy payloads (Candidate, Commit, WheelCommand, ...) and their layouts |

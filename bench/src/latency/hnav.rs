@@ -1,6 +1,8 @@
 //! The HNAV transport (`hnav_runtime::transport`): slice sender and receiver, measured with
-//! the same ping-pong as [raw iceoryx2](super::raw), waiting in the transport's `Waiter` as
-//! every HNAV process does.
+//! the same ping-pong as [raw iceoryx2](super::raw). In event mode the receiver waits as an
+//! HNAV process with one event source does, on the receiver itself (`SingleWaiter`); the
+//! opt-in `hnav-waitset` row waits in the transport's general `Waiter` (iceoryx2's `WaitSet`)
+//! instead, as a process with several sources does.
 
 use std::time::Instant;
 
@@ -31,6 +33,15 @@ fn open(run: &RunId, prefix: &str, role: Role, size: usize) -> Result<Ports> {
     Ok(Ports { tx, rx, transport })
 }
 
+/// Which of the transport's waits the event-mode receiver blocks in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Wait {
+    /// `Transport::single_waiter`: `ppoll` on the receiver's listener.
+    Single,
+    /// `Transport::waiter`: iceoryx2's `WaitSet` with the receiver attached.
+    WaitSet,
+}
+
 /// Plays `role` of an HNAV ping-pong of `size`-byte samples on topics `<prefix>/{a2b,b2a}`.
 ///
 /// The sender always notifies (that is built into [`SliceSender`]); in poll mode nobody waits
@@ -43,6 +54,7 @@ pub(crate) fn side(
     prefix: &str,
     size: usize,
     mode: Mode,
+    wait: Wait,
 ) -> Result<Vec<u64>> {
     let ports = pp.setup(role, || open(run, prefix, role, size))?;
     let send = |stamp: Stamp| -> Result<()> {
@@ -65,11 +77,19 @@ pub(crate) fn side(
             pp.check()?;
         }),
         Mode::Event => {
-            // The processes' own wait, re-check included: what a sample costs in HNAV.
-            let waiter = ports.transport.waiter()?;
-            let _attached = waiter.attach(&ports.rx)?;
+            // The processes' own waits, re-check included: what a sample costs in HNAV.
+            let single = ports.transport.single_waiter(&ports.rx);
+            let waitset = match wait {
+                Wait::Single => None,
+                Wait::WaitSet => Some(ports.transport.waiter()?),
+            };
+            let _attached = waitset.as_ref().map(|w| w.attach(&ports.rx)).transpose()?;
             pp.run(role, send, || loop {
-                waiter.wait(Some(Instant::now() + ABORT_POLL))?;
+                let deadline = Some(Instant::now() + ABORT_POLL);
+                match &waitset {
+                    Some(w) => w.wait(deadline)?,
+                    None => single.wait(deadline)?,
+                };
                 // Drains the listener; a wake-up may also be "publisher appeared", hence the
                 // loop when no sample is there.
                 ports.rx.take_wakeup()?;

@@ -17,8 +17,10 @@
 //! - Payload: a `[u8]` slice service of `size` bytes with the [`Stamp`] user header. It is not
 //!   filled per iteration: we measure transfer, not memset.
 //! - Modes: [`Mode::Poll`] spins on `receive`; [`Mode::Event`] also notifies and the receiver
-//!   blocks until woken: raw iceoryx2 in a WaitSet, HNAV in its `Waiter`, sockets in `read`,
-//!   crossbeam in `recv`, the futex in `FUTEX_WAIT`.
+//!   blocks until woken: raw iceoryx2 in a WaitSet, HNAV on its one receiver
+//!   (`SingleWaiter`; in the general `Waiter` for the opt-in `hnav-waitset` row), sockets in
+//!   `read` (`recv` for the opt-in `uds-dgram`), crossbeam in `recv`, the futex in
+//!   `FUTEX_WAIT`.
 //!
 //! Results: `DIR/latency.csv` (every point, dora-benchmark's columns then p99.9 and max),
 //! `DIR/latency.md` (the same as a markdown table) and `DIR/latency.svg` (one-way p50 and p99
@@ -46,6 +48,7 @@ use hnav_runtime::transport::{purge_run, Delivery, Qos, RunId};
 pub use csv::RunInfo;
 pub use stats::Summary;
 
+use hnav::Wait;
 use pingpong::{run_pair, Role, Samples};
 
 /// Iterations run before measuring: connections, page faults and caches settle.
@@ -111,6 +114,13 @@ pub enum TransportKind {
     /// iceoryx2, with neural-map payloads (`latency::bridge`). Measured only when named
     /// (`--only hnav-bridge`), at sizes that are whole `f32` maps up to 4 MiB.
     HnavBridge,
+    /// The HNAV transport with the receiver in the general `Waiter` (iceoryx2's `WaitSet`), as a
+    /// process with several event sources waits; the `hnav` row's receiver waits on its one
+    /// source directly (`SingleWaiter`). Event mode only, measured only when named.
+    HnavWaitSet,
+    /// A Unix datagram socket pair, blocking `recv`: the floor of a wake-up by datagram, which
+    /// is how an iceoryx2 event wakes its listener. Measured only when named, up to 64 B.
+    UdsDgram,
 }
 
 impl TransportKind {
@@ -130,7 +140,7 @@ impl TransportKind {
 
     /// Measured here, but only when named in `--only`: they start Zenoh sessions and
     /// threads of their own, which the default suite does not pay for.
-    pub const OPT_IN: [TransportKind; 1] = [Self::HnavBridge];
+    pub const OPT_IN: [TransportKind; 3] = [Self::HnavBridge, Self::HnavWaitSet, Self::UdsDgram];
 
     /// The name used in output (`iceoryx2`, `hnav`, `uds`, `tcp`, `crossbeam`, `futex`).
     pub fn name(self) -> &'static str {
@@ -145,6 +155,8 @@ impl TransportKind {
             Self::ZenohShm => "zenoh-shm",
             Self::Dora => "dora",
             Self::HnavBridge => "hnav-bridge",
+            Self::HnavWaitSet => "hnav-waitset",
+            Self::UdsDgram => "uds-dgram",
         }
     }
 
@@ -158,7 +170,9 @@ impl TransportKind {
             | Self::Zenoh
             | Self::ZenohShm
             | Self::Dora
-            | Self::HnavBridge => &[Mode::Event],
+            | Self::HnavBridge
+            | Self::HnavWaitSet
+            | Self::UdsDgram => &[Mode::Event],
         }
     }
 
@@ -166,7 +180,7 @@ impl TransportKind {
     /// at the smallest sizes (up to 64 B), as the wake-up reference.
     pub fn measures(self, size: usize) -> bool {
         match self {
-            Self::Futex => size <= 64,
+            Self::Futex | Self::UdsDgram => size <= 64,
             Self::HnavBridge => size.is_multiple_of(4) && size <= 4 << 20,
             _ => true,
         }
@@ -193,7 +207,8 @@ impl core::str::FromStr for TransportKind {
 pub enum Mode {
     /// Busy-loop on `receive` (the benchmark's explicit polling mode).
     Poll,
-    /// Block until woken: an iceoryx2 WaitSet (raw) or the HNAV `Waiter`, or a blocking socket read.
+    /// Block until woken: an iceoryx2 WaitSet (raw), the HNAV `SingleWaiter` or `Waiter`, or a
+    /// blocking socket read.
     Event,
 }
 
@@ -446,8 +461,14 @@ fn measure(
         TransportKind::Hnav => run_pair(
             w,
             n,
-            |pp| hnav::side(pp, Role::Ping, run, &prefix, size, mode),
-            |pp| hnav::side(pp, Role::Pong, run, &prefix, size, mode),
+            |pp| hnav::side(pp, Role::Ping, run, &prefix, size, mode, Wait::Single),
+            |pp| hnav::side(pp, Role::Pong, run, &prefix, size, mode, Wait::Single),
+        ),
+        TransportKind::HnavWaitSet => run_pair(
+            w,
+            n,
+            |pp| hnav::side(pp, Role::Ping, run, &prefix, size, mode, Wait::WaitSet),
+            |pp| hnav::side(pp, Role::Pong, run, &prefix, size, mode, Wait::WaitSet),
         ),
         TransportKind::Uds => {
             let (a, b) = sockets::uds_pair()?;
@@ -465,6 +486,15 @@ fn measure(
                 n,
                 move |pp| sockets::side(pp, Role::Ping, a, size),
                 move |pp| sockets::side(pp, Role::Pong, b, size),
+            )
+        }
+        TransportKind::UdsDgram => {
+            let (a, b) = sockets::uds_dgram_pair()?;
+            run_pair(
+                w,
+                n,
+                move |pp| sockets::dgram_side(pp, Role::Ping, a, size),
+                move |pp| sockets::dgram_side(pp, Role::Pong, b, size),
             )
         }
         TransportKind::Crossbeam => {

@@ -1,16 +1,17 @@
-//! Unix domain socket and TCP loopback: the copying baselines, with the same ping-pong.
+//! Unix domain socket and TCP loopback: the copying baselines, with the same ping-pong; and a
+//! Unix datagram pair, the floor of a wake-up by datagram.
 //!
 //! Each message is a 16-byte header (stamp, sequence number; little endian) followed by the
 //! payload. Buffers are allocated once per side and reused, so the numbers are the kernel's
 //! copy and wake-up cost, not the allocator's. Reads block, so these are `event` mode only.
 
-use std::io::{Read, Write};
+use std::io::{ErrorKind, Read, Write};
 use std::net::{Ipv4Addr, TcpListener, TcpStream};
-use std::os::unix::net::UnixStream;
+use std::os::unix::net::{UnixDatagram, UnixStream};
 
 use anyhow::{Context, Result};
 
-use super::pingpong::{PingPong, Role};
+use super::pingpong::{PingPong, Role, ABORT_POLL};
 use super::Stamp;
 
 /// Bytes of the header in front of every payload.
@@ -76,6 +77,55 @@ where
         // A peer that failed drops its socket, so this read ends with an error, not a hang.
         (&stream).read_exact(&mut rx_buf).context("read")?;
         Ok(decode_header(&rx_buf))
+    };
+    pp.run(role, send, recv)
+}
+
+/// A connected pair of Unix datagram sockets whose blocking `recv` gives up after
+/// [`ABORT_POLL`]: a peer that failed does not end a datagram socket's reads, as it ends a
+/// stream's.
+pub(crate) fn uds_dgram_pair() -> Result<(UnixDatagram, UnixDatagram)> {
+    let (a, b) = UnixDatagram::pair().context("create unix datagram pair")?;
+    for s in [&a, &b] {
+        s.set_read_timeout(Some(ABORT_POLL))
+            .context("set the receive timeout")?;
+    }
+    Ok((a, b))
+}
+
+/// Plays `role` over one end of a datagram pair: one datagram of header and `size` payload
+/// bytes per message, received by one blocking `recv` (the timeout set once, not per call).
+pub(crate) fn dgram_side(
+    pp: &PingPong,
+    role: Role,
+    socket: UnixDatagram,
+    size: usize,
+) -> Result<Vec<u64>> {
+    let (mut tx_buf, mut rx_buf) = pp.setup(role, || {
+        Ok((vec![0u8; HEADER_LEN + size], vec![0u8; HEADER_LEN + size]))
+    })?;
+    let send = |stamp: Stamp| -> Result<()> {
+        encode_header(stamp, &mut tx_buf);
+        let sent = socket.send(&tx_buf).context("send")?;
+        anyhow::ensure!(
+            sent == tx_buf.len(),
+            "sent {sent} of {} bytes",
+            tx_buf.len()
+        );
+        Ok(())
+    };
+    let recv = || -> Result<Stamp> {
+        loop {
+            match socket.recv(&mut rx_buf) {
+                Ok(n) if n == rx_buf.len() => return Ok(decode_header(&rx_buf)),
+                Ok(n) => anyhow::bail!("received {n} of {} bytes", rx_buf.len()),
+                // The timeout: look whether the other side gave up.
+                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
+                    pp.check()?;
+                }
+                Err(e) => return Err(e).context("recv"),
+            }
+        }
     };
     pp.run(role, send, recv)
 }

@@ -36,3 +36,19 @@ pub fn bench_within(args: &[&str], limit: Duration) -> Output {
         }
     }
 }
+
+/// `hnav-bench ARGS`, a `latency` run writing into `dir`, which must succeed within `limit`;
+/// the text of its `latency.csv`, checked to begin with the header.
+#[allow(dead_code)]
+pub fn latency_csv(args: &[&str], dir: &std::path::Path, limit: Duration) -> String {
+    let run = bench_within(args, limit);
+    assert!(
+        run.status.success(),
+        "{}\n{}",
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let text = std::fs::read_to_string(dir.join("latency.csv")).unwrap();
+    assert_eq!(text.lines().next(), Some(hnav_bench::latency::csv::HEADER));
+    text
+}

@@ -7,8 +7,9 @@
 //! (every one keeps room for observers, see `topics`) and never publishes. It reads with
 //! non-blocking receives when the viewer asks ([`Feed::pump`]): the topics are "latest"
 //! services without back-pressure, so a slow viewer loses the oldest samples and never
-//! holds up a publisher. Between pumps it sleeps in a [`Waiter`] with a deadline, woken early
-//! only by a lifecycle event (a death, a restart, `Stop`) or a termination signal.
+//! holds up a publisher. Between pumps it sleeps on its lifecycle receiver with a deadline
+//! ([`SingleWaiter`](hnav_runtime::transport::SingleWaiter)), woken early only by a lifecycle
+//! event (a death, a restart, `Stop`) or a termination signal.
 //!
 //! Progress and lifecycle are drained before ground truth and commits: a `done` or a `Stop`
 //! seen in a pump then comes with every pose the sim published before it. The registry is
@@ -26,9 +27,7 @@ use hnav_runtime::consensus_log::reader::LogReader;
 use hnav_runtime::consensus_log::record::Record;
 use hnav_runtime::msg::{Commit, Lifecycle, MoverPlace, MoversHeader, Progress, Truth, View};
 use hnav_runtime::topics;
-use hnav_runtime::transport::{
-    Receiver, RunId, SliceReceiver, Transport, TransportError, Waiter, Wake,
-};
+use hnav_runtime::transport::{Receiver, RunId, SliceReceiver, Transport, TransportError, Wake};
 
 /// How often the registry and `/proc` are read for the health rows.
 pub const HEALTH_PERIOD: Duration = Duration::from_secs(1);
@@ -95,7 +94,6 @@ pub struct LiveFeed {
     views: Vec<Receiver<View>>,
     /// The movers' places, in a run with movers.
     movers: Option<SliceReceiver<MoverPlace, MoversHeader>>,
-    waiter: Waiter,
     sampler: HealthSampler,
     rows: Vec<HealthRow>,
     next_health: Instant,
@@ -146,10 +144,9 @@ impl LiveFeed {
                 transport.receiver::<Commit>(topics::COMMIT, topics::commit_qos(n))?,
                 transport.receiver::<Progress>(topics::PROGRESS, topics::progress_qos())?,
                 transport.receiver::<Lifecycle>(topics::LIFECYCLE, topics::lifecycle_qos(n))?,
-                transport.waiter()?,
             ))
         };
-        let (truth, commit, progress, life, waiter) = open().map_err(transport_err)?;
+        let (truth, commit, progress, life) = open().map_err(transport_err)?;
         let views = match scenario.sensing {
             Some(_) => (0..n)
                 .map(|i| transport.receiver::<View>(&topics::view(i), topics::state_qos()))
@@ -171,7 +168,6 @@ impl LiveFeed {
             life,
             views,
             movers,
-            waiter,
             sampler: HealthSampler::new(),
             rows: Vec::new(),
             next_health: Instant::now(),
@@ -220,11 +216,9 @@ impl Feed for LiveFeed {
         if self.ended {
             return Ok(Waited::Ready);
         }
-        // Attached for this wait only: an attachment borrows the waiter and the receiver.
-        let attached = self.waiter.attach(&self.life).map_err(|e| self.err(e))?;
-        let wake = self.waiter.wait(Some(until)).map_err(|e| self.err(e));
-        drop(attached);
-        Ok(match wake? {
+        // The lifecycle is the one source the feed sleeps on (the rest is read at `until`).
+        let wake = self.transport.single_waiter(&self.life).wait(Some(until));
+        Ok(match wake.map_err(|e| self.err(e))? {
             Wake::Stop => Waited::Stop,
             Wake::Data | Wake::TimedOut => Waited::Ready,
         })

@@ -321,7 +321,9 @@ impl Loop {
     ) -> Result<(), TransportError> {
         for (i, rx) in inputs.wheels.iter().enumerate() {
             let mut latest = None;
-            rx.drain(|c| latest = Some((c.left_rad_s, c.right_rad_s)))?;
+            // Consumes the listener's events too (the waiter is attached to it): a pending
+            // event would end every later wait at once.
+            rx.drain_pending(|c| latest = Some((c.left_rad_s, c.right_rad_s)))?;
             let (Some(w), Some(r)) = (latest, outside.robots.get_mut(i)) else {
                 continue;
             };

@@ -5,13 +5,13 @@ use std::time::Duration;
 
 use iceoryx2::config::Config;
 use iceoryx2::node::Node;
-use iceoryx2::prelude::{NodeBuilder, NodeName, SignalHandlingMode, ZeroCopySend};
+use iceoryx2::prelude::{IceoryxSend, NodeBuilder, NodeName, SignalHandlingMode, ZeroCopySend};
 
 use super::nodes::{cleanup_dead_nodes_in, nodes_in, services_in, CleanupReport, NodeInfo};
 use super::run::check_ipc_root;
 use super::{
-    run_config, Ipc, Qos, Receiver, RunId, Sender, SliceReceiver, SliceSender, TransportError,
-    Waiter,
+    run_config, Ipc, Qos, Receiver, RunId, Sender, SingleWaiter, SliceReceiver, SliceSender,
+    TransportError, Waiter,
 };
 
 /// Builds a [`Transport`].
@@ -169,6 +169,20 @@ impl Transport {
     /// blocks in.
     pub fn waiter(&self) -> Result<Waiter, TransportError> {
         Waiter::create(self.run.as_str(), self.signals)
+    }
+
+    /// A [`SingleWaiter`] on `receiver`, with the same signal handling as the node: for a loop
+    /// whose only event source is that receiver (no interval, no second receiver, no bell);
+    /// it waits on the receiver's own descriptor, without a `WaitSet`.
+    pub fn single_waiter<'a, P, H>(&self, receiver: &'a Receiver<P, H>) -> SingleWaiter<'a>
+    where
+        P: Debug + IceoryxSend + ?Sized + 'static,
+        H: Debug + ZeroCopySend + 'static,
+    {
+        SingleWaiter::new(
+            receiver,
+            self.signals == SignalHandlingMode::HandleTerminationRequests,
+        )
     }
 
     /// Every node of this run, alive or dead.

@@ -1,9 +1,13 @@
-//! The one place a process blocks: a [`Waiter`] around iceoryx2's `WaitSet`.
+//! Where a process with several event sources blocks: a [`Waiter`] around iceoryx2's
+//! `WaitSet`.
 //!
 //! Every HNAV loop has the same shape: drain its inputs, then sleep until one of them is
 //! signalled, a period ticks, a deadline passes or the process is asked to stop. The
 //! [`Waiter`] is that sleep. It owns the iceoryx2 `WaitSet`, so no process crate names an
-//! iceoryx2 type, and it decides once, for every loop, what a wake-up means ([`Wake`]).
+//! iceoryx2 type, and it decides once, for every loop, what a wake-up means ([`Wake`]). A
+//! loop whose only source is one receiver sleeps on that receiver instead
+//! ([`SingleWaiter`](super::SingleWaiter), `transport::single`): the same [`Wake`]s, the same
+//! drain order and re-check, without the `WaitSet`'s cost per wake-up.
 //!
 //! ## Drain order
 //!
@@ -111,14 +115,39 @@ pub fn stop_requested() -> bool {
 /// Reads (and so consumes) iceoryx2's termination flag and makes it sticky. The first call
 /// also installs iceoryx2's handlers for SIGINT/SIGTERM, which is why only waiters of a
 /// transport that handles signals call it.
-fn poll_termination() -> bool {
+pub(super) fn poll_termination() -> bool {
     if SignalHandler::termination_requested() {
         STOP.store(true, Ordering::Relaxed);
     }
     stop_requested()
 }
 
-/// Why [`Waiter::wait`] returned.
+/// How long one wait may sleep: until `deadline`, and no longer than `recheck` (the
+/// lost-wake-up re-check) and [`LONGEST_TIMED_SLEEP`]. `Duration::MAX` when neither bounds
+/// it: iceoryx2's "no timeout", a plain blocking wait.
+pub(super) fn sleep_bound(deadline: Option<Instant>, recheck: Option<Duration>) -> Duration {
+    let left = deadline.map(|d| d.saturating_duration_since(Instant::now()));
+    match (left, recheck) {
+        (None, None) => Duration::MAX,
+        (l, r) => l
+            .unwrap_or(Duration::MAX)
+            .min(r.unwrap_or(Duration::MAX))
+            .min(LONGEST_TIMED_SLEEP),
+    }
+}
+
+/// What a wait that nothing signalled means: [`Wake::TimedOut`] when an interval `ticked` or
+/// the deadline passed; otherwise the re-check (or the longest timed sleep) ended it, which
+/// is [`Wake::Data`] too ("look again").
+pub(super) fn slept(ticked: bool, deadline: Option<Instant>) -> Wake {
+    if ticked || deadline.is_some_and(|d| Instant::now() >= d) {
+        Wake::TimedOut
+    } else {
+        Wake::Data
+    }
+}
+
+/// Why [`Waiter::wait`] (or [`SingleWaiter::wait`](super::SingleWaiter::wait)) returned.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Wake {
     /// Go and drain every attached receiver; there may be nothing there. Returned when
@@ -340,16 +369,7 @@ impl Waiter {
         if self.handle_signals && stop_requested() {
             return Ok(Wake::Stop);
         }
-        let now = Instant::now();
-        let left = deadline.map(|d| d.saturating_duration_since(now));
-        // Duration::MAX is iceoryx2's "no timeout" (a plain blocking wait).
-        let timeout = match (left, self.recheck) {
-            (None, None) => Duration::MAX,
-            (l, r) => l
-                .unwrap_or(Duration::MAX)
-                .min(r.unwrap_or(Duration::MAX))
-                .min(LONGEST_TIMED_SLEEP),
-        };
+        let timeout = sleep_bound(deadline, self.recheck);
         let (mut any_signalled, mut ticked) = (false, false);
         let intervals = self.intervals.borrow();
         let bells = self.bells.borrow();
@@ -381,13 +401,10 @@ impl Waiter {
                 }
             }
             Ok(WaitSetRunResult::AllEventsHandled | WaitSetRunResult::StopRequest) => {
-                let deadline_passed = deadline.is_some_and(|d| Instant::now() >= d);
-                // Nothing signalled and nothing due is data too: the re-check (or the longest
-                // timed sleep) ended the wait.
-                Ok(if !any_signalled && (ticked || deadline_passed) {
-                    Wake::TimedOut
-                } else {
+                Ok(if any_signalled {
                     Wake::Data
+                } else {
+                    slept(ticked, deadline)
                 })
             }
             Err(e) => Err(TransportError::ipc("wait", &self.run, e)),
