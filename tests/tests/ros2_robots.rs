@@ -194,14 +194,24 @@ fn a_ros2_stand_in_drives_the_demos_six_robots_to_their_goals_through_malformed_
         .lines()
         .find(|l| l.contains("periods=") && l.contains("malformed="))
         .unwrap_or_else(|| panic!("no final counts in sim.log:\n{sim_log}"));
-    let malformed: u64 = counts
-        .split("malformed=")
-        .nth(1)
-        .and_then(|v| v.split_whitespace().next())
-        .and_then(|v| v.parse().ok())
-        .unwrap();
-    assert!(malformed >= 1, "{counts}");
+    let field = |k: &str| -> f64 {
+        counts
+            .split(&format!("{k}="))
+            .nth(1)
+            .and_then(|v| v.split_whitespace().next())
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("no {k} in {counts}"))
+    };
+    let malformed = field("malformed");
+    assert!(malformed >= 1.0, "{counts}");
     assert!(counts.contains(" down=0"), "{counts}");
+    // It sleeps between periods: a loop that leaves a listener's event pending wakes at once
+    // forever and spends the whole run on a core (it did, before drain_pending).
+    let (cpu_s, wall_s) = (field("cpu_ms") / 1e3, field("periods") / 100.0);
+    assert!(
+        cpu_s < 0.5 * wall_s,
+        "hnav-ros2 --robots spent {cpu_s:.1} s of CPU in a {wall_s:.1} s run: {counts}"
+    );
 }
 
 #[test]

@@ -86,15 +86,32 @@ pub struct OutsideCounts {
     pub malformed: u64,
     /// Times a robot went down.
     pub down: u64,
+    /// The process's CPU time (user + system) at the end, ms: a loop that sleeps as it
+    /// should spends a small part of the run's wall time.
+    pub cpu_ms: u64,
 }
 
 impl std::fmt::Display for OutsideCounts {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} periods={} heard={} malformed={} down={}",
-            self.relay, self.periods, self.heard, self.malformed, self.down
+            "{} periods={} heard={} malformed={} down={} cpu_ms={}",
+            self.relay, self.periods, self.heard, self.malformed, self.down, self.cpu_ms
         )
+    }
+}
+
+impl OutsideCounts {
+    /// The counts at the end: the relay's, and the CPU time spent.
+    fn ended(mut self, relay: Counts) -> Self {
+        use nix::sys::resource::{getrusage, UsageWho};
+        use nix::sys::time::TimeValLike;
+        self.relay = relay;
+        if let Ok(u) = getrusage(UsageWho::RUSAGE_SELF) {
+            let ms = u.user_time().num_milliseconds() + u.system_time().num_milliseconds();
+            self.cpu_ms = u64::try_from(ms).unwrap_or(0);
+        }
+        self
     }
 }
 
@@ -220,14 +237,12 @@ pub fn drive(
             st.next_state = now + st.state_period;
         }
         if stop {
-            counts.relay = out.counts;
-            return Ok(counts);
+            return Ok(counts.ended(out.counts));
         }
         let until = st.due().min(st.next_state);
         if waiter.wait(heart.until(Some(until))?)? == Wake::Stop {
             publish_state(&mut scene, topics, &mut s, &mut out);
-            counts.relay = out.counts;
-            return Ok(counts);
+            return Ok(counts.ended(out.counts));
         }
     }
 }
