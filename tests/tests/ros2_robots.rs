@@ -258,6 +258,35 @@ fn a_robot_that_never_publishes_joint_states_is_down_and_the_run_ends_by_its_tim
 }
 
 #[test]
+fn robots_that_publish_their_own_odom_are_driven_home_from_its_differences() {
+    let Some(python) = python() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = tmp.path().join("two-lanes-odom.toml");
+    // The robots' odom frames start where each robot does, not at the map's origin.
+    std::fs::write(
+        &scenario,
+        format!("{TWO_LANES}[ros2]\nodometry = \"odom\"\n"),
+    )
+    .unwrap();
+    let d = drive("ros2-odom", &python, tmp.path(), &scenario, &["--odom"]);
+    let text = d.lines.join("\n");
+    assert!(
+        d.status.is_some_and(|s| s.success()),
+        "{:?}\n{text}\n--- sim.log:\n{}",
+        d.status,
+        d.sim_log
+    );
+    assert_eq!(d.lines.last().map(String::as_str), Some("OK"), "{text}");
+    assert!(
+        d.run_status.as_ref().is_ok_and(|s| s.success()),
+        "{:?}\n{}",
+        d.run_status,
+        d.swarm.log_tails()
+    );
+    assert!(d.sim_log.contains("down=0"), "{}", d.sim_log);
+}
+
+#[test]
 fn an_unreachable_router_is_said_and_the_run_goes_on() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = tmp.path().join("two-lanes.toml");

@@ -22,6 +22,10 @@ frame HNAV uses (x along the map's columns, y along its rows). Each step moves a
 the exact arc of its wheels' speeds. Its own collision check, every step: two robots' discs
 (`--radius`) overlapping, or a disc overlapping a blocked cell or leaving the map.
 
+With `--odom` each robot publishes `/robot_<i>/odom` (`nav_msgs/msg/Odometry` in its own
+frame `robot_<i>/odom`, whose origin is where the robot started) instead of `joint_states`,
+for a scenario with `[ros2] odometry = "odom"`.
+
 Bad input for HNAV, on request: `--silent I` never publishes robot I's `joint_states`;
 `--malformed I` publishes, once a second, a sample on robot I's `joint_states` that is not
 CDR of a JointState.
@@ -192,14 +196,19 @@ def joint_state(t_ns, wheels, speeds):
     )
 
 
-def odometry(t_ns, i, r):
+def odometry(t_ns, i, r, frame="map", origin=(0.0, 0.0, 0.0)):
+    """Robot `r`'s pose and twist, in `frame` whose origin is `origin` (x, y, yaw) in map."""
+    ox, oy, oyaw = origin
+    dx, dy = r.x - ox, r.y - oy
+    c, s = math.cos(-oyaw), math.sin(-oyaw)
+    x, y, yaw = c * dx - s * dy, s * dx + c * dy, r.yaw - oyaw
     return Odometry(
-        header=Header(stamp=stamp(t_ns), frame_id="map"),
+        header=Header(stamp=stamp(t_ns), frame_id=frame),
         child_frame_id=f"robot_{i}/base_link",
         pose=PoseWithCovariance(
             pose=Pose(
-                position=Point(x=r.x, y=r.y, z=0.0),
-                orientation=Quaternion(x=0.0, y=0.0, z=math.sin(r.yaw / 2), w=math.cos(r.yaw / 2)),
+                position=Point(x=x, y=y, z=0.0),
+                orientation=Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2)),
             ),
             covariance=np.zeros(36, dtype=np.float64),
         ),
@@ -221,6 +230,7 @@ def main():
     ap.add_argument("--rate", type=float, default=50.0, help="steps and messages per second")
     ap.add_argument("--cmd-timeout", type=float, default=0.5)
     ap.add_argument("--domain", type=int, default=0)
+    ap.add_argument("--odom", action="store_true", help="publish odom, not joint_states")
     ap.add_argument("--silent", type=int, action="append", default=[])
     ap.add_argument("--malformed", type=int, action="append", default=[])
     ap.add_argument("--timeout", type=float, default=150.0)
@@ -256,10 +266,14 @@ def main():
                     hnav["alive"] -= 1
 
     live = session.liveliness().declare_subscriber(f"@ros2_lv/{a.domain}/**", on_token, history=True)
-    subs, joints, truths = [], [], []
+    subs, joints, truths, odoms = [], [], [], []
+    origins = [(r.x, r.y, r.yaw) for r in robots]
     for r in robots:
         subs.append(node.subscription(f"/robot_{r.i}/cmd_vel", "geometry_msgs/msg/Twist", r.on_cmd))
-        joints.append(node.publisher(f"/robot_{r.i}/joint_states", "sensor_msgs/msg/JointState"))
+        if a.odom:
+            odoms.append(node.publisher(f"/robot_{r.i}/odom", "nav_msgs/msg/Odometry"))
+        else:
+            joints.append(node.publisher(f"/robot_{r.i}/joint_states", "sensor_msgs/msg/JointState"))
         truths.append(node.publisher(f"/robot_{r.i}/ground_truth", "nav_msgs/msg/Odometry"))
     contacts = Contacts(rows, a.cell, a.radius)
     print(f"router up {a.listen}", flush=True)
@@ -275,7 +289,13 @@ def main():
         now_ns = time.time_ns()
         for r in robots:
             speeds = r.step(dt, a.wheel_radius, a.axle, a.cmd_timeout)
-            if r.i not in a.silent:
+            if r.i in a.silent:
+                pass
+            elif a.odom:
+                odoms[r.i].put(TS.serialize_cdr(
+                    odometry(now_ns, r.i, r, f"robot_{r.i}/odom", origins[r.i]),
+                    "nav_msgs/msg/Odometry"))
+            else:
                 joints[r.i].put(TS.serialize_cdr(joint_state(now_ns, r.wheels, speeds),
                                                  "sensor_msgs/msg/JointState"))
             truths[r.i].put(TS.serialize_cdr(odometry(now_ns, r.i, r), "nav_msgs/msg/Odometry"))
