@@ -179,6 +179,7 @@ fn a_ros2_stand_in_drives_the_demos_six_robots_to_their_goals_through_malformed_
         swarm.log_tails()
     );
     let summary = swarm.summary().unwrap();
+    assert_eq!(summary["robots_outside"], true, "{summary:#}");
     let agents = summary["agents"].as_array().unwrap();
     assert_eq!(agents.len(), 6);
     assert!(

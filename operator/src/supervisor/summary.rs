@@ -94,6 +94,10 @@ pub struct RunSummary {
     pub agents: Vec<AgentSummary>,
     /// Collisions the sim recorded on ground truth.
     pub collisions: u32,
+    /// The robots were outside HNAV (`[sim] kind = "ros2"`): `collisions` is not counted
+    /// here but by their world. Only written when true.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub robots_outside: bool,
     /// Decision rounds committed.
     pub rounds: u64,
     /// Wall time of the run in seconds.
@@ -253,6 +257,7 @@ impl RunSummary {
             rules: String::new(),
             agents,
             collisions: truth.map_or(0, |t| t.collisions),
+            robots_outside: false,
             rounds,
             wall_time_s,
             end,
@@ -321,6 +326,7 @@ impl RunSummary {
             rules: scenario.coordinator.rules.name().to_string(),
             agents,
             collisions: truth.map_or(0, |t| t.collisions),
+            robots_outside: false,
             rounds: progress.map_or(0, |p| p.round),
             wall_time_s,
             end: end.to_string(),
@@ -344,6 +350,7 @@ impl RunSummary {
     pub fn fill_criteria(&mut self, scenario: &hnav_runtime::scenario::Scenario, run_dir: &Path) {
         let log = self.log.clone();
         criteria::fill(self, scenario, run_dir, &log);
+        self.robots_outside = scenario.sim.kind == hnav_runtime::scenario::SimKind::Ros2;
     }
 
     /// Writes `summary.json` into `dir` atomically; returns its path.
