@@ -288,6 +288,64 @@ fn robots_that_publish_their_own_odom_are_driven_home_from_its_differences() {
 }
 
 #[test]
+fn a_killed_robots_process_is_restarted_and_drives_on_from_where_the_run_was() {
+    let Some(python) = python() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = tmp.path().join("two-lanes.toml");
+    // Far enough that the robots are on their way at the kill.
+    std::fs::write(
+        &scenario,
+        TWO_LANES
+            .replace("\"......\"", "\"............\"")
+            .replace("goal = [5,", "goal = [11,")
+            .replace("time_limit_s = 12", "time_limit_s = 40"),
+    )
+    .unwrap();
+    let mut run = TestRun::new("ros2-restart");
+    let (mut robots, endpoint) = stand_in(&mut run, &python, &scenario, &[]);
+    let out = tmp.path().join("out");
+    let mut swarm = SwarmRun::start(
+        &mut run,
+        &scenario,
+        &out,
+        &tmp.path().join("runs"),
+        &["--ros2-router", &endpoint, "--kill", "sim@2s"],
+    )
+    .expect("hnav run starts");
+    let (lines, status) = until_exit(&mut robots);
+    let run_status = swarm.finish(Duration::from_secs(30));
+    let text = lines.join("\n");
+    let sim_log = std::fs::read_to_string(out.join("logs/sim.log")).unwrap_or_default();
+    let events = std::fs::read_to_string(out.join("events.jsonl")).unwrap_or_default();
+    assert!(
+        events.contains("\"event\":\"spawned\"") && events.contains("\"node\":\"sim\""),
+        "the sim's slot was not respawned:\n{events}"
+    );
+    assert!(
+        status.is_some_and(|s| s.success()),
+        "{status:?}\n{text}\n--- sim.log:\n{sim_log}"
+    );
+    assert!(
+        run_status.as_ref().is_ok_and(|s| s.success()),
+        "{run_status:?}\n{}\n{events}",
+        swarm.log_tails()
+    );
+    // The successor counted on from the run's start (2 s of 10 ms periods before the kill),
+    // not from 1, which every agent would have ignored.
+    let resumed: u64 = (sim_log.lines())
+        .find_map(|l| {
+            l.split("resumed at period ")
+                .nth(1)?
+                .split_whitespace()
+                .next()?
+                .parse()
+                .ok()
+        })
+        .unwrap_or_else(|| panic!("no resume in sim.log:\n{sim_log}"));
+    assert!(resumed >= 150, "resumed at period {resumed}\n{sim_log}");
+}
+
+#[test]
 fn an_unreachable_router_is_said_and_the_run_goes_on() {
     let tmp = tempfile::tempdir().unwrap();
     let scenario = tmp.path().join("two-lanes.toml");

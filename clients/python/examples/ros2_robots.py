@@ -30,7 +30,8 @@ Bad input for HNAV, on request: `--silent I` never publishes robot I's `joint_st
 `--malformed I` publishes, once a second, a sample on robot I's `joint_states` that is not
 CDR of a JointState.
 
-When HNAV's node `/hnav` has come and gone (the run's end), it prints each robot's final
+When HNAV's node `/hnav` has come and gone for `--end-grace` seconds (the run's end; a
+restarted `hnav-ros2 --robots` is away for less), it prints each robot's final
 pose and distance to its goal, the collisions, and `OK` (exit 0) if every robot that was not
 silent is within half a cell of its goal and nothing collided; otherwise `PROBLEM` lines,
 exit 1.
@@ -234,6 +235,9 @@ def main():
     ap.add_argument("--silent", type=int, action="append", default=[])
     ap.add_argument("--malformed", type=int, action="append", default=[])
     ap.add_argument("--timeout", type=float, default=150.0)
+    ap.add_argument("--end-grace", type=float, default=2.0,
+                    help="s without HNAV's node before the run counts as ended (a restarted "
+                         "hnav-ros2 --robots is away meanwhile)")
     a = ap.parse_args()
 
     scen = tomllib.loads(a.scenario.read_text())
@@ -282,10 +286,16 @@ def main():
     t0 = time.monotonic()
     deadline = t0 + a.timeout
     next_t, next_bad, malformed_sent = t0, t0 + 1.0, 0
+    gone_since = None
     while time.monotonic() < deadline:
         with lock:
-            if hnav["seen"] and hnav["alive"] <= 0:
-                break
+            gone = hnav["seen"] and hnav["alive"] <= 0
+        if not gone:
+            gone_since = None
+        elif gone_since is None:
+            gone_since = time.monotonic()
+        elif time.monotonic() - gone_since >= a.end_grace:
+            break
         now_ns = time.time_ns()
         for r in robots:
             speeds = r.step(dt, a.wheel_radius, a.axle, a.cmd_timeout)

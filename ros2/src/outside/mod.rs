@@ -211,6 +211,9 @@ pub fn drive(
     }
     attached.push(waiter.attach(ports.life.events())?);
     let mut st = Loop::new(scenario, opts, origin);
+    if opts.resume {
+        tracing::info!("resumed at period {} of the run's clock", st.k);
+    }
     tracing::info!(
         robots = n,
         odometry = ?opts.ros2.odometry,
