@@ -195,6 +195,7 @@ fn a_ros2_stand_in_drives_the_demos_six_robots_to_their_goals_through_malformed_
         .lines()
         .find(|l| l.contains("periods=") && l.contains("malformed="))
         .unwrap_or_else(|| panic!("no final counts in sim.log:\n{sim_log}"));
+    eprintln!("{counts}");
     let field = |k: &str| -> f64 {
         counts
             .split(&format!("{k}="))
