@@ -119,19 +119,22 @@ struct Driven {
     _run: TestRun,
 }
 
-/// Runs `scenario` (in `tmp`) with the stand-in given `extra`, until both have ended.
-fn drive(tag: &str, python: &Path, tmp: &Path, scenario: &Path, extra: &[&str]) -> Driven {
+/// Runs `scenario` (in `tmp`) with the stand-in given `extra` and `hnav run` given
+/// `run_extra`, until both have ended.
+fn drive(
+    tag: &str,
+    python: &Path,
+    tmp: &Path,
+    scenario: &Path,
+    (extra, run_extra): (&[&str], &[&str]),
+) -> Driven {
     let mut run = TestRun::new(tag);
     let (mut robots, endpoint) = stand_in(&mut run, python, scenario, extra);
     let out = tmp.join("out");
-    let mut swarm = SwarmRun::start(
-        &mut run,
-        scenario,
-        &out,
-        &tmp.join("runs"),
-        &["--ros2-router", &endpoint],
-    )
-    .expect("hnav run starts");
+    let mut args = vec!["--ros2-router", &endpoint];
+    args.extend_from_slice(run_extra);
+    let mut swarm = SwarmRun::start(&mut run, scenario, &out, &tmp.join("runs"), &args)
+        .expect("hnav run starts");
     let (lines, status) = until_exit(&mut robots);
     let run_status = swarm.finish(Duration::from_secs(30));
     eprintln!("{}", lines.join("\n"));
@@ -155,7 +158,7 @@ fn a_ros2_stand_in_drives_the_demos_six_robots_to_their_goals_through_malformed_
         &python,
         tmp.path(),
         &scenario,
-        &["--malformed", "0"],
+        (&["--malformed", "0"], &[]),
     );
     let Driven {
         lines,
@@ -227,7 +230,7 @@ fn a_robot_that_never_publishes_joint_states_is_down_and_the_run_ends_by_its_tim
         &python,
         tmp.path(),
         &scenario,
-        &["--silent", "1"],
+        (&["--silent", "1"], &[]),
     );
     let Driven {
         lines,
@@ -270,7 +273,13 @@ fn robots_that_publish_their_own_odom_are_driven_home_from_its_differences() {
         format!("{TWO_LANES}[ros2]\nodometry = \"odom\"\n"),
     )
     .unwrap();
-    let d = drive("ros2-odom", &python, tmp.path(), &scenario, &["--odom"]);
+    let d = drive(
+        "ros2-odom",
+        &python,
+        tmp.path(),
+        &scenario,
+        (&["--odom"], &[]),
+    );
     let text = d.lines.join("\n");
     assert!(
         d.status.is_some_and(|s| s.success()),
@@ -302,22 +311,23 @@ fn a_killed_robots_process_is_restarted_and_drives_on_from_where_the_run_was() {
             .replace("time_limit_s = 12", "time_limit_s = 40"),
     )
     .unwrap();
-    let mut run = TestRun::new("ros2-restart");
-    let (mut robots, endpoint) = stand_in(&mut run, &python, &scenario, &[]);
-    let out = tmp.path().join("out");
-    let mut swarm = SwarmRun::start(
-        &mut run,
+    let d = drive(
+        "ros2-restart",
+        &python,
+        tmp.path(),
         &scenario,
-        &out,
-        &tmp.path().join("runs"),
-        &["--ros2-router", &endpoint, "--kill", "sim@2s"],
-    )
-    .expect("hnav run starts");
-    let (lines, status) = until_exit(&mut robots);
-    let run_status = swarm.finish(Duration::from_secs(30));
+        (&[], &["--kill", "sim@2s"]),
+    );
+    let Driven {
+        lines,
+        status,
+        run_status,
+        sim_log,
+        swarm,
+        ..
+    } = &d;
     let text = lines.join("\n");
-    let sim_log = std::fs::read_to_string(out.join("logs/sim.log")).unwrap_or_default();
-    let events = std::fs::read_to_string(out.join("events.jsonl")).unwrap_or_default();
+    let events = std::fs::read_to_string(swarm.dir.join("events.jsonl")).unwrap_or_default();
     assert!(
         events.contains("\"event\":\"spawned\"") && events.contains("\"node\":\"sim\""),
         "the sim's slot was not respawned:\n{events}"
