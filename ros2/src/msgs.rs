@@ -178,6 +178,16 @@ pub struct Odometry {
     pub twist: TwistWithCovariance,
 }
 
+impl Odometry {
+    /// The pose as a planar robot's: x, y and yaw in `header.frame_id`; `None` if any is not a
+    /// finite number (what came from outside is not trusted to be).
+    pub fn planar(&self) -> Option<(f64, f64, f64)> {
+        let p = &self.pose.pose;
+        let v = (p.position.x, p.position.y, p.orientation.yaw_angle());
+        (v.0.is_finite() && v.1.is_finite() && v.2.is_finite()).then_some(v)
+    }
+}
+
 /// `geometry_msgs/msg/PoseStamped`.
 #[derive(serde::Serialize, Debug, Clone, Default, PartialEq)]
 pub struct PoseStamped {

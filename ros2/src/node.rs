@@ -98,6 +98,19 @@ impl Node {
         &self.name
     }
 
+    /// The next entity of the node on `topic`: its data key expression and its liveliness
+    /// token, which `token` makes of the node's names and the entity's id.
+    fn entity(
+        &mut self,
+        topic: &str,
+        ty: &TypeInfo,
+        token: impl FnOnce(&NodeName, u32) -> String,
+    ) -> (String, String) {
+        let eid = self.next_eid;
+        self.next_eid += 1;
+        (self.name.topic_key(topic, ty), token(&self.name, eid))
+    }
+
     /// Declares a publisher of `ty` on `topic` (a fully qualified name) with `qos`.
     pub fn publisher(
         &mut self,
@@ -105,10 +118,7 @@ impl Node {
         ty: &TypeInfo,
         qos: Qos,
     ) -> Result<Publisher, NodeError> {
-        let eid = self.next_eid;
-        self.next_eid += 1;
-        let key = self.name.topic_key(topic, ty);
-        let token = self.name.publisher_token(eid, topic, ty, qos);
+        let (key, token) = self.entity(topic, ty, |n, eid| n.publisher_token(eid, topic, ty, qos));
         let builder = (self.session.declare_publisher(key.clone()))
             .reliability(Reliability::Reliable)
             .congestion_control(CongestionControl::Drop);
@@ -145,10 +155,9 @@ impl Node {
         ty: &TypeInfo,
         qos: Qos,
     ) -> Result<Subscription, NodeError> {
-        let eid = self.next_eid;
-        self.next_eid += 1;
-        let key = self.name.topic_key(topic, ty);
-        let token = self.name.subscription_token(eid, topic, ty, qos);
+        let (key, token) = self.entity(topic, ty, |n, eid| {
+            n.subscription_token(eid, topic, ty, qos)
+        });
         // Only other sessions' samples: the node may publish on the same topic name (its
         // `odom`), and must not read its own.
         let subscriber = (self.session.declare_subscriber(key.clone()))

@@ -119,6 +119,20 @@ struct Driven {
     _run: TestRun,
 }
 
+impl Driven {
+    /// The stand-in's own checks passed: it exits 0 only after it printed `OK`.
+    fn stand_in_passed(&self) {
+        assert!(
+            self.status.is_some_and(|s| s.success()),
+            "the stand-in's checks ({:?}):\n{}\n--- sim.log:\n{}\n{}",
+            self.status,
+            self.lines.join("\n"),
+            self.sim_log,
+            self.swarm.log_tails()
+        );
+    }
+}
+
 /// Runs `scenario` (in `tmp`) with the stand-in given `extra` and `hnav run` given
 /// `run_extra`, until both have ended.
 fn drive(
@@ -162,18 +176,13 @@ fn a_ros2_stand_in_drives_the_demos_six_robots_to_their_goals_through_malformed_
     );
     let Driven {
         lines,
-        status,
         run_status,
         sim_log,
         swarm,
         ..
     } = &d;
     let text = lines.join("\n");
-    assert!(
-        status.is_some_and(|s| s.success()),
-        "the stand-in's checks ({status:?}):\n{text}\n--- sim.log:\n{sim_log}\n{}",
-        swarm.log_tails()
-    );
+    d.stand_in_passed();
     assert_eq!(lines.last().map(String::as_str), Some("OK"), "{text}");
     assert!(lines.iter().any(|l| l == "collisions 0"), "{text}");
     assert!(
@@ -233,19 +242,13 @@ fn a_robot_that_never_publishes_joint_states_is_down_and_the_run_ends_by_its_tim
         (&["--silent", "1"], &[]),
     );
     let Driven {
-        lines,
-        status,
         run_status,
         sim_log,
         swarm,
         ..
     } = &d;
-    let text = lines.join("\n");
     // Robot 0 went home; the stand-in leaves the silent robot out of its goal check.
-    assert!(
-        status.is_some_and(|s| s.success()),
-        "{status:?}\n{text}\n--- sim.log:\n{sim_log}"
-    );
+    d.stand_in_passed();
     assert!(
         sim_log.contains("robot 1 down: nothing on /robot_1/joint_states for 1.0 s"),
         "{sim_log}"
@@ -280,14 +283,13 @@ fn robots_that_publish_their_own_odom_are_driven_home_from_its_differences() {
         &scenario,
         (&["--odom"], &[]),
     );
-    let text = d.lines.join("\n");
-    assert!(
-        d.status.is_some_and(|s| s.success()),
-        "{:?}\n{text}\n--- sim.log:\n{}",
-        d.status,
-        d.sim_log
+    d.stand_in_passed();
+    assert_eq!(
+        d.lines.last().map(String::as_str),
+        Some("OK"),
+        "{}",
+        d.lines.join("\n")
     );
-    assert_eq!(d.lines.last().map(String::as_str), Some("OK"), "{text}");
     assert!(
         d.run_status.as_ref().is_ok_and(|s| s.success()),
         "{:?}\n{}",
@@ -319,23 +321,17 @@ fn a_killed_robots_process_is_restarted_and_drives_on_from_where_the_run_was() {
         (&[], &["--kill", "sim@2s"]),
     );
     let Driven {
-        lines,
-        status,
         run_status,
         sim_log,
         swarm,
         ..
     } = &d;
-    let text = lines.join("\n");
     let events = std::fs::read_to_string(swarm.dir.join("events.jsonl")).unwrap_or_default();
     assert!(
         events.contains("\"event\":\"spawned\"") && events.contains("\"node\":\"sim\""),
         "the sim's slot was not respawned:\n{events}"
     );
-    assert!(
-        status.is_some_and(|s| s.success()),
-        "{status:?}\n{text}\n--- sim.log:\n{sim_log}"
-    );
+    d.stand_in_passed();
     assert!(
         run_status.as_ref().is_ok_and(|s| s.success()),
         "{run_status:?}\n{}\n{events}",

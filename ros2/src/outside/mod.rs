@@ -395,13 +395,11 @@ impl Loop {
             });
             outside.truth[i].drain(|payload| match crate::msgs::decode::<Odometry>(payload) {
                 Ok(o) => {
-                    let p = &o.pose.pose;
-                    let yaw = p.orientation.yaw_angle();
-                    if p.position.x.is_finite() && p.position.y.is_finite() && yaw.is_finite() {
+                    if let Some((x_m, y_m, theta_rad)) = o.planar() {
                         r.truth = Some(Pose {
-                            x_m: p.position.x,
-                            y_m: p.position.y,
-                            theta_rad: yaw,
+                            x_m,
+                            y_m,
+                            theta_rad,
                         });
                         counts.heard += 1;
                     }

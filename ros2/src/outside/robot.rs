@@ -8,8 +8,9 @@ use hnav_runtime::msg::Pose;
 
 use super::wheels::OdomWheels;
 
-/// One robot outside HNAV.
-#[derive(Debug, Clone)]
+/// One robot outside HNAV; the default is one never heard, never commanded, never sent a
+/// stop (so the first stop a rule asks for goes out).
+#[derive(Debug, Clone, Default)]
 pub struct OutsideRobot {
     /// When its odometry source was last heard from (`None`: never).
     pub heard: Option<Instant>,
@@ -27,22 +28,6 @@ pub struct OutsideRobot {
     pub stopped: bool,
     /// The agent is down or lost (the supervisor's word): the robot is held.
     pub agent_down: bool,
-}
-
-impl Default for OutsideRobot {
-    fn default() -> Self {
-        OutsideRobot {
-            heard: None,
-            down: false,
-            angles: (0.0, 0.0),
-            odom: OdomWheels::default(),
-            truth: None,
-            commanded: None,
-            // Nothing was sent: the first stop a rule asks for goes out.
-            stopped: false,
-            agent_down: false,
-        }
-    }
 }
 
 /// What changed about a robot's liveness at a check.

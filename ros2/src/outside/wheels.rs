@@ -60,11 +60,7 @@ impl OdomWheels {
         radius_m: f64,
         axle_m: f64,
     ) -> Result<(f64, f64), Malformed> {
-        let p = &odom.pose.pose;
-        let now = (p.position.x, p.position.y, p.orientation.yaw_angle());
-        if !(now.0.is_finite() && now.1.is_finite() && now.2.is_finite()) {
-            return Err(Malformed::NotFinite);
-        }
+        let now = odom.planar().ok_or(Malformed::NotFinite)?;
         if let Some((x, y, th)) = self.last {
             let dth = wrap(now.2 - th);
             // The chord of an arc of turn dth is ds * sinc(dth / 2) long, along the mid
