@@ -78,6 +78,25 @@ pub enum PlacementError {
         /// The process (`the sim`, `agent 3`).
         what: String,
     },
+    /// Robots that share an agent process (`[run] agents_per_process`) placed on two hosts.
+    #[error(
+        "{file}: agents {a} and {b} share an agent process ([run] agents_per_process = {per}) \
+         but run on hosts `{host_a}` and `{host_b}`: place each process's robots on one host"
+    )]
+    SplitProcess {
+        /// The file.
+        file: String,
+        /// The scenario's robots per process.
+        per: u32,
+        /// The process's first robot.
+        a: u32,
+        /// A robot of it on another host.
+        b: u32,
+        /// The first robot's host.
+        host_a: String,
+        /// The other robot's host.
+        host_b: String,
+    },
     /// `--host NAME` names no host of the file.
     #[error("{file}: no host is named `{name}` (hosts: {known})")]
     NoSuchHost {

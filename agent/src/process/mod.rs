@@ -1,4 +1,12 @@
-//! The `hnav-agent` process: one robot's agent, wired to the run's services.
+//! The `hnav-agent` process: one robot's agent (or several, `[run] agents_per_process`),
+//! wired to the run's services.
+//!
+//! A process that hosts several robots has one node, one waiter, one commit subscriber, one
+//! candidate publisher, one heartbeat and one side of the lifecycle protocol, all under its
+//! first robot's name; each robot keeps its own topics (odometry, view, wheels, map,
+//! estimate), state and checkpoint, and its log lines carry an `agent{index=…}` span. A
+//! commit is received once and applied by each robot, so the coordinator wakes one
+//! listener per process, not one per robot.
 //!
 //! Inputs: its robot's odometry (`odom/<i>`), the coordinator's commits, the supervisor's
 //! lifecycle events. Outputs: candidates, wheel commands (`wheels/<i>`) and neural-map
@@ -19,7 +27,7 @@
 //!
 //! | module | what |
 //! |---|---|
-//! | `ports` | the topics the agent opens |
+//! | `ports` | the topics the process shares, and each robot's own |
 //! | `state` | the agent's state and its handler for each input |
 //! | `sightings` | what the robot saw change, for the coordinator's map (`[sensing]`) |
 //! | `oracle` | the all-knowing baseline: the scenario's closes and opens told when they happen |
@@ -43,7 +51,7 @@ use hnav_runtime::transport::{Transport, TransportError, Wake};
 use crate::navigator::Navigator;
 use crate::neural_map::NeuralMap;
 use checkpoint::CheckpointFile;
-use ports::Ports;
+use ports::{Ports, RobotPorts};
 use state::Core;
 
 /// What stopped or broke the agent.
@@ -88,108 +96,202 @@ pub struct AgentOutcome {
     pub at_goal: bool,
 }
 
-/// One agent process.
+/// One agent process: the robots `first .. first + count` of the run (one, unless
+/// `[run] agents_per_process` says more).
 pub struct AgentProcess<'t> {
     transport: &'t Transport,
     ports: Ports,
-    core: Core,
+    robots: Robots,
     heart: Heartbeat,
     startup_timeout: Duration,
 }
 
+/// The robots of the process, by position: their state apart from their ports, so that the
+/// loop can keep the ports attached to its waiter while it changes the state.
+struct Robots {
+    cores: Vec<Core>,
+    ports: Vec<RobotPorts>,
+    /// Names each robot in the log lines of a process that hosts several (none for one).
+    spans: Vec<tracing::Span>,
+}
+
 impl<'t> AgentProcess<'t> {
-    /// Loads agent `index` of the run described by `args` and opens its ports. A restarted
-    /// agent (`args.resume`) resumes from its checkpoint in the run directory if there is a
-    /// valid one.
+    /// Loads agent `index` of the run described by `args` and opens its ports: a process of
+    /// one robot. See [`AgentProcess::hosting`].
     pub fn new(
         transport: &'t Transport,
         args: &ProcessArgs,
         scenario: &Scenario,
         index: u32,
     ) -> Result<Self, AgentError> {
+        Self::hosting(transport, args, scenario, (index, 1))
+    }
+
+    /// Loads the `count` agents from `first` on of the run described by `args` and opens
+    /// their ports. A restarted process (`args.resume`) resumes each robot from its
+    /// checkpoint in the run directory if it has a valid one.
+    pub fn hosting(
+        transport: &'t Transport,
+        args: &ProcessArgs,
+        scenario: &Scenario,
+        (first, count): (u32, u32),
+    ) -> Result<Self, AgentError> {
         let agents = scenario.agents.len();
-        let spec = scenario
-            .agents
-            .get(index as usize)
-            .ok_or(AgentError::NoSuchAgent { index, agents })?;
+        let count = count.max(1);
+        let last = first.saturating_add(count - 1);
+        if last as usize >= agents {
+            return Err(AgentError::NoSuchAgent {
+                index: last,
+                agents,
+            });
+        }
         let sensing = scenario.sensing.is_some();
-        let ports = Ports::open(transport, &scenario.map.grid, (index, agents), sensing)?;
-        let heart = Heartbeat::open(transport, Role::Agent, index, agents, scenario.heartbeat())?;
+        let grid = &scenario.map.grid;
+        let ports = Ports::open(transport, (first, agents), sensing)?;
+        // One heartbeat for the process, under its first robot's name: the supervisor
+        // watches processes, and the robots of one process hang together.
+        let heart = Heartbeat::open(transport, Role::Agent, first, agents, scenario.heartbeat())?;
         if !args.resume {
             // Only a first start has a supervisor waiting on a bound; a restarted agent
-            // builds its map just the same but nobody times it.
-            let mib = NeuralMap::footprint(&scenario.map.grid).div_ceil(1 << 20);
+            // builds its maps just the same but nobody times it.
+            let mib = (NeuralMap::footprint(grid) * count as usize).div_ceil(1 << 20);
             let size = u32::try_from(mib).unwrap_or(u32::MAX);
             ports
                 .life
                 .report_phase(StartupPhase::BuildingNeuralMap, size)?;
         }
-        let checkpoint = args.dir.as_deref().and_then(|d| open_checkpoint(d, index));
-        let resumed = if args.resume {
-            checkpoint.as_ref().and_then(|c| c.load())
-        } else {
-            None
-        };
         let building = Instant::now();
-        let core = Core::new(scenario, spec, index, checkpoint, resumed, args.resume)?;
+        let n = count as usize;
+        let mut robots = Robots {
+            cores: Vec::with_capacity(n),
+            ports: Vec::with_capacity(n),
+            spans: Vec::with_capacity(n),
+        };
+        for index in first..=last {
+            let spec = &scenario.agents[index as usize];
+            let checkpoint = args.dir.as_deref().and_then(|d| open_checkpoint(d, index));
+            let resumed = (checkpoint.as_ref())
+                .filter(|_| args.resume)
+                .and_then(|c| c.load());
+            let span = match count {
+                1 => tracing::Span::none(),
+                _ => tracing::info_span!("agent", index),
+            };
+            let core = span
+                .in_scope(|| Core::new(scenario, spec, index, checkpoint, resumed, args.resume))?;
+            robots.cores.push(core);
+            robots
+                .ports
+                .push(RobotPorts::open(transport, grid, (index, agents), sensing)?);
+            robots.spans.push(span);
+        }
         // What a user needs to pick `[run] startup_timeout_s` for a large map.
         tracing::info!(
             seconds = building.elapsed().as_secs_f64(),
+            robots = n,
             "neural map built"
         );
         Ok(AgentProcess {
             startup_timeout: scenario.startup_timeout(),
             transport,
             ports,
-            core,
+            robots,
             heart,
         })
     }
 
-    /// The navigator (row, map, target).
+    /// The navigator (row, map, target) of the process's first robot.
     pub fn navigator(&self) -> &Navigator {
-        self.core.navigator()
+        self.robots.cores[0].navigator()
     }
 
     /// Announces itself, waits for the start (unless resuming) and runs until the
-    /// supervisor's `Stop` or a termination signal.
-    pub fn run(&mut self, resume: bool) -> Result<AgentOutcome, AgentError> {
+    /// supervisor's `Stop` or a termination signal. Returns each robot's outcome, in order.
+    pub fn run(&mut self, resume: bool) -> Result<Vec<AgentOutcome>, AgentError> {
         let started = self
             .ports
             .life
             .handshake(self.transport, resume, self.startup_timeout)?;
-        let (p, core) = (&self.ports, &mut self.core);
+        let p = &self.ports;
+        let (cores, rp, spans) = (
+            &mut self.robots.cores,
+            &self.robots.ports,
+            &self.robots.spans,
+        );
         if started == StartOutcome::Stopped {
-            return Ok(core.outcome());
+            return Ok(cores.iter().map(Core::outcome).collect());
         }
-        core.begin(p, resume)?;
+        for ((core, r), span) in cores.iter_mut().zip(rp).zip(spans) {
+            span.in_scope(|| core.begin(r, resume))?;
+        }
         let waiter = self.transport.waiter()?;
-        let _odom = waiter.attach(&p.odom)?;
-        let _commit = waiter.attach(&p.commit)?;
+        let mut attached = Vec::with_capacity(rp.len() + 2);
+        for r in rp {
+            attached.push(waiter.attach(&r.odom)?);
+        }
+        attached.push(waiter.attach(&p.commit)?);
         let _bell = p.bell.as_ref().map(|b| waiter.attach_bell(b)).transpose()?;
-        let _life = waiter.attach(p.life.events())?;
+        attached.push(waiter.attach(p.life.events())?);
         loop {
             self.heart.beat()?;
             if p.life.drain(|_, _, _| {})?.is_some() {
                 break;
             }
-            core.step(p)?;
-            // iceoryx2 hands a publisher's history (the last snapshot) to a new subscriber
-            // only when the publisher updates its connections, which a send does; the map is
-            // sent only when it is rebuilt, so without this a viewer that joins late would
-            // wait for the next rebuild. A counter compare unless someone joined.
-            if let Err(e) = p.map.update_connections() {
-                tracing::warn!("neural-map viewers not connected: {e}");
-            }
+            pass(p, rp, spans, cores)?;
             // The agent reacts to its inputs; its deadlines are the next beat and, in
             // realtime, the resend of an unanswered candidate. `TimedOut` means "look again".
-            match waiter.wait(self.heart.until(core.resend_due())?)? {
+            let resend = cores.iter().filter_map(Core::resend_due).min();
+            match waiter.wait(self.heart.until(resend)?)? {
                 Wake::Data | Wake::TimedOut => {}
                 Wake::Stop => break,
             }
         }
-        Ok(core.outcome())
+        Ok(cores.iter().map(Core::outcome).collect())
     }
+}
+
+/// One pass over every input of the process: the new commits and the coordinator's map,
+/// received once and handed to each robot, then each robot's own inputs; the candidates the
+/// pass posted wake the coordinator once.
+fn pass(
+    p: &Ports,
+    rp: &[RobotPorts],
+    spans: &[tracing::Span],
+    cores: &mut [Core],
+) -> Result<(), AgentError> {
+    // Not `drain_pending`: applying a decision can fail, and the error must end the loop.
+    let wake = p.commit.take_wakeup()?;
+    while let Some(sample) = p.commit.receive()? {
+        for (core, span) in cores.iter_mut().zip(spans) {
+            span.in_scope(|| core.apply_commit(sample.payload()))?;
+        }
+    }
+    for ((core, r), span) in cores.iter_mut().zip(rp).zip(spans) {
+        span.in_scope(|| core.after_commits(p, r, wake.peer_up))?;
+    }
+    if let Some(rx) = &p.world {
+        let mut result = Ok(());
+        rx.drain_pending(|h, cells| {
+            for (core, span) in cores.iter_mut().zip(spans) {
+                if result.is_ok() {
+                    result = span.in_scope(|| core.learn_world(h, cells));
+                }
+            }
+        })?;
+        result?;
+    }
+    for ((core, r), span) in cores.iter_mut().zip(rp).zip(spans) {
+        span.in_scope(|| core.step(p, r))?;
+        // iceoryx2 hands a publisher's history (the last snapshot) to a new subscriber
+        // only when the publisher updates its connections, which a send does; the map is
+        // sent only when it is rebuilt, so without this a viewer that joins late would
+        // wait for the next rebuild. A counter compare unless someone joined.
+        if let Err(e) = r.map.update_connections() {
+            tracing::warn!("neural-map viewers not connected: {e}");
+        }
+    }
+    p.candidates.flush()?;
+    Ok(())
 }
 
 /// The checkpoint file of agent `index` in the run directory `dir`; without one the agent

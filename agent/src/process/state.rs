@@ -10,12 +10,14 @@ use hnav_runtime::grid::geometry::{cell_centre_m, cell_centre_pose, cell_index};
 use hnav_runtime::grid::Cell;
 use hnav_runtime::grid::Grid;
 use hnav_runtime::hash::SplitMix64;
-use hnav_runtime::msg::{Estimate, MapHeader, Odometry, Pose, View, WheelCommand};
+use hnav_runtime::msg::{
+    Commit, Estimate, MapHeader, Odometry, Pose, View, WheelCommand, WorldHeader,
+};
 use hnav_runtime::scenario::{AgentSpec, ClockMode, Planner, RepairRule, Scenario};
 
 use super::checkpoint::{Checkpoint, CheckpointFile};
 use super::oracle::Oracle;
-use super::ports::Ports;
+use super::ports::{Ports, RobotPorts};
 use super::sightings::Sightings;
 use super::{AgentError, AgentOutcome};
 use crate::controller::{ControllerParams, FreeSpace, WheelController, WheelDrive};
@@ -64,6 +66,8 @@ pub(super) struct Core {
     sightings: Option<Sightings>,
     /// The all-knowing baseline's events (`[sensing] all_knowing`).
     oracle: Option<Oracle>,
+    /// A commit applied since the last pass rebuilt the neural map: a snapshot is due.
+    rebuilt: bool,
 }
 
 impl Core {
@@ -134,6 +138,7 @@ impl Core {
             repair: scenario.sensing.map(|s| s.repair),
             sightings: scenario.sensing.map(|_| Sightings::new(&scenario.map.grid)),
             oracle: Oracle::of(scenario),
+            rebuilt: false,
         })
     }
 
@@ -153,23 +158,24 @@ impl Core {
 
     /// What the agent publishes once started: its first map and, in a fresh lockstep run,
     /// period 0's wheel command (the sim steps the first period once every robot has one).
-    pub(super) fn begin(&mut self, p: &Ports, resume: bool) -> Result<(), AgentError> {
-        self.publish_map(p)?;
+    pub(super) fn begin(&mut self, r: &RobotPorts, resume: bool) -> Result<(), AgentError> {
+        self.publish_map(r)?;
         if self.clock == ClockMode::Lockstep && !resume {
             self.wheel_due = Some(self.last_period.map_or(0, |p| p + 1));
-            self.send_wheels(p)?;
+            self.send_wheels(r)?;
         }
         Ok(())
     }
 
-    /// One pass over the inputs, in the order that keeps lockstep runs deterministic: commits,
+    /// One pass over this robot's inputs once the process has handed it the new commits
+    /// ([`Core::apply_commit`], [`Core::after_commits`]) and the coordinator's map
+    /// ([`Core::learn_world`]), in the order that keeps lockstep runs deterministic: views,
     /// odometry, then what they made due.
-    pub(super) fn step(&mut self, p: &Ports) -> Result<(), AgentError> {
-        self.on_commits(p)?;
-        self.on_odometry(p)?;
-        self.send_candidate(p)?;
+    pub(super) fn step(&mut self, p: &Ports, r: &RobotPorts) -> Result<(), AgentError> {
+        self.on_odometry(r)?;
+        self.send_candidate(p, r)?;
         self.resend_if_unanswered(p)?;
-        self.send_wheels(p)
+        self.send_wheels(r)
     }
 
     /// When the open candidate is due to be sent again (realtime only).
@@ -190,49 +196,51 @@ impl Core {
             return Ok(());
         }
         tracing::debug!(round = r, "no commit for the open candidate: sent again");
-        p.candidates.send(self.nav.candidate(r))?;
+        p.candidates.post(self.nav.candidate(r))?;
         self.sent_at = Some(now);
         Ok(())
     }
 
-    /// Applies every new commit; resends the open candidate to a coordinator that just came up.
-    fn on_commits(&mut self, p: &Ports) -> Result<(), AgentError> {
-        // Not `drain_pending`: applying a decision can fail, and the error must end the loop.
-        let wake = p.commit.take_wakeup()?;
-        let mut rebuilt = false;
-        while let Some(sample) = p.commit.receive()? {
-            let c = sample.payload();
-            if c.round <= self.last_commit {
-                continue;
-            }
-            self.last_commit = c.round;
-            if let Some(d) = c.decisions().iter().find(|d| d.agent == self.index) {
-                rebuilt |= self.nav.apply(d)?.map_rebuilt;
-            }
-            // A later round than asked for also answers the open candidate: this agent was
-            // behind (restarted, or missed by the coordinator) and counted as standing in
-            // the rounds it missed; it goes on from the round that was decided.
-            if self.outstanding.is_some_and(|r| r <= c.round) {
-                self.outstanding = None;
-                self.sent_at = None;
-            }
+    /// Applies commit `c` if it is new.
+    pub(super) fn apply_commit(&mut self, c: &Commit) -> Result<(), AgentError> {
+        if c.round <= self.last_commit {
+            return Ok(());
         }
-        if rebuilt {
-            self.publish_map(p)?;
+        self.last_commit = c.round;
+        if let Some(d) = c.decisions().iter().find(|d| d.agent == self.index) {
+            self.rebuilt |= self.nav.apply(d)?.map_rebuilt;
         }
-        if wake.peer_up {
-            if let Some(r) = self.outstanding {
-                let cand = self.nav.candidate(r);
-                p.candidates.send(cand)?;
-            }
+        // A later round than asked for also answers the open candidate: this agent was
+        // behind (restarted, or missed by the coordinator) and counted as standing in
+        // the rounds it missed; it goes on from the round that was decided.
+        if self.outstanding.is_some_and(|r| r <= c.round) {
+            self.outstanding = None;
+            self.sent_at = None;
+        }
+        Ok(())
+    }
+
+    /// After the new commits: the snapshot of a map they rebuilt, and the open candidate
+    /// again to a coordinator that just came up (`peer_up`).
+    pub(super) fn after_commits(
+        &mut self,
+        p: &Ports,
+        r: &RobotPorts,
+        peer_up: bool,
+    ) -> Result<(), AgentError> {
+        if std::mem::take(&mut self.rebuilt) {
+            self.publish_map(r)?;
+        }
+        if let Some(round) = self.outstanding.filter(|_| peer_up) {
+            p.candidates.post(self.nav.candidate(round))?;
         }
         Ok(())
     }
 
     /// Folds in the newest views (they come before the odometry of their period): cells
     /// that changed are learned and the guide repaired.
-    fn on_views(&mut self, p: &Ports) -> Result<(), AgentError> {
-        let (Some(rx), Some(rule)) = (&p.view, self.repair) else {
+    fn on_views(&mut self, r: &RobotPorts) -> Result<(), AgentError> {
+        let (Some(rx), Some(rule)) = (&r.view, self.repair) else {
             return Ok(());
         };
         let mut latest: Option<View> = None;
@@ -270,53 +278,43 @@ impl Core {
         Ok(())
     }
 
-    /// Folds in the coordinator's map as it stands, when it was sent to this agent (it
-    /// restarted): the map at start is out of date by every change the swarm saw since.
-    fn on_world(&mut self, p: &Ports) -> Result<(), AgentError> {
-        let (Some(rx), Some(rule)) = (&p.world, self.repair) else {
+    /// Folds in the coordinator's map as it stands (`h`, `cells`), when it was sent to this
+    /// agent (it restarted): the map at start is out of date by every change the swarm saw
+    /// since.
+    pub(super) fn learn_world(&mut self, h: &WorldHeader, cells: &[u32]) -> Result<(), AgentError> {
+        let Some(rule) = self.repair.filter(|_| h.is_for(self.index as usize)) else {
             return Ok(());
         };
-        let (index, period) = (self.index as usize, self.last_period.unwrap_or(0));
-        let (nav, sightings, width) = (&mut self.nav, &mut self.sightings, self.width);
-        let mut result = Ok(None);
-        rx.drain_pending(|h, cells| {
-            if !h.is_for(index) {
-                return;
-            }
-            let closed = (h.closed as usize).min(cells.len());
-            let state = |k: usize| (cells[k], k < closed);
-            if let Some(s) = sightings.as_mut() {
-                (0..cells.len()).map(state).for_each(|(c, b)| s.learn(c, b));
-            }
-            let known = (0..cells.len())
-                .map(state)
-                .map(|(c, b)| (Cell::new(c % width.max(1), c / width.max(1)), b));
-            tracing::info!(
-                closed,
-                opened = cells.len() - closed,
-                round = h.round,
-                "the coordinator's map"
-            );
-            if result.is_ok() {
-                result = nav.learn(known, rule, period);
-            }
-        })?;
-        result?;
+        let (period, width) = (self.last_period.unwrap_or(0), self.width);
+        let closed = (h.closed as usize).min(cells.len());
+        let state = |k: usize| (cells[k], k < closed);
+        if let Some(s) = self.sightings.as_mut() {
+            (0..cells.len()).map(state).for_each(|(c, b)| s.learn(c, b));
+        }
+        let known = (0..cells.len())
+            .map(state)
+            .map(|(c, b)| (Cell::new(c % width.max(1), c / width.max(1)), b));
+        tracing::info!(
+            closed,
+            opened = cells.len() - closed,
+            round = h.round,
+            "the coordinator's map"
+        );
+        self.nav.learn(known, rule, period)?;
         Ok(())
     }
 
     /// Folds in the newest odometry reading and opens the next round.
-    fn on_odometry(&mut self, p: &Ports) -> Result<(), AgentError> {
-        self.on_world(p)?;
-        self.on_views(p)?;
+    fn on_odometry(&mut self, r: &RobotPorts) -> Result<(), AgentError> {
+        self.on_views(r)?;
         let mut latest: Option<Odometry> = None;
-        p.odom.drain_pending(|o| {
+        r.odom.drain_pending(|o| {
             if latest.is_none_or(|l| o.period >= l.period) {
                 latest = Some(*o);
             }
         })?;
         if let Some(o) = latest.filter(|o| Some(o.period) == self.last_period) {
-            return self.on_repeated_odometry(p, o.period);
+            return self.on_repeated_odometry(r, o.period);
         }
         let Some(o) = latest.filter(|o| self.last_period.is_none_or(|p| o.period > p)) else {
             return Ok(());
@@ -340,7 +338,7 @@ impl Core {
             }
         }
         // Silent: the recorder and viewers take the latest at their own pace.
-        p.estimate.send_silently(Estimate {
+        r.estimate.send_silently(Estimate {
             sim_time_ns: o.sim_time_ns,
             agent: self.index,
             reserved: 0,
@@ -349,7 +347,7 @@ impl Core {
         if self.nav.is_moving() {
             let (x, y) = cell_centre_m(self.cell_size_m, self.nav.next());
             if self.ctl.arrived(pose, x, y) && self.nav.arrived()? {
-                self.publish_map(p)?;
+                self.publish_map(r)?;
             }
         }
         self.candidate_due = true;
@@ -362,15 +360,15 @@ impl Core {
     /// its command for the next period (an iceoryx2 subscriber does not get what was sent
     /// before it existed), so in lockstep it would wait for that command for ever: send it
     /// again. The reading itself changes nothing.
-    fn on_repeated_odometry(&mut self, p: &Ports, period: u64) -> Result<(), AgentError> {
+    fn on_repeated_odometry(&mut self, r: &RobotPorts, period: u64) -> Result<(), AgentError> {
         if let Some(c) = self.last_wheels.filter(|c| c.period == period + 1) {
-            p.wheels.send(c)?;
+            r.wheels.send(c)?;
         }
         Ok(())
     }
 
     /// Publishes the candidate for round `last commit + 1` if one is due and none is open.
-    fn send_candidate(&mut self, p: &Ports) -> Result<(), AgentError> {
+    fn send_candidate(&mut self, p: &Ports, r: &RobotPorts) -> Result<(), AgentError> {
         if !self.candidate_due || self.outstanding.is_some() {
             return Ok(());
         }
@@ -389,17 +387,17 @@ impl Core {
         if let (Some(s), Some(tx)) = (&mut self.sightings, &p.sightings) {
             s.send(tx, round, self.index)?;
         }
-        p.candidates.send(cand)?;
+        p.candidates.post(cand)?;
         self.outstanding = Some(round);
         self.sent_at = Some(Instant::now());
         if self.nav.take_replanned() {
-            self.publish_map(p)?;
+            self.publish_map(r)?;
         }
         Ok(())
     }
 
     /// Sends the due wheel command; in lockstep only once the open round is decided.
-    fn send_wheels(&mut self, p: &Ports) -> Result<(), AgentError> {
+    fn send_wheels(&mut self, r: &RobotPorts) -> Result<(), AgentError> {
         let Some(period) = self.wheel_due else {
             return Ok(());
         };
@@ -409,7 +407,7 @@ impl Core {
         let pose = self.dr.pose();
         let (cx, cy) = cell_centre_m(self.cell_size_m, self.nav.current());
         let from_centre = (pose.x_m - cx).hypot(pose.y_m - cy) / self.cell_size_m;
-        let (l, r) = if self.nav.is_moving() && !self.nav.waits_for_mover(from_centre) {
+        let (left, right) = if self.nav.is_moving() && !self.nav.waits_for_mover(from_centre) {
             let (x, y) = cell_centre_m(self.cell_size_m, self.nav.next());
             let free = if self.ctl.needs_free_space() {
                 FreeSpace::from_grid(self.nav.grid(), self.cell_size_m, pose, self.ctl.range_m())
@@ -431,20 +429,20 @@ impl Core {
             period,
             agent: self.index,
             flags: 0,
-            left_rad_s: l,
-            right_rad_s: r,
+            left_rad_s: left,
+            right_rad_s: right,
         };
-        p.wheels.send(command)?;
+        r.wheels.send(command)?;
         self.last_wheels = Some(command);
         self.wheel_due = None;
         Ok(())
     }
 
     /// Publishes the neural map, written straight into loaned shared memory.
-    fn publish_map(&mut self, p: &Ports) -> Result<(), AgentError> {
+    fn publish_map(&mut self, r: &RobotPorts) -> Result<(), AgentError> {
         let nav = &self.nav;
-        let len = p.map.max_len();
-        let mut loan = p.map.loan(len)?;
+        let len = r.map.max_len();
+        let mut loan = r.map.loan(len)?;
         *loan.header_mut() = MapHeader {
             round: self.last_commit,
             agent: self.index,

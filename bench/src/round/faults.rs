@@ -297,6 +297,7 @@ fn rejoin(program: &Path, fsync: FsyncPolicy, trials: usize) -> Result<(Vec<u64>
         fsync,
         replicas: 1,
         observers: Observers::default(),
+        per_process: 1,
     };
     with_coordinator(program, REJOIN_AGENTS, setup, |session, swarm| {
         if let Some(t) = session.startup() {

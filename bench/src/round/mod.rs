@@ -94,6 +94,12 @@ pub struct RoundArgs {
     #[arg(long, value_delimiter = ',', value_name = "SET", default_values = ["none"],
           value_parser = Observers::parse, conflicts_with = "faults")]
     pub observers: Vec<Observers>,
+    /// Robots per agent process, one row each (comma-separated): 1 is one process per
+    /// robot (the default), 16 is `[run] agents_per_process = 16`: 128 agents then have 8
+    /// commit subscribers, each process sending its robots' candidates with one wake-up.
+    #[arg(long, value_delimiter = ',', value_name = "K", default_values_t = [1usize],
+          conflicts_with = "faults")]
+    pub agents_per_process: Vec<usize>,
     /// One JSON object per line instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -143,6 +149,10 @@ pub fn main(args: RoundArgs) -> Result<()> {
     }
     if args.replicas.is_empty() {
         bail!("--replicas needs at least one cluster size");
+    }
+    let max = hnav_runtime::scenario::RunParams::MAX_AGENTS_PER_PROCESS as usize;
+    if let Some(k) = args.agents_per_process.iter().find(|&&k| k == 0 || k > max) {
+        bail!("--agents-per-process {k}: must be 1 to {max}");
     }
     if args.rounds == Some(0) {
         bail!("--rounds must be at least 1");
@@ -202,12 +212,15 @@ fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
     let mut points = Vec::new();
     for &agents in &args.agents {
         for &fsync in &args.fsync {
-            for (&replicas, &observers) in
-                (args.replicas.iter()).flat_map(|r| args.observers.iter().map(move |o| (r, o)))
-            {
+            let rows = (args.replicas.iter()).flat_map(|r| {
+                (args.observers.iter())
+                    .flat_map(move |o| (args.agents_per_process.iter()).map(move |k| (*r, *o, *k)))
+            });
+            for (replicas, observers, per_process) in rows {
                 hnav_runtime::errln!(
-                    "round: {agents} agents, fsync {}, {replicas} coordinator(s), observers {}: \
-                     {} warm-up + {rounds} measured rounds",
+                    "round: {agents} agents ({per_process} per process), fsync {}, \
+                     {replicas} coordinator(s), observers {}: {} warm-up + {rounds} measured \
+                     rounds",
                     layout::fsync_name(fsync),
                     observers.name(),
                     args.warmup
@@ -216,6 +229,7 @@ fn round_cmd(args: &RoundArgs, program: &std::path::Path) -> Result<()> {
                     fsync,
                     replicas,
                     observers,
+                    per_process,
                 };
                 let point = measure_point(program, agents, setup, args.warmup, rounds)?;
                 if args.json {
@@ -315,6 +329,7 @@ fn measure_point(
         fsync: setup.fsync,
         replicas: setup.replicas,
         observers: setup.observers,
+        per_process: setup.per_process,
         dist: Dist::from_ns(&all)?,
         first: Dist::from_ns(&first)?,
         stalled,

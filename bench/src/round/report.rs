@@ -34,6 +34,8 @@ pub struct RoundPoint {
     pub replicas: u32,
     /// The observers beside the run.
     pub observers: Observers,
+    /// Robots per agent process.
+    pub per_process: usize,
     /// Round latencies (to the last agent's commit).
     pub dist: Dist,
     /// Latencies to the first agent's commit.
@@ -45,8 +47,9 @@ pub struct RoundPoint {
 /// The table header of the round benchmark.
 pub fn round_header() -> String {
     format!(
-        "{:>7}  {:<13} {:>8} {:<14} {:>7} {:>10} {:>10} {:>10} | {:>10} {:>10} | {:>7}",
+        "{:>7} {:>8}  {:<13} {:>8} {:<14} {:>7} {:>10} {:>10} {:>10} | {:>10} {:>10} | {:>7}",
         "agents",
+        "per proc",
         "fsync",
         "replicas",
         "observers",
@@ -65,8 +68,9 @@ impl RoundPoint {
     pub fn row(&self) -> String {
         let d = &self.dist;
         format!(
-            "{:>7}  {:<13} {:>8} {:<14} {:>7} {:>10.1} {:>10.1} {:>10.1} | {:>10.1} {:>10.1} | {:>7}",
+            "{:>7} {:>8}  {:<13} {:>8} {:<14} {:>7} {:>10.1} {:>10.1} {:>10.1} | {:>10.1} {:>10.1} | {:>7}",
             self.agents,
+            self.per_process,
             fsync_name(self.fsync),
             self.replicas,
             self.observers.name(),
@@ -86,6 +90,7 @@ impl RoundPoint {
         json!({
             "bench": "round",
             "agents": self.agents,
+            "agents_per_process": self.per_process,
             "fsync": fsync_name(self.fsync),
             "replicas": self.replicas,
             "observers": self.observers.name(),
@@ -194,10 +199,13 @@ pub fn write_round_csv(dir: &Path, points: &[RoundPoint]) -> Result<std::path::P
     let rows = points.iter().flat_map(|p| {
         let c = Some((p.agents, p.fsync, p.replicas));
         // The measure names the observers when there are any, so the file's columns stay.
-        let with = match p.observers.name() {
+        let mut with = match p.observers.name() {
             "none" => String::new(),
             o => format!("_with_{o}"),
         };
+        if p.per_process > 1 {
+            with.push_str(&format!("_{}_per_process", p.per_process));
+        }
         [
             csv_row(
                 &info,
@@ -279,6 +287,7 @@ mod tests {
                 ros2: true,
                 foxglove: true,
             },
+            per_process: 16,
             dist: d,
             first: d,
             stalled: 0,
@@ -286,6 +295,7 @@ mod tests {
         let v: serde_json::Value = serde_json::from_str(&p.json()).unwrap();
         assert_eq!(v["bench"], "round");
         assert_eq!(v["agents"], 8);
+        assert_eq!(v["agents_per_process"], 16);
         assert_eq!(v["fsync"], "none");
         assert_eq!(v["replicas"], 3);
         assert_eq!(v["observers"], "ros2+foxglove");

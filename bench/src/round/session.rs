@@ -140,6 +140,8 @@ pub struct CoordinatorSetup {
     pub replicas: u32,
     /// The observers running beside it (`--observers`).
     pub observers: Observers,
+    /// Robots per agent process (`--agents-per-process`, `[run] agents_per_process`).
+    pub per_process: usize,
 }
 
 /// Starts the coordinator (or its replicas) for `agents` agents, hands the session and the
@@ -195,7 +197,7 @@ fn session<T>(
         .into_iter()
         .collect();
     // Every agent port exists before the coordinator starts, as after a real start-up.
-    let mut swarm = Swarm::open(run, layout, bell)?;
+    let mut swarm = Swarm::open(run, layout, setup.per_process, bell)?;
     let args = ProcessArgs {
         dir: Some(dir.to_path_buf()),
         ..ProcessArgs::new(run.as_str(), scenario)

@@ -1,5 +1,8 @@
-//! The N agents of a round benchmark, played from one process: per agent one candidate
-//! publisher and one commit subscriber (as each real `hnav-agent` has), in one iceoryx2 node.
+//! The N agents of a round benchmark, played from one process: per agent process one
+//! candidate publisher and one commit subscriber (as each real `hnav-agent` has), in one
+//! iceoryx2 node. An agent process hosts one robot, or `per_process` of them
+//! (`[run] agents_per_process`): it then sends its robots' candidates silently and wakes the
+//! coordinator once, and takes each commit once for all of them, as `hnav-agent` does.
 
 use std::collections::HashMap;
 use std::ops::ControlFlow;
@@ -58,28 +61,39 @@ pub fn keep_going(obs: &RoundObs) -> ControlFlow<()> {
 /// The agents' ports.
 pub struct Swarm {
     layout: Layout,
-    /// Agents that send candidates, in sending order.
+    /// Robots per agent process.
+    per_process: usize,
+    /// Agent processes that send candidates, in sending order.
     order: Vec<usize>,
-    /// An agent whose next candidate carries the `RESTARTED` flag.
+    /// An agent process whose robots' next candidates carry the `RESTARTED` flag.
     restarted: Option<usize>,
     next_round: u64,
+    /// Per agent process.
     tx: Vec<Option<Sender<Candidate>>>,
+    /// Per agent process.
     rx: Vec<Option<Receiver<Commit>>>,
-    /// Each agent's watch of the commit bell, when the run has one (as each agent process
-    /// has its own).
+    /// Each agent process's watch of the commit bell, when the run has one.
     watch: Vec<Option<BellWatch>>,
     bell: Option<Bell>,
     transport: Transport,
 }
 
 impl Swarm {
-    /// Opens every agent's ports; with a `bell`, each agent watches it and its commit
-    /// listener is one the coordinator does not send datagrams to.
-    pub fn open(run: &RunId, layout: Layout, bell: Option<Bell>) -> Result<Self> {
-        let n = layout.agents();
+    /// Opens every agent process's ports, `per_process` robots to a process; with a
+    /// `bell`, each process watches it and its commit listener is one the coordinator does
+    /// not send datagrams to.
+    pub fn open(
+        run: &RunId,
+        layout: Layout,
+        per_process: usize,
+        bell: Option<Bell>,
+    ) -> Result<Self> {
+        let per_process = per_process.max(1);
+        let n = layout.agents().div_ceil(per_process);
         let transport = Transport::builder(run).node_name("bench-agents").create()?;
         let mut swarm = Swarm {
             layout,
+            per_process,
             order: Vec::with_capacity(n),
             restarted: None,
             next_round: 1,
@@ -111,7 +125,13 @@ impl Swarm {
         Ok(())
     }
 
-    /// Agent `i` dies: its ports are gone and it sends nothing.
+    /// The robots of agent process `p`.
+    fn robots(&self, p: usize) -> std::ops::Range<usize> {
+        let first = p * self.per_process;
+        first..(first + self.per_process).min(self.layout.agents())
+    }
+
+    /// Agent process `i` dies: its ports are gone and it sends nothing.
     pub fn kill(&mut self, i: usize) {
         self.tx[i] = None;
         self.rx[i] = None;
@@ -119,7 +139,7 @@ impl Swarm {
         self.order.retain(|&j| j != i);
     }
 
-    /// Agent `i` comes back with new ports (what a restarted process opens before it
+    /// Agent process `i` comes back with new ports (what a restarted process opens before it
     /// announces itself); from the next round on it sends first, its first candidate flagged
     /// `RESTARTED`.
     pub fn restart(&mut self, i: usize) -> Result<()> {
@@ -152,14 +172,15 @@ impl Swarm {
         mut after: impl FnMut(&RoundObs) -> ControlFlow<()>,
     ) -> Result<u64> {
         let n = self.layout.agents();
+        let processes = self.tx.len();
         let waiter = self.transport.waiter()?;
         let exits = coordinators
             .iter()
             .map(|c| c.watch(&waiter))
             .collect::<Result<Vec<_>, _>>()?;
         let exit_ids: Vec<AttachmentId> = exits.iter().map(|e| e.id()).collect();
-        let mut attached = Vec::with_capacity(n);
-        let mut owner: HashMap<AttachmentId, usize> = HashMap::with_capacity(n);
+        let mut attached = Vec::with_capacity(processes);
+        let mut owner: HashMap<AttachmentId, usize> = HashMap::with_capacity(processes);
         let mut live = 0;
         for (i, rx) in self.rx.iter().enumerate() {
             if let Some(rx) = rx {
@@ -175,22 +196,31 @@ impl Swarm {
             }
         }
         let mut got: Vec<Option<(Instant, bool)>> = vec![None; n];
-        let mut fired: Vec<usize> = Vec::with_capacity(n);
+        let mut fired: Vec<usize> = Vec::with_capacity(processes);
         let mut played = 0;
         while played < rounds {
             let round = self.next_round;
             got.iter_mut().for_each(|g| *g = None);
             before_send(round)?;
             let mut sent = Instant::now();
-            for &i in &self.order {
-                let mut c = self.layout.candidate(i, round);
-                if self.restarted == Some(i) {
-                    c.flags |= CandidateFlags::RESTARTED;
+            for &p in &self.order {
+                let Some(tx) = &self.tx[p] else { continue };
+                // The clock starts as the last candidates go out: before the last
+                // process's first send.
+                sent = Instant::now();
+                for i in self.robots(p) {
+                    let mut c = self.layout.candidate(i, round);
+                    if self.restarted == Some(p) {
+                        c.flags |= CandidateFlags::RESTARTED;
+                    }
+                    if self.per_process == 1 {
+                        tx.send(c)?;
+                    } else {
+                        tx.send_silently(c)?;
+                    }
                 }
-                if let Some(tx) = &self.tx[i] {
-                    // The clock starts as the last candidate goes out: before its `send`.
-                    sent = Instant::now();
-                    tx.send(c)?;
+                if self.per_process > 1 {
+                    tx.notify()?;
                 }
             }
             self.restarted = None;
@@ -208,7 +238,7 @@ impl Swarm {
                 let left = deadline.saturating_duration_since(now);
                 if left.is_zero() {
                     bail!(
-                        "round {round}: {missing} of {live} agents got no commit within \
+                        "round {round}: {missing} of {live} agent processes got no commit within \
                          {ROUND_TIMEOUT:?}"
                     );
                 }
@@ -244,14 +274,16 @@ impl Swarm {
                             .map_or("not reaped".to_string(), |e| e.to_string())
                     );
                 }
-                for &i in &fired {
-                    let Some(rx) = &self.rx[i] else { continue };
-                    let mut late = None;
+                for &p in &fired {
+                    let Some(rx) = &self.rx[p] else { continue };
+                    let (robots, mut late) = (self.robots(p), None);
                     let drained = rx.drain_pending(|c| {
-                        if c.round == round && got[i].is_none() {
+                        if c.round == round && got[robots.start].is_none() {
                             let now = Instant::now();
-                            let decided = c.decisions().iter().any(|d| d.agent as usize == i);
-                            got[i] = Some((now, decided));
+                            for i in robots.clone() {
+                                let decided = c.decisions().iter().any(|d| d.agent as usize == i);
+                                got[i] = Some((now, decided));
+                            }
                             first_in.get_or_insert(now);
                             all_in = now;
                             missing -= 1;
@@ -260,13 +292,15 @@ impl Swarm {
                         }
                     })?;
                     if let Some(r) = late {
-                        bail!("agent {i} got commit {r} while round {round} is open");
+                        bail!("agent process {p} got commit {r} while round {round} is open");
                     }
                     // A coordinator came to lead (or back) after this round's candidates
-                    // went out: like a real agent, resend the open candidate to it.
-                    if drained.wakeup.peer_up && got[i].is_none() {
-                        if let Some(tx) = &self.tx[i] {
-                            tx.send(self.layout.candidate(i, round))?;
+                    // went out: like a real agent, resend the open candidates to it.
+                    if drained.wakeup.peer_up && got[robots.start].is_none() {
+                        if let Some(tx) = &self.tx[p] {
+                            for i in robots {
+                                tx.send(self.layout.candidate(i, round))?;
+                            }
                         }
                     }
                 }

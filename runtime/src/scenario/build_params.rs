@@ -301,14 +301,40 @@ pub(super) fn build_run(
     raw: Option<RawRun>,
     lines: &Lines<'_>,
 ) -> Result<RunParams, ScenarioError> {
-    let Some(v) = raw.and_then(|r| r.startup_timeout_s) else {
-        return Ok(RunParams::default());
+    let d = RunParams::default();
+    let Some(raw) = raw else { return Ok(d) };
+    let per = count(
+        &raw.agents_per_process,
+        d.agents_per_process,
+        "run.agents_per_process",
+        lines,
+    )?;
+    if let Some(v) = raw
+        .agents_per_process
+        .as_ref()
+        .filter(|_| per > RunParams::MAX_AGENTS_PER_PROCESS)
+    {
+        return Err(ScenarioError::InvalidParameter {
+            at: lines.at(v),
+            key: "run.agents_per_process".into(),
+            problem: format!(
+                "must be at most {}, got {per}",
+                RunParams::MAX_AGENTS_PER_PROCESS
+            ),
+        });
+    }
+    let Some(v) = raw.startup_timeout_s else {
+        return Ok(RunParams {
+            agents_per_process: per,
+            ..d
+        });
     };
     let x = *v.get_ref();
     let max = RunParams::MAX_STARTUP_TIMEOUT_S;
     if x.is_finite() && x > 0.0 && x <= max {
         return Ok(RunParams {
             startup_timeout_s: Some(x),
+            agents_per_process: per,
         });
     }
     Err(ScenarioError::InvalidParameter {

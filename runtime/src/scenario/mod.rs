@@ -64,6 +64,8 @@
 //! startup_timeout_s = 60.0             # how long the processes get to come up; default
 //!                                      # 60 s plus the agents' neural-map builds, scaled
 //!                                      # with the map (params::default_startup_timeout_s)
+//! agents_per_process = 1               # robots per hnav-agent process, in [1, 256]; robots
+//!                                      # k*K..(k+1)*K share process k (default 1: one each)
 //!
 //! [health]                             # hang detection (docs/explanation/hangs.md); not in the hash
 //! heartbeat_ms = 50                    # every process beats this often, in [1, 60000]

@@ -338,16 +338,48 @@ impl Default for CoordinatorParams {
 
 /// Run parameters of the supervisor (`[run]`). They decide whether a run gets going, not what
 /// it does, so the scenario hash leaves them out.
-#[derive(Clone, Copy, PartialEq, Debug, Default, Serialize)]
+#[derive(Clone, Copy, PartialEq, Debug, Serialize)]
 pub struct RunParams {
     /// How long the processes get to come up, in seconds; `None` for the default that scales
     /// with the map ([`default_startup_timeout_s`]).
     pub startup_timeout_s: Option<f64>,
+    /// Robots hosted by one `hnav-agent` process (`agents_per_process`, default 1: one
+    /// process per robot, the dissertation's model). Robots `k*K .. (k+1)*K` share process
+    /// `k`: one node, one waiter, one commit subscriber; each keeps its own topics, state
+    /// and checkpoint. It changes how the run is laid out in processes, not what it decides.
+    pub agents_per_process: u32,
+}
+
+impl Default for RunParams {
+    fn default() -> Self {
+        RunParams {
+            startup_timeout_s: None,
+            agents_per_process: 1,
+        }
+    }
 }
 
 impl RunParams {
     /// Largest `startup_timeout_s` accepted: one day.
     pub const MAX_STARTUP_TIMEOUT_S: f64 = 86_400.0;
+    /// Largest `agents_per_process` accepted: the robots one process's node can hold ports
+    /// for (each robot opens about ten services; iceoryx2's node has no hard cap, but a
+    /// process of thousands of robots is one failure domain too many).
+    pub const MAX_AGENTS_PER_PROCESS: u32 = 256;
+
+    /// The agent processes of a run of `agents` robots: each one's first robot and how many
+    /// it hosts, in order.
+    pub fn agent_processes(&self, agents: usize) -> impl Iterator<Item = (u32, u32)> {
+        let k = self.agents_per_process.max(1);
+        let n = u32::try_from(agents).unwrap_or(u32::MAX);
+        (0..n.div_ceil(k)).map(move |p| (p * k, k.min(n - p * k)))
+    }
+
+    /// The first robot of the process that hosts robot `agent`.
+    pub fn process_of(&self, agent: u32) -> u32 {
+        let k = self.agents_per_process.max(1);
+        agent - agent % k
+    }
 }
 
 /// Neuron updates per second one core is assumed to manage while an agent builds its neural

@@ -82,7 +82,7 @@ pub const KEYS: &[(&str, &[&str])] = &[
             "snapshot_entries",
         ],
     ),
-    ("run", &["startup_timeout_s"]),
+    ("run", &["startup_timeout_s", "agents_per_process"]),
     ("restart", &["agent", "coordinator", "sim", "on_give_up"]),
     ("restart.ROLE", &["policy", "max_restarts", "backoff_ms"]),
     (
@@ -231,6 +231,7 @@ pub(super) struct RawCoordinator {
 #[serde(deny_unknown_fields)]
 pub(super) struct RawRun {
     pub startup_timeout_s: Option<Spanned<f64>>,
+    pub agents_per_process: Option<Spanned<u32>>,
 }
 
 /// `[restart]`.

@@ -115,3 +115,42 @@ fn robots_outside_hnav_run_in_realtime_in_a_world_hnav_does_not_simulate() {
     );
     assert!(parse(&format!("{BASE}[sim]\nkind = \"gazebo\"\n")).is_err());
 }
+
+#[test]
+fn agents_per_process_groups_robots_in_order_without_changing_the_hash() {
+    let s = parse(BASE).unwrap();
+    assert_eq!(s.run.agents_per_process, 1);
+    let one: Vec<_> = s.run.agent_processes(3).collect();
+    assert_eq!(one, [(0, 1), (1, 1), (2, 1)]);
+    let g = parse(&format!("{BASE}[run]\nagents_per_process = 4\n")).unwrap();
+    assert_eq!(g.run.agents_per_process, 4);
+    let groups: Vec<_> = g.run.agent_processes(10).collect();
+    assert_eq!(groups, [(0, 4), (4, 4), (8, 2)]);
+    assert_eq!(
+        (
+            g.run.process_of(0),
+            g.run.process_of(7),
+            g.run.process_of(9)
+        ),
+        (0, 4, 8)
+    );
+    assert_eq!(g.run.agent_processes(0).count(), 0);
+    // How robots are laid out in processes does not change what the run decides.
+    assert_eq!(s.scenario_hash(), g.scenario_hash());
+}
+
+#[test]
+fn bad_agents_per_process_name_line_and_range() {
+    let e = parse(&format!("{BASE}[run]\nagents_per_process = 0\n")).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "t.toml:17: run.agents_per_process must be at least 1"
+    );
+    let e = parse(&format!("{BASE}[run]\nagents_per_process = 257\n")).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "t.toml:17: run.agents_per_process must be at most 256, got 257"
+    );
+    let e = parse(&format!("{BASE}[run]\nagents_per_process = -2\n")).unwrap_err();
+    assert!(e.to_string().starts_with("t.toml:17"), "{e}");
+}

@@ -262,15 +262,22 @@ where
         let reached = sample
             .send()
             .map_err(|e| TransportError::ipc("send sample", self.name.as_str(), e))?;
-        match &self.bell {
-            None => {
-                self.notifier
-                    .notify()
-                    .map_err(|e| TransportError::ipc("notify", self.name.as_str(), e))?;
-            }
-            Some(bell) => self.ring_and_notify_the_others(bell)?,
-        }
+        self.notify()?;
         Ok(reached)
+    }
+
+    /// Wakes the receivers without a sample: after a batch of
+    /// [`send_silently`](Sender::send_silently)s, one wake-up for all of them (an agent
+    /// process that hosts several robots sends their candidates so).
+    pub fn notify(&self) -> Result<(), TransportError> {
+        match &self.bell {
+            None => self
+                .notifier
+                .notify()
+                .map(drop)
+                .map_err(|e| TransportError::ipc("notify", self.name.as_str(), e)),
+            Some(bell) => self.ring_and_notify_the_others(bell),
+        }
     }
 
     /// Notifies every listener that is not a [`BELL_LISTENER`], then rings `bell`: last, so

@@ -197,8 +197,8 @@ mod tests {
             pid,
         };
         // Told down as if exiting (the process itself runs on: the roster is all we look at).
-        assert!(slots.told_down(target).is_some());
-        assert!(slots.told_down(target).is_none(), "told once");
+        assert_eq!(slots.told_down(target).len(), 1);
+        assert!(slots.told_down(target).is_empty(), "told once");
         let roster = coordinator_restarted(&mut slots);
         let states: Vec<_> = roster.iter().map(|l| (l.index, l.reason)).collect();
         let up = RosterState::Up as u8;

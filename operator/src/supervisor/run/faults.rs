@@ -241,7 +241,10 @@ impl<'s> FaultSchedule<'s> {
             FaultAction::Kill(FaultSignal::Term) => Signal::SIGTERM,
             FaultAction::Freeze { .. } => Signal::SIGSTOP,
         };
-        let pid = slots.child(role, index)?.pid();
+        // `agent:N` names a robot: the signal goes to the process that hosts it, named by
+        // its first robot.
+        let child = slots.child(role, index)?;
+        let (index, pid) = (child.spec().index, child.pid());
         tracing::warn!(
             node = role.node_name(index),
             %signal,

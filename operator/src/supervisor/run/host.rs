@@ -38,6 +38,7 @@ impl HostPart {
     pub fn load(file: &Path, name: &str, scenario: &Scenario) -> Result<Self, PlacementError> {
         let placement =
             Placement::load(file, scenario.agents.len(), scenario.coordinator.replicas)?;
+        check_processes(&placement, file, scenario)?;
         let index = placement.index_of(name)?;
         Ok(Self {
             file: file.to_path_buf(),
@@ -170,11 +171,35 @@ impl HostPart {
     }
 }
 
+/// Checks that the robots of each agent process run on one host of `placement`.
+fn check_processes(
+    placement: &Placement,
+    file: &Path,
+    scenario: &Scenario,
+) -> Result<(), PlacementError> {
+    let run = &scenario.run;
+    for (first, count) in run.agent_processes(scenario.agents.len()) {
+        let host = |i| placement.host_of(Role::Agent, i).map(|h| h.name.as_str());
+        let (a, host_a) = (first, host(first));
+        if let Some(b) = (first + 1..first + count).find(|&b| host(b) != host_a) {
+            return Err(PlacementError::SplitProcess {
+                file: file.display().to_string(),
+                per: run.agents_per_process,
+                a,
+                b,
+                host_a: host_a.unwrap_or("none").to_string(),
+                host_b: host(b).unwrap_or("none").to_string(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Every process of a run of `scenario` that a host other than `me` of `placement` runs.
 fn remote_of(placement: &Placement, me: usize, scenario: &Scenario) -> Vec<(Role, u32, String)> {
     let me = &placement.hosts()[me].name;
     processes_of(scenario)
-        .filter_map(|(role, index)| {
+        .filter_map(|(role, index, _)| {
             let host = &placement.host_of(role, index)?.name;
             (host != me).then(|| (role, index, host.clone()))
         })
@@ -182,14 +207,17 @@ fn remote_of(placement: &Placement, me: usize, scenario: &Scenario) -> Vec<(Role
 }
 
 /// Every process of a run of `scenario` but the bridges, in the order they start: the sim,
-/// the coordinator (index 0) or its replicas (1 to n, their Raft ids), the agents. Each runs
-/// the binary `hnav-<role>`.
-pub(super) fn processes_of(scenario: &Scenario) -> impl Iterator<Item = (Role, u32)> {
+/// the coordinator (index 0) or its replicas (1 to n, their Raft ids), the agent processes
+/// (each named by its first robot, with how many robots it hosts: `[run]
+/// agents_per_process`). Each runs the binary `hnav-<role>`; the third field is the robots
+/// a process hosts (1 but for agents).
+pub(super) fn processes_of(scenario: &Scenario) -> impl Iterator<Item = (Role, u32, u32)> + '_ {
     let coordinators = match scenario.coordinator.replicas {
         1 => 0..=0,
         n => 1..=n,
     };
-    std::iter::once((Role::Sim, 0))
-        .chain(coordinators.map(|id| (Role::Coordinator, id)))
-        .chain((0..scenario.agents.len() as u32).map(|i| (Role::Agent, i)))
+    let agents = scenario.run.agent_processes(scenario.agents.len());
+    std::iter::once((Role::Sim, 0, 1))
+        .chain(coordinators.map(|id| (Role::Coordinator, id, 1)))
+        .chain(agents.map(|(first, count)| (Role::Agent, first, count)))
 }

@@ -28,6 +28,9 @@ use hnav_runtime::transport::{Bell, BELL_ENV, DOMAIN_ENV};
 /// One process of the run and what the supervisor knows of it.
 struct Slot {
     spec: ChildSpec,
+    /// The robots an agent process hosts, from `spec.index` on (`[run] agents_per_process`);
+    /// 1 for every other process.
+    robots: u32,
     child: Option<Child>,
     tracker: RestartTracker,
     restart_at: Option<Instant>,
@@ -41,17 +44,36 @@ struct Slot {
 }
 
 impl Slot {
+    /// Whether this slot is `role`/`index`: for an agent process, whether it hosts robot
+    /// `index`.
+    fn is(&self, role: Role, index: u32) -> bool {
+        self.spec.role == role && (self.spec.index..self.spec.index + self.robots).contains(&index)
+    }
+
+    /// The robots of this slot, each as its lifecycle events name it (the slot's own index
+    /// for a process that is not an agent).
+    fn indices(&self) -> std::ops::Range<u32> {
+        self.spec.index..self.spec.index + self.robots
+    }
+
+    /// `event` (`Lifecycle::down`, `lost` or `restarted`) of each robot of this slot.
+    fn tell(&self, event: fn(Role, u32, u32) -> Lifecycle) -> impl Iterator<Item = Action> + '_ {
+        let (role, restarts) = (self.spec.role, self.tracker.restarts());
+        self.indices()
+            .map(move |i| Action::Publish(event(role, i, restarts)))
+    }
+
     /// Whether `target` is this slot's running, unreaped incarnation, not yet told `Down`.
     fn may_tell_down(&self, target: Incarnation) -> bool {
-        self.spec.role == target.role
-            && self.spec.index == target.index
+        self.is(target.role, target.index)
             && self.down_told != Some(target.pid)
             && (self.child.as_ref()).is_some_and(|c| c.pid() == target.pid && c.exit().is_none())
     }
 }
 
 /// Every process of the run: the sim, the coordinator (or its replicas, index = Raft id) and
-/// one agent per robot, in that order.
+/// the agent processes (one per robot, or one per `[run] agents_per_process` robots, each
+/// named by its first), in that order.
 pub(super) struct Slots {
     slots: Vec<Slot>,
     /// The run directory, named when a process stops on a full disk.
@@ -79,7 +101,7 @@ impl Slots {
     ) -> Self {
         let mut slots = Vec::with_capacity(3 + scenario.agents.len());
         let runs_here = |role, index| host.is_none_or(|h| h.this().runs(role, index));
-        let mut add = |role: Role, index: u32| {
+        let mut add = |role: Role, index: u32, robots: u32| {
             let rule = match role {
                 Role::Sim => scenario.restart.sim,
                 Role::Coordinator => scenario.restart.coordinator,
@@ -103,6 +125,9 @@ impl Slots {
             if role == Role::Agent {
                 spec = spec.arg("--index").arg(index.to_string());
             }
+            if robots > 1 {
+                spec = spec.arg("--count").arg(robots.to_string());
+            }
             if role == Role::Coordinator && index > 0 {
                 spec = spec.arg("--replica").arg(index.to_string());
             }
@@ -114,6 +139,7 @@ impl Slots {
             }
             slots.push(Slot {
                 spec,
+                robots,
                 child: None,
                 tracker: RestartTracker::new(rule),
                 restart_at: None,
@@ -122,10 +148,10 @@ impl Slots {
                 down_told: None,
             });
         };
-        let bridge = host.map(|h| (Role::Bridge, h.index() as u32));
-        let local = processes_of(scenario).filter(|&(role, index)| runs_here(role, index));
-        for (role, index) in bridge.into_iter().chain(local) {
-            add(role, index);
+        let bridge = host.map(|h| (Role::Bridge, h.index() as u32, 1));
+        let local = processes_of(scenario).filter(|&(role, index, _)| runs_here(role, index));
+        for (role, index, robots) in bridge.into_iter().chain(local) {
+            add(role, index, robots);
         }
         Self {
             slots,
@@ -193,11 +219,12 @@ impl Slots {
             .filter_map(|s| Some((s.spec.role, s.spec.index, s.child.as_ref()?.pid())))
     }
 
-    /// The current incarnation of `role`/`index`, if it runs.
+    /// The current incarnation of `role`/`index` (for an agent: the process that hosts robot
+    /// `index`), if it runs.
     pub(super) fn child(&self, role: Role, index: u32) -> Option<&Child> {
         self.slots
             .iter()
-            .find(|s| s.spec.role == role && s.spec.index == index)
+            .find(|s| s.is(role, index))
             .and_then(|s| s.child.as_ref())
     }
 
@@ -207,18 +234,15 @@ impl Slots {
         self.slots.iter().any(|s| s.may_tell_down(target))
     }
 
-    /// `target`, which the supervisor SIGKILLed, can no longer act: its `Down`, told now
-    /// rather than at its reap (which then does not tell it again). None if `target` is not
-    /// the slot's running incarnation or was told already.
-    pub(super) fn told_down(&mut self, target: Incarnation) -> Option<Action> {
-        let s = self.slots.iter_mut().find(|s| s.may_tell_down(target))?;
+    /// `target`, which the supervisor SIGKILLed, can no longer act: its `Down` (one per robot
+    /// of an agent process), told now rather than at its reap (which then does not tell it
+    /// again). None if `target` is not the slot's running incarnation or was told already.
+    pub(super) fn told_down(&mut self, target: Incarnation) -> Vec<Action> {
+        let Some(s) = self.slots.iter_mut().find(|s| s.may_tell_down(target)) else {
+            return Vec::new();
+        };
         s.down_told = Some(target.pid);
-        let (role, index) = (s.spec.role, s.spec.index);
-        Some(Action::Publish(Lifecycle::down(
-            role,
-            index,
-            s.tracker.restarts(),
-        )))
+        s.tell(Lifecycle::down).collect()
     }
 
     /// Whether the incarnation `pid` of `role`/`index` is over for good or replaced: it was
@@ -226,7 +250,7 @@ impl Slots {
     pub(super) fn settled(&self, role: Role, index: u32, pid: u32) -> bool {
         self.slots
             .iter()
-            .find(|s| s.spec.role == role && s.spec.index == index)
+            .find(|s| s.is(role, index))
             .is_none_or(|s| match &s.child {
                 Some(c) => c.pid() != pid && !s.announce,
                 None => s.restart_at.is_none(),
@@ -240,12 +264,12 @@ impl Slots {
             .any(|s| s.spec.role == Role::Agent && (s.child.is_some() || s.restart_at.is_some()))
     }
 
-    /// The agents gone for good and why, by index.
+    /// The agents gone for good and why, by robot (every robot of a lost process).
     pub(super) fn lost_agents(&self) -> Vec<(u32, String)> {
-        self.slots
-            .iter()
-            .filter(|s| s.spec.role == Role::Agent)
-            .filter_map(|s| s.lost.clone().map(|why| (s.spec.index, why)))
+        let agents = self.slots.iter().filter(|s| s.spec.role == Role::Agent);
+        agents
+            .filter_map(|s| Some(s.indices().zip(std::iter::repeat(s.lost.clone()?))))
+            .flatten()
             .collect()
     }
 
@@ -262,7 +286,7 @@ impl Slots {
     /// and missed their events.
     fn roster(&self) -> impl Iterator<Item = Action> + '_ {
         let agents = self.slots.iter().filter(|s| s.spec.role == Role::Agent);
-        agents.map(|s| {
+        agents.flat_map(|s| {
             let restarts = s.tracker.restarts();
             let (state, restarts) = match (&s.child, s.lost.is_some()) {
                 (_, true) => (RosterState::Lost, restarts),
@@ -273,7 +297,7 @@ impl Slots {
                 // already counted is still to be announced.
                 _ => (RosterState::Down, restarts.saturating_sub(1)),
             };
-            Action::Publish(Lifecycle::roster(s.spec.index, state, restarts))
+            (s.indices()).map(move |i| Action::Publish(Lifecycle::roster(i, state, restarts)))
         })
     }
 
@@ -286,8 +310,11 @@ impl Slots {
     /// only costs `hnav ps` its view, so it is a warning.
     pub(super) fn write_record(&self, record: &mut RunRecord) {
         for s in &self.slots {
-            if let Some(c) = &s.child {
-                record.set_process(s.spec.role, s.spec.index, c.pid(), s.tracker.restarts());
+            // Each robot of an agent process under the process's pid: `hnav ps` lists robots,
+            // and `hnav kill agent:N` finds the process that hosts robot N.
+            for i in s.indices().filter(|_| s.child.is_some()) {
+                let pid = s.child.as_ref().map_or(0, Child::pid);
+                record.set_process(s.spec.role, i, pid, s.tracker.restarts());
             }
         }
         // In a run across hosts, the other hosts' processes too: `hnav ps` shows the run.
@@ -354,11 +381,7 @@ impl Slots {
             how: exit.to_string(),
         }));
         if s.down_told.take() != Some(pid) {
-            todo.push(Action::Publish(Lifecycle::down(
-                role,
-                index,
-                s.tracker.restarts(),
-            )));
+            todo.extend(s.tell(Lifecycle::down));
         }
         let why = match s.tracker.on_exit(&exit) {
             RestartDecision::Restart { after } => {
@@ -372,12 +395,8 @@ impl Slots {
             RestartDecision::GiveUp(why) => why,
         };
         tracing::warn!(node, %why, "not restarted");
-        todo.push(Action::Publish(Lifecycle::lost(
-            role,
-            index,
-            s.tracker.restarts(),
-        )));
-        let ended = not_restarted(role, index, &exit, why);
+        todo.extend(s.tell(Lifecycle::lost));
+        let ended = not_restarted(role, s.indices(), &exit, why);
         let why = gone.note(role, index, &ended, self.on_give_up);
         todo.push(Action::Journal(RunEvent::GaveUp { node, why }));
         s.lost = Some(ended);
@@ -424,15 +443,11 @@ impl Slots {
         role: Role,
         index: u32,
     ) -> Result<Option<RunEvent>, ChildError> {
-        let slot = self
-            .slots
-            .iter_mut()
-            .find(|s| s.spec.role == role && s.spec.index == index);
-        let Some(s) = slot else {
+        let Some(s) = self.slots.iter_mut().find(|s| s.is(role, index)) else {
             return Ok(None);
         };
         let child = Child::spawn(&s.spec.clone().arg("--resume"))?;
-        let (node, pid) = (role.node_name(index), child.pid());
+        let (node, pid) = (role.node_name(s.spec.index), child.pid());
         tracing::info!(node, pid, "restarted");
         s.child = Some(child);
         s.announce = true;
@@ -486,8 +501,7 @@ impl Slots {
                 node: role.node_name(index),
                 pid: s.child.as_ref().map_or(0, |c| c.pid()),
             }));
-            let restarts = s.tracker.restarts();
-            todo.push(Action::Publish(Lifecycle::restarted(role, index, restarts)));
+            todo.extend(s.tell(Lifecycle::restarted));
             if role != Role::Agent {
                 todo.extend(self.roster());
             }

@@ -168,9 +168,15 @@ pub struct Repairs {
 }
 
 /// The repairs in the text of an agent's log.
-pub fn repairs_in(log: &str) -> Repairs {
+pub fn repairs_in(log: &str, agent: Option<usize>) -> Repairs {
     let mut r = Repairs::default();
-    for line in log.lines().filter(|l| l.contains(": repair agent=")) {
+    let named = agent.map(|i| format!("agent={i}"));
+    let ours = |l: &&str| (named.as_deref()).is_none_or(|n| l.split_whitespace().any(|w| w == n));
+    for line in log
+        .lines()
+        .filter(|l| l.contains(": repair agent="))
+        .filter(ours)
+    {
         let kind = line
             .split_whitespace()
             .find_map(|w| w.strip_prefix("kind="));
@@ -196,11 +202,13 @@ pub fn fill(summary: &mut RunSummary, scenario: &Scenario, run_dir: &Path, log_d
     let fps = false_positives(log_dir, scenario, period_s);
     let lifelong = scenario.tasks.is_some();
     for (i, a) in summary.agents.iter_mut().enumerate() {
+        // A process that hosts several robots logs them all; each repair line names its robot.
+        let process = scenario.run.process_of(i as u32);
         let log = run_dir
             .join("logs")
-            .join(format!("{}.log", Role::Agent.node_name(i as u32)));
+            .join(format!("{}.log", Role::Agent.node_name(process)));
         let rep = std::fs::read_to_string(&log)
-            .map(|t| repairs_in(&t))
+            .map(|t| repairs_in(&t, (scenario.run.agents_per_process > 1).then_some(i)))
             .unwrap_or_default();
         (a.repairs_partial, a.repairs_rebuild, a.repairs_replan) =
             (rep.partial, rep.rebuild, rep.replan);
@@ -250,13 +258,27 @@ mod tests {
 2026-12-05T14:00:00.4Z  INFO hnav_agent::process: repair of nothing
 ";
         assert_eq!(
-            repairs_in(log),
+            repairs_in(log, None),
             Repairs {
                 partial: 1,
                 rebuild: 2,
                 replan: 0
             }
         );
+    }
+
+    #[test]
+    fn a_shared_processs_log_counts_each_robots_repairs_apart() {
+        let log = "2026-12-05T14:00:00.1Z  INFO agent{index=4}: hnav_agent::navigator::sense: repair agent=4 period=151 closed=1 opened=0 kind=Partial us=40
+2026-12-05T14:00:00.2Z  INFO agent{index=5}: hnav_agent::navigator::sense: repair agent=5 period=160 closed=1 opened=0 kind=Rebuild us=900
+2026-12-05T14:00:00.3Z  INFO agent{index=4}: hnav_agent::navigator::sense: repair agent=4 period=170 closed=0 opened=1 kind=Rebuild us=800
+2026-12-05T14:00:00.4Z  INFO agent{index=4}: hnav_agent::navigator::sense: repair agent=45 period=170 closed=0 opened=1 kind=Replan us=800
+";
+        let four = repairs_in(log, Some(4));
+        assert_eq!((four.partial, four.rebuild, four.replan), (1, 1, 0));
+        let five = repairs_in(log, Some(5));
+        assert_eq!((five.partial, five.rebuild, five.replan), (0, 1, 0));
+        assert_eq!(repairs_in(log, None).rebuild, 2);
     }
 
     fn decision(verdict: Verdict, kind: ConflictKind, refused: u8, cell: u32) -> LoggedDecision {

@@ -50,10 +50,22 @@ impl Gone {
     }
 }
 
-/// That `role`/`index` ended with `exit` and is not restarted for `why`, in words.
-pub(super) fn not_restarted(role: Role, index: u32, exit: &ExitInfo, why: GiveUpReason) -> String {
+/// That `role`'s process of `robots` (an agent process's robots; one index otherwise) ended
+/// with `exit` and is not restarted for `why`, in words.
+pub(super) fn not_restarted(
+    role: Role,
+    robots: std::ops::Range<u32>,
+    exit: &ExitInfo,
+    why: GiveUpReason,
+) -> String {
     let who = match role {
-        Role::Agent => format!("hnav-agent {index}"),
+        Role::Agent if robots.len() > 1 => format!(
+            "hnav-agent {} (robots {} to {})",
+            robots.start,
+            robots.start,
+            robots.end - 1
+        ),
+        Role::Agent => format!("hnav-agent {}", robots.start),
         other => format!("hnav-{}", other.name()),
     };
     format!("{who} ended ({exit}) and is not restarted ({why})")
