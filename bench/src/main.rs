@@ -219,6 +219,11 @@ struct ChaosCli {
     /// kill-mix or kill-leader (the Raft leader of 3 replicas).
     #[arg(long, value_name = "CLASS")]
     class: Option<String>,
+    /// Robots per agent process in every run (`[run] agents_per_process`); with 8, the
+    /// chaos swarm's six robots share one process and every agent fault takes all six down.
+    #[arg(long, value_name = "K", default_value_t = 1,
+          value_parser = clap::value_parser!(u32).range(1..=256))]
+    agents_per_process: u32,
 }
 
 fn chaos(args: ChaosCli) -> Result<()> {
@@ -242,6 +247,7 @@ fn chaos(args: ChaosCli) -> Result<()> {
         only: args.only,
         class,
         bin_dir,
+        agents_per_process: args.agents_per_process,
     };
     let report =
         run_campaign(&config, |line| hnav_runtime::outln!("{line}")).map_err(anyhow::Error::msg)?;

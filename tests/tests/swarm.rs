@@ -78,33 +78,75 @@ const GOLDEN_LOGS: [(&str, &str); 2] = [
 
 #[test]
 fn lockstep_logs_match_the_golden_sums() {
-    use sha2::{Digest, Sha256};
     let tmp = tempfile::tempdir().unwrap();
     let registry = tmp.path().join("runs");
     for (i, (scenario, want)) in GOLDEN_LOGS.iter().enumerate() {
-        let mut run = TestRun::new(&format!("gold{i}"));
         let dir = tmp.path().join(format!("g{i}"));
-        let mut swarm = SwarmRun::start(
-            &mut run,
+        let got = lockstep_log_sum(
+            &format!("gold{i}"),
             &repo_root().join(scenario),
             &dir,
             &registry,
-            &["--mode", "lockstep"],
-        )
-        .expect("hnav run starts");
-        let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
-        assert!(
-            status.success(),
-            "{scenario}: {status}\n{}",
-            swarm.log_tails()
         );
-        let log = std::fs::read(dir.join("log/seg-00000000.hlog")).unwrap();
-        let got: String = Sha256::digest(&log)
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect();
         assert_eq!(&got, want, "{scenario}: the lockstep log changed");
     }
+}
+
+/// Robots that share agent processes (`[run] agents_per_process`) decide as robots that do
+/// not: the same golden logs, with processes of 4 and 2 robots (the demo's six by 4) and of
+/// 3, 3 and 2 (the eight of random-32-32-10 by 3).
+#[test]
+fn robots_sharing_agent_processes_write_the_golden_logs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let registry = tmp.path().join("runs");
+    for (i, ((scenario, want), per)) in GOLDEN_LOGS.iter().zip([4, 3]).enumerate() {
+        let text = std::fs::read_to_string(repo_root().join(scenario)).unwrap();
+        // The copy lives elsewhere: its map path is made absolute.
+        let maps = format!("file = \"{}/maps/", repo_root().display());
+        let text = text.replace("file = \"../maps/", &maps);
+        let text = format!("{text}\n[run]\nagents_per_process = {per}\n");
+        let copy = tmp.path().join(format!("shared{i}.toml"));
+        std::fs::write(&copy, text).unwrap();
+        let dir = tmp.path().join(format!("s{i}"));
+        let got = lockstep_log_sum(&format!("shared{i}"), &copy, &dir, &registry);
+        assert_eq!(&got, want, "{scenario} with {per} robots a process");
+        let logs: Vec<String> = std::fs::read_dir(dir.join("logs"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with("agent-"))
+            .collect();
+        let agents = if i == 0 { 6 } else { 8 };
+        assert_eq!(
+            logs.len(),
+            agents / per + usize::from(agents % per > 0),
+            "{logs:?}"
+        );
+    }
+}
+
+/// Runs `scenario` in lockstep into `dir` and returns the sha256 of its log segment.
+fn lockstep_log_sum(
+    tag: &str,
+    scenario: &std::path::Path,
+    dir: &std::path::Path,
+    registry: &std::path::Path,
+) -> String {
+    use sha2::{Digest, Sha256};
+    let mut run = TestRun::new(tag);
+    let mut swarm = SwarmRun::start(&mut run, scenario, dir, registry, &["--mode", "lockstep"])
+        .expect("hnav run starts");
+    let status = swarm.finish(RUN_TIMEOUT).expect("hnav run ends");
+    assert!(
+        status.success(),
+        "{}: {status}\n{}",
+        scenario.display(),
+        swarm.log_tails()
+    );
+    let log = std::fs::read(dir.join("log/seg-00000000.hlog")).unwrap();
+    Sha256::digest(&log)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
 }
 
 /// The supervisor's `Stop` says why: at the time limit the coordinator logs the run's end as

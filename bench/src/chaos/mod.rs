@@ -66,6 +66,9 @@ pub struct CampaignConfig {
     pub class: Option<Class>,
     /// Where `hnav` and the process binaries are.
     pub bin_dir: PathBuf,
+    /// Robots per agent process (`[run] agents_per_process`; 1: one process per robot).
+    /// With more, a fault on `agent:N` takes down every robot of N's process.
+    pub agents_per_process: u32,
 }
 
 /// What a campaign showed.
@@ -160,9 +163,13 @@ pub fn run_campaign(
         .prefix("hnav-chaos-")
         .tempdir()
         .map_err(|e| format!("cannot make the campaign's directory: {e}"))?;
+    let base = match config.agents_per_process {
+        1 => CHAOS_SCENARIO.to_string(),
+        k => format!("{CHAOS_SCENARIO}\n[run]\nagents_per_process = {k}\n"),
+    };
     let setup = RunSetup {
         bin_dir: &config.bin_dir,
-        base_scenario: CHAOS_SCENARIO,
+        base_scenario: &base,
         agents: CHAOS_SPACE.agents as usize,
         root: root.path(),
         keep: config.only.is_some(),
