@@ -68,7 +68,8 @@ enum Command {
         #[command(subcommand)]
         command: MapCommand,
     },
-    /// Run a scenario end to end: sim, coordinator and one agent process per robot.
+    /// Run a scenario end to end: sim, coordinator and the agents (one process per robot, or
+    /// per `[run] agents_per_process` robots).
     Run(Box<run_cmd::RunArgs>),
     /// List the live runs on this machine and their processes.
     Ps(ps_cmd::PsArgs),
