@@ -101,8 +101,12 @@ pub enum KillError {
 /// What `hnav kill` did.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Killed {
-    /// The target's node name, e.g. `agent-3`.
+    /// The target's node name, e.g. `agent-3`; for a robot of a shared agent process
+    /// (`[run] agents_per_process`), the process's, named by its first robot.
     pub node: String,
+    /// The robots of the agent process signalled, ascending (the target alone when it has
+    /// a process of its own; empty for a sim or a coordinator).
+    pub robots: Vec<u32>,
     /// The pid signalled.
     pub pid: u32,
     /// The signal sent.
@@ -185,8 +189,15 @@ pub fn kill(
             })
         }
     }
+    // A robot of a shared process: the signal took the process, named by its first robot.
+    let mut robots: Vec<u32> = (record.processes.iter())
+        .filter(|q| q.role == Role::Agent && role == Role::Agent && q.pid == p.pid)
+        .map(|q| q.index)
+        .collect();
+    robots.sort_unstable();
+    let node = role.node_name(robots.first().copied().unwrap_or(index));
     held.record(RunEvent::Signalled {
-        node: role.node_name(index),
+        node: node.clone(),
         pid: p.pid,
         signal: signal.to_string(),
         fault: None,
@@ -194,7 +205,8 @@ pub fn kill(
     });
     drop(held);
     Ok(Killed {
-        node: role.node_name(index),
+        node,
+        robots,
         pid: p.pid,
         signal,
         round,
@@ -309,6 +321,42 @@ mod tests {
         assert_eq!(line["node"], "agent-1");
         assert_eq!(line["signal"], "SIGKILL");
         assert!(line["fault"].is_null());
+    }
+
+    /// `agent:N` of robots that share a process (`[run] agents_per_process`) signals that
+    /// process, and the journal names it by its first robot, as the supervisor's lines do.
+    #[test]
+    fn a_robot_of_a_shared_process_takes_its_process_and_the_journal_names_it() {
+        let tmp = tempfile::tempdir().unwrap();
+        let mut sleeper = std::process::Command::new("sleep")
+            .arg("30")
+            .spawn()
+            .unwrap();
+        let registry = RunRegistry::at(tmp.path().join("runs"));
+        let run = RunId::new("kill-shared").unwrap();
+        let mut record = registry.new_record(&run, tmp.path().join("dir"));
+        let gone = exited_pid();
+        for (i, pid) in [(0, gone), (1, gone), (2, sleeper.id()), (3, sleeper.id())] {
+            record.set_process(Role::Agent, i, pid, 0);
+        }
+        record.write().unwrap();
+        std::fs::create_dir_all(tmp.path().join("dir")).unwrap();
+        let k = kill(
+            &registry,
+            "kill-shared",
+            FaultTarget::Agent(3),
+            Signal::SIGKILL,
+        )
+        .unwrap();
+        assert_eq!(
+            (k.node.as_str(), k.robots.as_slice()),
+            ("agent-2", &[2, 3][..])
+        );
+        use std::os::unix::process::ExitStatusExt;
+        assert_eq!(sleeper.wait().unwrap().signal(), Some(9));
+        let text = std::fs::read_to_string(&k.journal).unwrap();
+        let line: serde_json::Value = serde_json::from_str(text.trim()).unwrap();
+        assert_eq!(line["node"], "agent-2");
     }
 
     #[test]

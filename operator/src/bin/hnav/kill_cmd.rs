@@ -69,8 +69,12 @@ pub fn run(a: KillArgs) -> ExitCode {
         a.signal.signal(),
     ) {
         Ok(k) => {
+            let shared = match k.robots.as_slice() {
+                [first, .., last] => format!(", the process of agents {first} to {last}"),
+                _ => String::new(),
+            };
             hnav_runtime::outln!(
-                "sent {} to {} (pid {}) of run {} at round {}; recorded in {}",
+                "sent {} to {} (pid {}{shared}) of run {} at round {}; recorded in {}",
                 k.signal,
                 a.target,
                 k.pid,
