@@ -277,3 +277,53 @@ fn a_mover_that_yields_comes_on_only_when_no_robot_claims_its_first_cell() {
         assert!(w.collisions().is_empty(), "{:?}", w.collisions());
     }
 }
+
+#[test]
+fn a_mover_held_at_an_end_of_its_path_steps_off_and_comes_back_when_the_way_is_free() {
+    // Back and forth along row 1 between (0, 1) and (3, 1); the turning robot at (2, 2)
+    // claims (1, 1), one diagonal move away, so from the start the mover waits at (0, 1),
+    // an end of its path, where turning back is the same way.
+    let path =
+        "[[events]]\nat_s = 0\nmover = \"p\"\npath = [[0, 1], [3, 1]]\nspeed = 1\nrepeat = true\n";
+    let cell = hnav_runtime::scenario::params::RobotParams::default().cell_size_m;
+    let mut w = world(path);
+    turn(&mut w, 2_900);
+    let (_, at) = w.movers().next().expect("on the floor, waiting");
+    assert_eq!((at.x / cell, at.y / cell), (0.5, 1.5), "waits at (0, 1)");
+    // Past the turn-back wait it steps off the floor, and stays off while the robot turns.
+    turn(&mut w, 300);
+    assert_eq!(w.movers().count(), 0, "it stepped off");
+    turn(&mut w, 2_000);
+    assert_eq!(
+        w.movers().count(),
+        0,
+        "off while the robot may enter its way"
+    );
+    // A checkpoint keeps it off, at its end.
+    let mut bytes = Vec::new();
+    w.write_snapshot(&mut bytes);
+    let mut back = world(path);
+    back.restore_snapshot(&bytes).unwrap();
+    assert_eq!(back.movers().count(), 0);
+    // The robot stands: the mover comes back on at (0, 1) and walks its way, a cell from
+    // the robot; nobody touched anybody.
+    for w in [&mut w, &mut back] {
+        // The robot's wheels come to rest first (motor lag): until then it may still enter.
+        let mut steps = 0;
+        while w.movers().count() == 0 {
+            stand(w, 1);
+            steps += 1;
+            assert!(steps < 2_000, "never came back on");
+        }
+        let (_, at) = w.movers().next().unwrap();
+        assert_eq!(
+            (at.x / cell, at.y / cell),
+            (0.5, 1.5),
+            "back where it stepped off"
+        );
+        stand(w, 2_000);
+        let (_, at) = w.movers().next().unwrap();
+        assert!(at.x / cell > 2.0, "walked on: {}", at.x / cell);
+        assert!(w.collisions().is_empty(), "{:?}", w.collisions());
+    }
+}

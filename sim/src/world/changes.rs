@@ -25,8 +25,12 @@
 //! away (with the default body, two radii are 0.725 cell: robots a cell apart do not touch).
 //! A mover that walks back and forth and has waited [`TURN_BACK_S`] turns back: the robot it
 //! waits for may itself be waiting for the mover to leave (pushed into the mover's cell by
-//! the coordinator, or head-on in a one-cell corridor), and a person would give way. A mover
-//! with `yields = false` walks on regardless.
+//! the coordinator, or head-on in a one-cell corridor), and a person would give way. At an
+//! end of its path turning back is the way it waits for, so there it steps off the floor
+//! instead (a person steps out of the aisle's end) and comes back on at that cell once no
+//! robot claims it or the cell it walks to next: a robot that waits for it to leave, a cell
+//! away, is otherwise held for good (robot 6 and walker 0 of the 50-robot dynamic
+//! experiment). A mover with `yields = false` walks on regardless.
 
 use hnav_runtime::scenario::{EventSpec, MoverSpec, WorldChange};
 use nalgebra::Point2;
@@ -50,6 +54,9 @@ struct Active {
     /// claims that cell (a person waits at the aisle's end for a robot to pass); until then
     /// it is nowhere: no contact, no view, no moving cell.
     on_floor: bool,
+    /// Off the floor after waiting at an end of its path (see the module docs): it comes
+    /// back on at its cell once no robot claims that cell or the next.
+    stepped_off: bool,
     /// Where it is now, m.
     at: Point2<f64>,
 }
@@ -104,6 +111,26 @@ impl Active {
         tracing::info!(mover = self.spec.name, "mover turned back");
     }
 
+    /// Whether it stands at an end of its back-and-forth path, where turning back is the
+    /// way it came.
+    fn at_an_end(&self) -> bool {
+        let period = 2 * (self.spec.cells.len() as u64).saturating_sub(1);
+        period > 0 && self.walked.fract() == 0.0 && (self.walked as u64 % (period / 2)) == 0
+    }
+
+    /// Steps off the floor where it stands (see the module docs).
+    fn step_off(&mut self, t_s: f64) {
+        self.on_floor = false;
+        self.stepped_off = true;
+        self.waited_s = 0.0;
+        self.moved_s = t_s;
+        tracing::info!(
+            mover = self.spec.name,
+            t_s,
+            "mover stepped off at its path's end"
+        );
+    }
+
     /// Walks on to `t_s`, waiting at a cell centre while a robot claims the next cell if it
     /// yields. It stops at every centre it reaches, so it looks there before going on.
     fn walk(&mut self, t_s: f64, robots: &Robots<'_>) {
@@ -119,8 +146,13 @@ impl Active {
                     tracing::info!(mover = self.spec.name, x, y, t_s, "mover waits for a robot");
                 }
                 self.waited_s += left / self.spec.speed;
-                if self.spec.repeat && self.waited_s >= TURN_BACK_S {
-                    self.turn_back();
+                match (
+                    self.spec.repeat && self.waited_s >= TURN_BACK_S,
+                    self.at_an_end(),
+                ) {
+                    (true, true) => self.step_off(t_s),
+                    (true, false) => self.turn_back(),
+                    (false, _) => {}
                 }
                 return;
             }
@@ -183,6 +215,7 @@ impl Changes {
                         touching: vec![false; robots],
                         at: Point2::origin(),
                         on_floor: false,
+                        stepped_off: false,
                     });
                 }
             }
@@ -205,8 +238,10 @@ impl Changes {
         let (r, cell) = (robots.radius, robots.cell);
         for (k, m) in self.movers.iter_mut().enumerate() {
             if !m.on_floor {
-                let first = m.spec.cell_at(0);
-                if m.spec.yields && robots.claim(first) {
+                let here = m.walked.floor() as u64;
+                let (first, ahead) = (m.spec.cell_at(here), m.spec.cell_at(here + 1));
+                let claimed = robots.claim(first) || (m.stepped_off && robots.claim(ahead));
+                if m.spec.yields && claimed {
                     // moved_s is -1 once it has said that it waits (it restarts at entry).
                     if m.moved_s >= 0.0 {
                         let (x, y) = (first.x, first.y);
@@ -216,10 +251,15 @@ impl Changes {
                     continue;
                 }
                 m.on_floor = true;
+                m.stepped_off = false;
                 m.moved_s = t_s;
                 tracing::info!(mover = m.spec.name, t_s, "mover came on");
             }
             m.walk(t_s, robots);
+            if !m.on_floor {
+                m.touching.iter_mut().for_each(|t| *t = false);
+                continue;
+            }
             let (x, y) = m.spec.point_at(m.walked);
             m.at = Point2::new((x + 0.5) * cell, (y + 0.5) * cell);
             for (i, p) in robots.centres.iter().enumerate() {
@@ -285,11 +325,17 @@ impl Changes {
     }
 
     /// How far each mover under way has walked and how long it has waited, for the sim's
-    /// checkpoint; a mover not on the floor yet has walked -1 (a walk is never negative).
+    /// checkpoint; a mover not on the floor yet has walked -1, one that stepped off after
+    /// walking `w` -(w + 2) (a walk is never negative).
     pub(crate) fn walked(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
-        self.movers
-            .iter()
-            .map(|m| (if m.on_floor { m.walked } else { -1.0 }, m.waited_s))
+        self.movers.iter().map(|m| {
+            let w = match (m.on_floor, m.stepped_off) {
+                (true, _) => m.walked,
+                (false, false) => -1.0,
+                (false, true) => -(m.walked + 2.0),
+            };
+            (w, m.waited_s)
+        })
     }
 
     /// Takes how far each mover walked and how long it waited from a checkpoint taken at
@@ -300,7 +346,8 @@ impl Changes {
         }
         for (m, &(w, waited)) in self.movers.iter_mut().zip(walked) {
             m.on_floor = w >= 0.0;
-            let w = w.max(0.0);
+            m.stepped_off = w <= -2.0;
+            let w = if m.stepped_off { -w - 2.0 } else { w.max(0.0) };
             m.walked = w;
             m.waited_s = waited;
             m.moved_s = t_s;
