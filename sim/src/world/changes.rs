@@ -115,7 +115,7 @@ impl Active {
     /// way it came.
     fn at_an_end(&self) -> bool {
         let period = 2 * (self.spec.cells.len() as u64).saturating_sub(1);
-        period > 0 && self.walked.fract() == 0.0 && (self.walked as u64 % (period / 2)) == 0
+        period > 0 && self.walked.fract() == 0.0 && (self.walked as u64).is_multiple_of(period / 2)
     }
 
     /// Steps off the floor where it stands (see the module docs).
