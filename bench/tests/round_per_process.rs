@@ -7,57 +7,29 @@ use std::collections::BTreeSet;
 use std::time::Duration;
 
 mod common;
-use common::bench_within;
+use common::{bench_within, round_rows};
 
 /// A few seconds on a quiet machine; past this it hangs.
 const LIMIT: Duration = Duration::from_secs(180);
 
 #[test]
 fn the_round_is_measured_with_one_and_with_five_robots_a_process_in_one_run() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().display().to_string();
     // 12 robots by 5: processes of 5, 5 and 2, so a short last process is played too.
-    let run = bench_within(
-        &[
-            "round",
-            "--agents",
-            "12",
-            "--fsync",
-            "none",
-            "--agents-per-process",
-            "1,5",
-            "--rounds",
-            "60",
-            "--warmup",
-            "20",
-            "--json",
-            "--out",
-            &out,
-        ],
-        LIMIT,
-    );
-    let stdout = String::from_utf8_lossy(&run.stdout);
-    assert!(
-        run.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let args = [
+        "--agents",
+        "12",
+        "--fsync",
+        "none",
+        "--agents-per-process",
+        "1,5",
+    ];
+    let (rows, csv) = round_rows(&args, LIMIT);
     let mut seen = BTreeSet::new();
-    for line in stdout.lines() {
-        let v: serde_json::Value = serde_json::from_str(line).unwrap();
-        if v["bench"] != "round" {
-            continue;
-        }
-        let (rounds, stalled) = (
-            v["rounds"].as_u64().unwrap(),
-            v["stalled"].as_u64().unwrap(),
-        );
-        assert_eq!(rounds + stalled, 60, "{line}");
-        assert_eq!(v["agents"], 12, "{line}");
+    for v in &rows {
+        assert_eq!(v["agents"], 12, "{v}");
         seen.insert(v["agents_per_process"].as_u64().unwrap());
     }
-    assert_eq!(seen, BTreeSet::from([1, 5]), "{stdout}");
-    let csv = std::fs::read_to_string(dir.path().join("round.csv")).unwrap();
+    assert_eq!(seen, BTreeSet::from([1, 5]), "{rows:?}");
     assert!(
         csv.contains("last_candidate_to_all_commits_5_per_process"),
         "{csv}"

@@ -7,60 +7,31 @@ use std::collections::BTreeSet;
 use std::time::Duration;
 
 mod common;
-use common::bench_within;
+use common::{bench_within, round_rows};
 
 /// A few seconds on a quiet machine (an election takes up to 1 s); past this it hangs.
 const LIMIT: Duration = Duration::from_secs(180);
 
 #[test]
 fn one_coordinator_and_three_replicas_are_measured_side_by_side() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().display().to_string();
-    let run = bench_within(
-        &[
-            "round",
-            "--agents",
-            "8",
-            "--fsync",
-            "every-record",
-            "--replicas",
-            "1,3",
-            "--rounds",
-            "60",
-            "--warmup",
-            "20",
-            "--json",
-            "--out",
-            &out,
-        ],
-        LIMIT,
-    );
-    let stdout = String::from_utf8_lossy(&run.stdout);
-    assert!(
-        run.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let args = [
+        "--agents",
+        "8",
+        "--fsync",
+        "every-record",
+        "--replicas",
+        "1,3",
+    ];
+    let (rows, csv) = round_rows(&args, LIMIT);
     let mut replicas = BTreeSet::new();
-    for line in stdout.lines() {
-        let v: serde_json::Value = serde_json::from_str(line).unwrap();
-        if v["bench"] != "round" {
-            continue;
-        }
-        assert_eq!(v["agents"], 8, "{line}");
-        assert_eq!(v["fsync"], "every-record", "{line}");
-        // Stalled rounds are left out of the distribution; every other round is in it.
-        let (rounds, stalled) = (
-            v["rounds"].as_u64().unwrap(),
-            v["stalled"].as_u64().unwrap(),
-        );
-        assert_eq!(rounds + stalled, 60, "{line}");
-        assert!(v["p50_us"].as_f64().unwrap() > 0.0, "{line}");
+    for v in &rows {
+        assert_eq!(v["agents"], 8, "{v}");
+        assert_eq!(v["fsync"], "every-record", "{v}");
+        assert!(v["p50_us"].as_f64().unwrap() > 0.0, "{v}");
         replicas.insert(v["replicas"].as_u64().unwrap());
     }
-    assert_eq!(replicas, BTreeSet::from([1, 3]), "{stdout}");
+    assert_eq!(replicas, BTreeSet::from([1, 3]), "{rows:?}");
 
-    let csv = std::fs::read_to_string(dir.path().join("round.csv")).unwrap();
     let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
     let col = header.iter().position(|h| *h == "replicas").unwrap();
     let seen: BTreeSet<&str> = csv

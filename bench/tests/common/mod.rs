@@ -52,3 +52,36 @@ pub fn latency_csv(args: &[&str], dir: &std::path::Path, limit: Duration) -> Str
     assert_eq!(text.lines().next(), Some(hnav_bench::latency::csv::HEADER));
     text
 }
+
+/// `hnav-bench round ARGS --rounds 60 --warmup 20 --json --out DIR`, which must succeed
+/// within `limit`: its round rows (JSON), each checked to account for all 60 measured rounds
+/// (a stalled round is left out of the distribution, every other is in it), and the text of
+/// its `DIR/round.csv`.
+#[allow(dead_code)]
+pub fn round_rows(args: &[&str], limit: Duration) -> (Vec<serde_json::Value>, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().display().to_string();
+    let mut all = vec!["round"];
+    all.extend_from_slice(args);
+    all.extend(["--rounds", "60", "--warmup", "20", "--json", "--out", &out]);
+    let run = bench_within(&all, limit);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let rows: Vec<serde_json::Value> = (stdout.lines())
+        .map(|l| serde_json::from_str(l).unwrap())
+        .filter(|v: &serde_json::Value| v["bench"] == "round")
+        .collect();
+    for v in &rows {
+        let (rounds, stalled) = (
+            v["rounds"].as_u64().unwrap(),
+            v["stalled"].as_u64().unwrap(),
+        );
+        assert_eq!(rounds + stalled, 60, "{v}");
+    }
+    let csv = std::fs::read_to_string(dir.path().join("round.csv")).unwrap();
+    (rows, csv)
+}
