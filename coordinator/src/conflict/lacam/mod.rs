@@ -25,12 +25,17 @@
 //! `docs/explanation/conflict-rules.md`); it runs in the round that plans, once per plan. Every other round follows the
 //! schedule without allocating.
 
+mod arena;
 mod generator;
 mod graph;
 mod schedule;
 pub mod search;
 #[cfg(test)]
+mod search_tests;
+pub mod standalone;
+#[cfg(test)]
 mod tests;
+mod tree;
 
 use hnav_runtime::grid::{Cell, Grid};
 
@@ -238,7 +243,7 @@ impl Lacam {
                 goals: &goals,
                 distance: &distance,
             };
-            search::solve(&problem, &starts, self.budget, tick)
+            search::solve(&problem, &starts, self.budget, None, tick)
         };
         let took = started.elapsed();
         match result {
