@@ -35,6 +35,9 @@ pub struct LacamArgs {
     /// Agents as points: a diagonal does not hold its side cells.
     #[arg(long)]
     points: bool,
+    /// Without LaCAM3's swap in the configuration generator.
+    #[arg(long)]
+    no_swap: bool,
     /// random-32-32-10, 50 agents, 1 s (the smoke check of bench/tests/lacam_quick.rs).
     #[arg(long)]
     quick: bool,
@@ -52,7 +55,7 @@ pub fn main(args: LacamArgs) -> Result<()> {
         bail!("--limit-s must be a positive number of seconds");
     }
     let limit = Duration::from_secs_f64(args.limit_s);
-    let cases: Vec<Case> = match (&args.map, &args.scen, args.quick) {
+    let mut cases: Vec<Case> = match (&args.map, &args.scen, args.quick) {
         (Some(map), Some(scen), _) => {
             if args.agents.is_empty() {
                 bail!("--map needs --agents");
@@ -67,12 +70,17 @@ pub fn main(args: LacamArgs) -> Result<()> {
                     memory_mib: args.memory_mib,
                     extend_seed: args.extend_seed,
                     points: args.points,
+                    swap: !args.no_swap,
                 })
                 .collect()
         }
         (_, _, true) => quick_cases(),
         _ => default_cases(limit, args.memory_mib),
     };
+    for case in &mut cases {
+        case.swap &= !args.no_swap;
+        case.points |= args.points;
+    }
     if args.child {
         let [case] = &cases[..] else {
             bail!("--child runs exactly one case");

@@ -21,7 +21,7 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 use hnav_coordinator::conflict::lacam::standalone::Instance as Search;
-use hnav_coordinator::conflict::lacam::Budget;
+use hnav_coordinator::conflict::lacam::{Budget, SearchError};
 use hnav_coordinator::conflict::Options;
 use hnav_runtime::grid::scen_gen::generate_scen;
 use hnav_runtime::grid::ScenEntry;
@@ -48,6 +48,8 @@ pub struct Case {
     pub extend_seed: Option<u64>,
     /// Agents as points (`sweep = false`): a diagonal does not hold its side cells.
     pub points: bool,
+    /// LaCAM3's swap in the generator (on unless `--no-swap`).
+    pub swap: bool,
 }
 
 /// What one search showed.
@@ -176,7 +178,9 @@ pub fn search_case(case: &Case) -> Result<SearchRow, String> {
         ..Options::default()
     };
     let t0 = Instant::now();
-    let search = Search::new(&bench.grid, &starts, &goals, options).map_err(|e| e.to_string())?;
+    let mut search =
+        Search::new(&bench.grid, &starts, &goals, options).map_err(|e| e.to_string())?;
+    search.set_swap(case.swap);
     let tables_s = t0.elapsed().as_secs_f64();
     let stem = Path::new(&bench.map_given)
         .file_stem()
@@ -218,7 +222,14 @@ pub fn search_case(case: &Case) -> Result<SearchRow, String> {
             row.visited = plan.visited;
             row.search_bytes = plan.bytes;
         }
-        Err(e) => row.error = Some(e.to_string()),
+        Err(e) => {
+            row.visited = match e {
+                SearchError::Budget { configurations }
+                | SearchError::Deadline { configurations } => configurations,
+                SearchError::NoPlan => 0,
+            };
+            row.error = Some(e.to_string());
+        }
     }
     row.peak_rss_kib = peak_rss_kib();
     Ok(row)
@@ -245,6 +256,9 @@ pub fn child_args(case: &Case) -> Vec<String> {
     }
     if case.points {
         args.push("--points".into());
+    }
+    if !case.swap {
+        args.push("--no-swap".into());
     }
     args
 }
@@ -312,6 +326,7 @@ pub fn quick_cases() -> Vec<Case> {
         memory_mib: 256,
         extend_seed: None,
         points: false,
+        swap: true,
     }]
 }
 
@@ -327,6 +342,7 @@ pub fn default_cases(limit: Duration, memory_mib: usize) -> Vec<Case> {
         memory_mib,
         extend_seed: Some(1).filter(|_| stem.starts_with("warehouse")),
         points: false,
+        swap: true,
     };
     vec![
         case("warehouse-10-20-10-2-1", 500),

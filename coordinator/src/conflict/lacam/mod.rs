@@ -33,6 +33,7 @@ pub mod search;
 #[cfg(test)]
 mod search_tests;
 pub mod standalone;
+mod swap;
 #[cfg(test)]
 mod tests;
 mod tree;
@@ -242,6 +243,7 @@ impl Lacam {
                 fixed: &self.blocked,
                 goals: &goals,
                 distance: &distance,
+                swap: false,
             };
             search::solve(&problem, &starts, self.budget, None, tick)
         };

@@ -159,6 +159,9 @@ pub(super) fn solve(
     let mut fixed: Vec<(u32, u32)> = Vec::with_capacity(n);
     let mut next: Vec<u32> = Vec::with_capacity(n);
     let mut order: Vec<u32> = Vec::with_capacity(n);
+    // The node whose order `order` holds: the depth-first search expands one node many times
+    // in a row, and a sort of a thousand agents is not free.
+    let mut ordered = NONE;
     let mut goal: Option<u32> = None;
     let mut first = (0, 0, None);
     // The first solution, kept: refinement lowers `g`, which counts an agent resting on its
@@ -198,7 +201,10 @@ pub(super) fn solve(
             open.pop();
             continue;
         };
-        tree.order(top, &mut order);
+        if ordered != top {
+            tree.order(top, &mut order);
+            ordered = top;
+        }
         tree.expand(p, top, low, &order);
         if tree.constraint_count() > budget.constraints {
             break End::Budget;

@@ -85,6 +85,7 @@ pub struct Instance {
     distances: Distances,
     width: u32,
     fixed: Vec<bool>,
+    swap: bool,
     /// The starts as row-major cell indices.
     pub starts: Vec<u32>,
     /// The goals as row-major cell indices.
@@ -129,9 +130,16 @@ impl Instance {
             distances,
             width: grid.width(),
             fixed: vec![false; grid.len()],
+            swap: true,
             starts: s,
             goals: g,
         })
+    }
+
+    /// Switches LaCAM3's swap in the generator (`swap.rs`) on (the default here; the rounds
+    /// search without it) or off.
+    pub fn set_swap(&mut self, on: bool) {
+        self.swap = on;
     }
 
     /// Whether the distance tables are exact (see [`Distances::exact`]).
@@ -152,6 +160,7 @@ impl Instance {
             fixed: &self.fixed,
             goals: &self.goals,
             distance: &distance,
+            swap: self.swap,
         };
         search::solve(&problem, &self.starts, budget, deadline, &mut || {})
     }
