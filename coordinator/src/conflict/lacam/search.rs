@@ -15,7 +15,9 @@
 //! does every configuration reached through it (a Dijkstra update, [`Tree::rewire`]). After the
 //! first solution the search goes on, dropping every configuration whose `g + h` cannot beat
 //! the best solution, and returns the best one when its budget or deadline ends it, or an
-//! optimal one when nothing is left to search. Without refinement nothing is rewired: the plan
+//! optimal one when nothing is left to search. One in [`RESTART`] revisits of a known
+//! configuration during refinement restarts from the start instead (Kei18/lacam3's random
+//! insertion, drawn here from a fixed seed). Without refinement nothing is rewired: the plan
 //! is the first one found, exactly as plain LaCAM finds it.
 //!
 //! # Determinism and budgets
@@ -40,6 +42,14 @@ use super::generator::{Generator, Problem};
 use super::graph::NONE;
 use super::tree::{step_cost, Tree};
 use crate::conflict::pibt::distance::DIAGONAL;
+use hnav_runtime::hash::SplitMix64;
+
+/// During refinement, one in this many revisits of a known configuration searches on from
+/// the start instead (Kei18/lacam3's `RANDOM_INSERT_PROB1` = 0.1): the depth-first search
+/// leaves the neighbourhood of the first solution.
+const RESTART: u64 = 10;
+/// The seed of those draws.
+const RESTART_SEED: u64 = 0x1aca_3;
 
 /// How much a search may grow before it gives up.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -169,6 +179,8 @@ pub(super) fn solve(
     // returned is never worse than the first by either.
     let mut first_path = Vec::new();
     let mut refined = 0usize;
+    // LaCAM3's random restarts, drawn from a fixed seed: deterministic like the rest.
+    let mut restarts = SplitMix64::new(RESTART_SEED);
     let end = loop {
         let Some(&top) = open.last() else {
             break End::Exhausted;
@@ -221,6 +233,10 @@ pub(super) fn solve(
                 tree.link(top, known, cost);
                 tree.rewire(top, bound, &mut open);
                 let bound = goal.map(|g| tree.nodes[g as usize].g);
+                if bound.is_some() && restarts.below(RESTART) == 0 {
+                    open.push(0);
+                    continue;
+                }
                 if bound.is_some_and(|b| tree.nodes[known as usize].f() >= b) {
                     continue;
                 }
