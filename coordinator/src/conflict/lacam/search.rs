@@ -49,7 +49,7 @@ use hnav_runtime::hash::SplitMix64;
 /// leaves the neighbourhood of the first solution.
 const RESTART: u64 = 10;
 /// The seed of those draws.
-const RESTART_SEED: u64 = 0x1aca_3;
+const RESTART_SEED: u64 = 0x0001_aca3;
 
 /// How much a search may grow before it gives up.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]

@@ -67,7 +67,10 @@ fn random_instances_are_solved_validly_with_and_without_refinement() {
     let mut solved = 0;
     for seed in 0..40u64 {
         let Some(props::Instance {
-            grid, starts, goals, ..
+            grid,
+            starts,
+            goals,
+            ..
         }) = props::instance(seed)
         else {
             continue;
@@ -97,11 +100,19 @@ fn a_small_instance_is_refined_to_a_proven_optimum() {
     // Two agents exchanging the ends of a 3 x 2 room: with nothing left to search LaCAM* has
     // proven its plan optimal.
     let g = Grid::new(3, 2).unwrap();
-    let inst = Instance::new(&g, &[c(0, 0), c(2, 0)], &[c(2, 0), c(0, 0)], Options::default())
-        .unwrap();
+    let inst = Instance::new(
+        &g,
+        &[c(0, 0), c(2, 0)],
+        &[c(2, 0), c(0, 0)],
+        Options::default(),
+    )
+    .unwrap();
     let plan = inst.solve(refining(1_000_000), None).unwrap();
     inst.check(&plan.configs).unwrap();
-    assert!(plan.optimal, "the search ran out before it proved the optimum");
+    assert!(
+        plan.optimal,
+        "the search ran out before it proved the optimum"
+    );
     assert!(inst.sum_of_costs(&plan.configs) >= inst.lower_bound());
 }
 
@@ -118,10 +129,18 @@ fn a_past_deadline_ends_the_search_without_a_plan() {
 #[test]
 fn the_check_refuses_jumps_swaps_and_shared_cells() {
     let g = Grid::new(3, 1).unwrap();
-    let inst = Instance::new(&g, &[c(0, 0), c(1, 0)], &[c(1, 0), c(0, 0)], Options::default())
-        .unwrap();
+    let inst = Instance::new(
+        &g,
+        &[c(0, 0), c(1, 0)],
+        &[c(1, 0), c(0, 0)],
+        Options::default(),
+    )
+    .unwrap();
     let plan = |steps: &[[u32; 2]]| -> Vec<Box<[u32]>> {
-        steps.iter().map(|s| s.to_vec().into_boxed_slice()).collect()
+        steps
+            .iter()
+            .map(|s| s.to_vec().into_boxed_slice())
+            .collect()
     };
     assert_eq!(
         inst.check(&plan(&[[0, 1], [1, 0]])),

@@ -151,10 +151,7 @@ impl Instance {
     /// [`search`](super::search)'s docs: only a deadline makes the search read the clock).
     pub fn solve(&self, budget: Budget, deadline: Option<Instant>) -> Result<Plan, SearchError> {
         let width = self.width;
-        let distance = |k: usize, c: u32| {
-            self.distances
-                .get(k, Cell::new(c % width, c / width))
-        };
+        let distance = |k: usize, c: u32| self.distances.get(k, Cell::new(c % width, c / width));
         let problem = Problem {
             graph: &self.graph,
             fixed: &self.fixed,
