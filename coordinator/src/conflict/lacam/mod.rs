@@ -23,7 +23,15 @@
 //!
 //! The search allocates and may take a while (milliseconds for the benchmark's instances, see
 //! `docs/explanation/conflict-rules.md`); it runs in the round that plans, once per plan. Every other round follows the
-//! schedule without allocating.
+//! schedule without allocating. Its memory is its [`Budget`]'s: `8 n` bytes a configuration of
+//! `n` robots, in one arena with a hash index (`arena.rs`), see [`search`].
+//!
+//! # The search alone
+//!
+//! [`standalone`] runs the same search on a MAPF instance without rounds, for the
+//! search-only benchmark (`hnav-bench lacam`): with LaCAM3's swap in the generator (`swap.rs`)
+//! and LaCAM*'s refinement under a wall-clock deadline, both off in the rounds so that the
+//! coordinator's plans stay what they were (and a lockstep run never reads the clock).
 
 mod arena;
 mod generator;
