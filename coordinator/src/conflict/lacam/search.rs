@@ -12,10 +12,10 @@
 //! Kei18/lacam2's `Planner::solve`): every configuration keeps its cost from the start `g`
 //! (sum of costs: one per agent and step, except an agent staying on its goal) and its known
 //! neighbours; a configuration met again through a cheaper way takes it as its parent, and so
-//! does every configuration reached through it (a Dijkstra update, [`Tree::rewire`]). After the
+//! does every configuration reached through it (a Dijkstra update, `Tree::rewire` in `tree.rs`). After the
 //! first solution the search goes on, dropping every configuration whose `g + h` cannot beat
 //! the best solution, and returns the best one when its budget or deadline ends it, or an
-//! optimal one when nothing is left to search. One in [`RESTART`] revisits of a known
+//! optimal one when nothing is left to search. One in ten (`RESTART`) revisits of a known
 //! configuration during refinement restarts from the start instead (Kei18/lacam3's random
 //! insertion, drawn here from a fixed seed). Without refinement nothing is rewired: the plan
 //! is the first one found, exactly as plain LaCAM finds it.
@@ -26,14 +26,14 @@
 //! restarts are left out), so a lockstep run replans the same way on every machine. The
 //! coordinator's budget counts nodes, not time, for the same reason, and it does not refine
 //! (`refine = 0`, the default): its plans are the first solutions they always were. A
-//! deadline ([`solve`]'s `deadline`) is for the search-only benchmark (`hnav-bench lacam`),
+//! deadline (`solve`'s `deadline`) is for the search-only benchmark (`hnav-bench lacam`),
 //! which gives the search a wall-clock limit as the papers do; the coordinator never passes
 //! one.
 //!
 //! # Memory
 //!
 //! A configuration costs `8 n` bytes for `n` agents (its cells as u32 in one arena,
-//! [`Configs`](super::arena::Configs), and its PIBT priorities as f32 in another) plus about
+//! `Configs` of `arena.rs`, and its PIBT priorities as f32 in another) plus about
 //! 80 bytes of node, table slot and constraint-queue; a constraint 16 bytes, a LaCAM* edge 12.
 
 use std::time::Instant;

@@ -1,6 +1,6 @@
 //! The search on its own, outside the rounds: a MAPF instance (a grid, starts, goals) planned
 //! at once, for the search-only benchmark (`hnav-bench lacam`) and the tests. The rounds
-//! ([`Lacam`](super::Lacam)) plan through the same [`search`](super::search), with the
+//! ([`Lacam`](super::Lacam)) plan through the same [`search`], with the
 //! online PIBT's distance tables; here the instance builds its own, once
 //! ([`Distances`]: one Dijkstra per goal, octile units, the rounds' corner rule), and every
 //! PIBT step and LaCAM* estimate of the search reads them.
@@ -148,7 +148,7 @@ impl Instance {
     }
 
     /// Searches a plan within `budget` and, if given, `deadline` (see
-    /// [`search`](super::search)'s docs: only a deadline makes the search read the clock).
+    /// [`search`]'s docs: only a deadline makes the search read the clock).
     pub fn solve(&self, budget: Budget, deadline: Option<Instant>) -> Result<Plan, SearchError> {
         let width = self.width;
         let distance = |k: usize, c: u32| self.distances.get(k, Cell::new(c % width, c / width));
@@ -163,7 +163,7 @@ impl Instance {
     }
 
     /// Whether `plan` is a solution: from the starts to the goals, every step each agent's
-    /// wait or move of the map (as the [graph](super::graph) allows it under the corner
+    /// wait or move of the map (as the graph, `graph.rs`, allows it under the corner
     /// rule), no two agents in one cell, no two swapping.
     pub fn check(&self, plan: &[Box<[u32]>]) -> Result<(), PlanError> {
         let n = self.starts.len();
