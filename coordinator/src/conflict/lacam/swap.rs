@@ -17,6 +17,7 @@
 
 use super::generator::{Generator, Problem};
 use super::graph::NONE;
+use crate::conflict::pibt::swap::{possible_walk, required_walk};
 
 impl Generator {
     /// The ways on from `at` other than `back` that count: how many, and the last one.
@@ -39,45 +40,22 @@ impl Generator {
 
     /// LaCAM3's `is_swap_required(pusher, puller, v_pusher, v_puller)`.
     fn swap_required(&self, p: &Problem, pusher: u32, puller: u32, from: u32, ahead: u32) -> bool {
-        let d = |agent: u32, cell: u32| (p.distance)(agent as usize, cell);
-        let (mut v_pusher, mut v_puller) = (from, ahead);
-        for _ in 0..p.graph.cells() {
-            if d(pusher, v_puller) >= d(pusher, v_pusher) {
-                break;
-            }
-            let (n, next) = self.ways_on(p, v_puller, v_pusher);
-            if n >= 2 {
-                return false;
-            }
-            if n == 0 {
-                break;
-            }
-            v_pusher = v_puller;
-            v_puller = next;
-        }
-        d(puller, v_pusher) < d(puller, v_puller)
-            && (d(pusher, v_pusher) == 0 || d(pusher, v_puller) < d(pusher, v_pusher))
+        required_walk(
+            from,
+            ahead,
+            p.graph.cells(),
+            |c| (p.distance)(pusher as usize, c),
+            |c| (p.distance)(puller as usize, c),
+            |at, back| self.ways_on(p, at, back),
+        )
     }
 
     /// LaCAM3's `is_swap_possible(v_pusher, v_puller)`: a place to pass behind `v_puller`,
     /// walking away from `v_pusher`.
-    fn swap_possible(&self, p: &Problem, v_pusher_origin: u32, v_puller_origin: u32) -> bool {
-        let (mut v_pusher, mut v_puller) = (v_pusher_origin, v_puller_origin);
-        for _ in 0..p.graph.cells() {
-            if v_puller == v_pusher_origin {
-                return false;
-            }
-            let (n, next) = self.ways_on(p, v_puller, v_pusher);
-            if n >= 2 {
-                return true;
-            }
-            if n == 0 {
-                return false;
-            }
-            v_pusher = v_puller;
-            v_puller = next;
-        }
-        false
+    fn swap_possible(&self, p: &Problem, v_pusher: u32, v_puller: u32) -> bool {
+        possible_walk(v_pusher, v_puller, p.graph.cells(), |at, back| {
+            self.ways_on(p, at, back)
+        })
     }
 
     /// The agent `i` (at `here`, best cell `best`) should swap with, or [`NONE`]: the
