@@ -66,6 +66,10 @@ enum Command {
     /// (lockstep), per N and rules: robots at goal, collisions, makespan, sum of lengths
     /// against the .scen's lower bound, conflicts, replans, wall time, memory.
     Mapf(MapfCli),
+    /// The coordinator's LaCAM search alone on MovingAI instances (up to thousands of agents,
+    /// no robots): first solution, LaCAM*'s refinement within a wall-clock limit, sum of
+    /// costs over the lower bound, configurations, peak memory of a child per instance.
+    Lacam(hnav_bench::mapf::search_cli::LacamArgs),
     /// The seeds' experiments, ours beside the paper's tables (`hnav-bench experiment list`
     /// names them).
     Experiment(ExperimentCli),
@@ -463,6 +467,7 @@ fn main() -> std::process::ExitCode {
         }
         Command::Chaos(args) => chaos(args),
         Command::Mapf(args) => mapf(args),
+        Command::Lacam(args) => hnav_bench::mapf::search_cli::main(args),
         Command::Experiment(args) => experiment(args),
         Command::RaftSim(args) => hnav_bench::raft_sim::main(args),
     };

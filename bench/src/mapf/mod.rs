@@ -6,12 +6,16 @@
 //! - [`instance`]: the `.scen` against its map, the first N entries, their scenario file;
 //! - [`run`]: one run through `hnav run`, sampled by [`memory`], read back from
 //!   `summary.json` and the consensus log, which must agree;
-//! - [`report`]: the rows as a markdown table or JSON lines.
+//! - [`report`]: the rows as a markdown table or JSON lines;
+//! - [`search_only`]: `hnav-bench lacam`, the coordinator's LaCAM search alone on the
+//!   instance, up to thousands of agents, against a wall-clock limit.
 
 pub mod instance;
 pub mod memory;
 pub mod report;
 pub mod run;
+pub mod search_cli;
+pub mod search_only;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;

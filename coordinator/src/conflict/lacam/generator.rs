@@ -22,12 +22,14 @@ pub(super) struct Problem<'a> {
     pub fixed: &'a [bool],
     pub goals: &'a [u32],
     pub distance: Distance<'a>,
+    /// Whether PIBT swaps in corridors (LaCAM3's swap, `swap.rs`): off in the rounds.
+    pub swap: bool,
 }
 
 /// The generator's scratch, sized once for a map and a number of agents.
 pub(super) struct Generator {
     /// Per cell, the agent standing there in the configuration stepped from.
-    occ_now: Vec<u32>,
+    pub(super) occ_now: Vec<u32>,
     /// Per cell, the agent entering (or staying in) it.
     occ_next: Vec<u32>,
     /// Per cell, the agent whose diagonal sweeps it.
@@ -35,7 +37,7 @@ pub(super) struct Generator {
     /// Cells written in `occ_next` and `swept`, to clear them.
     touched: Vec<u32>,
     /// Per agent, its cell after the step, [`NONE`] while undecided.
-    next: Vec<u32>,
+    pub(super) next: Vec<u32>,
     /// Per agent, the cycle check's colour (0 unvisited, 1 on the walk, 2 done).
     colour: Vec<u8>,
 }
@@ -113,13 +115,13 @@ impl Generator {
         true
     }
 
-    fn enterable(&self, p: &Problem, m: Move) -> bool {
+    pub(super) fn enterable(&self, p: &Problem, m: Move) -> bool {
         let u = m.to as usize;
         !p.fixed[u] && self.occ_next[u] == NONE && self.swept[u] == NONE
     }
 
     /// A diagonal's side cells: nobody in them before or after the step, nobody else sweeping.
-    fn sides_free(&self, p: &Problem, m: Move) -> bool {
+    pub(super) fn sides_free(&self, p: &Problem, m: Move) -> bool {
         m.sides.iter().filter(|&&s| s != NONE).all(|&s| {
             let s = s as usize;
             !p.fixed[s]
@@ -129,7 +131,7 @@ impl Generator {
         })
     }
 
-    fn take(&mut self, i: u32, m: Move) {
+    pub(super) fn take(&mut self, i: u32, m: Move) {
         self.next[i as usize] = m.to;
         self.occ_next[m.to as usize] = i;
         self.touched.push(m.to);
@@ -193,7 +195,15 @@ impl Generator {
             len += 1;
         }
         cands[..len].sort_unstable_by_key(|&(k, _)| k);
-        for &(_, m) in &cands[..len] {
+        let partner = if p.swap {
+            self.swap_partner(p, from, i, cands[0].1.to)
+        } else {
+            NONE
+        };
+        if partner != NONE {
+            cands[..len].reverse();
+        }
+        for (k, &(_, m)) in cands[..len].iter().enumerate() {
             if !self.enterable(p, m) || !self.sides_free(p, m) {
                 continue;
             }
@@ -209,6 +219,9 @@ impl Generator {
             if other && self.next[j as usize] == NONE && !self.pibt(p, from, j, salt) {
                 self.untake_sides(i, m);
                 continue;
+            }
+            if k == 0 && partner != NONE && m.to != here {
+                self.pull(p, from, partner, here);
             }
             return true;
         }

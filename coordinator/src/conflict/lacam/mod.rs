@@ -23,14 +23,28 @@
 //!
 //! The search allocates and may take a while (milliseconds for the benchmark's instances, see
 //! `docs/explanation/conflict-rules.md`); it runs in the round that plans, once per plan. Every other round follows the
-//! schedule without allocating.
+//! schedule without allocating. Its memory is its [`Budget`]'s: `8 n` bytes a configuration of
+//! `n` robots, in one arena with a hash index (`arena.rs`), see [`search`].
+//!
+//! # The search alone
+//!
+//! [`standalone`] runs the same search on a MAPF instance without rounds, for the
+//! search-only benchmark (`hnav-bench lacam`): with LaCAM3's swap in the generator (`swap.rs`)
+//! and LaCAM*'s refinement under a wall-clock deadline, both off in the rounds so that the
+//! coordinator's plans stay what they were (and a lockstep run never reads the clock).
 
+mod arena;
 mod generator;
 mod graph;
 mod schedule;
 pub mod search;
 #[cfg(test)]
+mod search_tests;
+pub mod standalone;
+mod swap;
+#[cfg(test)]
 mod tests;
+mod tree;
 
 use hnav_runtime::grid::{Cell, Grid};
 
@@ -237,8 +251,9 @@ impl Lacam {
                 fixed: &self.blocked,
                 goals: &goals,
                 distance: &distance,
+                swap: false,
             };
-            search::solve(&problem, &starts, self.budget, tick)
+            search::solve(&problem, &starts, self.budget, None, tick)
         };
         let took = started.elapsed();
         match result {

@@ -1,20 +1,55 @@
 //! LaCAM (Okumura, AAAI 2023): a depth-first search over configurations whose successors the
-//! generator (`generator.rs`) makes, one PIBT step each, under constraints that a lazily grown breadth-first
-//! tree of "agent `i` goes to cell `v`" adds per configuration. The first successor is plain
-//! PIBT's; every later visit of a configuration tries the next constraint, so in the end every
-//! executable successor is generated: the search is complete (it finds a solution whenever
-//! one exists within its budget), and on easy instances it costs about one PIBT step per step
-//! of the plan.
+//! generator (`generator.rs`) makes, one PIBT step each, under constraints that a lazily grown
+//! breadth-first tree of "agent `i` goes to cell `v`" adds per configuration. The first
+//! successor is plain PIBT's; every later visit of a configuration tries the next constraint,
+//! so in the end every executable successor is generated: the search is complete (it finds a
+//! solution whenever one exists within its budget), and on easy instances it costs about one
+//! PIBT step per step of the plan.
 //!
-//! Deterministic: ties are broken by hashes of the node, never by the clock or a random seed,
-//! so a lockstep run replans the same way on every machine. The budget counts nodes, not time,
-//! for the same reason.
+//! # LaCAM*: refinement
+//!
+//! With [`Budget::refine`] above zero the search is LaCAM* (Okumura, IJCAI 2023; the loop of
+//! Kei18/lacam2's `Planner::solve`): every configuration keeps its cost from the start `g`
+//! (sum of costs: one per agent and step, except an agent staying on its goal) and its known
+//! neighbours; a configuration met again through a cheaper way takes it as its parent, and so
+//! does every configuration reached through it (a Dijkstra update, `Tree::rewire` in `tree.rs`). After the
+//! first solution the search goes on, dropping every configuration whose `g + h` cannot beat
+//! the best solution, and returns the best one when its budget or deadline ends it, or an
+//! optimal one when nothing is left to search. One in ten (`RESTART`) revisits of a known
+//! configuration during refinement restarts from the start instead (Kei18/lacam3's random
+//! insertion, drawn here from a fixed seed). Without refinement nothing is rewired: the plan
+//! is the first one found, exactly as plain LaCAM finds it.
+//!
+//! # Determinism and budgets
+//!
+//! Ties are broken by hashes of the node, never by the clock or a random seed (LaCAM*'s random
+//! restarts are left out), so a lockstep run replans the same way on every machine. The
+//! coordinator's budget counts nodes, not time, for the same reason, and it does not refine
+//! (`refine = 0`, the default): its plans are the first solutions they always were. A
+//! deadline (`solve`'s `deadline`) is for the search-only benchmark (`hnav-bench lacam`),
+//! which gives the search a wall-clock limit as the papers do; the coordinator never passes
+//! one.
+//!
+//! # Memory
+//!
+//! A configuration costs `8 n` bytes for `n` agents (its cells as u32 in one arena,
+//! `Configs` of `arena.rs`, and its PIBT priorities as f32 in another) plus about
+//! 80 bytes of node, table slot and constraint-queue; a constraint 16 bytes, a LaCAM* edge 12.
 
-use std::collections::{HashMap, VecDeque};
-use std::rc::Rc;
+use std::time::Instant;
 
 use super::generator::{Generator, Problem};
 use super::graph::NONE;
+use super::tree::{step_cost, Tree};
+use crate::conflict::pibt::distance::DIAGONAL;
+use hnav_runtime::hash::SplitMix64;
+
+/// During refinement, one in this many revisits of a known configuration searches on from
+/// the start instead (Kei18/lacam3's `RANDOM_INSERT_PROB1` = 0.1): the depth-first search
+/// leaves the neighbourhood of the first solution.
+const RESTART: u64 = 10;
+/// The seed of those draws.
+const RESTART_SEED: u64 = 0x0001_aca3;
 
 /// How much a search may grow before it gives up.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -23,16 +58,20 @@ pub struct Budget {
     pub configurations: usize,
     /// Constraint nodes (the low-level search), in all.
     pub constraints: usize,
+    /// Search iterations after the first solution (LaCAM*'s refinement, see the
+    /// [module docs](self)); 0: plain LaCAM, the first solution is the plan.
+    pub refine: usize,
 }
 
 impl Default for Budget {
     /// At most about 200 MiB for 256 agents (a configuration and its priorities take 8 bytes
     /// per agent, a constraint 16 bytes); the MAPF benchmark's hardest instance here
-    /// (warehouse, 200 robots) needs 59 000 configurations.
+    /// (warehouse, 200 robots) needs 59 000 configurations. No refinement.
     fn default() -> Self {
         Budget {
             configurations: 100_000,
             constraints: 4_000_000,
+            refine: 0,
         }
     }
 }
@@ -49,189 +88,211 @@ pub enum SearchError {
         /// Configurations visited.
         configurations: usize,
     },
-}
-
-/// A high-level node: one configuration.
-struct Node {
-    parent: u32,
-    /// Constraint nodes still to try from here.
-    tree: VecDeque<u32>,
-}
-
-/// A low-level node: one more constraint on top of its parent's.
-#[derive(Clone, Copy)]
-struct Constraint {
-    parent: u32,
-    who: u32,
-    to: u32,
-    depth: u32,
-}
-
-/// The search's nodes.
-#[derive(Default)]
-struct Tree {
-    /// Shared with `explored`: a configuration is stored once.
-    configs: Vec<Rc<[u32]>>,
-    priorities: Vec<Box<[f32]>>,
-    nodes: Vec<Node>,
-    lows: Vec<Constraint>,
-    explored: HashMap<Rc<[u32]>, u32>,
-}
-
-impl Tree {
-    /// A new configuration.
-    fn add(&mut self, config: Rc<[u32]>, prio: Box<[f32]>, parent: u32) -> u32 {
-        let id = self.nodes.len() as u32;
-        self.lows.push(Constraint {
-            parent: NONE,
-            who: NONE,
-            to: NONE,
-            depth: 0,
-        });
-        self.nodes.push(Node {
-            parent,
-            tree: VecDeque::from([self.lows.len() as u32 - 1]),
-        });
-        self.explored.insert(config.clone(), id);
-        self.configs.push(config);
-        self.priorities.push(prio);
-        id
-    }
-
-    /// The configurations from the root to `end`.
-    fn path(&self, end: u32) -> Vec<Box<[u32]>> {
-        let mut out = Vec::new();
-        let mut k = end;
-        while k != NONE {
-            out.push(self.configs[k as usize].as_ref().into());
-            k = self.nodes[k as usize].parent;
-        }
-        out.reverse();
-        out
-    }
-
-    /// Grows the constraint tree of node `t` below constraint `low`: the next agent in the
-    /// node's order, to each of its cells.
-    fn expand(&mut self, p: &Problem, t: usize, low: u32, order: &[u32]) {
-        let c = self.lows[low as usize];
-        if c.depth as usize >= order.len() {
-            return;
-        }
-        let who = order[c.depth as usize];
-        let at = self.configs[t][who as usize];
-        let moves = p.graph.moves(at);
-        let k = moves.len() + 1;
-        let shift = t.wrapping_add(low as usize) % k;
-        for r in 0..k {
-            let m = (r + shift) % k;
-            let to = if m == 0 { at } else { moves[m - 1].to };
-            self.nodes[t].tree.push_back(self.lows.len() as u32);
-            self.lows.push(Constraint {
-                parent: low,
-                who,
-                to,
-                depth: c.depth + 1,
-            });
-        }
-    }
-
-    /// Node `t`'s agents by priority, highest first (PIBT's order), into `out`.
-    fn order(&self, t: usize, out: &mut Vec<u32>) {
-        let prio = &self.priorities[t];
-        out.clear();
-        out.extend(0..prio.len() as u32);
-        out.sort_by(|&a, &b| {
-            prio[b as usize]
-                .total_cmp(&prio[a as usize])
-                .then(a.cmp(&b))
-        });
-    }
-
-    /// The constraints of `low`, shallowest first.
-    fn constraints(&self, low: u32, out: &mut Vec<(u32, u32)>) {
-        out.clear();
-        let mut l = low;
-        while l != NONE && self.lows[l as usize].who != NONE {
-            let c = self.lows[l as usize];
-            out.push((c.who, c.to));
-            l = c.parent;
-        }
-        out.reverse();
-    }
+    /// The deadline passed first (only a search given one).
+    #[error("the deadline passed after {configurations} configurations")]
+    Deadline {
+        /// Configurations visited.
+        configurations: usize,
+    },
 }
 
 /// A plan found.
-pub(super) struct Plan {
+pub struct Plan {
     /// The configurations from the start to the goals, one executable step apart.
     pub configs: Vec<Box<[u32]>>,
     /// Configurations the search visited.
     pub visited: usize,
+    /// Constraint nodes it made.
+    pub constraints: usize,
+    /// Configurations visited when the first solution was found.
+    pub first_visited: usize,
+    /// The first solution's sum of costs ([`sum_of_costs`]).
+    pub first_cost: u64,
+    /// When the first solution was found: only a search with a deadline reads the clock.
+    pub first_at: Option<Instant>,
+    /// Whether the search proved the plan optimal (LaCAM*: nothing cheaper was left).
+    pub optimal: bool,
+    /// Bytes of the search's tables at the end.
+    pub bytes: usize,
 }
 
-/// Searches a plan from `starts` to the problem's goals, calling `tick` once per step of the
-/// search (a long search keeps the process's heartbeat going through it).
+/// The sum of costs of `plan` towards `goals`, as the MAPF papers count it: per agent, the
+/// step at which it last arrives at its goal (0 for one that never leaves it).
+pub fn sum_of_costs(plan: &[Box<[u32]>], goals: &[u32]) -> u64 {
+    let mut sum = 0;
+    for (i, &g) in goals.iter().enumerate() {
+        let last_off = plan.iter().rposition(|c| c[i] != g);
+        sum += last_off.map_or(0, |t| t as u64 + 1);
+    }
+    sum
+}
+
+/// LaCAM*'s `h`: the steps every agent needs at least, its distance over the longest step.
+fn estimate(p: &Problem, config: &[u32]) -> u64 {
+    let step = u64::from(DIAGONAL);
+    let mut h = 0;
+    for (i, &c) in config.iter().enumerate() {
+        h += u64::from((p.distance)(i, c)).div_ceil(step);
+    }
+    h
+}
+
+/// How the loop ended.
+enum End {
+    /// Nothing left to search.
+    Exhausted,
+    /// A budget or the refinement's iterations ran out.
+    Budget,
+    Deadline,
+}
+
+/// Searches a plan from `starts` to the problem's goals within `budget` and, if given,
+/// `deadline`, calling `tick` once per step of the search (a long search keeps the
+/// process's heartbeat going through it).
 pub(super) fn solve(
     p: &Problem,
     starts: &[u32],
     budget: Budget,
+    deadline: Option<Instant>,
     tick: &mut dyn FnMut(),
 ) -> Result<Plan, SearchError> {
     let n = starts.len();
+    let star = budget.refine > 0;
     let mut gen = Generator::new(p.graph.cells(), n);
-    let mut tree = Tree::default();
+    let mut tree = Tree::new(n);
     // LaCAM's initial priorities: the distance to go, scaled below one step of waiting.
     let scale = 1.0 / (1000.0 * p.graph.cells().max(1) as f32);
-    let first: Box<[f32]> = (0..n)
+    let mut prio: Vec<f32> = (0..n)
         .map(|i| ((p.distance)(i, starts[i]).min(1 << 30)) as f32 * scale)
         .collect();
-    let mut open = vec![tree.add(starts.into(), first, NONE)];
+    let mut open = vec![tree.add(starts, &prio, NONE, (0, estimate(p, starts)))];
     let mut fixed: Vec<(u32, u32)> = Vec::with_capacity(n);
     let mut next: Vec<u32> = Vec::with_capacity(n);
     let mut order: Vec<u32> = Vec::with_capacity(n);
-    let over = |tree: &Tree| SearchError::Budget {
-        configurations: tree.nodes.len(),
-    };
-    while let Some(&top) = open.last() {
+    // The node whose order `order` holds: the depth-first search expands one node many times
+    // in a row, and a sort of a thousand agents is not free.
+    let mut ordered = NONE;
+    let mut goal: Option<u32> = None;
+    let mut first = (0, 0, None);
+    // The first solution, kept: refinement lowers `g`, which counts an agent resting on its
+    // goal for nothing, while the sum of costs counts it until its last arrival; the plan
+    // returned is never worse than the first by either.
+    let mut first_path = Vec::new();
+    let mut refined = 0usize;
+    // LaCAM3's random restarts, drawn from a fixed seed: deterministic like the rest.
+    let mut restarts = SplitMix64::new(RESTART_SEED);
+    let end = loop {
+        let Some(&top) = open.last() else {
+            break End::Exhausted;
+        };
         tick();
-        let t = top as usize;
-        if tree.configs[t].iter().zip(p.goals).all(|(a, b)| a == b) {
-            return Ok(Plan {
-                configs: tree.path(top),
-                visited: tree.nodes.len(),
-            });
+        if deadline.is_some_and(|d| Instant::now() >= d) {
+            break End::Deadline;
         }
-        let Some(low) = tree.nodes[t].tree.pop_front() else {
+        if let Some(g) = goal {
+            refined += 1;
+            if refined > budget.refine {
+                break End::Budget;
+            }
+            if tree.nodes[top as usize].f() >= tree.nodes[g as usize].g {
+                open.pop();
+                continue;
+            }
+        }
+        if goal.is_none() && tree.config(top) == p.goals {
+            goal = Some(top);
+            first = (tree.nodes.len(), 0, deadline.map(|_| Instant::now()));
+            if !star {
+                break End::Budget;
+            }
+            first_path = tree.path(top);
+            first.1 = sum_of_costs(&first_path, p.goals);
+            continue;
+        }
+        let Some(low) = tree.nodes[top as usize].tree.pop_front() else {
             open.pop();
             continue;
         };
-        tree.order(t, &mut order);
-        tree.expand(p, t, low, &order);
-        if tree.lows.len() > budget.constraints {
-            return Err(over(&tree));
+        if ordered != top {
+            tree.order(top, &mut order);
+            ordered = top;
+        }
+        tree.expand(p, top, low, &order);
+        if tree.constraint_count() > budget.constraints {
+            break End::Budget;
         }
         tree.constraints(low, &mut fixed);
         let salt = (u64::from(top) << 32) | u64::from(low);
-        if !gen.generate(p, &tree.configs[t], &fixed, &order, salt, &mut next) {
+        if !gen.generate(p, tree.config(top), &fixed, &order, salt, &mut next) {
             continue;
         }
-        if let Some(&known) = tree.explored.get(next.as_slice()) {
+        let cost = step_cost(p.goals, tree.config(top), &next);
+        let bound = goal.map(|g| tree.nodes[g as usize].g);
+        if let Some(known) = tree.configs.find(&next) {
+            if star {
+                tree.link(top, known, cost);
+                tree.rewire(top, bound, &mut open);
+                let bound = goal.map(|g| tree.nodes[g as usize].g);
+                if bound.is_some() && restarts.below(RESTART) == 0 {
+                    open.push(0);
+                    continue;
+                }
+                if bound.is_some_and(|b| tree.nodes[known as usize].f() >= b) {
+                    continue;
+                }
+            }
             open.push(known);
             continue;
         }
         if tree.nodes.len() >= budget.configurations {
-            return Err(over(&tree));
+            break End::Budget;
         }
-        let prio: Box<[f32]> = (0..n)
-            .map(|i| {
-                let p0 = tree.priorities[t][i];
-                if next[i] == p.goals[i] {
-                    p0 - p0.floor()
-                } else {
-                    p0 + 1.0
-                }
-            })
-            .collect();
-        open.push(tree.add(next.as_slice().into(), prio, top));
+        let parent = tree.priorities(top);
+        for (i, q) in prio.iter_mut().enumerate() {
+            let p0 = parent[i];
+            *q = if next[i] == p.goals[i] {
+                p0 - p0.floor()
+            } else {
+                p0 + 1.0
+            };
+        }
+        let g = tree.nodes[top as usize].g + u64::from(cost);
+        let id = tree.add(&next, &prio, top, (g, estimate(p, &next)));
+        if star {
+            tree.link(top, id, cost);
+        }
+        if bound.is_none_or(|b| tree.nodes[id as usize].f() < b) {
+            open.push(id);
+        }
+    };
+    let visited = tree.nodes.len();
+    let Some(g) = goal else {
+        return Err(match end {
+            End::Exhausted => SearchError::NoPlan,
+            End::Budget => SearchError::Budget {
+                configurations: visited,
+            },
+            End::Deadline => SearchError::Deadline {
+                configurations: visited,
+            },
+        });
+    };
+    let mut configs = tree.path(g);
+    let mut optimal = star && matches!(end, End::Exhausted);
+    if !star {
+        first.1 = sum_of_costs(&configs, p.goals);
+    } else if sum_of_costs(&configs, p.goals) > first.1 {
+        configs = first_path;
+        optimal = false;
     }
-    Err(SearchError::NoPlan)
+    Ok(Plan {
+        configs,
+        visited,
+        constraints: tree.constraint_count(),
+        first_visited: first.0,
+        first_cost: first.1,
+        first_at: first.2,
+        optimal,
+        bytes: tree.bytes(),
+    })
 }

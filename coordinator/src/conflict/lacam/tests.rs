@@ -30,6 +30,7 @@ fn executable(grid: &Grid, from: &[Cell], to: &[Cell]) -> bool {
         fixed: &fixed,
         goals: &to,
         distance: &distance,
+        swap: false,
     };
     let constraints: Vec<(u32, u32)> = to.iter().enumerate().map(|(i, &v)| (i as u32, v)).collect();
     let mut gen = Generator::new(grid.len(), from.len());

@@ -65,7 +65,7 @@
 //! caller's `out` keeps its capacity).
 
 pub mod distance;
-mod swap;
+pub(crate) mod swap;
 #[cfg(test)]
 pub(crate) mod tests;
 

@@ -71,47 +71,22 @@ impl Pibt {
 
     /// LaCAM3's `is_swap_required(pusher, puller, v_pusher, v_puller)`.
     fn swap_required(&self, pusher: usize, puller: usize, from: Cell, ahead: Cell) -> bool {
-        let d = |agent: usize, cell: Cell| self.distances.get(agent, cell);
-        let (mut v_pusher, mut v_puller) = (from, ahead);
-        // The distance to the pusher's goal falls strictly on every step: at most a walk over
-        // the map; the cap only guards against a malformed table.
-        for _ in 0..self.blocked.len() {
-            if d(pusher, v_puller) >= d(pusher, v_pusher) {
-                break;
-            }
-            let (n, next) = self.ways_on(v_puller, v_pusher);
-            if n >= 2 {
-                return false;
-            }
-            if n == 0 {
-                break;
-            }
-            v_pusher = v_puller;
-            v_puller = next;
-        }
-        d(puller, v_pusher) < d(puller, v_puller)
-            && (d(pusher, v_pusher) == 0 || d(pusher, v_puller) < d(pusher, v_pusher))
+        required_walk(
+            from,
+            ahead,
+            self.blocked.len(),
+            |c| self.distances.get(pusher, c),
+            |c| self.distances.get(puller, c),
+            |at, back| self.ways_on(at, back),
+        )
     }
 
     /// LaCAM3's `is_swap_possible(v_pusher, v_puller)`: a place to pass behind `v_puller`,
     /// walking away from `v_pusher`.
-    fn swap_possible(&self, v_pusher_origin: Cell, v_puller_origin: Cell) -> bool {
-        let (mut v_pusher, mut v_puller) = (v_pusher_origin, v_puller_origin);
-        for _ in 0..self.blocked.len() {
-            if v_puller == v_pusher_origin {
-                return false;
-            }
-            let (n, next) = self.ways_on(v_puller, v_pusher);
-            if n >= 2 {
-                return true;
-            }
-            if n == 0 {
-                return false;
-            }
-            v_pusher = v_puller;
-            v_puller = next;
-        }
-        false
+    fn swap_possible(&self, v_pusher: Cell, v_puller: Cell) -> bool {
+        possible_walk(v_pusher, v_puller, self.blocked.len(), |at, back| {
+            self.ways_on(at, back)
+        })
     }
 
     /// The agent `i` (at `from`, best cell `best`) should swap with, if any: the undecided
@@ -139,4 +114,64 @@ impl Pibt {
             .then_some(k)
         })
     }
+}
+
+/// LaCAM3's `is_swap_required` over any cells: walking from `from` through `ahead` along the
+/// pusher's way (`d_pusher` falls) meets no cell with two `ways_on` before the way ends, and
+/// the puller (`d_puller`) wants to come towards the pusher. At most `limit` steps. Shared
+/// with LaCAM's generator (`conflict/lacam/swap.rs`).
+pub(crate) fn required_walk<C: Copy>(
+    from: C,
+    ahead: C,
+    limit: usize,
+    d_pusher: impl Fn(C) -> u32,
+    d_puller: impl Fn(C) -> u32,
+    ways_on: impl Fn(C, C) -> (usize, C),
+) -> bool {
+    let (mut v_pusher, mut v_puller) = (from, ahead);
+    // The distance to the pusher's goal falls strictly on every step: at most a walk over
+    // the map; the cap only guards against a malformed table.
+    for _ in 0..limit {
+        if d_pusher(v_puller) >= d_pusher(v_pusher) {
+            break;
+        }
+        let (n, next) = ways_on(v_puller, v_pusher);
+        if n >= 2 {
+            return false;
+        }
+        if n == 0 {
+            break;
+        }
+        v_pusher = v_puller;
+        v_puller = next;
+    }
+    d_puller(v_pusher) < d_puller(v_puller)
+        && (d_pusher(v_pusher) == 0 || d_pusher(v_puller) < d_pusher(v_pusher))
+}
+
+/// LaCAM3's `is_swap_possible` over any cells: a cell with two `ways_on` behind
+/// `v_puller_origin`, walking away from `v_pusher_origin`, before a dead end. At most `limit`
+/// steps.
+pub(crate) fn possible_walk<C: Copy + PartialEq>(
+    v_pusher_origin: C,
+    v_puller_origin: C,
+    limit: usize,
+    ways_on: impl Fn(C, C) -> (usize, C),
+) -> bool {
+    let (mut v_pusher, mut v_puller) = (v_pusher_origin, v_puller_origin);
+    for _ in 0..limit {
+        if v_puller == v_pusher_origin {
+            return false;
+        }
+        let (n, next) = ways_on(v_puller, v_pusher);
+        if n >= 2 {
+            return true;
+        }
+        if n == 0 {
+            return false;
+        }
+        v_pusher = v_puller;
+        v_puller = next;
+    }
+    false
 }
