@@ -291,6 +291,14 @@ mod tests {
         registry
     }
 
+    /// A live process to signal: `sleep 30`.
+    fn sleeper() -> std::process::Child {
+        std::process::Command::new("sleep")
+            .arg("30")
+            .spawn()
+            .unwrap()
+    }
+
     /// The pid of a process that has exited and been reaped.
     fn exited_pid() -> u32 {
         let mut c = std::process::Command::new("true").spawn().unwrap();
@@ -302,10 +310,7 @@ mod tests {
     #[test]
     fn a_live_target_is_signalled_and_the_journal_says_so() {
         let tmp = tempfile::tempdir().unwrap();
-        let mut sleeper = std::process::Command::new("sleep")
-            .arg("30")
-            .spawn()
-            .unwrap();
+        let mut sleeper = sleeper();
         let registry = registry_with(tmp.path(), "kill-ok", sleeper.id());
         std::fs::create_dir_all(tmp.path().join("dir")).unwrap();
         let k = kill(&registry, "kill-ok", FaultTarget::Agent(1), Signal::SIGKILL).unwrap();
@@ -328,10 +333,7 @@ mod tests {
     #[test]
     fn a_robot_of_a_shared_process_takes_its_process_and_the_journal_names_it() {
         let tmp = tempfile::tempdir().unwrap();
-        let mut sleeper = std::process::Command::new("sleep")
-            .arg("30")
-            .spawn()
-            .unwrap();
+        let mut sleeper = sleeper();
         let registry = RunRegistry::at(tmp.path().join("runs"));
         let run = RunId::new("kill-shared").unwrap();
         let mut record = registry.new_record(&run, tmp.path().join("dir"));
@@ -362,10 +364,7 @@ mod tests {
     #[test]
     fn coordinator_names_the_replica_that_leads_in_the_highest_term() {
         let tmp = tempfile::tempdir().unwrap();
-        let mut sleeper = std::process::Command::new("sleep")
-            .arg("30")
-            .spawn()
-            .unwrap();
+        let mut sleeper = sleeper();
         let registry = RunRegistry::at(tmp.path().join("runs"));
         let run = RunId::new("kill-leader").unwrap();
         let dir = tmp.path().join("dir");
@@ -483,10 +482,7 @@ mod tests {
     #[test]
     fn the_signal_is_journalled_before_the_exit_it_causes() {
         let tmp = tempfile::tempdir().unwrap();
-        let mut sleeper = std::process::Command::new("sleep")
-            .arg("30")
-            .spawn()
-            .unwrap();
+        let mut sleeper = sleeper();
         let registry = registry_with(tmp.path(), "kill-order", sleeper.id());
         let dir = tmp.path().join("dir");
         long_log(&dir.join("log"), 100_000);
