@@ -28,10 +28,21 @@ const COMMITS: usize = 150;
 /// Runs the Python example `args` against `swarm`'s run until it exits, then stops the run
 /// (the rest of it is not the test's business, and takes minutes on a loaded machine); the
 /// lines it printed, once it exited 0.
-fn watch(run: &mut TestRun, python: &Path, args: &[String], mut swarm: SwarmRun) -> Vec<String> {
+fn watch(
+    run: &mut TestRun,
+    python: &Path,
+    args: &[String],
+    start: impl FnOnce(&mut TestRun) -> SwarmRun,
+) -> Vec<String> {
+    // The example first, the run after it: the example waits for the run to be live and
+    // joins it while its processes start up, so it is subscribed before the first round.
+    // Started the other way round, a Python slow to import could join after round 1 (the
+    // commit topic keeps only the latest commit for a late joiner), and the first test's
+    // check of round 1 failed now and then under load.
     let mut watcher = run
         .spawn_exact(&python.display().to_string(), args)
         .expect("the example starts");
+    let mut swarm = start(run);
     let deadline = Instant::now() + WATCH_TIMEOUT;
     let mut lines = Vec::new();
     while let Ok(line) = watcher.next_line(deadline.saturating_duration_since(Instant::now())) {
@@ -79,14 +90,16 @@ fn the_python_example_watches_a_live_run() {
     let Some(python) = python() else { return };
     let tmp = tempfile::tempdir().unwrap();
     let mut run = TestRun::new("pywatch");
-    let swarm = SwarmRun::start(
-        &mut run,
-        &repo_root().join("scenarios/demo.toml"),
-        &tmp.path().join("out"),
-        &tmp.path().join("runs"),
-        &["--mode", "lockstep"],
-    )
-    .expect("hnav run starts");
+    let start = |run: &mut TestRun| {
+        SwarmRun::start(
+            run,
+            &repo_root().join("scenarios/demo.toml"),
+            &tmp.path().join("out"),
+            &tmp.path().join("runs"),
+            &["--mode", "lockstep"],
+        )
+        .expect("hnav run starts")
+    };
     let example = repo_root().join("clients/python/examples/watch_run.py");
     let args = vec![
         example.display().to_string(),
@@ -96,7 +109,7 @@ fn the_python_example_watches_a_live_run() {
         "--commits".into(),
         COMMITS.to_string(),
     ];
-    let lines = watch(&mut run, &python, &args, swarm);
+    let lines = watch(&mut run, &python, &args, start);
     let text = lines.join("\n");
 
     let commits: Vec<&String> = lines.iter().filter(|l| l.starts_with("commit ")).collect();
@@ -154,8 +167,10 @@ fn the_python_world_example_reads_views_sightings_and_the_coordinators_map() {
     let scenario = late_door(tmp.path());
     let args = ["--mode", "realtime", "--kill", "agent:0@round:700"];
     let out = tmp.path().join("out");
-    let swarm = SwarmRun::start(&mut run, &scenario, &out, &tmp.path().join("runs"), &args)
-        .expect("hnav run starts");
+    let start = |run: &mut TestRun| {
+        SwarmRun::start(run, &scenario, &out, &tmp.path().join("runs"), &args)
+            .expect("hnav run starts")
+    };
     let example = repo_root().join("clients/python/examples/watch_world.py");
     let args = [example.display().to_string(), run.run.as_str().to_string()];
     let args = [
@@ -167,7 +182,7 @@ fn the_python_world_example_reads_views_sightings_and_the_coordinators_map() {
             "60".into(),
         ],
     ];
-    let lines = watch(&mut run, &python, &args.concat(), swarm);
+    let lines = watch(&mut run, &python, &args.concat(), start);
     let text = lines.join("\n");
     let has = |start: &str, part: &str| {
         lines
