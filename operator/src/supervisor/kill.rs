@@ -190,10 +190,13 @@ pub fn kill(
         }
     }
     // A robot of a shared process: the signal took the process, named by its first robot.
-    let mut robots: Vec<u32> = (record.processes.iter())
-        .filter(|q| q.role == Role::Agent && role == Role::Agent && q.pid == p.pid)
-        .map(|q| q.index)
-        .collect();
+    let mut robots: Vec<u32> = match role {
+        Role::Agent => (record.processes.iter())
+            .filter(|q| q.role == Role::Agent && q.pid == p.pid)
+            .map(|q| q.index)
+            .collect(),
+        _ => Vec::new(),
+    };
     robots.sort_unstable();
     let node = role.node_name(robots.first().copied().unwrap_or(index));
     held.record(RunEvent::Signalled {

@@ -312,9 +312,10 @@ impl Slots {
         for s in &self.slots {
             // Each robot of an agent process under the process's pid: `hnav ps` lists robots,
             // and `hnav kill agent:N` finds the process that hosts robot N.
-            for i in s.indices().filter(|_| s.child.is_some()) {
-                let pid = s.child.as_ref().map_or(0, Child::pid);
-                record.set_process(s.spec.role, i, pid, s.tracker.restarts());
+            if let Some(c) = &s.child {
+                for i in s.indices() {
+                    record.set_process(s.spec.role, i, c.pid(), s.tracker.restarts());
+                }
             }
         }
         // In a run across hosts, the other hosts' processes too: `hnav ps` shows the run.
