@@ -4,9 +4,10 @@
 use std::cell::RefCell;
 use std::io::Write;
 
+use bytemuck::Zeroable;
 use hnav_runtime::msg::{
-    Candidate, Commit, Lifecycle, MapHeader, Odometry, Progress, Truth, WheelCommand, Wire,
-    WireError,
+    Candidate, CommitHeader, Lifecycle, MapHeader, Odometry, Progress, TruthHeader, WheelCommand,
+    Wire, WireError, WireSlice,
 };
 use hnav_runtime::topics;
 use hnav_runtime::transport::{
@@ -134,21 +135,33 @@ impl<T: Wire + Default> Port for Typed<T> {
     }
 }
 
-/// The port of a neural-map topic (`map/<i>`): `f32` activations with a [`MapHeader`],
-/// on a link as the header's bytes followed by the activations'.
-struct Map {
+/// The port of a slice topic: a neural map (`map/<i>`, `f32` activations with a
+/// [`MapHeader`]), the commits (`[Decision]` with a `CommitHeader`) or the ground truth
+/// (`[Pose]` with a `TruthHeader`); on a link as the header's bytes followed by the
+/// elements' ([`WireSlice`]).
+struct Sliced<H: WireSlice> {
     topic: String,
     qos: Qos,
-    rx: SliceReceiver<f32, MapHeader>,
-    /// Opened with the first snapshot from another host, as long as it (a map keeps its
-    /// size for a run); a longer one is dropped.
-    tx: RefCell<Option<SliceSender<f32, MapHeader>>>,
+    rx: SliceReceiver<H::Element, H>,
+    /// Opened with the first sample from another host, as long as it (a topic's slices keep
+    /// their length for a run: the map's cells, the run's agents); a longer one is dropped.
+    tx: RefCell<Option<SliceSender<H::Element, H>>>,
     own: RefCell<Vec<PublisherId>>,
 }
 
-const HEADER: usize = core::mem::size_of::<MapHeader>();
+impl<H: WireSlice> Sliced<H> {
+    fn open(transport: &Transport, spec: &TopicSpec) -> Result<Box<dyn Port>, TransportError> {
+        Ok(Box::new(Self {
+            topic: spec.topic.clone(),
+            qos: spec.qos,
+            rx: transport.slice_receiver::<H::Element, H>(&spec.topic, spec.qos)?,
+            tx: RefCell::new(None),
+            own: RefCell::new(Vec::new()),
+        }))
+    }
+}
 
-impl Port for Map {
+impl<H: WireSlice> Port for Sliced<H> {
     fn topic(&self) -> &str {
         &self.topic
     }
@@ -165,13 +178,13 @@ impl Port for Map {
         let own = self.own.borrow();
         self.rx.drain_pending_except(&own, |h, values| {
             let mut w = ZBytes::writer();
-            // Copied once, into Zenoh's buffer: the header, then the activations.
+            // Copied once, into Zenoh's buffer: the header, then the elements.
             let written = w
                 .write_all(h.bytes())
                 .and_then(|()| w.write_all(bytemuck::cast_slice(values)));
             let put = written
                 .map_err(|e| e.to_string())
-                .and_then(|()| out.put(w.finish(), MapHeader::wire_name()));
+                .and_then(|()| out.put(w.finish(), H::wire_name()));
             counts.put(&self.topic, put);
         })?;
         Ok(())
@@ -183,47 +196,56 @@ impl Port for Map {
         payload: &ZBytes,
         type_name: Option<&str>,
     ) -> Result<Result<(), WireError>, TransportError> {
-        if let Err(e) = expect_type::<MapHeader>(type_name) {
+        if let Err(e) = expect_type::<H>(type_name) {
             return Ok(Err(e));
         }
         let bytes = payload.to_bytes();
-        let field = |what: String| WireError::Field {
-            type_name: MapHeader::wire_name(),
-            what,
+        let (header, elements) = match H::from_wire(&bytes) {
+            Ok(read) => read,
+            Err(e) => return Ok(Err(e)),
         };
-        if bytes.len() < HEADER || !(bytes.len() - HEADER).is_multiple_of(4) {
-            return Ok(Err(field(format!(
-                "{} bytes are no header and whole f32 activations",
-                bytes.len()
-            ))));
-        }
-        let mut header = MapHeader::default();
-        if let Err(e) = header.assign(&bytes[..HEADER]) {
-            return Ok(Err(e));
-        }
-        let values = &bytes[HEADER..];
-        let len = values.len() / 4;
+        let len = elements.len() / core::mem::size_of::<H::Element>().max(1);
         let mut tx = self.tx.borrow_mut();
         if tx.is_none() {
-            let sender = transport.slice_sender::<f32, MapHeader>(&self.topic, len, self.qos)?;
+            let sender = transport.slice_sender::<H::Element, H>(&self.topic, len, self.qos)?;
             self.own.borrow_mut().push(sender.id());
             *tx = Some(sender);
         }
         let tx = tx.as_ref().expect("opened above");
         if len > tx.max_len() {
-            return Ok(Err(field(format!(
-                "{len} activations, over the {} this host's map topic was opened for",
+            return Ok(Err(H::field(format!(
+                "{len} elements, over the {} this host's topic was opened for",
                 tx.max_len()
             ))));
         }
         let mut loan = tx.loan(len)?;
         *loan.header_mut() = header;
-        // Each element written once, straight from the link's bytes (no memset first).
-        loan.fill_and_send(|i| {
-            let b = &values[4 * i..4 * i + 4];
-            f32::from_ne_bytes([b[0], b[1], b[2], b[3]])
-        })?;
-        Ok(Ok(()))
+        // Each element written once, straight from the link's bytes, then checked in place;
+        // a sample that fails the check is dropped unsent.
+        let sent = loan.fill_with(H::Element::zeroed(), |out| {
+            header
+                .elements_from_wire(elements, out)
+                .map_err(Refused::Wire)
+        });
+        match sent {
+            Ok(_) => Ok(Ok(())),
+            Err(Refused::Wire(e)) => Ok(Err(e)),
+            Err(Refused::Transport(e)) => Err(e),
+        }
+    }
+}
+
+/// Why a slice from another host was not published here.
+enum Refused {
+    /// Its elements failed their check.
+    Wire(WireError),
+    /// Shared memory refused it.
+    Transport(TransportError),
+}
+
+impl From<TransportError> for Refused {
+    fn from(e: TransportError) -> Self {
+        Self::Transport(e)
     }
 }
 
@@ -308,10 +330,10 @@ pub(crate) fn open(
     }
     match spec.payload {
         Payload::Candidate => typed::<Candidate>(transport, spec),
-        Payload::Commit => typed::<Commit>(transport, spec),
+        Payload::Commit => Sliced::<CommitHeader>::open(transport, spec),
         Payload::Lifecycle => typed::<Lifecycle>(transport, spec),
         Payload::Progress => typed::<Progress>(transport, spec),
-        Payload::Truth => typed::<Truth>(transport, spec),
+        Payload::Truth => Sliced::<TruthHeader>::open(transport, spec),
         Payload::Odometry => typed::<Odometry>(transport, spec),
         Payload::WheelCommand => typed::<WheelCommand>(transport, spec),
         Payload::Raft => {
@@ -324,12 +346,6 @@ pub(crate) fn open(
                 tx,
             }))
         }
-        Payload::Map => Ok(Box::new(Map {
-            topic: spec.topic.clone(),
-            qos: spec.qos,
-            rx: transport.slice_receiver::<f32, MapHeader>(&spec.topic, spec.qos)?,
-            tx: RefCell::new(None),
-            own: RefCell::new(Vec::new()),
-        })),
+        Payload::Map => Sliced::<MapHeader>::open(transport, spec),
     }
 }

@@ -11,9 +11,11 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use hnav_runtime::msg::{Candidate, Commit, Lifecycle, MapHeader, Role, Wire};
+use hnav_runtime::msg::{
+    Candidate, Commit, CommitHeader, Decision, Lifecycle, MapHeader, Role, Verdict, Wire,
+};
 use hnav_runtime::topics;
-use hnav_runtime::transport::{purge_run, Receiver, RunId, Transport};
+use hnav_runtime::transport::{purge_run, Receiver, RunId, SliceReceiver, Transport};
 
 const AGENTS: usize = 2;
 /// Bound on every wait; a healthy exchange takes milliseconds.
@@ -96,6 +98,31 @@ fn collect<T: Wire>(t: &Transport, rx: &Receiver<T>, enough: impl Fn(&[T]) -> bo
     }
 }
 
+/// The commits `rx` receives until `enough` of them came, each held as a [`Commit`].
+fn collect_commits(
+    t: &Transport,
+    rx: &SliceReceiver<Decision, CommitHeader>,
+    enough: usize,
+) -> Vec<Commit> {
+    let waiter = t.waiter().unwrap();
+    let _a = waiter.attach(rx).unwrap();
+    let deadline = Instant::now() + TIMEOUT;
+    let mut got = Vec::new();
+    loop {
+        rx.drain_pending(|h, d| {
+            let mut c = Commit::default();
+            c.set(hnav_runtime::msg::CommitView::new(h, d));
+            got.push(c);
+        })
+        .unwrap();
+        if got.len() >= enough {
+            return got;
+        }
+        assert!(Instant::now() < deadline, "only {got:?} within {TIMEOUT:?}");
+        waiter.wait(Some(deadline)).unwrap();
+    }
+}
+
 fn candidate(round: u64, agent: u32) -> Candidate {
     Candidate {
         round,
@@ -133,8 +160,10 @@ fn two_hosts_exchange_the_run_s_topics_once_and_drop_what_is_invalid() {
     let cand_b = b.receiver::<Candidate>(topics::CANDIDATES, cq).unwrap();
     let kq = topics::commit_qos(AGENTS);
     let (commit_b, commit_a) = (
-        b.sender::<Commit>(topics::COMMIT, kq).unwrap(),
-        a.receiver::<Commit>(topics::COMMIT, kq).unwrap(),
+        b.slice_sender::<Decision, CommitHeader>(topics::COMMIT, AGENTS, kq)
+            .unwrap(),
+        a.slice_receiver::<Decision, CommitHeader>(topics::COMMIT, kq)
+            .unwrap(),
     );
     let lq = topics::lifecycle_qos(AGENTS);
     let (ready_b, ready_a) = (
@@ -185,16 +214,37 @@ fn two_hosts_exchange_the_run_s_topics_once_and_drop_what_is_invalid() {
     let rounds: Vec<u64> = got.iter().map(|c| c.round).filter(|&r| r > 0).collect();
     assert_eq!(rounds, (1..=100).collect::<Vec<_>>());
 
-    // B -> A: 20 commits and a lifecycle event.
+    // B -> A: 20 commits, a decision per agent, and a lifecycle event.
+    let decision = |r: u64, i: usize| Decision {
+        agent: i as u32,
+        verdict: Verdict::Accept as u8,
+        cell: (r * 10) as u32 + i as u32,
+        ..Decision::default()
+    };
     for r in 1..=20 {
-        commit_b.send_in_place(|c| c.round = r).unwrap();
+        let header = CommitHeader {
+            round: r,
+            count: AGENTS as u32,
+            term: 0,
+        };
+        commit_b
+            .send_from_fn(header, AGENTS, |i| decision(r, i))
+            .unwrap();
     }
     ready_b.send(Lifecycle::up(Role::Agent, 1)).unwrap();
-    let commits = collect(&a, &commit_a, |g| g.len() >= 20);
+    let commits = collect_commits(&a, &commit_a, 20);
     assert_eq!(
         commits.iter().map(|c| c.round).collect::<Vec<_>>(),
         (1..=20).collect::<Vec<_>>()
     );
+    for c in &commits {
+        let want: Vec<Decision> = (0..AGENTS).map(|i| decision(c.round, i)).collect();
+        assert_eq!(
+            c.decisions, want,
+            "round {}'s decisions crossed whole",
+            c.round
+        );
+    }
     let ups = collect(&a, &ready_a, |g| !g.is_empty());
     assert_eq!((ups[0].role, ups[0].index), (Role::Agent as u8, 1));
 

@@ -30,7 +30,7 @@
 //! | `scenario` | `Scenario::from_str` (TOML), then `validate` and `scenario_hash` | none (no writer) |
 //! | `record` | `consensus_log::frame::decode_payload` with the payload's own checksum, then `show` and `Tally` | `encode_frame` gives the same payload |
 //! | `log` | a log directory (the input split into segments at each `HNAVLOG1`): `read_log`, `verify` | an intact log re-encodes to the input's bytes |
-//! | `payload` | every `msg` payload as its raw bytes from shared memory: the `from_u8` decoders, `Commit::decisions`, `Truth::poses`, `Lifecycle::period`, and their consensus-log records | `Decision` through `LoggedDecision` |
+//! | `payload` | every `msg` payload as its raw bytes from shared memory: the `from_u8` decoders, `CommitView::decisions`, `TruthView::poses`, the bridge's `WireSlice` checks, `Lifecycle::period`, and their consensus-log records | `Decision` through `LoggedDecision` |
 
 mod log;
 mod mutate;

@@ -9,9 +9,9 @@ use hnav_runtime::consensus_log::{
     LifecycleRecord, LoggedDecision, Record, RecordPos, RoundRecord,
 };
 use hnav_runtime::msg::{
-    ActivationKind, Candidate, Commit, ConflictKind, Decision, Lifecycle, LifecycleEvent,
-    MapHeader, Odometry, Progress, Role, StartupPhase, StopReason, Truth, Verdict, WheelCommand,
-    MAX_AGENTS,
+    ActivationKind, Candidate, CommitHeader, CommitView, ConflictKind, Decision, Lifecycle,
+    LifecycleEvent, MapHeader, Odometry, Pose, Progress, Role, StartupPhase, StopReason,
+    TruthHeader, TruthView, Verdict, WheelCommand, WireSlice,
 };
 
 use crate::Outcome;
@@ -30,7 +30,7 @@ unsafe impl Plain for Candidate {}
 // SAFETY: as above.
 unsafe impl Plain for Decision {}
 // SAFETY: as above.
-unsafe impl Plain for Commit {}
+unsafe impl Plain for CommitHeader {}
 // SAFETY: as above.
 unsafe impl Plain for Progress {}
 // SAFETY: as above.
@@ -38,7 +38,9 @@ unsafe impl Plain for WheelCommand {}
 // SAFETY: as above.
 unsafe impl Plain for Odometry {}
 // SAFETY: as above.
-unsafe impl Plain for Truth {}
+unsafe impl Plain for TruthHeader {}
+// SAFETY: as above.
+unsafe impl Plain for Pose {}
 // SAFETY: as above.
 unsafe impl Plain for Lifecycle {}
 // SAFETY: as above.
@@ -55,6 +57,34 @@ fn from_bytes<T: Plain>(data: &[u8]) -> T {
         std::ptr::copy_nonoverlapping(data.as_ptr(), (&raw mut value).cast::<u8>(), n);
     }
     value
+}
+
+/// A slice sample of `data`'s bytes: the header `H` (zero-padded or cut), then as many whole
+/// elements `E` as the rest holds, as a subscriber of a slice topic would see them.
+fn slice_from_bytes<H: Plain, E: Plain>(data: &[u8]) -> (H, Vec<E>) {
+    let n = data.len().min(size_of::<H>());
+    let elements = data[n..].chunks_exact(size_of::<E>()).map(from_bytes);
+    (from_bytes(data), elements.collect())
+}
+
+/// The bridge's check of a slice sample from another host, over the same bytes: refused or
+/// taken, never a panic; what it takes must be what a local reader sees.
+fn wire_check<H: WireSlice + PartialEq>(data: &[u8], local: &[H::Element]) -> bool
+where
+    H::Element: Plain + PartialEq,
+{
+    let Ok((h, rest)) = H::from_wire(data) else {
+        return false;
+    };
+    let mut out = vec![H::Element::default(); rest.len() / size_of::<H::Element>().max(1)];
+    let taken = h.elements_from_wire(rest, &mut out).is_ok();
+    if taken {
+        assert_eq!(
+            out, local,
+            "the wire reads the elements a local reader reads"
+        );
+    }
+    taken
 }
 
 /// A record's renderings, as `hnav log show` prints what the coordinator logged from the
@@ -133,12 +163,13 @@ pub(crate) fn payload(data: &[u8]) -> Outcome {
         }
         1 => decision(&from_bytes(bytes)),
         2 => {
-            let c: Commit = from_bytes(bytes);
+            let (h, slice): (CommitHeader, Vec<Decision>) = slice_from_bytes(bytes);
+            let c = CommitView::new(&h, &slice);
             let decisions = c.decisions();
-            assert_eq!(decisions.len(), (c.count as usize).min(MAX_AGENTS));
+            assert_eq!(decisions.len(), (h.count as usize).min(slice.len()));
             let logged = RoundRecord {
-                round: c.round,
-                candidates: c.count,
+                round: c.round(),
+                candidates: h.count,
                 candidates_digest: 0,
                 decisions: decisions.iter().map(LoggedDecision::from).collect(),
             };
@@ -153,17 +184,23 @@ pub(crate) fn payload(data: &[u8]) -> Outcome {
             for d in decisions {
                 decision(d);
             }
+            let wire = wire_check::<CommitHeader>(bytes, decisions);
             render(&Record::Round(logged));
-            Outcome::class(if c.count as usize > MAX_AGENTS {
-                "ok:commit-count-past-capacity"
-            } else {
-                "ok:commit"
+            Outcome::class(match (h.count as usize > slice.len(), wire) {
+                (true, _) => "ok:commit-count-past-slice",
+                (false, true) => "ok:commit",
+                (false, false) => "ok:commit-refused-on-the-wire",
             })
         }
         3 => {
-            let t: Truth = from_bytes(bytes);
-            assert_eq!(t.poses().len(), (t.robots as usize).min(MAX_AGENTS));
-            Outcome::class("ok:truth")
+            let (h, slice): (TruthHeader, Vec<Pose>) = slice_from_bytes(bytes);
+            let t = TruthView::new(&h, &slice);
+            assert_eq!(t.poses().len(), (h.robots as usize).min(slice.len()));
+            Outcome::class(if wire_check::<TruthHeader>(bytes, t.poses()) {
+                "ok:truth"
+            } else {
+                "ok:truth-refused-on-the-wire"
+            })
         }
         4 => lifecycle(&from_bytes(bytes)),
         5 => {

@@ -13,8 +13,8 @@ use hnav_runtime::consensus_log::{
     FRAME_HEADER_LEN, MAGIC,
 };
 use hnav_runtime::msg::{
-    Candidate, CandidateFlags, Commit, ConflictKind, Decision, Lifecycle, MapHeader, Odometry,
-    Pose, Progress, Role, StartupPhase, StopReason, Truth, Verdict, WheelCommand,
+    Candidate, CandidateFlags, CommitHeader, ConflictKind, Decision, Lifecycle, MapHeader,
+    Odometry, Pose, Progress, Role, StartupPhase, StopReason, TruthHeader, Verdict, WheelCommand,
 };
 use hnav_runtime::scenario::FsyncPolicy;
 
@@ -231,28 +231,39 @@ fn payload_corpus() {
     payload(0, "candidate-nan", bytes_of(&nan), usize::MAX);
     let d = decision(2, Verdict::Replan, ConflictKind::HeadOn, 9);
     payload(1, "decision", bytes_of(&d), usize::MAX);
-    let mut commit = Commit {
+    // A slice sample as it sits in shared memory: the header, then its elements.
+    let commit = CommitHeader {
         round: 41,
         count: 3,
-        ..Commit::default()
+        term: 0,
     };
-    commit.decisions[0] = decision(0, Verdict::Accept, ConflictKind::None, 1);
-    commit.decisions[1] = decision(1, Verdict::Block, ConflictKind::StableCell, u32::MAX);
-    commit.decisions[2] = decision(2, Verdict::Hold, ConflictKind::Reserved, u32::MAX);
-    payload(2, "commit", bytes_of(&commit), 16 + 3 * 16);
-    let mut truth = Truth {
+    let mut bytes = bytes_of(&commit);
+    for d in [
+        decision(0, Verdict::Accept, ConflictKind::None, 1),
+        decision(1, Verdict::Block, ConflictKind::StableCell, u32::MAX),
+        decision(2, Verdict::Hold, ConflictKind::Reserved, u32::MAX),
+    ] {
+        bytes.extend(bytes_of(&d));
+    }
+    payload(2, "commit", bytes, usize::MAX);
+    let truth = TruthHeader {
         sim_time_ns: 5_000_000,
         period: 5,
         robots: 2,
         collisions: 0,
-        ..Truth::default()
     };
-    truth.poses[1] = Pose {
-        x_m: 1.5,
-        y_m: 0.5,
-        theta_rad: 1.0,
-    };
-    payload(3, "truth", bytes_of(&truth), 24 + 2 * 24);
+    let mut bytes = bytes_of(&truth);
+    for p in [
+        Pose::default(),
+        Pose {
+            x_m: 1.5,
+            y_m: 0.5,
+            theta_rad: 1.0,
+        },
+    ] {
+        bytes.extend(bytes_of(&p));
+    }
+    payload(3, "truth", bytes, usize::MAX);
     for (name, l) in [
         ("up", Lifecycle::up(Role::Agent, 3)),
         ("stop", Lifecycle::stop(StopReason::TimeLimit)),

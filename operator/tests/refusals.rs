@@ -40,13 +40,14 @@ fn run(scenario: &Path, out: &Path, extra: &[&str]) -> Output {
     o
 }
 
-/// A 20 x 20 open map with `n` agents, each on its own line pair: agent `i` starts on cell
-/// `i` (row-major) and goes to cell `399 - i`. Returns the file and the line of agent
-/// `MAX_AGENTS`'s `[[agents]]` header.
+/// An open square map with room for `n` agents, each on its own line pair: agent `i`
+/// starts on cell `i` (row-major) and goes to the cell as far from the last. Returns the file
+/// and the line of agent `MAX_AGENTS`'s `[[agents]]` header.
 fn many_agents(dir: &Path, n: usize) -> (PathBuf, usize) {
+    let side = (1..).find(|s| s * s >= 2 * n).unwrap();
     let mut text = String::from("name = \"many\"\n[map]\nrows = [\n");
-    for _ in 0..20 {
-        text += "  \"....................\",\n";
+    for _ in 0..side {
+        text += &format!("  \"{}\",\n", ".".repeat(side));
     }
     text += "]\n";
     let mut line_of_extra = 0;
@@ -54,13 +55,13 @@ fn many_agents(dir: &Path, n: usize) -> (PathBuf, usize) {
         if i == MAX_AGENTS {
             line_of_extra = text.lines().count() + 1;
         }
-        let goal = 399 - i;
+        let goal = side * side - 1 - i;
         text += &format!(
             "[[agents]]\nstart = [{}, {}]\ngoal = [{}, {}]\n",
-            i % 20,
-            i / 20,
-            goal % 20,
-            goal / 20
+            i % side,
+            i / side,
+            goal % side,
+            goal / side
         );
     }
     let path = dir.join("many.toml");
@@ -69,11 +70,11 @@ fn many_agents(dir: &Path, n: usize) -> (PathBuf, usize) {
 }
 
 #[test]
-fn more_agents_than_the_message_format_holds_are_refused_by_check_and_run() {
+fn more_agents_than_a_run_holds_are_refused_by_check_and_run() {
     let dir = tempfile::tempdir().unwrap();
     let (path, line) = many_agents(dir.path(), MAX_AGENTS + 1);
     let limit = format!(
-        "{} agents, but a run holds at most {MAX_AGENTS} (the limit of its message format)",
+        "{} agents, but a run holds at most {MAX_AGENTS}",
         MAX_AGENTS + 1
     );
 

@@ -12,10 +12,10 @@
 use std::time::{Duration, Instant};
 
 use hnav_runtime::msg::{
-    Commit, Estimate, Lifecycle, LifecycleEvent, MapHeader, Truth, WheelCommand,
+    CommitView, Estimate, Lifecycle, LifecycleEvent, MapHeader, TruthView, WheelCommand,
 };
 use hnav_runtime::scenario::{OdometrySource, Scenario};
-use hnav_runtime::topics;
+use hnav_runtime::topics::{self, CommitReceiver, TruthReceiver};
 use hnav_runtime::transport::{Receiver, RunId, SliceReceiver, Transport, TransportError, Wake};
 use zenoh::Session;
 
@@ -150,9 +150,9 @@ impl Topics {
 /// The run's topics this relay reads.
 pub(crate) struct Inputs {
     /// `None` when this process sends the ground truth itself (robots outside HNAV).
-    truth: Option<Receiver<Truth>>,
+    truth: Option<TruthReceiver>,
     estimate: Receiver<Estimate>,
-    commit: Receiver<Commit>,
+    commit: CommitReceiver,
     pub(crate) wheels: Vec<Receiver<WheelCommand>>,
     maps: Vec<SliceReceiver<f32, MapHeader>>,
 }
@@ -163,10 +163,10 @@ impl Inputs {
     pub(crate) fn open(t: &Transport, n: usize, observer: bool) -> Result<Inputs, TransportError> {
         Ok(Inputs {
             truth: observer
-                .then(|| t.receiver(topics::TRUTH, topics::truth_qos()))
+                .then(|| t.slice_receiver(topics::TRUTH, topics::truth_qos()))
                 .transpose()?,
             estimate: t.receiver(topics::ESTIMATE, topics::estimate_qos(n))?,
-            commit: t.receiver(topics::COMMIT, topics::commit_qos(n))?,
+            commit: t.slice_receiver(topics::COMMIT, topics::commit_qos(n))?,
             wheels: (0..n)
                 .map(|i| t.receiver(&topics::wheels(i), topics::state_qos()))
                 .collect::<Result<_, _>>()?,
@@ -234,14 +234,15 @@ pub(crate) fn read(
     out: &mut Out,
 ) -> Result<(), TransportError> {
     if let Some(truth) = &inputs.truth {
-        truth.drain(|t| scene.truth(t))?;
+        truth.drain(|h, p| scene.truth(TruthView::new(h, p)))?;
     }
     inputs.estimate.drain(|e| {
         if let Some(r) = scene.robots.get_mut(e.agent as usize) {
             r.estimate = Some((e.sim_time_ns, e.pose));
         }
     })?;
-    inputs.commit.drain(|c| {
+    inputs.commit.drain(|h, d| {
+        let c = CommitView::new(h, d);
         scene.commit(c);
         scene.decisions_json(c, &mut s.text.data);
         out.put(&mut topics.decisions, &s.text);

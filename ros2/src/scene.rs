@@ -15,7 +15,9 @@ use std::fmt::Write;
 
 use hnav_runtime::grid::geometry::cell_centre_m;
 use hnav_runtime::grid::{Cell, CornerCutting, Grid};
-use hnav_runtime::msg::{self, Commit, ConflictKind, MapHeader, Pose, Truth, Verdict};
+use hnav_runtime::msg::{
+    self, CommitView, ConflictKind, MapHeader, Pose, Truth, TruthView, Verdict,
+};
 use hnav_runtime::scenario::Scenario;
 
 use crate::msgs::{
@@ -82,9 +84,9 @@ impl Scene {
     }
 
     /// Takes ground truth in, applying the world changes its time has passed.
-    pub fn truth(&mut self, t: &Truth) {
+    pub fn truth(&mut self, t: TruthView<'_>) {
         while let Some((at, _, _)) = self.changes.last() {
-            if *at > t.sim_time_ns {
+            if *at > t.sim_time_ns() {
                 break;
             }
             if let Some((_, cells, closed)) = self.changes.pop() {
@@ -94,14 +96,13 @@ impl Scene {
                 self.map_dirty = true;
             }
         }
-        self.truth = Some(*t);
+        self.truth.get_or_insert_with(Truth::default).set(t);
     }
 
     /// Takes a commit in: its conflicts become the markers' conflicts.
-    pub fn commit(&mut self, c: &Commit) {
+    pub fn commit(&mut self, c: CommitView<'_>) {
         self.conflicts.clear();
-        let n = (c.count as usize).min(c.decisions.len());
-        for d in &c.decisions[..n] {
+        for d in c.decisions() {
             let conflict = ConflictKind::from_u8(d.kind).is_some_and(|k| {
                 !matches!(
                     k,
@@ -130,7 +131,7 @@ impl Scene {
     /// Robot `i`'s true pose.
     pub fn true_pose(&self, i: usize) -> Option<Pose> {
         let t = self.truth.as_ref()?;
-        (i < t.robots as usize).then(|| t.poses[i])
+        t.poses().get(i).copied()
     }
 
     fn cell_of(&self, p: &Pose) -> Option<Cell> {
@@ -341,15 +342,15 @@ impl Scene {
     /// Writes `c` as `/hnav/decisions`' JSON into `out`: `{"round":R,"term":T,"decisions":
     /// [{"agent":A,"verdict":"accept","kind":"none","cell":[x,y]|null,"waypoint":[x,y]|null,
     /// "refused":BITS}]}`.
-    pub fn decisions_json(&self, c: &Commit, out: &mut String) {
+    pub fn decisions_json(&self, c: CommitView<'_>, out: &mut String) {
         out.clear();
         let _ = write!(
             out,
             "{{\"round\":{},\"term\":{},\"decisions\":[",
-            c.round, c.term
+            c.round(),
+            c.term()
         );
-        let n = (c.count as usize).min(c.decisions.len());
-        for (k, d) in c.decisions[..n].iter().enumerate() {
+        for (k, d) in c.decisions().iter().enumerate() {
             let verdict = Verdict::from_u8(d.verdict).map_or("unknown", Verdict::name);
             let kind = ConflictKind::from_u8(d.kind).map_or("unknown", ConflictKind::name);
             let _ = write!(
@@ -432,16 +433,15 @@ mod tests {
             ..MapHeader::default()
         };
         scene.robots[0].map = Some((header, values));
-        let mut truth = Truth {
-            robots: 1,
+        let truth = Truth {
+            poses: vec![Pose {
+                x_m: 0.08,
+                y_m: 0.08,
+                theta_rad: 0.0,
+            }],
             ..Truth::default()
         };
-        truth.poses[0] = Pose {
-            x_m: 0.08,
-            y_m: 0.08,
-            theta_rad: 0.0,
-        };
-        scene.truth(&truth);
+        scene.truth(truth.view());
         let mut path = msgs::Path::default();
         scene.plan(0, &mut path);
         let cells: Vec<(f64, f64)> = (path.poses.iter())
@@ -468,13 +468,13 @@ mod tests {
             sim_time_ns: 999_999_999,
             ..Truth::default()
         };
-        scene.truth(&truth);
+        scene.truth(truth.view());
         scene.occupancy(&mut grid);
         assert_eq!(grid.data[3], 0);
         assert_eq!(grid.data[4 + 1], 100);
         truth.sim_time_ns = 1_000_000_000;
         scene.map_dirty = false;
-        scene.truth(&truth);
+        scene.truth(truth.view());
         assert!(scene.map_dirty);
         scene.occupancy(&mut grid);
         assert_eq!(grid.data[3], 100);
@@ -484,15 +484,15 @@ mod tests {
     #[test]
     fn decisions_are_one_json_object_per_commit() {
         let scene = Scene::new(&scenario());
-        let mut c = Commit {
+        let mut c = msg::Commit {
             round: 7,
-            count: 1,
-            ..Commit::default()
+            decisions: vec![msg::Decision::default()],
+            ..msg::Commit::default()
         };
         c.decisions[0].verdict = Verdict::Accept as u8;
         c.decisions[0].cell = 1;
         let mut out = String::new();
-        scene.decisions_json(&c, &mut out);
+        scene.decisions_json(c.view(), &mut out);
         let v: serde_json::Value = serde_json::from_str(&out).unwrap();
         assert_eq!(v["round"], 7);
         assert_eq!(v["decisions"][0]["verdict"], "accept");

@@ -12,8 +12,8 @@ use iceoryx2::prelude::ZeroCopySend;
 use serde::Serialize;
 
 use crate::msg::{
-    Candidate, Commit, Decision, Estimate, Heartbeat, Lifecycle, MapHeader, MoverPlace,
-    MoversHeader, Odometry, Pose, Progress, Sighting, Truth, View, WheelCommand, WorldHeader,
+    Candidate, CommitHeader, Decision, Estimate, Heartbeat, Lifecycle, MapHeader, MoverPlace,
+    MoversHeader, Odometry, Pose, Progress, Sighting, TruthHeader, View, WheelCommand, WorldHeader,
     MAX_AGENTS,
 };
 use crate::topics;
@@ -27,7 +27,7 @@ pub struct FieldLayout {
     pub offset: usize,
     /// Its size in bytes.
     pub size: usize,
-    /// Its Rust type, as written in the struct (`u32`, `[Decision; MAX_AGENTS]`).
+    /// Its Rust type, as written in the struct (`u32`, `[u32; 32]`).
     pub ty: &'static str,
 }
 
@@ -62,7 +62,7 @@ pub struct TopicLayout {
 /// The whole table: payload types and topics.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Layouts {
-    /// [`MAX_AGENTS`], the length of the arrays in [`Commit`] and [`Truth`].
+    /// [`MAX_AGENTS`]: the largest run, and the bound on an agent index a reader accepts.
     pub max_agents: usize,
     /// Every payload type.
     pub types: Vec<TypeLayout>,
@@ -119,11 +119,10 @@ pub fn layouts() -> Layouts {
             cell: u32,
             waypoint: u32
         }),
-        layout!(Commit {
+        layout!(CommitHeader {
             round: u64,
             count: u32,
-            term: u32,
-            decisions: [Decision; MAX_AGENTS]
+            term: u32
         }),
         layout!(Progress {
             round: u64,
@@ -156,12 +155,11 @@ pub fn layouts() -> Layouts {
             y_m: f64,
             theta_rad: f64
         }),
-        layout!(Truth {
+        layout!(TruthHeader {
             sim_time_ns: u64,
             period: u64,
             robots: u32,
-            collisions: u32,
-            poses: [Pose; MAX_AGENTS]
+            collisions: u32
         }),
         layout!(Estimate {
             sim_time_ns: u64,
@@ -220,7 +218,8 @@ pub fn layouts() -> Layouts {
             round: u64,
             closed: u32,
             opened: u32,
-            to: [u32; 8]
+            to: u32,
+            reserved: u32
         }),
         layout!(MoversHeader {
             sim_time_ns: u64,
@@ -238,37 +237,48 @@ pub fn layouts() -> Layouts {
         slice: false,
         user_header: type_name_of::<()>(),
     };
+    let sliced = |topic, payload, user_header| TopicLayout {
+        topic,
+        payload,
+        slice: true,
+        user_header,
+    };
     let topics = vec![
         fixed("wheels/<i>", type_name_of::<WheelCommand>()),
         fixed("odom/<i>", type_name_of::<Odometry>()),
         fixed("view/<i>", type_name_of::<View>()),
-        fixed(topics::TRUTH, type_name_of::<Truth>()),
+        sliced(
+            topics::TRUTH,
+            type_name_of::<Pose>(),
+            type_name_of::<TruthHeader>(),
+        ),
         fixed(topics::CANDIDATES, type_name_of::<Candidate>()),
-        fixed(topics::COMMIT, type_name_of::<Commit>()),
-        TopicLayout {
-            topic: "map/<i>",
-            payload: type_name_of::<f32>(),
-            slice: true,
-            user_header: type_name_of::<MapHeader>(),
-        },
+        sliced(
+            topics::COMMIT,
+            type_name_of::<Decision>(),
+            type_name_of::<CommitHeader>(),
+        ),
+        sliced(
+            "map/<i>",
+            type_name_of::<f32>(),
+            type_name_of::<MapHeader>(),
+        ),
         fixed(topics::PROGRESS, type_name_of::<Progress>()),
         fixed(topics::READY, type_name_of::<Lifecycle>()),
         fixed(topics::LIFECYCLE, type_name_of::<Lifecycle>()),
         fixed(topics::HEARTBEAT, type_name_of::<Heartbeat>()),
         fixed(topics::ESTIMATE, type_name_of::<Estimate>()),
         fixed(topics::SIGHTINGS, type_name_of::<Sighting>()),
-        TopicLayout {
-            topic: topics::WORLD,
-            payload: type_name_of::<u32>(),
-            slice: true,
-            user_header: type_name_of::<WorldHeader>(),
-        },
-        TopicLayout {
-            topic: topics::MOVERS,
-            payload: type_name_of::<MoverPlace>(),
-            slice: true,
-            user_header: type_name_of::<MoversHeader>(),
-        },
+        sliced(
+            topics::WORLD,
+            type_name_of::<u32>(),
+            type_name_of::<WorldHeader>(),
+        ),
+        sliced(
+            topics::MOVERS,
+            type_name_of::<MoverPlace>(),
+            type_name_of::<MoversHeader>(),
+        ),
     ];
     Layouts {
         max_agents: MAX_AGENTS,

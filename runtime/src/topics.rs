@@ -5,17 +5,17 @@
 //! |---|---|---|---|
 //! | `wheels/<i>` | [`WheelCommand`](crate::msg::WheelCommand) | agent i -> sim | latest |
 //! | `odom/<i>` | [`Odometry`](crate::msg::Odometry) | sim -> agent i | latest |
-//! | `truth` | [`Truth`](crate::msg::Truth) | sim -> supervisor, recorder, viewers | latest, deep buffer ([`truth_qos`]) |
+//! | `truth` | [`Pose`](crate::msg::Pose) slice + [`TruthHeader`](crate::msg::TruthHeader), one pose per robot | sim -> supervisor, recorder, viewers | latest, deep buffer ([`truth_qos`]) |
 //! | `estimate` | [`Estimate`](crate::msg::Estimate) | every agent -> recorder, `hnav-ros2`, viewers | latest, depth 1, not notified ([`estimate_qos`]) |
 //! | `candidates` | [`Candidate`](crate::msg::Candidate) | agents -> coordinator | reliable |
-//! | `commit` | [`Commit`](crate::msg::Commit) | coordinator -> agents | latest, deep buffer |
+//! | `commit` | [`Decision`](crate::msg::Decision) slice + [`CommitHeader`](crate::msg::CommitHeader), one decision per agent | coordinator -> agents | latest, deep buffer |
 //! | `map/<i>` | `[f32]` + [`MapHeader`](crate::msg::MapHeader) | agent i -> viewers (`hnav services` lists who) | latest |
 //! | `progress` | [`Progress`](crate::msg::Progress) | coordinator -> supervisor | latest |
 //! | `ready` | [`Lifecycle`](crate::msg::Lifecycle) (`Up`; the sim's `Hold`) | every process -> supervisor | latest, deep buffer |
 //! | `lifecycle` | [`Lifecycle`](crate::msg::Lifecycle) | supervisor -> every process | latest, deep buffer |
 //! | `heartbeat` | [`Heartbeat`](crate::msg::Heartbeat) | every process -> supervisor | latest, depth 1, not notified |
 //! | `sightings` | [`Sighting`](crate::msg::Sighting) | agents -> coordinator (with `[sensing]`) | reliable |
-//! | `world` | `[u32]` + [`WorldHeader`](crate::msg::WorldHeader) | coordinator -> restarted agents (with `[sensing]`) | latest, shallow ([`world_qos`]) |
+//! | `world` | `[u32]` (addressee bits, then cells) + [`WorldHeader`](crate::msg::WorldHeader) | coordinator -> restarted agents (with `[sensing]`) | latest, shallow ([`world_qos`]) |
 //! | `movers` | [`MoverPlace`](crate::msg::MoverPlace) slice + [`MoversHeader`](crate::msg::MoversHeader) | sim -> recorder, viewers (a run with movers) | latest, deep buffer ([`truth_qos`]) |
 //! | `raft/<i>` | `[u8]`: a Raft message | every other coordinator replica -> replica i | latest ([`raft_qos`]) |
 //!
@@ -41,7 +41,18 @@
 //! without a service (and its shared memory) per process. Beats do not notify: the
 //! supervisor reads them at its own deadline, so a beat costs a sample write and wakes nobody.
 
-use crate::transport::{Delivery, Qos};
+use crate::msg::{CommitHeader, Decision, Pose, TruthHeader};
+use crate::transport::{Delivery, Qos, SliceReceiver, SliceSender};
+
+/// The `commit` topic's sending side: a slice of one decision per agent (its length, the
+/// run's agents, fixed when the coordinator creates the service).
+pub type CommitSender = SliceSender<Decision, CommitHeader>;
+/// The `commit` topic's receiving side.
+pub type CommitReceiver = SliceReceiver<Decision, CommitHeader>;
+/// The `truth` topic's sending side: a slice of one pose per robot.
+pub type TruthSender = SliceSender<Pose, TruthHeader>;
+/// The `truth` topic's receiving side.
+pub type TruthReceiver = SliceReceiver<Pose, TruthHeader>;
 
 /// Robot `i`'s wheel commands.
 pub fn wheels(i: usize) -> String {

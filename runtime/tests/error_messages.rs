@@ -278,15 +278,15 @@ fn every_scenario_error_class_has_its_exact_message() {
         "bad.toml:8: agent 0: goal [3, 2] is unreachable from start [0, 0] (write \
          allow_unreachable = true at the top of the scenario to run it anyway)",
     );
-    let many: String = (0..257)
+    let many: String = (0..4097)
         .map(|i| format!("[[agents]]\nstart = [{i}, 0]\ngoal = [{i}, 1]\n"))
         .collect();
     check(
         &format!(
             "name = \"bad\"\n\n[map]\nrows = [\"{0}\", \"{0}\"]\n\n{many}",
-            ".".repeat(257)
+            ".".repeat(4097)
         ),
-        "bad.toml:774: 257 agents, but a run holds at most 256 (the limit of its message format)",
+        "bad.toml:12294: 4097 agents, but a run holds at most 4096",
     );
     let small = Scenario::from_str(&scenario("", ok_agent), "small.toml", dir.path()).unwrap();
     let e = small.with_agent_count(50, 1).unwrap_err();

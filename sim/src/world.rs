@@ -22,7 +22,7 @@ use crate::robot::RobotModel;
 use crate::watchdog::Watchdog;
 use hnav_runtime::grid::geometry::{cell_centre_pose, wrap_angle};
 use hnav_runtime::grid::Grid;
-use hnav_runtime::msg::{MoverPlace, Odometry, Pose, Truth, MAX_AGENTS};
+use hnav_runtime::msg::{MoverPlace, Odometry, Pose, Truth, TruthHeader};
 use hnav_runtime::scenario::params::{RobotParams, SimParams};
 use hnav_runtime::scenario::LocalisationParams;
 use hnav_runtime::scenario::Scenario;
@@ -463,22 +463,32 @@ impl World {
         })
     }
 
-    /// Fills `truth` for control period `period`: time, collision count and the poses of the
-    /// first [`MAX_AGENTS`] robots (the message holds no more). Unused pose slots are zeroed so
-    /// the sample's bytes are fully defined.
-    pub fn fill_truth(&self, period: u64, truth: &mut Truth) {
-        let n = self.robots().min(MAX_AGENTS);
-        truth.sim_time_ns = self.time_ns();
-        truth.period = period;
-        truth.robots = n as u32;
-        truth.collisions = u32::try_from(self.collisions.len()).unwrap_or(u32::MAX);
-        for (i, p) in truth.poses.iter_mut().enumerate() {
-            *p = if i < n {
-                self.pose_at(i)
-            } else {
-                Pose::default()
-            };
+    /// The header of the ground truth for control period `period`: time, robots and the
+    /// collision count; [`World::pose_of`] gives each robot's pose to go with it.
+    pub fn truth_header(&self, period: u64) -> TruthHeader {
+        TruthHeader {
+            sim_time_ns: self.time_ns(),
+            period,
+            robots: u32::try_from(self.robots()).unwrap_or(u32::MAX),
+            collisions: u32::try_from(self.collisions.len()).unwrap_or(u32::MAX),
         }
+    }
+
+    /// Robot `i`'s pose as the ground truth gives it (`i` below [`World::robots`]).
+    pub fn pose_of(&self, i: usize) -> Pose {
+        self.pose_at(i)
+    }
+
+    /// Fills `truth` for control period `period`, reusing its poses' memory.
+    pub fn fill_truth(&self, period: u64, truth: &mut Truth) {
+        let h = self.truth_header(period);
+        truth.sim_time_ns = h.sim_time_ns;
+        truth.period = h.period;
+        truth.collisions = h.collisions;
+        truth.poses.clear();
+        truth
+            .poses
+            .extend((0..self.robots()).map(|i| self.pose_at(i)));
     }
 
     /// What the sim measured of each robot for the summary: energy drawn, first time at

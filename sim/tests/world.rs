@@ -130,10 +130,10 @@ fn watchdog_brakes_a_robot_whose_commands_stop() {
     assert_eq!(w.pose(0).unwrap(), p, "a braked robot stands still");
 }
 
-/// FNV-1a over a Truth sample's bytes (fields hashed one by one; the layout has no padding).
+/// FNV-1a over a Truth's fields, one by one, as a sample carries them.
 fn hash_truth(h: &mut Fnv1a64, t: &Truth) {
     h.u64(t.sim_time_ns).u64(t.period);
-    h.bytes(&t.robots.to_le_bytes())
+    h.bytes(&(t.poses.len() as u32).to_le_bytes())
         .bytes(&t.collisions.to_le_bytes());
     for p in &t.poses {
         h.f64(p.x_m).f64(p.y_m).f64(p.theta_rad);

@@ -13,7 +13,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use hnav_runtime::clock::monotonic_ns;
-use hnav_runtime::msg::{Commit, ConflictKind, Pose, Progress, Truth};
+use hnav_runtime::msg::{CommitView, ConflictKind, Pose, Progress};
 use hnav_runtime::topics;
 use hnav_runtime::transport::{RunId, Transport};
 use hnav_tests::swarm::{verify_log, wait_for_ps, SwarmRun};
@@ -95,11 +95,11 @@ impl Observer {
                 .handle_signals(false)
                 .create()
                 .unwrap();
-            let commits = t
-                .receiver::<Commit>(topics::COMMIT, topics::commit_qos(2))
+            let commits: topics::CommitReceiver = t
+                .slice_receiver(topics::COMMIT, topics::commit_qos(2))
                 .unwrap();
-            let truth = t
-                .receiver::<Truth>(topics::TRUTH, topics::truth_qos())
+            let truth: topics::TruthReceiver = t
+                .slice_receiver(topics::TRUTH, topics::truth_qos())
                 .unwrap();
             let progress = t
                 .receiver::<Progress>(topics::PROGRESS, topics::progress_qos())
@@ -112,17 +112,18 @@ impl Observer {
             while !stop2.load(Ordering::Relaxed) {
                 let now = monotonic_ns();
                 let mut s = seen2.lock().unwrap_or_else(|e| e.into_inner());
-                let _ = commits.drain_pending(|c| {
+                let _ = commits.drain_pending(|h, d| {
+                    let c = CommitView::new(h, d);
                     let of = |agent: u32| {
                         c.decisions()
                             .iter()
                             .find(|d| d.agent == agent)
                             .map_or((NONE, NONE), |d| (d.verdict, d.kind))
                     };
-                    s.commits.push((now, c.round, [of(0), of(1)]));
-                    s.round = s.round.max(c.round);
+                    s.commits.push((now, c.round(), [of(0), of(1)]));
+                    s.round = s.round.max(c.round());
                 });
-                let _ = truth.drain_pending(|t| s.poses.push((now, t.poses[0])));
+                let _ = truth.drain_pending(|_, poses| s.poses.push((now, poses[0])));
                 let _ = progress.drain_pending(|p| s.round = s.round.max(p.round));
                 drop(s);
                 let _ = waiter.wait(Some(Instant::now() + Duration::from_millis(100)));

@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use hnav_runtime::msg::{Commit, MapHeader};
-use hnav_runtime::topics;
-use hnav_runtime::transport::{Receiver, Transport};
+use hnav_runtime::msg::MapHeader;
+use hnav_runtime::topics::{self, CommitReceiver};
+use hnav_runtime::transport::Transport;
 use hnav_tests::swarm::{hnav_output, SwarmRun};
 use hnav_tests::TestRun;
 use nix::sys::signal::Signal;
@@ -44,7 +44,7 @@ fn scenario(dir: &Path) -> PathBuf {
 }
 
 /// Takes commits until one of round `round` or later has been seen; returns that round.
-fn wait_for_round(t: &Transport, commits: &Receiver<Commit>, round: u64) -> u64 {
+fn wait_for_round(t: &Transport, commits: &CommitReceiver, round: u64) -> u64 {
     let waiter = t.waiter().unwrap();
     let _attached = waiter.attach(commits).unwrap();
     let deadline = Instant::now() + RUN_TIMEOUT;
@@ -54,7 +54,9 @@ fn wait_for_round(t: &Transport, commits: &Receiver<Commit>, round: u64) -> u64 
             Instant::now() < deadline,
             "no commit of round {round} within {RUN_TIMEOUT:?} (last {last})"
         );
-        commits.drain_pending(|c| last = last.max(c.round)).unwrap();
+        commits
+            .drain_pending(|h, _| last = last.max(h.round))
+            .unwrap();
         let _ = waiter.wait(Some(Instant::now() + Duration::from_millis(100)));
     }
     last
@@ -92,7 +94,7 @@ fn a_late_viewer_gets_the_latest_map_at_once() {
             .create()
             .unwrap();
         let commits = t
-            .receiver::<Commit>(topics::COMMIT, topics::commit_qos(2))
+            .slice_receiver(topics::COMMIT, topics::commit_qos(2))
             .unwrap();
         // Long after agent 0's one and only build (before round 1), and long before the run
         // ends (about round 3000).
@@ -153,7 +155,7 @@ fn services_lists_the_topics_with_their_publishers_and_subscribers() {
             .create()
             .unwrap();
         let commits = t
-            .receiver::<Commit>(topics::COMMIT, topics::commit_qos(2))
+            .slice_receiver(topics::COMMIT, topics::commit_qos(2))
             .unwrap();
         wait_for_round(&t, &commits, 100);
         let ask = |json: bool| {
@@ -198,7 +200,10 @@ fn services_lists_the_topics_with_their_publishers_and_subscribers() {
     );
     let topic = |name: &str| topics.iter().find(|t| t["topic"] == name).unwrap();
     let commit = topic("commit");
-    assert_eq!(commit["payload"], "hnav::Commit");
+    assert_eq!(
+        (commit["payload"].as_str(), commit["user_header"].as_str()),
+        (Some("[hnav::Decision]"), Some("hnav::CommitHeader"))
+    );
     assert_eq!(node_names(&commit["publishers"]), ["coordinator"], "{json}");
     let readers = node_names(&commit["subscribers"]);
     for n in ["agent-0", "agent-1", "services-test"] {
@@ -231,7 +236,7 @@ fn services_lists_the_topics_with_their_publishers_and_subscribers() {
     assert_eq!(writers, ["agent-0", "agent-1"], "{json}");
     assert!(
         text.contains(&format!(
-            "hnav/{id}/commit  [hnav::Commit]  history 1, buffer 64, latest"
+            "hnav/{id}/commit  [[hnav::Decision], header hnav::CommitHeader]  history 1, buffer 64, latest"
         )),
         "{text}"
     );

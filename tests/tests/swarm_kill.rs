@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use hnav_runtime::consensus_log::{read_log, Record};
-use hnav_runtime::msg::{Commit, MapHeader};
+use hnav_runtime::msg::{Commit, CommitView, MapHeader};
 use hnav_runtime::topics;
 use hnav_runtime::transport::{RunId, Transport};
 use hnav_tests::swarm::{repo_root, verify_log, SwarmRun};
@@ -71,8 +71,8 @@ impl Observer {
                 .node_name("observer")
                 .create()
                 .unwrap();
-            let rx = t
-                .receiver::<Commit>(topics::COMMIT, topics::commit_qos(agents))
+            let rx: topics::CommitReceiver = t
+                .slice_receiver(topics::COMMIT, topics::commit_qos(agents))
                 .unwrap();
             let maps = t
                 .slice_receiver::<f32, MapHeader>(&topics::map(0), topics::state_qos())
@@ -92,14 +92,17 @@ impl Observer {
                         .unwrap_or(f32::NAN);
                     *m2.lock().unwrap() = Some((h, v, s.payload().len()));
                 }
-                let _ = rx.drain_pending(|c| {
+                let _ = rx.drain_pending(|h, d| {
+                    let mut c = Commit::default();
+                    c.set(CommitView::new(h, d));
                     let now = hnav_runtime::clock::monotonic_ns();
                     t2.lock().unwrap().push((now, c.round));
                     let mut m = s2.lock().unwrap();
-                    if let Some(mut old) = m.insert(c.round, *c) {
+                    let (round, term) = (c.round, c.term);
+                    if let Some(mut old) = m.insert(round, c.clone()) {
                         // A new leader's resend of the last round carries its own term.
-                        old.term = c.term;
-                        assert!(old == *c, "round {} committed twice, differently", c.round);
+                        old.term = term;
+                        assert!(old == c, "round {round} committed twice, differently");
                     }
                 });
                 // Bounded, so that the thread sees `stop`.
@@ -294,7 +297,7 @@ fn check_replicas(
             })
             .collect();
         for (round, commit) in seen {
-            let mut logged = decided.get(round).copied();
+            let mut logged = decided.get(round).cloned();
             if let Some(l) = &mut logged {
                 l.term = commit.term;
             }

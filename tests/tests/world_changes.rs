@@ -331,7 +331,7 @@ fn seen_as_it_happens(dir: &Path) {
             match u {
                 Update::Movers(m) => movers += usize::from(m.len() == 2),
                 Update::View(_) => views += 1,
-                Update::Truth(t) => t_ns = Some(t.sim_time_ns),
+                Update::Truth(t) => t_ns = Some(t.sim_time_ns()),
                 _ => {}
             }
             state.apply(u, Instant::now());

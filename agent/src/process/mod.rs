@@ -44,7 +44,7 @@ use std::time::{Duration, Instant};
 
 use hnav_runtime::health::Heartbeat;
 use hnav_runtime::launch::{ProcessArgs, StartOutcome};
-use hnav_runtime::msg::{Role, StartupPhase};
+use hnav_runtime::msg::{CommitView, Role, StartupPhase};
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::transport::{Transport, TransportError, Wake};
 
@@ -263,7 +263,8 @@ fn pass(
     let wake = p.commit.take_wakeup()?;
     while let Some(sample) = p.commit.receive()? {
         for (core, span) in cores.iter_mut().zip(spans) {
-            span.in_scope(|| core.apply_commit(sample.payload()))?;
+            let c = CommitView::new(sample.user_header(), sample.payload());
+            span.in_scope(|| core.apply_commit(c))?;
         }
     }
     for ((core, r), span) in cores.iter_mut().zip(rp).zip(spans) {

@@ -7,10 +7,9 @@ use std::cell::Cell;
 use hnav_runtime::grid::Grid;
 use hnav_runtime::launch::LifecyclePorts;
 use hnav_runtime::msg::{
-    Candidate, Commit, Estimate, MapHeader, Odometry, Role, Sighting, View, WheelCommand,
-    WorldHeader,
+    Candidate, Estimate, MapHeader, Odometry, Role, Sighting, View, WheelCommand, WorldHeader,
 };
-use hnav_runtime::topics;
+use hnav_runtime::topics::{self, CommitReceiver};
 use hnav_runtime::transport::{
     Bell, BellWatch, Receiver, Sender, SliceReceiver, SliceSender, Transport, TransportError,
 };
@@ -22,7 +21,7 @@ pub(super) struct Ports {
     pub(super) sightings: Option<Sender<Sighting>>,
     /// The coordinator's map as it stands, sent when an agent restarted (with `[sensing]`).
     pub(super) world: Option<SliceReceiver<u32, WorldHeader>>,
-    pub(super) commit: Receiver<Commit>,
+    pub(super) commit: CommitReceiver,
     /// The run's commit bell, watched in place of a datagram per commit (under a supervisor).
     pub(super) bell: Option<BellWatch>,
     pub(super) candidates: Candidates,
@@ -78,8 +77,8 @@ impl Ports {
         // it still reports a coordinator that appears or dies.
         let bell = Bell::from_env()?;
         let commit = match bell {
-            Some(_) => transport.bell_receiver(topics::COMMIT, topics::commit_qos(agents))?,
-            None => transport.receiver(topics::COMMIT, topics::commit_qos(agents))?,
+            Some(_) => transport.slice_bell_receiver(topics::COMMIT, topics::commit_qos(agents))?,
+            None => transport.slice_receiver(topics::COMMIT, topics::commit_qos(agents))?,
         };
         Ok(Self {
             sightings: sensing

@@ -11,7 +11,7 @@ use hnav_runtime::grid::Cell;
 use hnav_runtime::grid::Grid;
 use hnav_runtime::hash::SplitMix64;
 use hnav_runtime::msg::{
-    Commit, Estimate, MapHeader, Odometry, Pose, View, WheelCommand, WorldHeader,
+    CommitView, Decision, Estimate, MapHeader, Odometry, Pose, View, WheelCommand, WorldHeader,
 };
 use hnav_runtime::scenario::{AgentSpec, ClockMode, Planner, RepairRule, Scenario};
 
@@ -202,18 +202,22 @@ impl Core {
     }
 
     /// Applies commit `c` if it is new.
-    pub(super) fn apply_commit(&mut self, c: &Commit) -> Result<(), AgentError> {
-        if c.round <= self.last_commit {
+    pub(super) fn apply_commit(&mut self, c: CommitView<'_>) -> Result<(), AgentError> {
+        if c.round() <= self.last_commit {
             return Ok(());
         }
-        self.last_commit = c.round;
-        if let Some(d) = c.decisions().iter().find(|d| d.agent == self.index) {
+        self.last_commit = c.round();
+        // The coordinator writes decision i for agent i; the search is for a commit that
+        // does not, so that a thousand robots do not each scan a thousand decisions.
+        let own = |d: &&Decision| d.agent == self.index;
+        let mine = c.decisions().get(self.index as usize).filter(own);
+        if let Some(d) = mine.or_else(|| c.decisions().iter().find(own)) {
             self.rebuilt |= self.nav.apply(d)?.map_rebuilt;
         }
         // A later round than asked for also answers the open candidate: this agent was
         // behind (restarted, or missed by the coordinator) and counted as standing in
         // the rounds it missed; it goes on from the round that was decided.
-        if self.outstanding.is_some_and(|r| r <= c.round) {
+        if self.outstanding.is_some_and(|r| r <= c.round()) {
             self.outstanding = None;
             self.sent_at = None;
         }
@@ -281,8 +285,12 @@ impl Core {
     /// Folds in the coordinator's map as it stands (`h`, `cells`), when it was sent to this
     /// agent (it restarted): the map at start is out of date by every change the swarm saw
     /// since.
-    pub(super) fn learn_world(&mut self, h: &WorldHeader, cells: &[u32]) -> Result<(), AgentError> {
-        let Some(rule) = self.repair.filter(|_| h.is_for(self.index as usize)) else {
+    pub(super) fn learn_world(&mut self, h: &WorldHeader, slice: &[u32]) -> Result<(), AgentError> {
+        let (to, cells) = h.split(slice);
+        let Some(rule) = self
+            .repair
+            .filter(|_| WorldHeader::is_for(to, self.index as usize))
+        else {
             return Ok(());
         };
         let (period, width) = (self.last_period.unwrap_or(0), self.width);

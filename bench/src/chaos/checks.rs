@@ -124,7 +124,10 @@ pub fn logged_commits(log_dir: &Path) -> Result<Vec<(u64, u64)>, String> {
         .records
         .iter()
         .filter_map(|r| match r {
-            Record::Round(rec) => Some((rec.round, super::observer::commit_digest(&rec.commit()))),
+            Record::Round(rec) => Some((
+                rec.round,
+                super::observer::commit_digest(rec.commit().view()),
+            )),
             _ => None,
         })
         .collect())

@@ -8,8 +8,8 @@
 
 use hnav_runtime::clock::monotonic_ns;
 use hnav_runtime::hash::Fnv1a64;
-use hnav_runtime::msg::{Candidate, Commit, Lifecycle, LifecycleEvent, Role, Truth};
-use hnav_runtime::topics;
+use hnav_runtime::msg::{Candidate, CommitView, Lifecycle, LifecycleEvent, Role};
+use hnav_runtime::topics::{self, CommitReceiver, TruthReceiver};
 use hnav_runtime::transport::{Receiver, RunId, Transport, TransportError, Waiter};
 
 /// One commit as the observer received it.
@@ -54,11 +54,11 @@ pub struct Observed {
 }
 
 /// A digest of a commit's round and valid decisions, equal for equal commits: the log's
-/// commit of a round and the one received are compared through it, without keeping 4 KiB per
-/// round.
-pub fn commit_digest(c: &Commit) -> u64 {
+/// commit of a round and the one received are compared through it, without keeping every
+/// round's decisions.
+pub fn commit_digest(c: CommitView<'_>) -> u64 {
     let mut h = Fnv1a64::new();
-    h.u64(c.round).u64(u64::from(c.count));
+    h.u64(c.round()).u64(c.decisions().len() as u64);
     for d in c.decisions() {
         h.u64(u64::from(d.agent))
             .u64(u64::from(d.verdict))
@@ -73,10 +73,10 @@ pub fn commit_digest(c: &Commit) -> u64 {
 /// The observer's node and ports in one run.
 pub struct Observer {
     transport: Transport,
-    commit: Receiver<Commit>,
+    commit: CommitReceiver,
     life: Receiver<Lifecycle>,
     candidates: Receiver<Candidate>,
-    truth: Receiver<Truth>,
+    truth: TruthReceiver,
 }
 
 impl Observed {
@@ -102,10 +102,10 @@ impl Observer {
             .handle_signals(false)
             .create()?;
         Ok(Observer {
-            commit: transport.receiver(topics::COMMIT, topics::commit_qos(agents))?,
+            commit: transport.slice_receiver(topics::COMMIT, topics::commit_qos(agents))?,
             life: transport.receiver(topics::LIFECYCLE, topics::lifecycle_qos(agents))?,
             candidates: transport.receiver(topics::CANDIDATES, topics::candidates_qos(agents))?,
-            truth: transport.receiver(topics::TRUTH, topics::truth_qos())?,
+            truth: transport.slice_receiver(topics::TRUTH, topics::truth_qos())?,
             transport,
         })
     }
@@ -134,15 +134,16 @@ impl Observer {
     pub fn drain(&self, seen: &mut Observed) -> Result<(), TransportError> {
         self.candidates
             .drain_pending(|c| seen.candidates.push((monotonic_ns(), c.agent)))?;
-        self.commit.drain_pending(|c| {
+        self.commit.drain_pending(|h, d| {
+            let c = CommitView::new(h, d);
             seen.commits.push(SeenCommit {
                 t_ns: monotonic_ns(),
-                round: c.round,
+                round: c.round(),
                 digest: commit_digest(c),
             })
         })?;
         self.truth
-            .drain_pending(|_| seen.truths.push(monotonic_ns()))?;
+            .drain_pending(|_, _| seen.truths.push(monotonic_ns()))?;
         self.life.drain_pending(|l| {
             let t_ns = monotonic_ns();
             match LifecycleEvent::from_u8(l.event) {

@@ -12,11 +12,9 @@ use anyhow::{bail, Result};
 
 use hnav_operator::supervisor::child::Child;
 use hnav_operator::supervisor::startup::SupervisorPorts;
-use hnav_runtime::msg::{Candidate, CandidateFlags, Commit, Lifecycle, Role};
-use hnav_runtime::topics;
-use hnav_runtime::transport::{
-    AttachmentId, Bell, BellWatch, Receiver, RunId, Sender, Transport, Wake,
-};
+use hnav_runtime::msg::{Candidate, CandidateFlags, CommitView, Lifecycle, Role};
+use hnav_runtime::topics::{self, CommitReceiver};
+use hnav_runtime::transport::{AttachmentId, Bell, BellWatch, RunId, Sender, Transport, Wake};
 
 use super::layout::Layout;
 
@@ -71,7 +69,7 @@ pub struct Swarm {
     /// Per agent process.
     tx: Vec<Option<Sender<Candidate>>>,
     /// Per agent process.
-    rx: Vec<Option<Receiver<Commit>>>,
+    rx: Vec<Option<CommitReceiver>>,
     /// Each agent process's watch of the commit bell, when the run has one.
     watch: Vec<Option<BellWatch>>,
     bell: Option<Bell>,
@@ -118,8 +116,8 @@ impl Swarm {
         );
         let qos = topics::commit_qos(n);
         self.rx[i] = Some(match &self.bell {
-            Some(_) => self.transport.bell_receiver(topics::COMMIT, qos)?,
-            None => self.transport.receiver(topics::COMMIT, qos)?,
+            Some(_) => self.transport.slice_bell_receiver(topics::COMMIT, qos)?,
+            None => self.transport.slice_receiver(topics::COMMIT, qos)?,
         });
         self.watch[i] = self.bell.as_ref().map(Bell::watch).transpose()?;
         Ok(())
@@ -277,8 +275,9 @@ impl Swarm {
                 for &p in &fired {
                     let Some(rx) = &self.rx[p] else { continue };
                     let (robots, mut late) = (self.robots(p), None);
-                    let drained = rx.drain_pending(|c| {
-                        if c.round == round && got[robots.start].is_none() {
+                    let drained = rx.drain_pending(|h, d| {
+                        let c = CommitView::new(h, d);
+                        if c.round() == round && got[robots.start].is_none() {
                             let now = Instant::now();
                             for i in robots.clone() {
                                 let decided = c.decisions().iter().any(|d| d.agent as usize == i);
@@ -287,8 +286,8 @@ impl Swarm {
                             first_in.get_or_insert(now);
                             all_in = now;
                             missing -= 1;
-                        } else if c.round > round {
-                            late.get_or_insert(c.round);
+                        } else if c.round() > round {
+                            late.get_or_insert(c.round());
                         }
                     })?;
                     if let Some(r) = late {

@@ -119,8 +119,9 @@ def watch(run: Run, a) -> int:
     deadline = time.monotonic() + a.timeout
     while seen < a.commits:
         for s in commits.drain():
-            c = s.payload().contents
-            decisions = ", ".join(describe(d, width) for d in c.decided()) or "no decisions"
+            c = msg.CommitHeader.from_buffer_copy(bytes(s.user_header().contents))
+            decided = msg.slice_of(msg.Decision, c.count, s)
+            decisions = ", ".join(describe(d, width) for d in decided) or "no decisions"
             print(f"commit {c.round}: {decisions}")
             first = c.round if first is None else first
             last = c.round
@@ -131,7 +132,8 @@ def watch(run: Run, a) -> int:
             if seen == a.commits:
                 break
         for s in truth.drain():
-            latest_truth = msg.Truth.from_buffer_copy(bytes(s.payload().contents))
+            header = msg.TruthHeader.from_buffer_copy(bytes(s.user_header().contents))
+            latest_truth = (header, msg.slice_of(msg.Pose, header.robots, s))
         snapshot = newest_map(maps, snapshot)
         if seen < a.commits:
             left = deadline - time.monotonic()
@@ -166,11 +168,12 @@ def newest_map(topic, current):
     return current
 
 
-def print_truth(t) -> None:
-    """The ground truth: each robot's pose and the collisions so far."""
+def print_truth(truth) -> None:
+    """The ground truth, (header, poses): each robot's pose and the collisions so far."""
+    t, robots = truth
     poses = ", ".join(
         f"r{i} ({p.x_m:.2f}, {p.y_m:.2f}, {math.degrees(p.theta_rad):.0f} deg)"
-        for i, p in enumerate(t.poses[: min(t.robots, msg.MAX_AGENTS)])
+        for i, p in enumerate(robots)
     )
     print(f"truth period {t.period}: {poses}; {t.collisions} collisions")
 

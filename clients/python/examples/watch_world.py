@@ -70,14 +70,11 @@ def watch(run: Run, a) -> int:
             missing.discard("sighting")
         for s in topics["world"].drain():
             h = msg.WorldHeader.from_buffer_copy(bytes(s.user_header().contents))
-            p = s.payload()
-            # The header's counts, not `p.len()`: the binding gives a slice's length in bytes.
-            # Copied out: the sample's chunk goes back to the coordinator when `s` is dropped.
-            n = h.closed + h.opened
-            world = list((ctypes.c_uint32 * n).from_address(p.as_ptr()))
-            closed, opened = world[: h.closed], world[h.closed :]
+            # The header's counts, not the payload's length: the binding gives it in bytes.
+            words = msg.slice_of(ctypes.c_uint32, h.to + h.closed + h.opened, s)
+            agents, closed, opened = h.split(words)
             print(
-                f"world round {h.round} for {h.addressees()}: closed {cells(a.width, closed)}; "
+                f"world round {h.round} for {agents}: closed {cells(a.width, closed)}; "
                 f"opened {cells(a.width, opened)}"
             )
             missing.discard("world")

@@ -10,8 +10,9 @@ Enumerations travel as plain integers; the constants below name their values.
 
 import ctypes
 
-# The length of the arrays in Commit and Truth (msg::MAX_AGENTS).
-MAX_AGENTS = 256
+# The largest run (msg::MAX_AGENTS). No payload is an array of this length: a commit and the
+# ground truth are slices sized to the run, read with `slice_of` below.
+MAX_AGENTS = 4096
 # "No cell" in a cell field (msg::NO_CELL).
 NO_CELL = 0xFFFFFFFF
 
@@ -91,19 +92,16 @@ class Decision(_Payload):
     ]
 
 
-class Commit(_Payload):
-    """One decided round: `count` decisions, the rest of the array unused."""
+class CommitHeader(_Payload):
+    """The user header of one decided round (`commit`, a slice of Decision, one per agent of
+    the run): read `count` decisions with `slice_of` (the binding's slice length is in
+    bytes)."""
 
     _fields_ = [
         ("round", ctypes.c_uint64),
         ("count", ctypes.c_uint32),
         ("term", ctypes.c_uint32),
-        ("decisions", Decision * MAX_AGENTS),
     ]
-
-    def decided(self):
-        """The decisions in use."""
-        return self.decisions[: min(self.count, MAX_AGENTS)]
 
 
 class Progress(_Payload):
@@ -158,15 +156,15 @@ class Odometry(_Payload):
     ]
 
 
-class Truth(_Payload):
-    """The sim's ground truth: `robots` poses and the collisions so far."""
+class TruthHeader(_Payload):
+    """The user header of the sim's ground truth (`truth`, a slice of Pose, one per robot):
+    the time, the collisions so far, and `robots`, the poses to read with `slice_of`."""
 
     _fields_ = [
         ("sim_time_ns", ctypes.c_uint64),
         ("period", ctypes.c_uint64),
         ("robots", ctypes.c_uint32),
         ("collisions", ctypes.c_uint32),
-        ("poses", Pose * MAX_AGENTS),
     ]
 
 
@@ -311,21 +309,33 @@ class Sighting(_Payload):
 
 
 class WorldHeader(_Payload):
-    """The user header of the coordinator's map (`world`, a slice of u32 cell indices): the
-    cells that differ from the scenario's map after `round`, the `closed` ones first, then the
-    `opened` ones (read closed + opened cells: the binding's slice length is in bytes). Bit i % 32 of `to[i // 32]` names agent i, a restarted agent it
-    answers."""
+    """The user header of the coordinator's map (`world`, a slice of u32): `to` words of
+    addressee bits (bit i % 32 of word i // 32 names agent i, a restarted agent it answers),
+    then the cells that differ from the scenario's map after `round`, the `closed` ones first,
+    then the `opened` ones. Read to + closed + opened words: the binding's slice length is in
+    bytes."""
 
     _fields_ = [
         ("round", ctypes.c_uint64),
         ("closed", ctypes.c_uint32),
         ("opened", ctypes.c_uint32),
-        ("to", ctypes.c_uint32 * 8),
+        ("to", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
     ]
 
-    def addressees(self):
-        """The agents it answers."""
-        return [i for i in range(32 * len(self.to)) if self.to[i // 32] >> (i % 32) & 1]
+    def split(self, words):
+        """A sample's words (a list) as (addressees, closed cells, opened cells)."""
+        to = words[: self.to]
+        cells = words[self.to : self.to + self.closed + self.opened]
+        agents = [i for i in range(32 * len(to)) if to[i // 32] >> (i % 32) & 1]
+        return agents, cells[: self.closed], cells[self.closed :]
+
+
+def slice_of(element, count, sample):
+    """The first `count` elements of type `element` of a slice sample's payload, copied out
+    (the sample's memory goes back to its publisher when the sample is dropped). `count` comes
+    from the header: the binding reports a slice's length in bytes, not elements."""
+    return list((element * count).from_address(sample.payload().as_ptr()))
 
 
 # Every payload mirror, for the layout test.
@@ -353,12 +363,12 @@ class MoverPlace(_Payload):
 PAYLOADS = [
     Candidate,
     Decision,
-    Commit,
+    CommitHeader,
     Progress,
     WheelCommand,
     Odometry,
     Pose,
-    Truth,
+    TruthHeader,
     Estimate,
     Lifecycle,
     Heartbeat,

@@ -24,8 +24,8 @@ pub enum CoordinatorError {
         /// What differs.
         what: String,
     },
-    /// The swarm is larger than a commit can carry.
-    #[error("{0} agents; a commit carries at most {MAX_AGENTS}")]
+    /// The swarm is larger than a run may be.
+    #[error("{0} agents; a run holds at most {MAX_AGENTS}")]
     TooManyAgents(usize),
     /// The replica's Raft peer, journal or link failed.
     #[error(transparent)]

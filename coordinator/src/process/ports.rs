@@ -3,8 +3,8 @@
 //! agents' sightings in, the map as it stands out to restarted agents). The lifecycle ports with the supervisor are opened beside them, by
 //! every replica; these only by the one that decides.
 
-use hnav_runtime::msg::{Candidate, Commit, Progress, Sighting, WorldHeader};
-use hnav_runtime::topics;
+use hnav_runtime::msg::{Candidate, Progress, Sighting, WorldHeader};
+use hnav_runtime::topics::{self, CommitSender};
 use hnav_runtime::transport::{Bell, Receiver, Sender, SliceSender, Transport, TransportError};
 
 /// The ports of the rounds: a single coordinator opens them before it announces itself, a
@@ -12,8 +12,8 @@ use hnav_runtime::transport::{Bell, Receiver, Sender, SliceSender, Transport, Tr
 pub(super) struct Ports {
     /// The agents' candidate steps.
     pub(super) candidates: Receiver<Candidate>,
-    /// The decided rounds, to every agent.
-    pub(super) commit: Sender<Commit>,
+    /// The decided rounds, to every agent: a slice of one decision per agent.
+    pub(super) commit: CommitSender,
     /// The run's progress, for the supervisor (`hnav run`), `hnav top` and the bridge.
     pub(super) progress: Sender<Progress>,
     /// The cells the agents saw change (with `[sensing]`).
@@ -24,7 +24,8 @@ pub(super) struct Ports {
 
 impl Ports {
     /// Opens the ports of the coordinator of a swarm of `agents`, with the world's ports for
-    /// a map of `world_cells` cells when the run senses (`[sensing]`). Under a supervisor the
+    /// a map of `world_cells` cells when the run senses (`[sensing]`): a sample of the world
+    /// holds the addressees' bits and at most every cell of the map. Under a supervisor the
     /// commits ring the run's [`Bell`], which wakes every agent with one write.
     pub(super) fn open(
         transport: &Transport,
@@ -40,9 +41,13 @@ impl Ports {
             .map(|_| transport.receiver(topics::SIGHTINGS, topics::candidates_qos(agents)))
             .transpose()?;
         let world = world_cells
-            .map(|cells| transport.slice_sender(topics::WORLD, cells, topics::world_qos(agents)))
+            .map(|cells| {
+                let len = WorldHeader::words_for(agents) + cells;
+                transport.slice_sender(topics::WORLD, len, topics::world_qos(agents))
+            })
             .transpose()?;
-        let mut commit = transport.sender(topics::COMMIT, topics::commit_qos(agents))?;
+        let mut commit =
+            transport.slice_sender(topics::COMMIT, agents, topics::commit_qos(agents))?;
         if let Some(bell) = Bell::from_env()? {
             commit = commit.ringing(bell);
         }

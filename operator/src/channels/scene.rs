@@ -23,7 +23,7 @@ use super::messages::{cell, occupancy, pose, stamp, FRAME};
 use super::{schemas, Message, LOG, MAP, SCENE};
 use hnav_runtime::grid::Grid;
 use hnav_runtime::msg::{
-    Commit, ConflictKind, LifecycleEvent, MoverPlace, Pose, Role, Truth, Verdict, NO_CELL,
+    CommitView, ConflictKind, LifecycleEvent, MoverPlace, Pose, Role, TruthView, Verdict, NO_CELL,
 };
 
 /// `foxglove.Log` levels.
@@ -101,11 +101,11 @@ impl SceneFold {
 
     /// Folds a ground-truth sample: each robot's pose and speed. Returns `/scene` and each
     /// robot's `/robots/<i>/stats`.
-    pub fn truth(&mut self, truth: &Truth) -> Vec<Message> {
-        let t = truth.sim_time_ns;
-        let n = (truth.robots as usize).min(self.robots.len());
+    pub fn truth(&mut self, truth: TruthView<'_>) -> Vec<Message> {
+        let t = truth.sim_time_ns();
+        let n = truth.poses().len().min(self.robots.len());
         let mut out = Vec::with_capacity(n + 1);
-        for (i, (r, p)) in self.robots.iter_mut().zip(&truth.poses[..n]).enumerate() {
+        for (i, (r, p)) in self.robots.iter_mut().zip(truth.poses()).enumerate() {
             if let Some(last) = r.pose.filter(|_| t > r.at_ns) {
                 let dt = (t - r.at_ns) as f64 * 1e-9;
                 r.speed_m_s = (p.x_m - last.x_m).hypot(p.y_m - last.y_m) / dt;
@@ -124,9 +124,9 @@ impl SceneFold {
     }
 
     /// Robot `i`'s `/robots/<i>/truth` of a ground-truth sample.
-    pub fn pose_in_frame(truth: &Truth, i: usize) -> Message {
-        let t = truth.sim_time_ns;
-        let p = truth.poses[i];
+    pub fn pose_in_frame(truth: TruthView<'_>, i: usize) -> Message {
+        let t = truth.sim_time_ns();
+        let p = truth.poses()[i];
         Message {
             topic: super::truth(i),
             schema: schemas::POSE_IN_FRAME,
@@ -136,10 +136,10 @@ impl SceneFold {
     }
 
     /// Folds one round's decisions, decided at `t_ns`; returns their `/log` lines.
-    pub fn commit(&mut self, t_ns: u64, c: &Commit) -> Vec<Message> {
+    pub fn commit(&mut self, t_ns: u64, c: CommitView<'_>) -> Vec<Message> {
         let width = self.picture.grid.width();
         let mut out = Vec::new();
-        for d in c.decisions.iter().take(c.count as usize) {
+        for d in c.decisions() {
             let Some(r) = self.robots.get_mut(d.agent as usize) else {
                 continue;
             };
@@ -174,7 +174,7 @@ impl SceneFold {
                 t_ns,
                 level,
                 &format!("agent-{}", d.agent),
-                format!("round {}: {text}", c.round),
+                format!("round {}: {text}", c.round()),
             ));
         }
         out
@@ -352,6 +352,7 @@ fn log(t_ns: u64, level: u8, name: &str, message: String) -> Message {
 mod tests {
     use super::*;
     use hnav_runtime::msg::Decision;
+    use hnav_runtime::msg::{Commit, Truth};
 
     fn fold() -> SceneFold {
         let grid = Grid::new(4, 2).unwrap();
@@ -365,7 +366,7 @@ mod tests {
     fn truth(t_ns: u64, xs: [f64; 2]) -> Truth {
         let mut t = Truth {
             sim_time_ns: t_ns,
-            robots: 2,
+            poses: vec![Pose::default(); 2],
             ..Truth::default()
         };
         t.poses[0] = Pose {
@@ -384,9 +385,9 @@ mod tests {
     #[test]
     fn robots_move_in_the_scene_and_their_speed_is_plotted() {
         let mut f = fold();
-        let first = f.truth(&truth(0, [0.25, 0.25]));
+        let first = f.truth(truth(0, [0.25, 0.25]).view());
         assert_eq!(first[0].topic, SCENE);
-        let out = f.truth(&truth(500_000_000, [0.75, 0.25]));
+        let out = f.truth(truth(500_000_000, [0.75, 0.25]).view());
         let speed = |m: &Message| m.body["speed_m_s"].as_f64().unwrap();
         assert_eq!(out[1].topic, "/robots/0/stats");
         assert!((speed(&out[1]) - 1.0).abs() < 1e-9, "{}", out[1].body);
@@ -408,10 +409,10 @@ mod tests {
     #[test]
     fn a_conflict_is_drawn_and_logged_once_while_it_repeats() {
         let mut f = fold();
-        f.truth(&truth(0, [0.25, 0.25]));
+        f.truth(truth(0, [0.25, 0.25]).view());
         let mut c = Commit {
             round: 4,
-            count: 1,
+            decisions: vec![Decision::default()],
             ..Commit::default()
         };
         c.decisions[0] = Decision {
@@ -421,7 +422,7 @@ mod tests {
             cell: 6,
             ..Decision::default()
         };
-        let lines = f.commit(40, &c);
+        let lines = f.commit(40, c.view());
         assert_eq!(lines.len(), 1);
         assert_eq!(lines[0].body["name"], "agent-1");
         assert!(
@@ -430,7 +431,7 @@ mod tests {
             lines[0].body
         );
         assert!(
-            f.commit(50, &c).is_empty(),
+            f.commit(50, c.view()).is_empty(),
             "the same block again is not logged again"
         );
         let scene = f.scene(60);

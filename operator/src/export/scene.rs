@@ -14,7 +14,7 @@ use crate::recording::world::RecordedWorld;
 use crate::recording::{PoseSource, TrajectoryReader};
 use hnav_runtime::consensus_log::Record;
 use hnav_runtime::grid::Grid;
-use hnav_runtime::msg::{Commit, Truth, MAX_AGENTS};
+use hnav_runtime::msg::{Commit, Pose, Truth};
 
 /// Writes the channels [`channels::shown`] lists that come from the fold, from the
 /// trajectories at `path` and `records`.
@@ -43,11 +43,13 @@ pub(super) fn write(
         records,
         next: 0,
         period_ns: info.period_ns,
-        commit: Box::default(),
+        commit: Commit::default(),
     };
     let mut r = TrajectoryReader::open(path)?;
-    let mut truth = Box::<Truth>::default();
-    truth.robots = u32::from(r.header().robots).min(MAX_AGENTS as u32);
+    let mut truth = Truth {
+        poses: vec![Pose::default(); usize::from(r.header().robots)],
+        ..Truth::default()
+    };
     let mut at: Option<u64> = None;
     // The recorder writes a time's movers after its truth: they are in before it is folded.
     let mut world = RecordedWorld::new(folding.fold.picture().grid.clone(), Vec::new(), cell_m);
@@ -80,7 +82,7 @@ struct Folding<'a> {
     records: &'a [Record],
     next: usize,
     period_ns: u64,
-    commit: Box<Commit>,
+    commit: Commit,
 }
 
 impl Folding<'_> {
@@ -91,7 +93,7 @@ impl Folding<'_> {
         truth: &mut Truth,
     ) -> Result<(), ExportError> {
         self.records_until(w, truth.sim_time_ns)?;
-        for m in self.fold.truth(truth) {
+        for m in self.fold.truth(truth.view()) {
             put(w, &m)?;
         }
         Ok(())
@@ -116,7 +118,7 @@ impl Folding<'_> {
             match r {
                 Record::Round(rec) => {
                     rec.write_commit(&mut self.commit);
-                    for m in self.fold.commit(t, &self.commit) {
+                    for m in self.fold.commit(t, self.commit.view()) {
                         put(w, &m)?;
                     }
                 }

@@ -7,7 +7,7 @@ use super::health::HealthRow;
 pub use crate::recording::world::{world_steps, WorldStep};
 use crate::supervisor::registry::LiveRunError;
 use hnav_runtime::grid::Grid;
-use hnav_runtime::msg::{Commit, Lifecycle, MoverPlace, Pose, Progress, Truth, View};
+use hnav_runtime::msg::{CommitView, Lifecycle, MoverPlace, Pose, Progress, TruthView, View};
 use hnav_runtime::scenario::{Scenario, ScenarioError};
 use hnav_runtime::transport::TransportError;
 
@@ -96,9 +96,9 @@ impl RunEnd {
 #[derive(Debug, Clone, Copy)]
 pub enum Update<'a> {
     /// Ground truth: every robot's pose, the collisions so far.
-    Truth(&'a Truth),
+    Truth(TruthView<'a>),
     /// One round's decisions.
-    Commit(&'a Commit),
+    Commit(CommitView<'a>),
     /// The coordinator's tally.
     Progress(&'a Progress),
     /// A process came up, went down, was restarted or lost; `Stop`.

@@ -25,8 +25,10 @@ use crate::supervisor::registry::LiveRunError;
 use crate::supervisor::registry::{RunRecord, RunRegistry};
 use hnav_runtime::consensus_log::reader::LogReader;
 use hnav_runtime::consensus_log::record::Record;
-use hnav_runtime::msg::{Commit, Lifecycle, MoverPlace, MoversHeader, Progress, Truth, View};
-use hnav_runtime::topics;
+use hnav_runtime::msg::{
+    CommitView, Lifecycle, MoverPlace, MoversHeader, Progress, TruthView, View,
+};
+use hnav_runtime::topics::{self, CommitReceiver, TruthReceiver};
 use hnav_runtime::transport::{Receiver, RunId, SliceReceiver, Transport, TransportError, Wake};
 
 /// How often the registry and `/proc` are read for the health rows.
@@ -86,8 +88,8 @@ pub struct LiveFeed {
     info: RunInfo,
     registry: RunRegistry,
     run: RunId,
-    truth: Receiver<Truth>,
-    commit: Receiver<Commit>,
+    truth: TruthReceiver,
+    commit: CommitReceiver,
     progress: Receiver<Progress>,
     life: Receiver<Lifecycle>,
     /// Each robot's view, with `[sensing]`.
@@ -140,8 +142,8 @@ impl LiveFeed {
         let n = scenario.agents.len();
         let open = || -> Result<_, TransportError> {
             Ok((
-                transport.receiver::<Truth>(topics::TRUTH, topics::state_qos())?,
-                transport.receiver::<Commit>(topics::COMMIT, topics::commit_qos(n))?,
+                transport.slice_receiver(topics::TRUTH, topics::state_qos())?,
+                transport.slice_receiver(topics::COMMIT, topics::commit_qos(n))?,
                 transport.receiver::<Progress>(topics::PROGRESS, topics::progress_qos())?,
                 transport.receiver::<Lifecycle>(topics::LIFECYCLE, topics::lifecycle_qos(n))?,
             ))
@@ -245,9 +247,10 @@ impl Feed for LiveFeed {
             apply(Update::Lifecycle(l));
         });
         life.map_err(|e| self.err(e))?;
-        let truth = self.truth.drain_pending(|t| apply(Update::Truth(t)));
+        let truth = (self.truth).drain_pending(|h, p| apply(Update::Truth(TruthView::new(h, p))));
         truth.map_err(|e| self.err(e))?;
-        let commits = self.commit.drain_pending(|c| apply(Update::Commit(c)));
+        let commits =
+            (self.commit).drain_pending(|h, d| apply(Update::Commit(CommitView::new(h, d))));
         commits.map_err(|e| self.err(e))?;
         for rx in &self.views {
             // The newest view is what the robot sees now; older ones are gone already.

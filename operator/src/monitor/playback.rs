@@ -47,7 +47,7 @@ use hnav_runtime::consensus_log::read_decided;
 use hnav_runtime::consensus_log::record::{EndReason, Record, RunHeader};
 use hnav_runtime::consensus_log::tally::Tally;
 use hnav_runtime::grid::movingai::read_map_file;
-use hnav_runtime::msg::{Commit, Lifecycle, Pose, Progress, Truth, View, MAX_AGENTS};
+use hnav_runtime::msg::{Commit, Lifecycle, Pose, Progress, Truth, View};
 
 /// The slowest and fastest playback speeds `--speed` takes.
 pub const SPEEDS: std::ops::RangeInclusive<f64> = 0.01..=10_000.0;
@@ -61,7 +61,7 @@ pub struct PlaybackFeed {
     trajectories: TrajectoryReader,
     /// The next ground-truth sample, read ahead to know when a time's samples are complete.
     pending: Option<PoseSample>,
-    truth: Box<Truth>,
+    truth: Truth,
     /// The map with the scenario's changes, the movers, and the views rebuilt from them.
     world: RecordedWorld,
     view: View,
@@ -69,7 +69,7 @@ pub struct PlaybackFeed {
     records: std::vec::IntoIter<Record>,
     next: Option<Record>,
     tally: Tally,
-    commit: Box<Commit>,
+    commit: Commit,
     agents: u32,
     ended: bool,
 }
@@ -121,8 +121,10 @@ impl PlaybackFeed {
             )));
         }
         let info = run_info(dir, &header, f64::from(th.cell_size_m), speed)?;
-        let mut truth = Box::<Truth>::default();
-        truth.robots = u32::from(th.robots).min(MAX_AGENTS as u32);
+        let mut truth = Truth {
+            poses: vec![Pose::default(); usize::from(th.robots)],
+            ..Truth::default()
+        };
         for (pose, a) in truth.poses.iter_mut().zip(&header.agents) {
             *pose = cell_centre(a.start, header.width, th.cell_size_m);
         }
@@ -141,7 +143,7 @@ impl PlaybackFeed {
             records,
             next: None,
             tally: Tally::from_header(&header),
-            commit: Box::default(),
+            commit: Commit::default(),
             agents: header.agents.len() as u32,
             ended: false,
         })
@@ -203,7 +205,7 @@ impl PlaybackFeed {
         self.truth.period += 1;
         let seen = self.collisions_at.partition_point(|&c| c <= t);
         self.truth.collisions = u32::try_from(seen).unwrap_or(u32::MAX);
-        apply(Update::Truth(&self.truth));
+        apply(Update::Truth(self.truth.view()));
         self.world.advance(t);
         if !self.world.movers().is_empty() {
             apply(Update::Movers(self.world.movers()));
@@ -224,7 +226,7 @@ impl PlaybackFeed {
         match self.next.take() {
             Some(Record::Round(r)) => {
                 r.write_commit(&mut self.commit);
-                apply(Update::Commit(&self.commit));
+                apply(Update::Commit(self.commit.view()));
                 self.tally.fold_round(&r);
                 apply(Update::Progress(&self.progress(r.round, 0)));
             }

@@ -31,8 +31,8 @@ use super::feed::{RunEnd, RunInfo, Update};
 use super::health::HealthRow;
 use crate::recording::world::apply_due;
 use hnav_runtime::msg::{
-    Commit, ConflictKind, Decision, Lifecycle, LifecycleEvent, MoverPlace, Pose, Progress, Role,
-    RosterState, Truth, Verdict, View,
+    CommitView, ConflictKind, Decision, Lifecycle, LifecycleEvent, MoverPlace, Pose, Progress,
+    Role, RosterState, TruthView, Verdict, View,
 };
 
 /// How many of the latest decisions and events the view keeps.
@@ -371,19 +371,19 @@ impl ViewState {
             .count()
     }
 
-    fn truth(&mut self, t: &Truth) {
-        if self.truth_period.is_some_and(|p| t.period <= p) {
+    fn truth(&mut self, t: TruthView<'_>) {
+        if self.truth_period.is_some_and(|p| t.period() <= p) {
             return; // a restarted sim sends its last period again
         }
-        self.truth_period = Some(t.period);
-        self.collisions = t.collisions;
+        self.truth_period = Some(t.period());
+        self.collisions = t.collisions();
         // The world's changes the sim has made by now: closed cells are walls on screen.
         let info = &mut self.info;
         apply_due(
             &mut info.grid,
             &info.changes,
             &mut self.changed,
-            t.sim_time_ns,
+            t.sim_time_ns(),
         );
         for (agent, pose) in self.agents.iter_mut().zip(t.poses()) {
             let cell = self.info.cell_of(pose);
@@ -391,17 +391,17 @@ impl ViewState {
         }
     }
 
-    fn commit(&mut self, c: &Commit, now: Instant) {
+    fn commit(&mut self, c: CommitView<'_>, now: Instant) {
         if let Some(last) = self.last_commit {
-            if c.round <= last {
+            if c.round() <= last {
                 return; // a restarted coordinator resends its last commit
             }
-            self.missed_commits += c.round - last - 1;
+            self.missed_commits += c.round() - last - 1;
         }
-        self.last_commit = Some(c.round);
-        self.note_round(c.round, now);
+        self.last_commit = Some(c.round());
+        self.note_round(c.round(), now);
         for d in c.decisions() {
-            self.decision(c.round, d);
+            self.decision(c.round(), d);
         }
     }
 

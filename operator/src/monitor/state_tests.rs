@@ -1,5 +1,6 @@
 use super::*;
 use hnav_runtime::grid::Grid;
+use hnav_runtime::msg::{Commit, Truth};
 
 /// A 4 x 2 room, cells 1 m wide, agent 0 from cell 0 to cell 2, agent 1 from 4 to 7.
 fn view() -> ViewState {
@@ -19,7 +20,7 @@ fn view() -> ViewState {
 fn commit(round: u64, decisions: &[(u32, Verdict, ConflictKind, u32)]) -> Commit {
     let mut c = Commit {
         round,
-        count: decisions.len() as u32,
+        decisions: vec![Decision::default(); decisions.len()],
         ..Commit::default()
     };
     for (slot, &(agent, verdict, kind, cell)) in c.decisions.iter_mut().zip(decisions) {
@@ -37,7 +38,7 @@ fn commit(round: u64, decisions: &[(u32, Verdict, ConflictKind, u32)]) -> Commit
 fn truth(period: u64, poses: &[(f64, f64)]) -> Truth {
     let mut t = Truth {
         period,
-        robots: poses.len() as u32,
+        poses: vec![Pose::default(); poses.len()],
         ..Truth::default()
     };
     for (slot, &(x_m, y_m)) in t.poses.iter_mut().zip(poses) {
@@ -62,52 +63,67 @@ fn decisions_and_ground_truth_make_the_states() {
     let mut v = view();
     let now = Instant::now();
     assert_eq!(states(&v), [AgentState::Waiting; 2]);
-    v.apply(Update::Truth(&truth(1, &[(0.5, 0.5), (0.5, 1.5)])), now);
     v.apply(
-        Update::Commit(&commit(
-            1,
-            &[(0, V::Accept, K::None, 1), (1, V::Block, K::HeadOn, 0)],
-        )),
+        Update::Truth(truth(1, &[(0.5, 0.5), (0.5, 1.5)]).view()),
+        now,
+    );
+    v.apply(
+        Update::Commit(
+            commit(
+                1,
+                &[(0, V::Accept, K::None, 1), (1, V::Block, K::HeadOn, 0)],
+            )
+            .view(),
+        ),
         now,
     );
     assert_eq!(states(&v), [AgentState::Moving, AgentState::Blocked]);
     // Driving: "held, nothing asked" keeps a pending move moving, even with the pose still.
-    v.apply(Update::Truth(&truth(2, &[(0.5, 0.5), (0.5, 1.5)])), now);
     v.apply(
-        Update::Commit(&commit(
-            2,
-            &[(0, V::Hold, K::None, 0), (1, V::Replan, K::None, 0)],
-        )),
+        Update::Truth(truth(2, &[(0.5, 0.5), (0.5, 1.5)]).view()),
+        now,
+    );
+    v.apply(
+        Update::Commit(commit(2, &[(0, V::Hold, K::None, 0), (1, V::Replan, K::None, 0)]).view()),
         now,
     );
     assert_eq!(states(&v), [AgentState::Moving, AgentState::Replanning]);
     // Agent 0 arrives in cell 1 and stands there: held by a conflict now.
-    v.apply(Update::Truth(&truth(3, &[(1.5, 0.5), (0.5, 1.5)])), now);
-    v.apply(Update::Truth(&truth(4, &[(1.5, 0.5), (0.5, 1.5)])), now);
     v.apply(
-        Update::Commit(&commit(
-            3,
-            &[(0, V::Hold, K::Crossing, 0), (1, V::Hold, K::Reserved, 0)],
-        )),
+        Update::Truth(truth(3, &[(1.5, 0.5), (0.5, 1.5)]).view()),
+        now,
+    );
+    v.apply(
+        Update::Truth(truth(4, &[(1.5, 0.5), (0.5, 1.5)]).view()),
+        now,
+    );
+    v.apply(
+        Update::Commit(
+            commit(
+                3,
+                &[(0, V::Hold, K::Crossing, 0), (1, V::Hold, K::Reserved, 0)],
+            )
+            .view(),
+        ),
         now,
     );
     assert_eq!(states(&v), [AgentState::Held, AgentState::Held]);
     // On to the goal: moving until ground truth is in it, then at goal.
     v.apply(
-        Update::Commit(&commit(
-            4,
-            &[(0, V::Accept, K::None, 2), (1, V::Hold, K::None, 0)],
-        )),
+        Update::Commit(commit(4, &[(0, V::Accept, K::None, 2), (1, V::Hold, K::None, 0)]).view()),
         now,
     );
-    v.apply(Update::Truth(&truth(5, &[(1.9, 0.5), (0.5, 1.5)])), now);
-    assert_eq!(v.agents[0].state(), AgentState::Moving);
-    v.apply(Update::Truth(&truth(6, &[(2.1, 0.5), (0.5, 1.5)])), now);
     v.apply(
-        Update::Commit(&commit(
-            5,
-            &[(0, V::Hold, K::None, 0), (1, V::Hold, K::None, 0)],
-        )),
+        Update::Truth(truth(5, &[(1.9, 0.5), (0.5, 1.5)]).view()),
+        now,
+    );
+    assert_eq!(v.agents[0].state(), AgentState::Moving);
+    v.apply(
+        Update::Truth(truth(6, &[(2.1, 0.5), (0.5, 1.5)]).view()),
+        now,
+    );
+    v.apply(
+        Update::Commit(commit(5, &[(0, V::Hold, K::None, 0), (1, V::Hold, K::None, 0)]).view()),
         now,
     );
     assert_eq!(v.agents[0].state(), AgentState::AtGoal);
@@ -118,13 +134,25 @@ fn decisions_and_ground_truth_make_the_states() {
 fn a_robot_that_moves_is_moving_even_when_its_accept_was_missed() {
     let mut v = view();
     let now = Instant::now();
-    v.apply(Update::Commit(&commit(1, &[(0, V::Hold, K::None, 0)])), now);
-    v.apply(Update::Truth(&truth(1, &[(0.5, 0.5), (0.5, 1.5)])), now);
+    v.apply(
+        Update::Commit(commit(1, &[(0, V::Hold, K::None, 0)]).view()),
+        now,
+    );
+    v.apply(
+        Update::Truth(truth(1, &[(0.5, 0.5), (0.5, 1.5)]).view()),
+        now,
+    );
     assert_eq!(v.agents[0].state(), AgentState::Held);
-    v.apply(Update::Truth(&truth(2, &[(0.8, 0.5), (0.5, 1.5)])), now);
+    v.apply(
+        Update::Truth(truth(2, &[(0.8, 0.5), (0.5, 1.5)]).view()),
+        now,
+    );
     assert_eq!(v.agents[0].state(), AgentState::Moving);
     // An older period (a restarted sim's repeat) changes nothing.
-    v.apply(Update::Truth(&truth(1, &[(3.5, 0.5), (0.5, 1.5)])), now);
+    v.apply(
+        Update::Truth(truth(1, &[(3.5, 0.5), (0.5, 1.5)]).view()),
+        now,
+    );
     assert_eq!(v.agents[0].cell, Some(0));
 }
 
@@ -182,10 +210,13 @@ fn a_restart_stays_in_view_under_a_flood_of_holds() {
     // lacam: both robots wait for their turn, held every round for the same cell.
     for round in 1..=500 {
         v.apply(
-            Update::Commit(&commit(
-                round,
-                &[(0, V::Hold, K::Reserved, 1), (1, V::Hold, K::Reserved, 5)],
-            )),
+            Update::Commit(
+                commit(
+                    round,
+                    &[(0, V::Hold, K::Reserved, 1), (1, V::Hold, K::Reserved, 5)],
+                )
+                .view(),
+            ),
             now,
         );
     }
@@ -200,7 +231,7 @@ fn a_restart_stays_in_view_under_a_flood_of_holds() {
     assert_eq!(lines, [(0, 500, 500), (1, 500, 500)]);
     // Another cell asked is another line.
     v.apply(
-        Update::Commit(&commit(501, &[(0, V::Hold, K::Reserved, 2)])),
+        Update::Commit(commit(501, &[(0, V::Hold, K::Reserved, 2)]).view()),
         now,
     );
     assert_eq!(v.recent.len(), 3);
@@ -226,10 +257,13 @@ fn the_latest_records_skip_idle_holds_and_keep_ten() {
     let now = Instant::now();
     for round in 1..=15 {
         v.apply(
-            Update::Commit(&commit(
-                round,
-                &[(0, V::Accept, K::None, 1), (1, V::Hold, K::None, 0)],
-            )),
+            Update::Commit(
+                commit(
+                    round,
+                    &[(0, V::Accept, K::None, 1), (1, V::Hold, K::None, 0)],
+                )
+                .view(),
+            ),
             now,
         );
     }
@@ -249,10 +283,10 @@ fn the_latest_records_skip_idle_holds_and_keep_ten() {
 fn missed_and_repeated_commits_are_counted_once() {
     let mut v = view();
     let now = Instant::now();
-    v.apply(Update::Commit(&commit(10, &[])), now);
-    v.apply(Update::Commit(&commit(14, &[])), now);
-    v.apply(Update::Commit(&commit(14, &[])), now);
-    v.apply(Update::Commit(&commit(15, &[])), now);
+    v.apply(Update::Commit(commit(10, &[]).view()), now);
+    v.apply(Update::Commit(commit(14, &[]).view()), now);
+    v.apply(Update::Commit(commit(14, &[]).view()), now);
+    v.apply(Update::Commit(commit(15, &[]).view()), now);
     assert_eq!((v.round, v.missed_commits), (15, 3));
 }
 
@@ -327,11 +361,11 @@ fn the_map_follows_the_worlds_closes_and_opens_as_sim_time_passes_them() {
         ..truth(period, &[(0.5, 0.5), (0.5, 1.5)])
     };
     let now = Instant::now();
-    v.apply(Update::Truth(&at(1, 999)), now);
+    v.apply(Update::Truth(at(1, 999).view()), now);
     assert!(blocked(&v).is_empty());
-    v.apply(Update::Truth(&at(2, 1_000)), now);
+    v.apply(Update::Truth(at(2, 1_000).view()), now);
     assert_eq!(blocked(&v), [5, 6]);
-    v.apply(Update::Truth(&at(3, 5_000)), now);
+    v.apply(Update::Truth(at(3, 5_000).view()), now);
     assert_eq!(blocked(&v), [5]);
 }
 

@@ -26,8 +26,8 @@ use serde::Serialize;
 
 use super::registry::{LiveRunError, RunRegistry};
 use hnav_runtime::msg::{
-    Candidate, Commit, Estimate, Heartbeat, Lifecycle, MapHeader, Odometry, Progress, Truth,
-    WheelCommand,
+    Candidate, CommitHeader, Decision, Estimate, Heartbeat, Lifecycle, MapHeader, MoverPlace,
+    MoversHeader, Odometry, Pose, Progress, Sighting, TruthHeader, View, WheelCommand, WorldHeader,
 };
 use hnav_runtime::transport::{run_config, Ipc, TransportError};
 
@@ -246,20 +246,32 @@ fn open_ports(
             })*
         };
     }
+    macro_rules! sliced {
+        ($(($e:ty, $h:ty)),*) => {
+            $(if slice && element == type_name::<$e>() && header == type_name::<$h>() {
+                return Some(ports_of!(node, name, [$e], $h));
+            })*
+        };
+    }
     fixed!(
         Candidate,
-        Commit,
         Progress,
         WheelCommand,
         Odometry,
-        Truth,
         Lifecycle,
         Heartbeat,
-        Estimate
+        Estimate,
+        Sighting,
+        View
     );
-    if slice && element == type_name::<f32>() && header == type_name::<MapHeader>() {
-        return Some(ports_of!(node, name, [f32], MapHeader));
-    }
+    sliced!(
+        (Decision, CommitHeader),
+        (Pose, TruthHeader),
+        (f32, MapHeader),
+        (u32, WorldHeader),
+        (MoverPlace, MoversHeader),
+        (u8, ())
+    );
     None
 }
 
@@ -361,8 +373,8 @@ mod tests {
             topics: vec![TopicStatus {
                 topic: "commit".into(),
                 service: "hnav/r/commit".into(),
-                payload: "hnav::Commit".into(),
-                user_header: None,
+                payload: "[hnav::Decision]".into(),
+                user_header: Some("hnav::CommitHeader".into()),
                 history: 1,
                 buffer: 64,
                 overflow: true,
@@ -380,7 +392,9 @@ mod tests {
         };
         let text = r.render();
         assert!(
-            text.contains("hnav/r/commit  [hnav::Commit]  history 1, buffer 64, latest"),
+            text.contains(
+                "hnav/r/commit  [[hnav::Decision], header hnav::CommitHeader]  history 1, buffer 64, latest"
+            ),
             "{text}"
         );
         assert!(

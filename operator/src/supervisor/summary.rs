@@ -392,7 +392,7 @@ mod tests {
     /// Every robot of `s` in the middle of its goal cell, or of its start cell for `away`.
     fn truth(s: &Scenario, away: Option<usize>) -> Truth {
         let mut t = Truth {
-            robots: s.agents.len() as u32,
+            poses: vec![Default::default(); s.agents.len()],
             ..Truth::default()
         };
         let cell = s.robot.cell_size_m;

@@ -234,7 +234,7 @@ pub fn show(
     server.advertise(&channels::shown(robots));
     let mut world = info.grid.clone();
     let mut applied = 0;
-    let mut latest = Box::<Truth>::default();
+    let mut latest = Truth::default();
     let mut now_ns = 0;
     let mut ended = None;
     loop {
@@ -254,8 +254,8 @@ pub fn show(
         let mut out: Vec<Message> = Vec::new();
         feed.pump(&mut |u| match u {
             Update::Truth(t) => {
-                *latest = *t;
-                now_ns = now_ns.max(t.sim_time_ns);
+                latest.set(t);
+                now_ns = now_ns.max(t.sim_time_ns());
                 fresh = true;
             }
             Update::Commit(c) => out.extend(fold.commit(now_ns, c)),
@@ -273,11 +273,11 @@ pub fn show(
             }
         }
         if fresh {
-            for m in fold.truth(&latest) {
+            for m in fold.truth(latest.view()) {
                 server.publish(&m);
             }
-            for i in 0..(latest.robots as usize).min(robots) {
-                server.publish(&SceneFold::pose_in_frame(&latest, i));
+            for i in 0..latest.poses().len().min(robots) {
+                server.publish(&SceneFold::pose_in_frame(latest.view(), i));
             }
         }
         for m in &out {

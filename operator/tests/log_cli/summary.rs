@@ -58,7 +58,7 @@ fn the_summary_is_the_tally_of_the_log_and_the_truth_of_the_goals() {
 
     // The goals of header(2) are cells 79 = [9,7] and 78 = [8,7].
     let mut truth = Truth {
-        robots: 2,
+        poses: vec![Pose::default(); 2],
         collisions: 1,
         ..Truth::default()
     };

@@ -31,9 +31,11 @@ use std::time::{Duration, Instant};
 use hnav_runtime::grid::geometry::cell_centre_pose;
 use hnav_runtime::health::Heartbeat;
 use hnav_runtime::launch::{LifecyclePorts, StartOutcome};
-use hnav_runtime::msg::{LifecycleEvent, Odometry as HallOdometry, Pose, Role, RosterState, Truth};
+use hnav_runtime::msg::{
+    LifecycleEvent, Odometry as HallOdometry, Pose, Role, RosterState, TruthHeader, TruthView,
+};
 use hnav_runtime::scenario::{OdometrySource, Ros2Params, Scenario};
-use hnav_runtime::topics;
+use hnav_runtime::topics::{self, TruthSender};
 use hnav_runtime::transport::{RunId, Sender, Transport, TransportError, Wake};
 
 use crate::graph::Qos;
@@ -168,7 +170,7 @@ impl Outside {
 /// The run's ports that `hnav-sim` would have.
 struct SimPorts {
     odom: Vec<Sender<HallOdometry>>,
-    truth: Sender<Truth>,
+    truth: TruthSender,
     life: LifecyclePorts,
 }
 
@@ -191,7 +193,7 @@ pub fn drive(
         odom: (0..n)
             .map(|i| transport.sender(&topics::odometry(i), q))
             .collect::<Result<_, _>>()?,
-        truth: transport.sender(topics::TRUTH, topics::truth_qos())?,
+        truth: transport.slice_sender(topics::TRUTH, n, topics::truth_qos())?,
         life: LifecyclePorts::open(&transport, Role::Sim, 0, n)?,
     };
     let heart = Heartbeat::open(&transport, Role::Sim, 0, n, scenario.heartbeat())?;
@@ -462,17 +464,23 @@ impl Loop {
             })?;
         }
         let (k, starts) = (self.k, &self.starts);
-        ports.truth.send_in_place(|t| {
-            t.sim_time_ns = sim_time_ns;
-            t.period = k;
-            t.robots = outside.robots.len() as u32;
-            t.collisions = 0;
-            for (i, r) in outside.robots.iter().enumerate() {
+        let n = outside.robots.len();
+        let header = TruthHeader {
+            sim_time_ns,
+            period: k,
+            robots: n as u32,
+            collisions: 0,
+        };
+        let mut loan = ports.truth.loan(n)?;
+        *loan.header_mut() = header;
+        loan.fill_with(Pose::default(), |poses| {
+            for (i, (p, r)) in poses.iter_mut().zip(&outside.robots).enumerate() {
                 // Without a ground truth from outside, the agent's own estimate stands for it.
                 let estimate = scene.robots[i].estimate.map(|e| e.1);
-                t.poses[i] = r.truth.or(estimate).unwrap_or(starts[i]);
+                *p = r.truth.or(estimate).unwrap_or(starts[i]);
             }
-            scene.truth(t);
+            scene.truth(TruthView::new(&header, poses));
+            Ok::<(), TransportError>(())
         })?;
         self.k += 1;
         Ok(())

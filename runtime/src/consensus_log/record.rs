@@ -7,7 +7,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::hash::Fnv1a64;
-use crate::msg::{Candidate, Commit, Decision, Lifecycle, MAX_AGENTS};
+use crate::msg::{Candidate, Commit, CommitHeader, Decision, Lifecycle};
 
 /// One entry of the log. A log starts with exactly one [`Header`](Record::Header).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -191,16 +191,29 @@ impl RoundRecord {
         }
     }
 
-    /// Writes the commit this record describes into `c` (e.g. a loaned sample), so the
-    /// decisions reach shared memory without a copy of the whole `Commit` on the stack.
+    /// The header of the commit this record describes, published in Raft term `term`.
+    pub fn commit_header(&self, term: u32) -> CommitHeader {
+        CommitHeader {
+            round: self.round,
+            count: u32::try_from(self.decisions.len()).unwrap_or(u32::MAX),
+            term,
+        }
+    }
+
+    /// Decision `i` of the commit this record describes, as published (`i` below the
+    /// record's decisions), for writing straight into a loaned sample.
+    pub fn decision(&self, i: usize) -> Decision {
+        Decision::from(&self.decisions[i])
+    }
+
+    /// Writes the commit this record describes into `c`, reusing its decisions' memory (a
+    /// replay folds every round into one `Commit`).
     pub fn write_commit(&self, c: &mut Commit) {
         c.round = self.round;
         c.term = 0;
-        let n = self.decisions.len().min(MAX_AGENTS);
-        for (slot, d) in c.decisions.iter_mut().zip(&self.decisions) {
-            *slot = Decision::from(d);
-        }
-        c.count = n as u32;
+        c.decisions.clear();
+        c.decisions
+            .extend(self.decisions.iter().map(Decision::from));
     }
 
     /// The commit this record describes (for a resend after a restart, or a comparison).

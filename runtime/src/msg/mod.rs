@@ -19,11 +19,11 @@
 //! |---|---|---|---|
 //! | [`Candidate`] | 40 | 8 | 0 round u64, 8 agent u32, 12 current u32, 16 next u32, 20 probable u32, 24 priority f32, 28 speed f32, 32 flags u32, 36 reserved u32 |
 //! | [`Decision`] | 16 | 4 | 0 agent u32, 4 verdict u8, 5 refused u8, 6 kind u8, 7 reserved u8, 8 cell u32, 12 waypoint u32 |
-//! | [`Commit`] | 16 + 16·[`MAX_AGENTS`] = 4112 | 8 | 0 round u64, 8 count u32, 12 reserved u32, 16 decisions [Decision; 256] |
+//! | [`CommitHeader`] | 16 | 8 | 0 round u64, 8 count u32, 12 term u32 |
 //! | [`WheelCommand`] | 32 | 8 | 0 period u64, 8 agent u32, 12 flags u32, 16 left_rad_s f64, 24 right_rad_s f64 |
 //! | [`Odometry`] | 64 | 8 | 0 sim_time_ns u64, 8 period u64, 16 agent u32, 20 flags u32, 24 ticks_left i64, 32 ticks_right i64, 40 fix Pose |
 //! | [`Pose`] | 24 | 8 | 0 x_m f64, 8 y_m f64, 16 theta_rad f64 |
-//! | [`Truth`] | 24 + 24·[`MAX_AGENTS`] = 6168 | 8 | 0 sim_time_ns u64, 8 period u64, 16 robots u32, 20 collisions u32, 24 poses [Pose; 256] |
+//! | [`TruthHeader`] | 24 | 8 | 0 sim_time_ns u64, 8 period u64, 16 robots u32, 20 collisions u32 |
 //! | [`Estimate`] | 40 | 8 | 0 sim_time_ns u64, 8 agent u32, 12 reserved u32, 16 pose Pose |
 //! | [`Lifecycle`] | 24 | 8 | 0 time_ns u64, 8 pid u32, 12 index u32, 16 role u8, 17 event u8, 18 reason u8, 19 reserved u8, 20 restarts u32 |
 //! | [`Progress`] | 32 | 8 | 0 round u64, 8 agents u32, 12 at_goal u32, 16 conflicts u32, 20 replans u32, 24 done u8, 25 reserved [u8; 7] |
@@ -32,24 +32,32 @@
 //! | [`MoversHeader`] | 16 | 8 | 0 sim_time_ns u64, 8 period u64 |
 //! | [`MoverPlace`] | 32 | 8 | 0 mover u32, 4 reserved u32, 8 pose Pose |
 //! | [`Sighting`] | 152 | 8 | 0 round u64, 8 agent u32, 12 count u32, 16 closed u32, 20 reserved u32, 24 cells [u32; 32] |
-//! | [`WorldHeader`] | 48 | 8 | 0 round u64, 8 closed u32, 12 opened u32, 16 to [u32; 8] |
+//! | [`WorldHeader`] | 24 | 8 | 0 round u64, 8 closed u32, 12 opened u32, 16 to u32, 20 reserved u32 |
 //! | [`MapHeader`] | 32 | 8 | 0 round u64, 8 agent u32, 12 width u32, 16 height u32, 20 iterations u32, 24 target u32, 28 activation u8, 29 reserved [u8; 3] |
+//!
+//! A round's commit is a slice service of [`Decision`] (one per agent of the run) whose user
+//! header is a [`CommitHeader`]; the ground truth is a slice service of [`Pose`] (one per
+//! robot) whose user header is a [`TruthHeader`]. Both are sized to the run when their
+//! services are created, so nothing in a sample is an array of [`MAX_AGENTS`]: a run of 6
+//! robots sends 96 bytes of decisions a round, one of 1 000 sends 16 000. Readers take them
+//! as a [`CommitView`] or [`TruthView`] borrowed from the sample; [`Commit`] and [`Truth`]
+//! are the same held in memory (a replay, an export).
 //!
 //! The neural-map snapshot is a slice service of `f32` (one activation per cell, row-major) whose
 //! user header is a [`MapHeader`]; the coordinator's map of a changing world is a slice service
-//! of `u32` cells whose user header is a [`WorldHeader`]; the movers' places are a slice service of
+//! of `u32` (the addressees' bits, then the cells) whose user header is a [`WorldHeader`]; the movers' places are a slice service of
 //! [`MoverPlace`] whose user header is a [`MoversHeader`].
 //!
 //! | module | payloads |
 //! |---|---|
-//! | `round` | the decision round: [`Candidate`], [`Decision`], [`Commit`], [`Progress`] |
-//! | `motion` | wheels, ground truth and estimates: [`WheelCommand`], [`Odometry`], [`Pose`], [`Truth`], [`Estimate`] |
+//! | `round` | the decision round: [`Candidate`], [`Decision`], [`CommitHeader`], [`CommitView`], [`Commit`], [`Progress`] |
+//! | `motion` | wheels, ground truth and estimates: [`WheelCommand`], [`Odometry`], [`Pose`], [`TruthHeader`], [`TruthView`], [`Truth`], [`Estimate`] |
 //! | `lifecycle` | the supervisor's protocol: [`Role`] and its names, [`LifecycleEvent`], [`StopReason`], [`StartupPhase`], [`Lifecycle`] and its constructors |
 //! | `map` | the neural-map snapshot: [`MapHeader`], [`ActivationKind`] |
 //! | `health` | a process's proof of life: [`Heartbeat`] |
 //! | `sensing` | what a robot's range sensor sees, and the movers it may see: [`View`], [`MoversHeader`], [`MoverPlace`] |
 //! | `world` | the shared picture of a changing world: [`Sighting`], [`WorldHeader`] |
-//! | [`wire`] | a payload as its bytes, checked on arrival, for links that leave the host ([`Wire`]) |
+//! | [`wire`] | a payload as its bytes, checked on arrival, for links that leave the host ([`Wire`], [`WireSlice`]) |
 
 mod health;
 mod lifecycle;
@@ -65,14 +73,23 @@ pub use lifecycle::{
     Lifecycle, LifecycleEvent, Role, RosterState, StartupPhase, StopReason, MAX_REPLICAS,
 };
 pub use map::{ActivationKind, MapHeader};
-pub use motion::{Estimate, Odometry, Pose, Truth, WheelCommand};
-pub use round::{Candidate, CandidateFlags, Commit, ConflictKind, Decision, Progress, Verdict};
+pub use motion::{Estimate, Odometry, Pose, Truth, TruthHeader, TruthView, WheelCommand};
+pub use round::{
+    Candidate, CandidateFlags, Commit, CommitHeader, CommitView, ConflictKind, Decision, Progress,
+    Verdict,
+};
 pub use sensing::{MoverPlace, MoversHeader, View, VIEW_EDGE};
-pub use wire::{Wire, WireError};
-pub use world::{Sighting, WorldHeader, SIGHTING_CELLS, WORLD_TO_WORDS};
+pub use wire::{Wire, WireError, WireSlice};
+pub use world::{Sighting, WorldHeader, SIGHTING_CELLS};
 
-/// The largest swarm one [`Commit`] or [`Truth`] sample can describe.
-pub const MAX_AGENTS: usize = 256;
+/// The largest swarm a run may hold.
+///
+/// No message is an array of this length: commits, ground truth and the world's addressees
+/// are slices sized to the run. It bounds what a receiver accepts as an agent index and what
+/// a scenario may ask for: 4 096 is four times the largest swarm measured on one machine
+/// (1 000 robots, `docs/explanation/performance.md`), and a run's per-run tables (progress, the
+/// supervisor's roster) stay small at that size.
+pub const MAX_AGENTS: usize = 4096;
 
 /// Marks "no cell" in a cell field.
 pub const NO_CELL: u32 = u32::MAX;

@@ -3,8 +3,6 @@
 
 use iceoryx2::prelude::ZeroCopySend;
 
-use super::MAX_AGENTS;
-
 /// Wheel speed set-points for one robot and one control period.
 #[derive(
     Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
@@ -73,32 +71,114 @@ pub struct Pose {
     pub theta_rad: f64,
 }
 
-/// Ground truth from the sim: every robot's pose and the collision count so far.
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable)]
+/// The user header of the sim's ground truth (`truth`, a [`Pose`] slice sized to the run's
+/// robots): when, and the collision count so far. The 24 bytes that opened the fixed-size
+/// `Truth` of 256 poses before runs were sized to their swarm.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
+)]
 #[repr(C)]
-#[type_name("hnav::Truth")]
+#[type_name("hnav::TruthHeader")]
+pub struct TruthHeader {
+    /// Simulated time, ns since the start of the run.
+    pub sim_time_ns: u64,
+    /// Control period.
+    pub period: u64,
+    /// How many poses the slice holds, said again for readers whose binding reports a
+    /// slice's length in bytes.
+    pub robots: u32,
+    /// Collisions detected since the start of the run.
+    pub collisions: u32,
+}
+
+/// Ground truth as it is read: every robot's pose, borrowed from a sample in shared memory
+/// (no copy) or from an owned [`Truth`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TruthView<'a> {
+    header: TruthHeader,
+    poses: &'a [Pose],
+}
+
+impl<'a> TruthView<'a> {
+    /// The truth of `header` and `poses`; a header whose count disagrees with the slice reads
+    /// as the shorter of the two.
+    pub fn new(header: &TruthHeader, poses: &'a [Pose]) -> Self {
+        let n = (header.robots as usize).min(poses.len());
+        Self {
+            header: *header,
+            poses: &poses[..n],
+        }
+    }
+
+    /// Simulated time, ns since the start of the run.
+    pub fn sim_time_ns(&self) -> u64 {
+        self.header.sim_time_ns
+    }
+
+    /// Control period.
+    pub fn period(&self) -> u64 {
+        self.header.period
+    }
+
+    /// Collisions detected since the start of the run.
+    pub fn collisions(&self) -> u32 {
+        self.header.collisions
+    }
+
+    /// The poses, one per robot.
+    pub fn poses(&self) -> &'a [Pose] {
+        self.poses
+    }
+
+    /// The header, its count that of [`TruthView::poses`].
+    pub fn header(&self) -> TruthHeader {
+        TruthHeader {
+            robots: self.poses.len() as u32,
+            ..self.header
+        }
+    }
+}
+
+/// Ground truth held in memory (a replay, an export, a test); what travels is a
+/// [`TruthHeader`] and its poses, read as a [`TruthView`].
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Truth {
     /// Simulated time, ns since the start of the run.
     pub sim_time_ns: u64,
     /// Control period.
     pub period: u64,
-    /// How many entries of `poses` are valid.
-    pub robots: u32,
     /// Collisions detected since the start of the run.
     pub collisions: u32,
-    /// The poses, `poses[..robots]`.
-    pub poses: [Pose; MAX_AGENTS],
+    /// The poses, one per robot.
+    pub poses: Vec<Pose>,
 }
 
-impl Default for Truth {
-    fn default() -> Self {
-        Self {
-            sim_time_ns: 0,
-            period: 0,
-            robots: 0,
-            collisions: 0,
-            poses: [Pose::default(); MAX_AGENTS],
+impl Truth {
+    /// The truth borrowed as it is read from the topic.
+    pub fn view(&self) -> TruthView<'_> {
+        TruthView {
+            header: TruthHeader {
+                sim_time_ns: self.sim_time_ns,
+                period: self.period,
+                robots: self.poses.len() as u32,
+                collisions: self.collisions,
+            },
+            poses: &self.poses,
         }
+    }
+
+    /// The poses, one per robot.
+    pub fn poses(&self) -> &[Pose] {
+        &self.poses
+    }
+
+    /// Holds `v` (copied out of its sample), reusing this truth's memory for the poses.
+    pub fn set(&mut self, v: TruthView<'_>) {
+        self.sim_time_ns = v.sim_time_ns();
+        self.period = v.period();
+        self.collisions = v.collisions();
+        self.poses.clear();
+        self.poses.extend_from_slice(v.poses());
     }
 }
 
@@ -119,13 +199,6 @@ pub struct Estimate {
     pub reserved: u32,
     /// The estimated pose.
     pub pose: Pose,
-}
-
-impl Truth {
-    /// The valid poses (`robots` clamped to [`MAX_AGENTS`]).
-    pub fn poses(&self) -> &[Pose] {
-        &self.poses[..(self.robots as usize).min(MAX_AGENTS)]
-    }
 }
 
 #[cfg(test)]
@@ -159,14 +232,12 @@ mod tests {
         assert_eq!(offset_of!(Pose, x_m), 0);
         assert_eq!(offset_of!(Pose, y_m), 8);
         assert_eq!(offset_of!(Pose, theta_rad), 16);
-        assert_eq!(size_of::<Truth>(), 24 + 24 * MAX_AGENTS);
-        assert_eq!(size_of::<Truth>(), 6168);
-        assert_eq!(align_of::<Truth>(), 8);
-        assert_eq!(offset_of!(Truth, sim_time_ns), 0);
-        assert_eq!(offset_of!(Truth, period), 8);
-        assert_eq!(offset_of!(Truth, robots), 16);
-        assert_eq!(offset_of!(Truth, collisions), 20);
-        assert_eq!(offset_of!(Truth, poses), 24);
+        assert_eq!(size_of::<TruthHeader>(), 24);
+        assert_eq!(align_of::<TruthHeader>(), 8);
+        assert_eq!(offset_of!(TruthHeader, sim_time_ns), 0);
+        assert_eq!(offset_of!(TruthHeader, period), 8);
+        assert_eq!(offset_of!(TruthHeader, robots), 16);
+        assert_eq!(offset_of!(TruthHeader, collisions), 20);
     }
 
     #[test]
@@ -181,10 +252,20 @@ mod tests {
 
     #[test]
     fn a_corrupt_count_does_not_index_out_of_bounds() {
-        let t = Truth {
-            robots: 7,
+        let poses = [Pose::default(); 7];
+        let h = TruthHeader {
+            robots: 9,
+            ..TruthHeader::default()
+        };
+        assert_eq!(TruthView::new(&h, &poses).poses().len(), 7);
+        let h = TruthHeader { robots: 3, ..h };
+        assert_eq!(TruthView::new(&h, &poses).header().robots, 3);
+        let owned = Truth {
+            poses: poses.to_vec(),
+            collisions: 2,
             ..Truth::default()
         };
-        assert_eq!(t.poses().len(), 7);
+        assert_eq!(owned.view().header().robots, 7);
+        assert_eq!(owned.view().collisions(), 2);
     }
 }

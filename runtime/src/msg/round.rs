@@ -2,7 +2,7 @@
 
 use iceoryx2::prelude::ZeroCopySend;
 
-use super::{MAX_AGENTS, NO_CELL};
+use super::NO_CELL;
 
 /// One agent's row of the dissertation's `shared_paths` table, proposed for a decision round.
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable)]
@@ -210,41 +210,110 @@ impl Default for Decision {
     }
 }
 
-/// One decision round's outcome, published only after it is durable in the consensus log.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable)]
+/// The user header of a round's commit (`commit`, a `[Decision]` slice sized to the run's
+/// agents): one decision round's outcome, published only after it is durable in the
+/// consensus log.
+///
+/// These are the 16 bytes that opened the fixed-size `Commit` of 256 decisions before runs
+/// were sized to their swarm; the decisions now follow as the sample's slice, one per agent of
+/// the run, so a commit of 1 000 agents is 16 kB and one of 6 agents is 96 bytes.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
+)]
 #[repr(C)]
-#[type_name("hnav::Commit")]
-pub struct Commit {
+#[type_name("hnav::CommitHeader")]
+pub struct CommitHeader {
     /// The round decided.
     pub round: u64,
-    /// How many entries of `decisions` are valid.
+    /// How many decisions the slice holds, said again for readers whose binding reports a
+    /// slice's length in bytes (iceoryx2's Python does).
     pub count: u32,
     /// The Raft term of the coordinator replica that published it (`coordinator.replicas`
     /// 3 or 5), 0 for a single coordinator. A replica publishes only committed rounds, so a
     /// deposed leader can only repeat a round every agent already has: agents ignore a
-    /// commit for a round at or below the last they applied, whatever its term. Was
-    /// `reserved` (always 0) before replicas; the layout is unchanged.
+    /// commit for a round at or below the last they applied, whatever its term.
     pub term: u32,
-    /// The decisions, `decisions[..count]`.
-    pub decisions: [Decision; MAX_AGENTS],
 }
 
-impl Default for Commit {
-    fn default() -> Self {
+/// A round's commit as it is read: its header and decisions, borrowed from a sample in
+/// shared memory (no copy) or from an owned [`Commit`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CommitView<'a> {
+    header: CommitHeader,
+    decisions: &'a [Decision],
+}
+
+impl<'a> CommitView<'a> {
+    /// The commit of `header` and `decisions`. A header whose count disagrees with the slice
+    /// reads as the shorter of the two, so a corrupt count cannot index out of bounds.
+    pub fn new(header: &CommitHeader, decisions: &'a [Decision]) -> Self {
+        let n = (header.count as usize).min(decisions.len());
         Self {
-            round: 0,
-            count: 0,
-            term: 0,
-            decisions: [Decision::default(); MAX_AGENTS],
+            header: *header,
+            decisions: &decisions[..n],
+        }
+    }
+
+    /// The round decided.
+    pub fn round(&self) -> u64 {
+        self.header.round
+    }
+
+    /// The publishing replica's Raft term (0 for a single coordinator).
+    pub fn term(&self) -> u32 {
+        self.header.term
+    }
+
+    /// The decisions, one per agent of the run.
+    pub fn decisions(&self) -> &'a [Decision] {
+        self.decisions
+    }
+
+    /// The header, its count that of [`CommitView::decisions`].
+    pub fn header(&self) -> CommitHeader {
+        CommitHeader {
+            count: self.decisions.len() as u32,
+            ..self.header
         }
     }
 }
 
+/// A round's commit held in memory (a replay, an export, a test); what travels is a
+/// [`CommitHeader`] and its decisions, read as a [`CommitView`].
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Commit {
+    /// The round decided.
+    pub round: u64,
+    /// The publishing replica's Raft term (0 for a single coordinator).
+    pub term: u32,
+    /// The decisions, one per agent of the run.
+    pub decisions: Vec<Decision>,
+}
+
 impl Commit {
-    /// The valid decisions (`count` clamped to [`MAX_AGENTS`], so a corrupt count cannot
-    /// index out of bounds).
+    /// The commit borrowed as it is read from a topic.
+    pub fn view(&self) -> CommitView<'_> {
+        CommitView {
+            header: CommitHeader {
+                round: self.round,
+                count: self.decisions.len() as u32,
+                term: self.term,
+            },
+            decisions: &self.decisions,
+        }
+    }
+
+    /// The valid decisions.
     pub fn decisions(&self) -> &[Decision] {
-        &self.decisions[..(self.count as usize).min(MAX_AGENTS)]
+        &self.decisions
+    }
+
+    /// Holds `v` (copied out of its sample), reusing this commit's memory for the decisions.
+    pub fn set(&mut self, v: CommitView<'_>) {
+        self.round = v.round();
+        self.term = v.term();
+        self.decisions.clear();
+        self.decisions.extend_from_slice(v.decisions());
     }
 }
 
@@ -316,13 +385,11 @@ mod tests {
         assert_eq!(offset_of!(Decision, reserved), 7);
         assert_eq!(offset_of!(Decision, cell), 8);
         assert_eq!(offset_of!(Decision, waypoint), 12);
-        assert_eq!(size_of::<Commit>(), 16 + 16 * MAX_AGENTS);
-        assert_eq!(size_of::<Commit>(), 4112);
-        assert_eq!(align_of::<Commit>(), 8);
-        assert_eq!(offset_of!(Commit, round), 0);
-        assert_eq!(offset_of!(Commit, count), 8);
-        assert_eq!(offset_of!(Commit, term), 12);
-        assert_eq!(offset_of!(Commit, decisions), 16);
+        assert_eq!(size_of::<CommitHeader>(), 16);
+        assert_eq!(align_of::<CommitHeader>(), 8);
+        assert_eq!(offset_of!(CommitHeader, round), 0);
+        assert_eq!(offset_of!(CommitHeader, count), 8);
+        assert_eq!(offset_of!(CommitHeader, term), 12);
     }
 
     #[test]
@@ -361,10 +428,28 @@ mod tests {
 
     #[test]
     fn a_corrupt_count_does_not_index_out_of_bounds() {
-        let c = Commit {
+        let d = [Decision::default(); 3];
+        let h = CommitHeader {
+            round: 4,
             count: u32::MAX,
-            ..Commit::default()
+            term: 1,
         };
-        assert_eq!(c.decisions().len(), MAX_AGENTS);
+        let v = CommitView::new(&h, &d);
+        assert_eq!(v.decisions().len(), 3);
+        assert_eq!(v.header().count, 3);
+        let short = CommitHeader { count: 2, ..h };
+        assert_eq!(CommitView::new(&short, &d).decisions().len(), 2);
+    }
+
+    #[test]
+    fn an_owned_commit_reads_as_the_view_of_its_decisions() {
+        let c = Commit {
+            round: 9,
+            term: 2,
+            decisions: vec![Decision::default(); 5],
+        };
+        let v = c.view();
+        assert_eq!((v.round(), v.term(), v.decisions().len()), (9, 2, 5));
+        assert_eq!(v, CommitView::new(&v.header(), c.decisions()));
     }
 }

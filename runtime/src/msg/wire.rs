@@ -13,8 +13,8 @@ use core::fmt::Debug;
 use iceoryx2::prelude::ZeroCopySend;
 
 use super::{
-    Candidate, Commit, Estimate, Heartbeat, LifecycleEvent, MapHeader, Odometry, Progress, Role,
-    Truth, Verdict, WheelCommand, MAX_AGENTS,
+    Candidate, CommitHeader, Decision, Estimate, Heartbeat, LifecycleEvent, MapHeader, Odometry,
+    Pose, Progress, Role, TruthHeader, Verdict, WheelCommand, MAX_AGENTS,
 };
 use crate::msg::Lifecycle;
 
@@ -85,6 +85,70 @@ pub trait Wire: bytemuck::Pod + ZeroCopySend + Debug {
     }
 }
 
+/// The header of a slice payload (a commit's decisions, the truth's poses, a neural map's
+/// activations) that travels with its elements as bytes: the header's bytes, then the
+/// elements', each in its `#[repr(C)]` layout. [`Wire::check`] checks the header alone,
+/// [`WireSlice::check_elements`] the elements against it.
+pub trait WireSlice: Wire + Default {
+    /// The slice's element.
+    type Element: bytemuck::Pod + ZeroCopySend + Debug;
+
+    /// Whether `elements` agree with the header (their count) and are in range.
+    fn check_elements(&self, elements: &[Self::Element]) -> Result<(), String>;
+
+    /// Reads the header from `bytes` (checked) and returns it with the bytes of its elements,
+    /// as many whole elements as the header counts. `Err` says why the bytes are not such a
+    /// payload.
+    fn from_wire(bytes: &[u8]) -> Result<(Self, &[u8]), WireError> {
+        let header = core::mem::size_of::<Self>();
+        let element = core::mem::size_of::<Self::Element>().max(1);
+        if bytes.len() < header || !(bytes.len() - header).is_multiple_of(element) {
+            return Err(Self::field(format!(
+                "{} bytes are no {header}-byte header and whole {element}-byte elements",
+                bytes.len()
+            )));
+        }
+        let mut h = Self::default();
+        h.assign(&bytes[..header])?;
+        Ok((h, &bytes[header..]))
+    }
+
+    /// Copies the elements' bytes (from [`WireSlice::from_wire`]) into `out`, which has room
+    /// for exactly as many (a loaned sample), and checks them against the header. The link's
+    /// bytes need not be aligned for the element type, so each is read unaligned: this is the
+    /// one copy a sample from another host costs.
+    fn elements_from_wire(&self, bytes: &[u8], out: &mut [Self::Element]) -> Result<(), WireError> {
+        let size = core::mem::size_of::<Self::Element>().max(1);
+        if bytes.len() != out.len() * size {
+            return Err(Self::field(format!(
+                "{} bytes of elements for {} places",
+                bytes.len(),
+                out.len()
+            )));
+        }
+        for (slot, b) in out.iter_mut().zip(bytes.chunks_exact(size)) {
+            *slot = bytemuck::pod_read_unaligned(b);
+        }
+        self.check_elements(out).map_err(Self::field)
+    }
+
+    /// A field error of this type.
+    fn field(what: String) -> WireError {
+        WireError::Field {
+            type_name: Self::wire_name(),
+            what,
+        }
+    }
+}
+
+fn same_count(name: &str, said: u32, len: usize) -> Result<(), String> {
+    if said as usize == len {
+        Ok(())
+    } else {
+        Err(format!("{name} {said} but {len} elements follow"))
+    }
+}
+
 fn agent(name: &str, agent: u32) -> Result<(), String> {
     if (agent as usize) < MAX_AGENTS {
         Ok(())
@@ -109,12 +173,21 @@ impl Wire for Candidate {
     }
 }
 
-impl Wire for Commit {
+impl Wire for CommitHeader {
     fn check(&self) -> Result<(), String> {
         if self.count as usize > MAX_AGENTS {
             return Err(format!("count {} is over {MAX_AGENTS}", self.count));
         }
-        for d in self.decisions() {
+        Ok(())
+    }
+}
+
+impl WireSlice for CommitHeader {
+    type Element = Decision;
+
+    fn check_elements(&self, decisions: &[Decision]) -> Result<(), String> {
+        same_count("count", self.count, decisions.len())?;
+        for d in decisions {
             agent("a decision's agent", d.agent)?;
             if Verdict::from_u8(d.verdict).is_none() {
                 return Err(format!("verdict {} is none of the known ones", d.verdict));
@@ -177,12 +250,21 @@ impl Wire for Odometry {
     }
 }
 
-impl Wire for Truth {
+impl Wire for TruthHeader {
     fn check(&self) -> Result<(), String> {
         if self.robots as usize > MAX_AGENTS {
             return Err(format!("{} robots, over {MAX_AGENTS}", self.robots));
         }
-        for p in &self.poses[..self.robots as usize] {
+        Ok(())
+    }
+}
+
+impl WireSlice for TruthHeader {
+    type Element = Pose;
+
+    fn check_elements(&self, poses: &[Pose]) -> Result<(), String> {
+        same_count("robots", self.robots, poses.len())?;
+        for p in poses {
             finite("a pose's x_m", p.x_m)?;
             finite("a pose's y_m", p.y_m)?;
             finite("a pose's theta_rad", p.theta_rad)?;
@@ -202,6 +284,15 @@ impl Wire for Estimate {
 impl Wire for MapHeader {
     fn check(&self) -> Result<(), String> {
         agent("agent", self.agent)
+    }
+}
+
+impl WireSlice for MapHeader {
+    type Element = f32;
+
+    /// Any activation goes: a viewer draws what it gets, and nothing decides by it.
+    fn check_elements(&self, _: &[f32]) -> Result<(), String> {
+        Ok(())
     }
 }
 
@@ -241,23 +332,26 @@ mod tests {
             ..Candidate::default()
         };
         let e = c.assign(bad.bytes()).unwrap_err().to_string();
-        assert_eq!(e, "hnav::Candidate: agent 256 is not below 256");
+        assert_eq!(e, "hnav::Candidate: agent 4096 is not below 4096");
         let nan = Candidate {
             speed: f32::NAN,
             ..Candidate::default()
         };
         assert!(c.assign(nan.bytes()).is_err());
 
-        let mut commit = Commit {
+        let header = CommitHeader {
+            round: 1,
             count: 1,
-            ..Commit::default()
+            term: 0,
         };
-        commit.decisions[0] = Decision {
+        let bad = [Decision {
             verdict: 200,
             ..Decision::default()
-        };
-        let e = Commit::default().assign(commit.bytes()).unwrap_err();
-        assert!(e.to_string().contains("verdict 200"), "{e}");
+        }];
+        let e = header.check_elements(&bad).unwrap_err();
+        assert!(e.contains("verdict 200"), "{e}");
+        let e = header.check_elements(&[]).unwrap_err();
+        assert_eq!(e, "count 1 but 0 elements follow");
 
         let l = Lifecycle {
             role: 9,
@@ -265,14 +359,55 @@ mod tests {
         };
         assert!(Lifecycle::default().assign(l.bytes()).is_err());
 
-        let mut t = Truth {
+        let t = TruthHeader {
             robots: 1,
-            ..Truth::default()
+            ..TruthHeader::default()
         };
-        t.poses[0] = Pose {
+        let inf = [Pose {
             x_m: f64::INFINITY,
             ..Pose::default()
+        }];
+        assert!(t.check_elements(&inf).is_err());
+        assert!(t.check_elements(&[Pose::default()]).is_ok());
+    }
+
+    #[test]
+    fn a_slice_comes_back_from_its_bytes_and_a_short_one_is_refused() {
+        let header = CommitHeader {
+            round: 3,
+            count: 2,
+            term: 1,
         };
-        assert!(Truth::default().assign(t.bytes()).is_err());
+        let decisions = [
+            Decision {
+                agent: 0,
+                ..Decision::default()
+            },
+            Decision {
+                agent: 1,
+                cell: 7,
+                verdict: Verdict::Accept as u8,
+                ..Decision::default()
+            },
+        ];
+        // As a link carries it, one byte off any alignment.
+        let mut wire = vec![0u8; 1 + 16 + 32];
+        wire[1..17].copy_from_slice(header.bytes());
+        wire[17..].copy_from_slice(bytemuck::cast_slice(&decisions));
+        let (h, rest) = CommitHeader::from_wire(&wire[1..]).unwrap();
+        assert_eq!(h, header);
+        let mut out = [Decision::default(); 2];
+        h.elements_from_wire(rest, &mut out).unwrap();
+        assert_eq!(out, decisions);
+        let e = CommitHeader::from_wire(&wire[1..41])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("40 bytes are no 16-byte header"), "{e}");
+        let (h, rest) = CommitHeader::from_wire(&wire[1..33]).unwrap();
+        let e = h.elements_from_wire(rest, &mut out[..1]).unwrap_err();
+        assert!(
+            e.to_string().contains("count 2 but 1 elements follow"),
+            "{e}"
+        );
     }
 }

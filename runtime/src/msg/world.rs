@@ -70,17 +70,19 @@ impl Sighting {
     }
 }
 
-/// Words of [`WorldHeader::to`]: one bit per agent.
-pub const WORLD_TO_WORDS: usize = crate::msg::MAX_AGENTS / 32;
-
 /// The user header of the coordinator's map (`world`, a `[u32]` slice): the cells whose state
 /// differs from the scenario's map after round `round`, the `closed` cells that are closed now
 /// first, then the opened ones, each ascending. A whole picture, not a difference from the
 /// last sample, so the newest sample is all a reader needs.
 ///
-/// Sent to the agents that restarted (bit `i % 32` of `to[i / 32]` for agent `i`): the others
-/// learn the world by their own sensing only, as `[sensing]` promises; one sample answers every
-/// agent that restarted since the last, so a shallow buffer never drops one's answer.
+/// Sent to the agents that restarted: the others learn the world by their own sensing only,
+/// as `[sensing]` promises; one sample answers every agent that restarted since the last, so
+/// a shallow buffer never drops one's answer. Whom it answers opens the slice: `to` words of
+/// one bit per agent (bit `i % 32` of word `i / 32` for agent `i`), as many as the run's
+/// agents need, so the header keeps its size whatever the swarm's.
+///
+/// The slice is `[addressees: to words][closed cells][opened cells]`;
+/// [`WorldHeader::split`] reads it.
 #[derive(
     Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend, bytemuck::Pod, bytemuck::Zeroable,
 )]
@@ -89,26 +91,39 @@ pub const WORLD_TO_WORDS: usize = crate::msg::MAX_AGENTS / 32;
 pub struct WorldHeader {
     /// The last round decided on this map.
     pub round: u64,
-    /// How many of the slice's cells closed (they come first).
+    /// How many of the slice's cells closed (they come first after the addressees).
     pub closed: u32,
-    /// How many opened (they follow): with `closed`, the slice's length, said again for
-    /// readers whose binding reports a slice's length in bytes (iceoryx2's Python does).
+    /// How many opened (they follow): with `to` and `closed`, the slice's length, said again
+    /// for readers whose binding reports a slice's length in bytes (iceoryx2's Python does).
     pub opened: u32,
-    /// The agents it answers, one bit each.
-    pub to: [u32; WORLD_TO_WORDS],
+    /// Words of addressee bits that open the slice ([`WorldHeader::words_for`] the run).
+    pub to: u32,
+    /// Zero.
+    pub reserved: u32,
 }
 
 impl WorldHeader {
-    /// Adds agent `i` to the addressees (an index beyond the bits is ignored).
-    pub fn address(&mut self, i: usize) {
-        if let Some(w) = self.to.get_mut(i / 32) {
+    /// Words of addressee bits for a run of `agents`.
+    pub fn words_for(agents: usize) -> usize {
+        agents.div_ceil(32)
+    }
+
+    /// A sample's slice as its addressee words and its cells (closed, then opened); a header
+    /// that claims more words than the slice holds reads as all of it addressees.
+    pub fn split<'a>(&self, slice: &'a [u32]) -> (&'a [u32], &'a [u32]) {
+        slice.split_at((self.to as usize).min(slice.len()))
+    }
+
+    /// Adds agent `i` to the addressee words `to` (an index beyond them is ignored).
+    pub fn address(to: &mut [u32], i: usize) {
+        if let Some(w) = to.get_mut(i / 32) {
             *w |= 1 << (i % 32);
         }
     }
 
-    /// Whether agent `i` is an addressee.
-    pub fn is_for(&self, i: usize) -> bool {
-        self.to.get(i / 32).is_some_and(|w| w >> (i % 32) & 1 != 0)
+    /// Whether agent `i` is among the addressee words `to`.
+    pub fn is_for(to: &[u32], i: usize) -> bool {
+        to.get(i / 32).is_some_and(|w| w >> (i % 32) & 1 != 0)
     }
 }
 
@@ -131,22 +146,34 @@ mod tests {
 
     #[test]
     fn world_header_layout() {
-        assert_eq!(size_of::<WorldHeader>(), 48);
+        assert_eq!(size_of::<WorldHeader>(), 24);
         assert_eq!(align_of::<WorldHeader>(), 8);
         assert_eq!(offset_of!(WorldHeader, round), 0);
         assert_eq!(offset_of!(WorldHeader, closed), 8);
         assert_eq!(offset_of!(WorldHeader, opened), 12);
         assert_eq!(offset_of!(WorldHeader, to), 16);
+        assert_eq!(offset_of!(WorldHeader, reserved), 20);
     }
 
     #[test]
     fn a_world_header_says_whom_it_answers() {
-        let mut h = WorldHeader::default();
-        h.address(0);
-        h.address(37);
-        h.address(100_000);
-        assert!(h.is_for(0) && h.is_for(37));
-        assert!(!h.is_for(1) && !h.is_for(36) && !h.is_for(100_000));
+        let h = WorldHeader {
+            to: WorldHeader::words_for(40) as u32,
+            closed: 1,
+            opened: 1,
+            ..WorldHeader::default()
+        };
+        let mut slice = vec![0, 0, 17, 18];
+        WorldHeader::address(&mut slice[..2], 0);
+        WorldHeader::address(&mut slice[..2], 37);
+        WorldHeader::address(&mut slice[..2], 100_000);
+        let (to, cells) = h.split(&slice);
+        assert_eq!(cells, [17, 18]);
+        assert!(WorldHeader::is_for(to, 0) && WorldHeader::is_for(to, 37));
+        assert!(!WorldHeader::is_for(to, 1) && !WorldHeader::is_for(to, 100_000));
+        let liar = WorldHeader { to: 9, ..h };
+        assert_eq!(liar.split(&slice), (&slice[..], &[][..]));
+        assert_eq!(WorldHeader::words_for(4096), 128);
     }
 
     #[test]

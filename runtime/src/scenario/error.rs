@@ -289,9 +289,7 @@ pub enum ScenarioError {
     },
     /// More agents than a run can carry: the round and truth messages have room for
     /// [`MAX_AGENTS`](crate::msg::MAX_AGENTS).
-    #[error(
-        "{at}: {agents} agents, but a run holds at most {max} (the limit of its message format)"
-    )]
+    #[error("{at}: {agents} agents, but a run holds at most {max}")]
     TooManyAgents {
         /// The first agent beyond the limit, or the scenario for a requested agent count.
         at: Loc,

@@ -167,8 +167,8 @@ fn validate_refuses_unreachable_goals_and_too_many_agents() {
         matches!(
             e,
             ScenarioError::TooManyAgents {
-                agents: 257,
-                max: 256,
+                agents: 4097,
+                max: 4096,
                 ..
             }
         ),

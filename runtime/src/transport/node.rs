@@ -162,7 +162,26 @@ impl Transport {
         E: Debug + ZeroCopySend + 'static,
         H: Debug + ZeroCopySend + 'static,
     {
-        SliceReceiver::open_slice(&self.node, self.run.service_name(topic)?, qos)
+        SliceReceiver::open_slice(&self.node, self.run.service_name(topic)?, qos, None)
+    }
+
+    /// Opens the receiving half of a slice topic whose senders ring the run's bell, as
+    /// [`bell_receiver`](Self::bell_receiver) does for a fixed-size one (the commit stream).
+    pub fn slice_bell_receiver<E, H>(
+        &self,
+        topic: &str,
+        qos: Qos,
+    ) -> Result<SliceReceiver<E, H>, TransportError>
+    where
+        E: Debug + ZeroCopySend + 'static,
+        H: Debug + ZeroCopySend + 'static,
+    {
+        SliceReceiver::open_slice(
+            &self.node,
+            self.run.service_name(topic)?,
+            qos,
+            Some(super::BELL_LISTENER),
+        )
     }
 
     /// A [`Waiter`] with the same signal handling as the node: what every process loop

@@ -162,10 +162,13 @@ where
     E: Debug + ZeroCopySend + 'static,
     H: Debug + ZeroCopySend + 'static,
 {
+    /// Opens the receiver; its listener is named `listener_port` if given (see
+    /// [`Receiver::open`]).
     pub(crate) fn open_slice(
         node: &Node<Ipc>,
         name: ServiceName,
         qos: Qos,
+        listener_port: Option<&str>,
     ) -> Result<Self, TransportError> {
         let service = open_pubsub!(node, &name, qos, [E], H)?;
         let subscriber = service
@@ -173,7 +176,7 @@ where
             .buffer_size(qos.buffer)
             .create()
             .map_err(|e| TransportError::ipc("create slice subscriber", name.as_str(), e))?;
-        Self::assemble(node, name, &qos, subscriber, None)
+        Self::assemble(node, name, &qos, subscriber, listener_port)
     }
 
     /// Takes the oldest unread sample; `sample.user_header()` and `sample.payload()` read it in
@@ -182,6 +185,17 @@ where
         self.subscriber()
             .receive()
             .map_err(|e| self.receive_error(e))
+    }
+
+    /// Hands every unread sample's header and elements to `f`, read in place, in publication
+    /// order, and returns how many there were.
+    pub fn drain(&self, mut f: impl FnMut(&H, &[E])) -> Result<usize, TransportError> {
+        let mut n = 0;
+        while let Some(sample) = self.receive()? {
+            f(sample.user_header(), sample.payload());
+            n += 1;
+        }
+        Ok(n)
     }
 
     /// Consumes the listener's events, then hands every unread sample's header and elements

@@ -2,8 +2,8 @@
 //! (and, when the scenario senses, one view sender) per robot, the Truth sender and, when joined to the run's lifecycle protocol, its ports.
 
 use hnav_runtime::launch::LifecyclePorts;
-use hnav_runtime::msg::{MoverPlace, MoversHeader, Odometry, Truth, View, WheelCommand};
-use hnav_runtime::topics;
+use hnav_runtime::msg::{MoverPlace, MoversHeader, Odometry, View, WheelCommand};
+use hnav_runtime::topics::{self, TruthSender};
 use hnav_runtime::transport::{
     Attachment, Receiver, Sender, SliceSender, Transport, TransportError, Waiter,
 };
@@ -18,7 +18,7 @@ pub(crate) struct Ports {
     /// Robot `i`'s sensor view (empty when the scenario senses nothing).
     pub(crate) view: Vec<Sender<View>>,
     /// Ground truth of every robot, once per control period.
-    pub(crate) truth: Sender<Truth>,
+    pub(crate) truth: TruthSender,
     /// Where the movers are, once per control period (a world with movers only).
     pub(crate) movers: Option<SliceSender<MoverPlace, MoversHeader>>,
     /// The lifecycle protocol's ports, if joined.
@@ -49,7 +49,7 @@ impl Ports {
             wheels,
             odom,
             view,
-            truth: transport.sender(topics::TRUTH, topics::truth_qos())?,
+            truth: transport.slice_sender(topics::TRUTH, robots, topics::truth_qos())?,
             movers: (movers > 0)
                 .then(|| transport.slice_sender(topics::MOVERS, movers, topics::truth_qos()))
                 .transpose()?,

@@ -277,7 +277,8 @@ impl State {
             }
         }
         let world = &self.world;
-        ports.truth.send_in_place(|t| world.fill_truth(period, t))?;
+        let n = world.robots();
+        (ports.truth).send_from_fn(world.truth_header(period), n, |i| world.pose_of(i))?;
         if let Some(tx) = &ports.movers {
             let header = MoversHeader {
                 sim_time_ns: world.time_ns(),

@@ -14,7 +14,7 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use clap::Parser;
-use hnav_runtime::msg::{Candidate, Commit};
+use hnav_runtime::msg::Candidate;
 use hnav_runtime::rejected::Rejections;
 use hnav_runtime::scenario::Scenario;
 use hnav_runtime::topics;
@@ -76,7 +76,8 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let transport = Transport::builder(&run).node_name("rogue").create()?;
     let candidates =
         transport.sender::<Candidate>(topics::CANDIDATES, topics::candidates_qos(n))?;
-    let commits = transport.receiver::<Commit>(topics::COMMIT, topics::commit_qos(n))?;
+    let commits: topics::CommitReceiver =
+        transport.slice_receiver(topics::COMMIT, topics::commit_qos(n))?;
     let waiter = transport.waiter()?;
     let _commits = waiter.attach(&commits)?;
     println!("READY");
@@ -100,7 +101,7 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
                 Ok(_) => {}
                 Err(e) => break Err(e),
             }
-            if let Err(e) = commits.drain_pending(|c| last_commit = last_commit.max(c.round)) {
+            if let Err(e) = commits.drain_pending(|h, _| last_commit = last_commit.max(h.round)) {
                 break Err(e);
             }
         }

@@ -502,9 +502,8 @@ impl State {
 
 /// Publishes `rec`'s commit in term `term`.
 fn publish_commit(p: &Ports, rec: &RoundRecord, term: u32) -> Result<(), CoordinatorError> {
-    p.commit.send_in_place(|slot| {
-        rec.write_commit(slot);
-        slot.term = term;
-    })?;
+    let n = rec.decisions.len();
+    p.commit
+        .send_from_fn(rec.commit_header(term), n, |i| rec.decision(i))?;
     Ok(())
 }

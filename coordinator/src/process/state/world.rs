@@ -82,18 +82,22 @@ impl World {
             return Ok(());
         }
         let closed = arbiter.world(&mut self.cells);
-        let mut loan = tx.loan(self.cells.len())?;
-        let h: &mut WorldHeader = loan.header_mut();
-        *h = WorldHeader {
+        let words = WorldHeader::words_for(arbiter.agents());
+        let mut loan = tx.loan(words + self.cells.len())?;
+        *loan.header_mut() = WorldHeader {
             round,
             closed: closed as u32,
             opened: (self.cells.len() - closed) as u32,
-            ..WorldHeader::default()
+            to: words as u32,
+            reserved: 0,
         };
-        for &a in &self.asking {
-            h.address(a);
-        }
-        loan.copy_and_send(&self.cells)?;
+        let (asking, cells) = (&self.asking, &self.cells);
+        loan.fill_with(0, |slice| {
+            let (to, rest) = slice.split_at_mut(words);
+            asking.iter().for_each(|&a| WorldHeader::address(to, a));
+            rest.copy_from_slice(cells);
+            Ok::<(), CoordinatorError>(())
+        })?;
         tracing::info!(
             agents = ?self.asking,
             closed,

@@ -26,9 +26,9 @@ use serde::Serialize;
 use crate::recording::{
     self, MapWriter, PoseSample, PoseSource, RecordingError, TrajectoryHeader, TrajectoryWriter,
 };
-use hnav_runtime::msg::{Estimate, MapHeader, MoverPlace, MoversHeader, Pose, Truth};
+use hnav_runtime::msg::{Estimate, MapHeader, MoverPlace, MoversHeader, Pose, TruthView};
 use hnav_runtime::scenario::Scenario;
-use hnav_runtime::topics;
+use hnav_runtime::topics::{self, TruthReceiver};
 use hnav_runtime::transport::{Receiver, RunId, SliceReceiver, Transport, TransportError};
 use sampler::{MapAction, MapThrottle, TruthSampler};
 
@@ -240,7 +240,7 @@ impl Files {
 /// The thread's subscribers.
 struct Live {
     transport: Transport,
-    truth: Receiver<Truth>,
+    truth: TruthReceiver,
     estimate: Receiver<Estimate>,
     /// The movers' places (a run with movers): read whenever truth wakes the thread.
     movers: Option<SliceReceiver<MoverPlace, MoversHeader>>,
@@ -254,7 +254,7 @@ impl Live {
             .node_name("recorder")
             .handle_signals(false)
             .create()?;
-        let truth = transport.receiver(topics::TRUTH, topics::truth_qos())?;
+        let truth = transport.slice_receiver(topics::TRUTH, topics::truth_qos())?;
         let estimate = transport.receiver(topics::ESTIMATE, topics::estimate_qos(agents))?;
         let movers = movers
             .then(|| transport.slice_receiver(topics::MOVERS, topics::truth_qos()))
@@ -375,13 +375,14 @@ impl State {
             maps_dropped,
         } = self;
         let mut failed = None;
-        live.truth.drain_pending(|t| {
-            *now_ns = (*now_ns).max(t.sim_time_ns);
-            if failed.is_some() || !truth.take(t.sim_time_ns, t.period, t.collisions) {
+        live.truth.drain_pending(|h, poses| {
+            let t = TruthView::new(h, poses);
+            *now_ns = (*now_ns).max(t.sim_time_ns());
+            if failed.is_some() || !truth.take(t.sim_time_ns(), t.period(), t.collisions()) {
                 return;
             }
             for (i, p) in t.poses().iter().enumerate() {
-                let s = sample(t.sim_time_ns, i, PoseSource::Truth, p);
+                let s = sample(t.sim_time_ns(), i, PoseSource::Truth, p);
                 match files.trajectories.push(&s) {
                     Ok(true) => *truth_samples += 1,
                     Ok(false) => {}

@@ -90,7 +90,7 @@ use faults::FaultSchedule;
 use hang::HangWatch;
 use hnav_runtime::consensus_log::EndReason;
 use hnav_runtime::launch::ProcessArgs;
-use hnav_runtime::msg::{Lifecycle, Role, StopReason};
+use hnav_runtime::msg::{Lifecycle, Role, StopReason, TruthView};
 use hnav_runtime::scenario::{Scenario, SimKind};
 use hnav_runtime::transport::{purge_run, Bell, RunId};
 use slots::Slots;
@@ -207,7 +207,7 @@ fn run_owned(
     );
     // Taken while the sim still runs; after the end of the run nothing moves any more in
     // lockstep.
-    ports.truth.drain(|t| seen.truth = Some(*t))?;
+    (ports.truth).drain(|h, p| seen.hold_truth(TruthView::new(h, p)))?;
     let recording = recorder.map(|r| r.map_or_else(|failed| failed, Recorder::finish));
     let reason = match result {
         Ok(End::TimeLimit) => StopReason::TimeLimit,

@@ -22,9 +22,9 @@ use crate::supervisor::child::Signal;
 use crate::supervisor::events::{RunEvent, RunEvents};
 use crate::supervisor::registry::RunRecord;
 use crate::supervisor::startup::SupervisorPorts;
-use hnav_runtime::msg::{Lifecycle, LifecycleEvent, Progress, StopReason, Truth};
+use hnav_runtime::msg::{Lifecycle, LifecycleEvent, Progress, StopReason, Truth, TruthView};
 use hnav_runtime::scenario::{ClockMode, Scenario};
-use hnav_runtime::topics;
+use hnav_runtime::topics::{self, TruthReceiver};
 use hnav_runtime::transport::{Receiver, RunId, Transport, Wake};
 
 /// Refresh period of the progress bar and the fault schedule.
@@ -51,7 +51,7 @@ pub(super) struct Ports {
     sweeper: Sweeper,
     pub(super) life: SupervisorPorts,
     pub(super) progress: Receiver<Progress>,
-    pub(super) truth: Receiver<Truth>,
+    pub(super) truth: TruthReceiver,
     /// In a run across hosts, the `lifecycle` topic, where another host's supervisor that
     /// saw the run end first says `Stop` (the coordinator's last progress may not cross: a
     /// realtime bridge drops what a busy link cannot take).
@@ -72,7 +72,7 @@ impl Ports {
             sweeper,
             life: SupervisorPorts::open(&transport, agents)?,
             progress: transport.receiver(topics::PROGRESS, topics::progress_qos())?,
-            truth: transport.receiver(topics::TRUTH, topics::truth_qos())?,
+            truth: transport.slice_receiver(topics::TRUTH, topics::truth_qos())?,
             others_stop: across
                 .then(|| transport.receiver(topics::LIFECYCLE, topics::lifecycle_qos(agents)))
                 .transpose()?,
@@ -86,6 +86,13 @@ impl Ports {
 pub(super) struct Seen {
     pub(super) truth: Option<Truth>,
     pub(super) progress: Option<Progress>,
+}
+
+impl Seen {
+    /// Keeps `t` as the latest ground truth, in the memory of the one before.
+    pub(super) fn hold_truth(&mut self, t: TruthView<'_>) {
+        self.truth.get_or_insert_with(Truth::default).set(t);
+    }
 }
 
 /// What one look at the run found.
@@ -262,7 +269,7 @@ impl<'s> Watch<'s> {
     /// it ended the run.
     fn on_progress(&mut self, slots: &mut Slots) -> Result<Option<End>, RunError> {
         let seen = &mut *self.seen;
-        self.ports.truth.drain_pending(|t| seen.truth = Some(*t))?;
+        (self.ports.truth).drain_pending(|h, p| seen.hold_truth(TruthView::new(h, p)))?;
         let mut last = None;
         self.ports.progress.drain_pending(|p| last = Some(*p))?;
         if let Some(end) = self.other_host_stopped()? {
