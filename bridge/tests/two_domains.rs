@@ -248,8 +248,9 @@ fn two_hosts_exchange_the_run_s_topics_once_and_drop_what_is_invalid() {
     let ups = collect(&a, &ready_a, |g| !g.is_empty());
     assert_eq!((ups[0].role, ups[0].index), (Role::Agent as u8, 1));
 
-    // An agent index past the swarm is dropped on arrival; the valid one after it arrives.
-    send_a(candidate(101, 999));
+    // An agent index past the largest swarm is dropped on arrival; the valid one after it
+    // arrives.
+    send_a(candidate(101, hnav_runtime::msg::MAX_AGENTS as u32));
     send_a(candidate(102, 1));
     let got = collect(&b, &cand_b, |g| g.iter().any(|c| c.round == 102));
     assert_eq!(
