@@ -35,6 +35,8 @@ const PAIRS_PER_ROW: u32 = SIDE / 4;
 const AGENT_ROWS: u32 = (SIDE - 2) / 2;
 /// The largest swarm the layout holds: a pair of agents every four cells of every odd row.
 pub const MAX_AGENTS: usize = (2 * PAIRS_PER_ROW * AGENT_ROWS) as usize;
+// The round table measures up to 256 agents.
+const _: () = assert!(MAX_AGENTS >= 256);
 
 /// The layout of a swarm of `n` agents.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -167,10 +169,6 @@ mod tests {
 
     #[test]
     fn the_largest_swarm_fits_on_distinct_cells() {
-        assert!(
-            MAX_AGENTS >= 256,
-            "the bench reaches the round table's largest swarm"
-        );
         let l = Layout::new(MAX_AGENTS).unwrap();
         let starts: HashSet<_> = (0..MAX_AGENTS).map(|i| l.start(i)).collect();
         let goals: HashSet<_> = (0..MAX_AGENTS).map(|i| l.goal(i)).collect();

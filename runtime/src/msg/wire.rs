@@ -391,7 +391,7 @@ mod tests {
             },
         ];
         // As a link carries it, one byte off any alignment.
-        let mut wire = vec![0u8; 1 + 16 + 32];
+        let mut wire = [0u8; 1 + 16 + 32];
         wire[1..17].copy_from_slice(header.bytes());
         wire[17..].copy_from_slice(bytemuck::cast_slice(&decisions));
         let (h, rest) = CommitHeader::from_wire(&wire[1..]).unwrap();
