@@ -1,5 +1,5 @@
 //! What a run shows in Foxglove, folded from the swarm's own messages: [`SceneFold`] takes
-//! ground truth ([`Truth`]), each round's decisions ([`Commit`]) and process events, and
+//! ground truth ([`TruthView`]), each round's decisions ([`CommitView`]) and process events, and
 //! gives the messages of [`super::shown`]'s channels. The live view feeds it from a run's
 //! topics, the export from the recording and the consensus log, so both draw the same.
 //!
