@@ -5,10 +5,10 @@
 //! |---|---|---|---|
 //! | `wheels/<i>` | [`WheelCommand`](crate::msg::WheelCommand) | agent i -> sim | latest |
 //! | `odom/<i>` | [`Odometry`](crate::msg::Odometry) | sim -> agent i | latest |
-//! | `truth` | [`Pose`](crate::msg::Pose) slice + [`TruthHeader`](crate::msg::TruthHeader), one pose per robot | sim -> supervisor, recorder, viewers | latest, deep buffer ([`truth_qos`]) |
+//! | `truth` | [`Pose`] slice + [`TruthHeader`], one pose per robot | sim -> supervisor, recorder, viewers | latest, deep buffer ([`truth_qos`]) |
 //! | `estimate` | [`Estimate`](crate::msg::Estimate) | every agent -> recorder, `hnav-ros2`, viewers | latest, depth 1, not notified ([`estimate_qos`]) |
 //! | `candidates` | [`Candidate`](crate::msg::Candidate) | agents -> coordinator | reliable |
-//! | `commit` | [`Decision`](crate::msg::Decision) slice + [`CommitHeader`](crate::msg::CommitHeader), one decision per agent | coordinator -> agents | latest, deep buffer |
+//! | `commit` | [`Decision`] slice + [`CommitHeader`], one decision per agent | coordinator -> agents | latest, deep buffer |
 //! | `map/<i>` | `[f32]` + [`MapHeader`](crate::msg::MapHeader) | agent i -> viewers (`hnav services` lists who) | latest |
 //! | `progress` | [`Progress`](crate::msg::Progress) | coordinator -> supervisor | latest |
 //! | `ready` | [`Lifecycle`](crate::msg::Lifecycle) (`Up`; the sim's `Hold`) | every process -> supervisor | latest, deep buffer |
