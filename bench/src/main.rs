@@ -147,6 +147,9 @@ struct MapfCli {
     /// Wall-clock cap of each run, start-up included; a run past it is stopped.
     #[arg(long, value_name = "S", default_value_t = 1800.0)]
     wall_limit_s: f64,
+    /// Robots hosted by one agent process (the scenarios' [run] agents_per_process).
+    #[arg(long, value_name = "K", default_value_t = 1)]
+    agents_per_process: u32,
     /// One JSON object per run instead of the table.
     #[arg(long)]
     json: bool,
@@ -183,6 +186,7 @@ fn mapf(args: MapfCli) -> Result<()> {
         rules: args.rules,
         mode: args.mode,
         time_limit_s: args.time_limit_s,
+        agents_per_process: args.agents_per_process,
         wall_limit: std::time::Duration::from_secs_f64(args.wall_limit_s),
         out: args.out,
         bin_dir: hnav_bench::swarm_run::bin_dir().map_err(anyhow::Error::msg)?,

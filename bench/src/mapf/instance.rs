@@ -133,6 +133,8 @@ pub struct RunSettings {
     pub rules: Option<String>,
     /// `[coordinator] time_limit_s`: simulated seconds in lockstep.
     pub time_limit_s: f64,
+    /// `[run] agents_per_process`: robots hosted by one agent process.
+    pub agents_per_process: u32,
 }
 
 /// Hang deadline of every process in a benchmark run (ms). Hundreds of processes share the
@@ -202,8 +204,9 @@ impl Instance<'_> {
         }
         let _ = writeln!(
             out,
-            "\n[run]\nstartup_timeout_s = {:?}",
-            startup_timeout_s(self.agents())
+            "\n[run]\nstartup_timeout_s = {:?}\nagents_per_process = {}",
+            startup_timeout_s(self.agents()),
+            settings.agents_per_process
         );
         let _ = writeln!(
             out,
@@ -255,6 +258,7 @@ mod tests {
             mode: "lockstep".into(),
             rules: None,
             time_limit_s: 90.0,
+            agents_per_process: 2,
         };
         let s = Scenario::from_str(&i.scenario_toml(&settings), "i.toml", dir.path()).unwrap();
         assert_eq!(s.agents.len(), 2);
@@ -263,6 +267,7 @@ mod tests {
             (Cell::new(3, 1), Cell::new(0, 1))
         );
         assert_eq!(s.coordinator.time_limit_s, 90.0);
+        assert_eq!(s.run.agents_per_process, 2);
         assert_eq!(s.map.grid, b.grid);
     }
 

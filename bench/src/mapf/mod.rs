@@ -62,6 +62,8 @@ pub struct MapfConfig {
     pub mode: String,
     /// The scenario's time limit; `None`: [`default_time_limit_s`] per instance.
     pub time_limit_s: Option<f64>,
+    /// Robots per agent process (`[run] agents_per_process`).
+    pub agents_per_process: u32,
     /// The wall-clock cap of each run.
     pub wall_limit: Duration,
     /// Where each run gets its directory (`<map>-<rules>-<N>/`, replaced by the next run).
@@ -134,6 +136,7 @@ pub fn run_benchmark(
                 time_limit_s: config
                     .time_limit_s
                     .unwrap_or_else(|| default_time_limit_s(instance)),
+                agents_per_process: config.agents_per_process,
             };
             let dir = config
                 .out

@@ -23,6 +23,10 @@ pub struct Row {
     pub mode: String,
     /// The scenario's time limit (simulated seconds in lockstep).
     pub time_limit_s: f64,
+    /// Robots per agent process (`[run] agents_per_process`): the agent column's memory is a
+    /// process's, so of this many robots.
+    #[serde(default = "one")]
+    pub agents_per_process: u32,
     /// Robots whose true pose ended in their goal cell (`summary.json`).
     pub at_goal: usize,
     /// Collisions on ground truth (`summary.json`).
@@ -75,6 +79,11 @@ pub struct Row {
     pub memory: RunMemory,
 }
 
+/// One robot a process, the default.
+fn one() -> u32 {
+    1
+}
+
 impl Row {
     /// A row for `instance` with nothing measured yet but its memory.
     pub fn new(instance: &Instance<'_>, settings: &RunSettings, memory: RunMemory) -> Self {
@@ -88,6 +97,7 @@ impl Row {
                 .unwrap_or_else(|| "dissertation".into()),
             mode: settings.mode.clone(),
             time_limit_s: settings.time_limit_s,
+            agents_per_process: settings.agents_per_process,
             at_goal: 0,
             collisions: 0,
             rounds: 0,
