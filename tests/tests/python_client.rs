@@ -23,7 +23,7 @@ const RUN_TIMEOUT: Duration = Duration::from_secs(120);
 /// Bound on the Python example, joining included.
 const WATCH_TIMEOUT: Duration = Duration::from_secs(90);
 /// Commits the example is asked to print.
-const COMMITS: usize = 150;
+const COMMITS: usize = 300;
 
 /// Runs the Python example `args` against `swarm`'s run until it exits, then stops the run
 /// (the rest of it is not the test's business, and takes minutes on a loaded machine); the
@@ -119,12 +119,14 @@ fn the_python_example_watches_a_live_run() {
         commits.len()
     );
     assert_eq!(commits.len(), COMMITS);
-    // The first round decides every robot's first move; each decision names its agent.
+    // Each decision names its agent, and every robot moves within the commits watched. Not
+    // "round 1 moves them all": a watcher that joins under load after round 1 (the topic keeps
+    // only the latest commit for a late joiner) sees the later moves one by one.
     assert!(
-        commits
+        (0..6).all(|a| commits
             .iter()
-            .any(|l| (0..6).all(|a| l.contains(&format!("a{a} accept [")))),
-        "no commit with a move of every agent:\n{text}"
+            .any(|l| l.contains(&format!("a{a} accept [")))),
+        "not every agent's move was printed:\n{text}"
     );
     assert!(lines
         .iter()
