@@ -9,8 +9,8 @@
 //! before it). The coordinator decides what it accepts; a sighting it never received (it died
 //! first) is not sent again until the cell changes once more.
 
-use hnav_runtime::grid::Grid;
-use hnav_runtime::msg::{Sighting, View};
+use hnav_runtime::grid::{Cell, Direction, Grid};
+use hnav_runtime::msg::{ConflictKind, Decision, Sighting, Verdict, View};
 use hnav_runtime::transport::{Sender, TransportError};
 
 /// The agent's copy of the swarm's picture and the changes not reported yet.
@@ -58,6 +58,27 @@ impl Sightings {
     pub(super) fn learn(&mut self, cell: u32, blocked: bool) {
         if let Some(known) = self.picture.get_mut(cell as usize) {
             *known = blocked;
+        }
+    }
+
+    /// Takes the coordinator's word from decision `d` for a robot at `from`: a step refused
+    /// as invalid (rule 1) is a cell closed on its map. The picture follows, so that the next
+    /// view that shows the cell open reports it: the coordinator learned the cell closed from
+    /// another robot, and no robot that saw it open again told it so (the first to see a door
+    /// open had never seen it shut, and its picture had it open all along).
+    pub(super) fn refused(&mut self, from: Cell, d: &Decision) {
+        let invalid = d.verdict == Verdict::Block as u8 && d.kind == ConflictKind::Invalid as u8;
+        if !invalid {
+            return;
+        }
+        for dir in Direction::ALL
+            .into_iter()
+            .filter(|x| (d.refused >> x.index()) & 1 == 1)
+        {
+            let Some(c) = from.offset(dir.dx(), dir.dy()).filter(|c| c.x < self.width) else {
+                continue;
+            };
+            self.learn(c.y * self.width + c.x, true);
         }
     }
 
@@ -115,5 +136,42 @@ mod tests {
         v.mark_moving(3, 3); // a person walking by: no change of the map
         s.fold(&v);
         assert_eq!(s.unsent.len(), 2);
+    }
+
+    #[test]
+    fn a_step_refused_as_invalid_makes_the_next_view_of_the_cell_open_news() {
+        let map = Grid::new(4, 4).unwrap();
+        let mut s = Sightings::new(&map);
+        let open = |s: &mut Sightings| {
+            let mut v = View::default();
+            v.reset(0, 0, 4);
+            v.mark(2, 1, false);
+            s.fold(&v);
+        };
+        // Another robot saw (2, 1) shut and the coordinator closed it; this agent never saw
+        // it shut: seeing it open is no news to its picture.
+        open(&mut s);
+        assert!(s.unsent.is_empty());
+        // A Crossing refusal says nothing about the map.
+        let east = 1 << Direction::E.index();
+        let mut d = Decision {
+            verdict: Verdict::Block as u8,
+            refused: east,
+            kind: ConflictKind::Crossing as u8,
+            ..Decision::default()
+        };
+        s.refused(Cell::new(1, 1), &d);
+        open(&mut s);
+        assert!(s.unsent.is_empty());
+        // Its step east from (1, 1) refused as invalid: the coordinator has (2, 1) closed,
+        // and the view that shows it open reports it.
+        d.kind = ConflictKind::Invalid as u8;
+        s.refused(Cell::new(1, 1), &d);
+        assert!(
+            s.unsent.is_empty(),
+            "the coordinator's word is not news to it"
+        );
+        open(&mut s);
+        assert_eq!(s.unsent, [(6, false)]);
     }
 }

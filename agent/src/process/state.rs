@@ -208,6 +208,9 @@ impl Core {
         }
         self.last_commit = c.round;
         if let Some(d) = c.decisions().iter().find(|d| d.agent == self.index) {
+            if let Some(s) = &mut self.sightings {
+                s.refused(self.nav.current(), d);
+            }
             self.rebuilt |= self.nav.apply(d)?.map_rebuilt;
         }
         // A later round than asked for also answers the open candidate: this agent was
