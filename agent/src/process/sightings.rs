@@ -9,8 +9,8 @@
 //! before it). The coordinator decides what it accepts; a sighting it never received (it died
 //! first) is not sent again until the cell changes once more.
 
-use hnav_runtime::grid::{Cell, Direction, Grid};
-use hnav_runtime::msg::{ConflictKind, Decision, Sighting, Verdict, View};
+use hnav_runtime::grid::Grid;
+use hnav_runtime::msg::{ConflictKind, Decision, Sighting, Verdict, View, NO_CELL};
 use hnav_runtime::transport::{Sender, TransportError};
 
 /// The agent's copy of the swarm's picture and the changes not reported yet.
@@ -61,24 +61,15 @@ impl Sightings {
         }
     }
 
-    /// Takes the coordinator's word from decision `d` for a robot at `from`: a step refused
-    /// as invalid (rule 1) is a cell closed on its map. The picture follows, so that the next
-    /// view that shows the cell open reports it: the coordinator learned the cell closed from
-    /// another robot, and no robot that saw it open again told it so (the first to see a door
-    /// open had never seen it shut, and its picture had it open all along).
-    pub(super) fn refused(&mut self, from: Cell, d: &Decision) {
-        let invalid = d.verdict == Verdict::Block as u8 && d.kind == ConflictKind::Invalid as u8;
-        if !invalid {
-            return;
-        }
-        for dir in Direction::ALL
-            .into_iter()
-            .filter(|x| (d.refused >> x.index()) & 1 == 1)
-        {
-            let Some(c) = from.offset(dir.dx(), dir.dy()).filter(|c| c.x < self.width) else {
-                continue;
-            };
-            self.learn(c.y * self.width + c.x, true);
+    /// Takes the coordinator's word from decision `d`: a step held or refused as invalid names
+    /// a cell closed on its map. The picture follows, so that the next view that shows the
+    /// cell open reports it: the coordinator learned the cell closed from another robot, and
+    /// no robot that saw it open again told it so (the first to see a door open had never seen
+    /// it shut, and its picture had it open all along).
+    pub(super) fn refused(&mut self, d: &Decision) {
+        let invalid = d.kind == ConflictKind::Invalid as u8 && d.verdict != Verdict::Accept as u8;
+        if invalid && d.cell != NO_CELL {
+            self.learn(d.cell, true);
         }
     }
 
@@ -139,7 +130,7 @@ mod tests {
     }
 
     #[test]
-    fn a_step_refused_as_invalid_makes_the_next_view_of_the_cell_open_news() {
+    fn a_step_held_as_invalid_makes_the_next_view_of_the_cell_open_news() {
         let map = Grid::new(4, 4).unwrap();
         let mut s = Sightings::new(&map);
         let open = |s: &mut Sightings| {
@@ -152,21 +143,20 @@ mod tests {
         // it shut: seeing it open is no news to its picture.
         open(&mut s);
         assert!(s.unsent.is_empty());
-        // A Crossing refusal says nothing about the map.
-        let east = 1 << Direction::E.index();
+        // A Crossing hold says nothing about the map.
         let mut d = Decision {
-            verdict: Verdict::Block as u8,
-            refused: east,
+            verdict: Verdict::Hold as u8,
             kind: ConflictKind::Crossing as u8,
+            cell: 6,
             ..Decision::default()
         };
-        s.refused(Cell::new(1, 1), &d);
+        s.refused(&d);
         open(&mut s);
         assert!(s.unsent.is_empty());
-        // Its step east from (1, 1) refused as invalid: the coordinator has (2, 1) closed,
-        // and the view that shows it open reports it.
+        // Its step into (2, 1) held as invalid: the coordinator has the cell closed, and the
+        // view that shows it open reports it.
         d.kind = ConflictKind::Invalid as u8;
-        s.refused(Cell::new(1, 1), &d);
+        s.refused(&d);
         assert!(
             s.unsent.is_empty(),
             "the coordinator's word is not news to it"

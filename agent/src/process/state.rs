@@ -209,7 +209,7 @@ impl Core {
         self.last_commit = c.round;
         if let Some(d) = c.decisions().iter().find(|d| d.agent == self.index) {
             if let Some(s) = &mut self.sightings {
-                s.refused(self.nav.current(), d);
+                s.refused(d);
             }
             self.rebuilt |= self.nav.apply(d)?.map_rebuilt;
         }

@@ -53,15 +53,16 @@
 //! that asked and stays gets a Hold: `Reserved` while it waits for a cell being left,
 //! [`Crossing`](ConflictKind::Crossing) when every better cell is taken.
 //!
-//! The one Block is rule 1 of the [module docs](super): an agent deciding for itself (not
-//! pushed) whose `probable` is no step on the coordinator's map (a wall, a cell an agent saw
-//! close, off the grid, not a neighbour) stays, with the refused direction's bit and
-//! [`Invalid`](ConflictKind::Invalid). Its map and the coordinator's disagree on that cell,
-//! and only the agent can find out which is right: the Block tells it the coordinator's
-//! word, and a robot that sees the cell open reports it (`agent/src/process/sightings.rs`).
-//! Redirecting it instead, along the coordinator's distances, made a robot whose map had a
-//! door open that the coordinator still held closed walk back and forth beside the door for
-//! the rest of the run: each step back was the coordinator's, each step forward its map's.
+//! An agent deciding for itself (not pushed) whose `probable` is no step on the
+//! coordinator's map (a wall, a cell an agent saw close, off the grid, not a neighbour) stays
+//! with a Hold of kind [`Invalid`](ConflictKind::Invalid), the asked cell as its `cell`. Its
+//! map and the coordinator's disagree on that cell, and only the agent can find out which is
+//! right: the Hold tells it the coordinator's word, and a robot that sees the cell open reports
+//! it (`agent/src/process/sightings.rs`); the agent asks again meanwhile. Redirecting it
+//! instead, along the coordinator's distances, made a robot whose map had a door open that the
+//! coordinator still held closed walk back and forth beside the door for the rest of the run;
+//! a Block (the dissertation's rule 1) made an HNAV agent turn round in a one-cell corridor
+//! (its path constructor may step down after a block and then avoids the cells it left).
 //!
 //! Accepted moves keep the invariants of the [module docs](super): no cell is held by two
 //! rows after `next <- cell`, hence no swap, and a diagonal's side cells are free.
@@ -159,8 +160,6 @@ struct Choice {
     to: Cell,
     kind: ConflictKind,
     other: u32,
-    /// The refused direction's bit of a Block (rule 1), 0 otherwise.
-    refused: u8,
 }
 
 /// PIBT rounds for one grid and one set of goals; see the [module docs](self).
@@ -203,7 +202,6 @@ impl Pibt {
                     to: Cell::new(0, 0),
                     kind: ConflictKind::None,
                     other: NOBODY,
-                    refused: 0,
                 };
                 n
             ],
@@ -446,9 +444,8 @@ impl Pibt {
         self.state[i] = State::InChain;
         let row = &rows[i];
         if parent.is_none() {
-            if let Some(bit) = self.invalid_request(row) {
+            if self.invalid_request(row) {
                 self.stay(i, row.current, ConflictKind::Invalid, NOBODY);
-                self.choice[i].refused = bit;
                 return Step::Failed;
             }
         }
@@ -536,18 +533,17 @@ impl Pibt {
         Step::Failed
     }
 
-    /// The refused bit (rule 1) if the row asks for a step that is none on this map: a
-    /// blocked or off-grid cell, a diagonal past a blocked corner, or no neighbour (bit 0).
-    fn invalid_request(&self, row: &AgentRow) -> Option<u8> {
-        let p = row.probable.filter(|_| row.mode == AgentMode::Active)?;
+    /// Whether the row asks for a step that is none on this map: a blocked or off-grid cell, a
+    /// diagonal past a blocked corner, or no neighbour.
+    fn invalid_request(&self, row: &AgentRow) -> bool {
+        let Some(p) = row.probable.filter(|_| row.mode == AgentMode::Active) else {
+            return false;
+        };
         let Some(d) = Direction::between(row.current, p) else {
-            return Some(0);
+            return true;
         };
         let (blocked, w, h) = (&self.blocked, self.width, self.height);
-        let rule = self.options.corner_cutting;
-        can_step(blocked, w, h, rule, row.current, d)
-            .is_none()
-            .then_some(1 << d.index())
+        can_step(blocked, w, h, self.options.corner_cutting, row.current, d).is_none()
     }
 
     /// Who keeps agent `i` from `cell` (for the outcome's `other`), if anyone.
@@ -565,7 +561,6 @@ impl Pibt {
             to: at,
             kind,
             other,
-            refused: 0,
         };
     }
 
@@ -593,7 +588,6 @@ impl Pibt {
             to,
             kind,
             other: parent.unwrap_or(NOBODY),
-            refused: 0,
         };
         let sides = side_cells(row.current, to).filter(|_| self.options.sweep);
         for cell in [Some(to)]
@@ -613,15 +607,6 @@ impl Pibt {
         }
         let c = self.choice[i];
         let other = (c.other != NOBODY).then_some(c.other);
-        if c.kind == ConflictKind::Invalid {
-            return Outcome {
-                verdict: Verdict::Block,
-                refused: c.refused,
-                kind: c.kind,
-                cell: row.probable.filter(|&p| self.index(p).is_some()),
-                other: None,
-            };
-        }
         if c.to != row.current {
             return Outcome {
                 verdict: Verdict::Accept,
