@@ -443,11 +443,9 @@ impl Pibt {
     fn attempt(&mut self, i: usize, parent: Option<u32>, rows: &[AgentRow]) -> Step {
         self.state[i] = State::InChain;
         let row = &rows[i];
-        if parent.is_none() {
-            if self.invalid_request(row) {
-                self.stay(i, row.current, ConflictKind::Invalid, NOBODY);
-                return Step::Failed;
-            }
+        if parent.is_none() && self.invalid_request(row) {
+            self.stay(i, row.current, ConflictKind::Invalid, NOBODY);
+            return Step::Failed;
         }
         let (mut prefs, len) = self.preferences(i, row, parent);
         let partner = self
