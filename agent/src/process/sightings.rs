@@ -10,7 +10,7 @@
 //! first) is not sent again until the cell changes once more.
 
 use hnav_runtime::grid::Grid;
-use hnav_runtime::msg::{Sighting, View};
+use hnav_runtime::msg::{ConflictKind, Decision, Sighting, Verdict, View, NO_CELL};
 use hnav_runtime::transport::{Sender, TransportError};
 
 /// The agent's copy of the swarm's picture and the changes not reported yet.
@@ -58,6 +58,18 @@ impl Sightings {
     pub(super) fn learn(&mut self, cell: u32, blocked: bool) {
         if let Some(known) = self.picture.get_mut(cell as usize) {
             *known = blocked;
+        }
+    }
+
+    /// Takes the coordinator's word from decision `d`: a step held or refused as invalid names
+    /// a cell closed on its map. The picture follows, so that the next view that shows the
+    /// cell open reports it: the coordinator learned the cell closed from another robot, and
+    /// no robot that saw it open again told it so (the first to see a door open had never seen
+    /// it shut, and its picture had it open all along).
+    pub(super) fn refused(&mut self, d: &Decision) {
+        let invalid = d.kind == ConflictKind::Invalid as u8 && d.verdict != Verdict::Accept as u8;
+        if invalid && d.cell != NO_CELL {
+            self.learn(d.cell, true);
         }
     }
 
@@ -115,5 +127,41 @@ mod tests {
         v.mark_moving(3, 3); // a person walking by: no change of the map
         s.fold(&v);
         assert_eq!(s.unsent.len(), 2);
+    }
+
+    #[test]
+    fn a_step_held_as_invalid_makes_the_next_view_of_the_cell_open_news() {
+        let map = Grid::new(4, 4).unwrap();
+        let mut s = Sightings::new(&map);
+        let open = |s: &mut Sightings| {
+            let mut v = View::default();
+            v.reset(0, 0, 4);
+            v.mark(2, 1, false);
+            s.fold(&v);
+        };
+        // Another robot saw (2, 1) shut and the coordinator closed it; this agent never saw
+        // it shut: seeing it open is no news to its picture.
+        open(&mut s);
+        assert!(s.unsent.is_empty());
+        // A Crossing hold says nothing about the map.
+        let mut d = Decision {
+            verdict: Verdict::Hold as u8,
+            kind: ConflictKind::Crossing as u8,
+            cell: 6,
+            ..Decision::default()
+        };
+        s.refused(&d);
+        open(&mut s);
+        assert!(s.unsent.is_empty());
+        // Its step into (2, 1) held as invalid: the coordinator has the cell closed, and the
+        // view that shows it open reports it.
+        d.kind = ConflictKind::Invalid as u8;
+        s.refused(&d);
+        assert!(
+            s.unsent.is_empty(),
+            "the coordinator's word is not news to it"
+        );
+        open(&mut s);
+        assert_eq!(s.unsent, [(6, false)]);
     }
 }

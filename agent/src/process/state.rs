@@ -212,6 +212,9 @@ impl Core {
         let own = |d: &&Decision| d.agent == self.index;
         let mine = c.decisions().get(self.index as usize).filter(own);
         if let Some(d) = mine.or_else(|| c.decisions().iter().find(own)) {
+            if let Some(s) = &mut self.sightings {
+                s.refused(d);
+            }
             self.rebuilt |= self.nav.apply(d)?.map_rebuilt;
         }
         // A later round than asked for also answers the open candidate: this agent was

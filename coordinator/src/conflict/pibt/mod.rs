@@ -51,8 +51,18 @@
 //! [`Pushed`](ConflictKind::Pushed) (moved out of a higher-priority agent's way) or
 //! [`Redirected`](ConflictKind::Redirected) (its cell was taken, or it asked for none). An agent
 //! that asked and stays gets a Hold: `Reserved` while it waits for a cell being left,
-//! [`Crossing`](ConflictKind::Crossing) when every better cell is taken. Nothing is ever
-//! blocked: an invalid `probable` is ignored.
+//! [`Crossing`](ConflictKind::Crossing) when every better cell is taken.
+//!
+//! An agent deciding for itself (not pushed) whose `probable` is no step on the
+//! coordinator's map (a wall, a cell an agent saw close, off the grid, not a neighbour) stays
+//! with a Hold of kind [`Invalid`](ConflictKind::Invalid), the asked cell as its `cell`. Its
+//! map and the coordinator's disagree on that cell, and only the agent can find out which is
+//! right: the Hold tells it the coordinator's word, and a robot that sees the cell open reports
+//! it (`agent/src/process/sightings.rs`); the agent asks again meanwhile. Redirecting it
+//! instead, along the coordinator's distances, made a robot whose map had a door open that the
+//! coordinator still held closed walk back and forth beside the door for the rest of the run;
+//! a Block (the dissertation's rule 1) made an HNAV agent turn round in a one-cell corridor
+//! (its path constructor may step down after a block and then avoids the cells it left).
 //!
 //! Accepted moves keep the invariants of the [module docs](super): no cell is held by two
 //! rows after `next <- cell`, hence no swap, and a diagonal's side cells are free.
@@ -433,6 +443,10 @@ impl Pibt {
     fn attempt(&mut self, i: usize, parent: Option<u32>, rows: &[AgentRow]) -> Step {
         self.state[i] = State::InChain;
         let row = &rows[i];
+        if parent.is_none() && self.invalid_request(row) {
+            self.stay(i, row.current, ConflictKind::Invalid, NOBODY);
+            return Step::Failed;
+        }
         let (mut prefs, len) = self.preferences(i, row, parent);
         let partner = self
             .swap
@@ -515,6 +529,19 @@ impl Pibt {
             parent.unwrap_or(NOBODY),
         );
         Step::Failed
+    }
+
+    /// Whether the row asks for a step that is none on this map: a blocked or off-grid cell, a
+    /// diagonal past a blocked corner, or no neighbour.
+    fn invalid_request(&self, row: &AgentRow) -> bool {
+        let Some(p) = row.probable.filter(|_| row.mode == AgentMode::Active) else {
+            return false;
+        };
+        let Some(d) = Direction::between(row.current, p) else {
+            return true;
+        };
+        let (blocked, w, h) = (&self.blocked, self.width, self.height);
+        can_step(blocked, w, h, self.options.corner_cutting, row.current, d).is_none()
     }
 
     /// Who keeps agent `i` from `cell` (for the outcome's `other`), if anyone.

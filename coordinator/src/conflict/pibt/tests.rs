@@ -417,3 +417,23 @@ fn with_the_swap_an_agent_backs_out_of_a_dead_end_for_the_one_leaving_it() {
     let rounds = w.run(80).unwrap();
     assert!(w.pibt.waited(1) == 0 && rounds > 4, "{rounds} rounds");
 }
+
+#[test]
+fn a_step_into_a_cell_closed_on_the_coordinators_map_is_held_as_invalid() {
+    // The coordinator holds the door (3, 0) closed (an agent saw it shut); agent 0's map has
+    // it open and asks for it. Redirected west along the coordinator's way, it came back on
+    // its map's the next round, for ever (the dynamic experiment, 50 robots, robot 14). It
+    // stays and is told why, with the cell: it asks again once it has reported it open.
+    let g = Grid::from_rows(&["...@...", ".@@@@@.", "......."]).unwrap();
+    let rows = [AgentRow::at_rest(c(2, 0), Some(c(3, 0)), 1.0)];
+    let mut p = Pibt::new(&g, &[c(6, 0)], Options::default());
+    let mut out = Vec::new();
+    p.resolve(&rows, &mut out);
+    expect(&out[0], Verdict::Hold, ConflictKind::Invalid);
+    assert_eq!((out[0].cell, out[0].other), (Some(c(3, 0)), None));
+    // Asking nothing or a step the map has, it is decided as before.
+    for (probable, verdict) in [(None, Verdict::Accept), (Some(c(1, 0)), Verdict::Accept)] {
+        p.resolve(&[AgentRow::at_rest(c(2, 0), probable, 1.0)], &mut out);
+        assert_eq!(out[0].verdict, verdict, "{out:?}");
+    }
+}
