@@ -64,7 +64,7 @@ impl Sampler {
         }
         let listed = pids.len() > 1;
         let mut pss_sum = 0;
-        for (pid, role) in pids {
+        for (pid, role) in one_per_process(pids) {
             let Some(hwm) = status_kib(pid, "VmHWM:") else {
                 continue;
             };
@@ -103,6 +103,15 @@ impl Sampler {
     }
 }
 
+/// `pids` with each process once: the registry lists every robot of an agent process that
+/// hosts several (`agents_per_process`) under the process's pid, and a process counted once
+/// per robot would multiply its PSS in the sum.
+fn one_per_process(mut pids: Vec<(u32, Option<Role>)>) -> Vec<(u32, Option<Role>)> {
+    let mut seen = std::collections::HashSet::new();
+    pids.retain(|&(pid, _)| seen.insert(pid));
+    pids
+}
+
 /// A `KEY value kB` line of `/proc/PID/status`.
 fn status_kib(pid: u32, key: &str) -> Option<u64> {
     kib_field(
@@ -129,6 +138,16 @@ fn kib_field(text: &str, key: &str) -> Option<u64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_process_of_several_robots_is_sampled_once() {
+        let a = Some(Role::Agent);
+        let pids = vec![(1, None), (7, a), (7, a), (9, Some(Role::Sim)), (7, a)];
+        assert_eq!(
+            one_per_process(pids),
+            [(1, None), (7, a), (9, Some(Role::Sim))]
+        );
+    }
 
     #[test]
     fn fields_are_read_in_kib() {
