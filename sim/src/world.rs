@@ -414,7 +414,9 @@ impl World {
         (i < self.robots()).then(|| self.pose_at(i))
     }
 
-    fn pose_at(&self, i: usize) -> Pose {
+    /// Robot `i`'s pose as the ground truth gives it (`i` below [`World::robots`]): the
+    /// unchecked [`World::pose`], for filling a truth sample in place.
+    pub fn pose_at(&self, i: usize) -> Pose {
         Pose {
             x_m: self.pos[i].x,
             y_m: self.pos[i].y,
@@ -464,7 +466,7 @@ impl World {
     }
 
     /// The header of the ground truth for control period `period`: time, robots and the
-    /// collision count; [`World::pose_of`] gives each robot's pose to go with it.
+    /// collision count; [`World::pose_at`] gives each robot's pose to go with it.
     pub fn truth_header(&self, period: u64) -> TruthHeader {
         TruthHeader {
             sim_time_ns: self.time_ns(),
@@ -472,11 +474,6 @@ impl World {
             robots: u32::try_from(self.robots()).unwrap_or(u32::MAX),
             collisions: u32::try_from(self.collisions.len()).unwrap_or(u32::MAX),
         }
-    }
-
-    /// Robot `i`'s pose as the ground truth gives it (`i` below [`World::robots`]).
-    pub fn pose_of(&self, i: usize) -> Pose {
-        self.pose_at(i)
     }
 
     /// Fills `truth` for control period `period`, reusing its poses' memory.

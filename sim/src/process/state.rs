@@ -278,7 +278,7 @@ impl State {
         }
         let world = &self.world;
         let n = world.robots();
-        (ports.truth).send_from_fn(world.truth_header(period), n, |i| world.pose_of(i))?;
+        (ports.truth).send_from_fn(world.truth_header(period), n, |i| world.pose_at(i))?;
         if let Some(tx) = &ports.movers {
             let header = MoversHeader {
                 sim_time_ns: world.time_ns(),
