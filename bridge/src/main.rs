@@ -24,9 +24,14 @@ struct Args {
     /// The run id (the same on every host).
     #[arg(long)]
     run: String,
-    /// The run's agent count (which `odom/<i>` and `wheels/<i>` topics exist).
+    /// The run's agent count (with `--agents-per-process`, which `odom/<first>` and
+    /// `wheels/<first>` topics exist).
     #[arg(long)]
     agents: usize,
+    /// Robots per agent process (`[run] agents_per_process`): one `odom/<first>` and one
+    /// `wheels/<first>` topic per process.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    agents_per_process: u32,
     /// Zenoh endpoint to listen on (`tcp/10.0.0.1:7447`); repeatable.
     #[arg(long)]
     listen: Vec<String>,
@@ -80,7 +85,7 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         ..Endpoints::default()
     };
     let mut peers = None;
-    let mut specs = topics::run_topics(args.agents, args.maps);
+    let mut specs = topics::run_topics(args.agents, args.agents_per_process, args.maps);
     if let (Some(file), Some(name)) = (&args.hosts, &args.host) {
         let placement = Placement::load(file, args.agents, args.replicas)?;
         if placement.replicas_apart() {

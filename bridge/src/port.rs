@@ -6,8 +6,8 @@ use std::io::Write;
 
 use bytemuck::Zeroable;
 use hnav_runtime::msg::{
-    Candidate, CommitHeader, Lifecycle, MapHeader, Odometry, Progress, TruthHeader, WheelCommand,
-    Wire, WireError, WireSlice,
+    Candidate, CommitHeader, Lifecycle, MapHeader, OdometryHeader, Progress, TruthHeader,
+    WheelsHeader, Wire, WireError, WireSlice,
 };
 use hnav_runtime::topics;
 use hnav_runtime::transport::{
@@ -334,8 +334,8 @@ pub(crate) fn open(
         Payload::Lifecycle => typed::<Lifecycle>(transport, spec),
         Payload::Progress => typed::<Progress>(transport, spec),
         Payload::Truth => Sliced::<TruthHeader>::open(transport, spec),
-        Payload::Odometry => typed::<Odometry>(transport, spec),
-        Payload::WheelCommand => typed::<WheelCommand>(transport, spec),
+        Payload::Odometry => Sliced::<OdometryHeader>::open(transport, spec),
+        Payload::WheelCommand => Sliced::<WheelsHeader>::open(transport, spec),
         Payload::Raft => {
             let tx =
                 transport.slice_sender::<u8, ()>(&spec.topic, topics::RAFT_MAX_BYTES, spec.qos)?;

@@ -1,5 +1,5 @@
 //! The topics a bridge forwards: the run's decision round, lifecycle and state, and each
-//! robot's wheels and odometry. Each with the payload type and QoS its processes open it with
+//! agent process's wheels and odometry. Each with the payload type and QoS its processes open it with
 //! (a different QoS would not open).
 //!
 //! The neural-map snapshots (`map/<i>`, up to megabytes each) only on request
@@ -23,9 +23,9 @@ pub enum Payload {
     Progress,
     /// `truth`.
     Truth,
-    /// `odom/<i>`.
+    /// `odom/<first>`: an agent process's robots' odometry.
     Odometry,
-    /// `wheels/<i>`.
+    /// `wheels/<first>`: an agent process's robots' wheel commands.
     WheelCommand,
     /// `map/<i>`: a neural-map snapshot (`f32` activations with a `MapHeader`).
     Map,
@@ -68,9 +68,9 @@ pub fn best_effort(specs: &mut [TopicSpec]) {
     }
 }
 
-/// Every topic a run of `agents` agents forwards; with `maps`, each agent's neural-map
-/// snapshots too.
-pub fn run_topics(agents: usize, maps: bool) -> Vec<TopicSpec> {
+/// Every topic a run of `agents` agents, `per_process` to an agent process, forwards; with
+/// `maps`, each agent's neural-map snapshots too.
+pub fn run_topics(agents: usize, per_process: u32, maps: bool) -> Vec<TopicSpec> {
     let spec = |topic: &str, payload, qos| TopicSpec {
         topic: topic.to_string(),
         payload,
@@ -97,18 +97,21 @@ pub fn run_topics(agents: usize, maps: bool) -> Vec<TopicSpec> {
         spec(topics::PROGRESS, Payload::Progress, topics::progress_qos()),
         spec(topics::TRUTH, Payload::Truth, topics::truth_qos()),
     ];
-    for i in 0..agents {
+    let per_process = per_process.max(1) as usize;
+    for first in (0..agents).step_by(per_process) {
         out.push(spec(
-            &topics::odometry(i),
+            &topics::odometry(first),
             Payload::Odometry,
             topics::state_qos(),
         ));
         out.push(spec(
-            &topics::wheels(i),
+            &topics::wheels(first),
             Payload::WheelCommand,
             topics::state_qos(),
         ));
-        if maps {
+    }
+    if maps {
+        for i in 0..agents {
             out.push(spec(&topics::map(i), Payload::Map, topics::state_qos()));
         }
     }
@@ -135,13 +138,17 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_run_forwards_six_topics_and_two_per_robot() {
-        let t = run_topics(3, false);
+    fn a_run_forwards_six_topics_and_two_per_agent_process() {
+        let t = run_topics(3, 1, false);
         assert_eq!(t.len(), 6 + 2 * 3);
+        let grouped = run_topics(10, 4, false);
+        assert_eq!(grouped.len(), 6 + 2 * 3);
+        assert!(grouped.iter().any(|s| s.topic == "odom/8"));
+        assert!(!grouped.iter().any(|s| s.topic == "odom/9"));
         assert_eq!(t[0].topic, "candidates");
         assert!(t.iter().any(|s| s.topic == "wheels/2"));
         assert!(!t.iter().any(|s| s.topic.starts_with("map/")));
-        let mut t = run_topics(3, true);
+        let mut t = run_topics(3, 1, true);
         assert_eq!(t.iter().filter(|s| s.payload == Payload::Map).count(), 3);
         assert!(t.iter().all(|s| !s.droppable));
         best_effort(&mut t);

@@ -12,10 +12,10 @@
 use std::time::{Duration, Instant};
 
 use hnav_runtime::msg::{
-    CommitView, Estimate, Lifecycle, LifecycleEvent, MapHeader, TruthView, WheelCommand,
+    CommitView, Estimate, Lifecycle, LifecycleEvent, MapHeader, TruthView,
 };
 use hnav_runtime::scenario::{OdometrySource, Scenario};
-use hnav_runtime::topics::{self, CommitReceiver, TruthReceiver};
+use hnav_runtime::topics::{self, CommitReceiver, TruthReceiver, WheelsReceiver};
 use hnav_runtime::transport::{Receiver, RunId, SliceReceiver, Transport, TransportError, Wake};
 use zenoh::Session;
 
@@ -153,22 +153,28 @@ pub(crate) struct Inputs {
     truth: Option<TruthReceiver>,
     estimate: Receiver<Estimate>,
     commit: CommitReceiver,
-    pub(crate) wheels: Vec<Receiver<WheelCommand>>,
+    /// One per agent process: its robots' wheel commands.
+    pub(crate) wheels: Vec<WheelsReceiver>,
     maps: Vec<SliceReceiver<f32, MapHeader>>,
 }
 
 impl Inputs {
-    /// Opens the topics of a run of `n` robots; the ground truth's only for an `observer`
+    /// Opens the topics of a run of `scenario`; the ground truth's only for an `observer`
     /// (the relay beside the roster, not the sim's stand-in in it, which sends it).
-    pub(crate) fn open(t: &Transport, n: usize, observer: bool) -> Result<Inputs, TransportError> {
+    pub(crate) fn open(
+        t: &Transport,
+        scenario: &Scenario,
+        observer: bool,
+    ) -> Result<Inputs, TransportError> {
+        let n = scenario.agents.len();
         Ok(Inputs {
             truth: observer
                 .then(|| t.slice_receiver(topics::TRUTH, topics::truth_qos()))
                 .transpose()?,
             estimate: t.receiver(topics::ESTIMATE, topics::estimate_qos(n))?,
             commit: t.slice_receiver(topics::COMMIT, topics::commit_qos(n))?,
-            wheels: (0..n)
-                .map(|i| t.receiver(&topics::wheels(i), topics::state_qos()))
+            wheels: (scenario.run.agent_processes(n))
+                .map(|(first, _)| t.slice_receiver(&topics::wheels(first as usize), topics::state_qos()))
                 .collect::<Result<_, _>>()?,
             maps: (0..n)
                 .map(|i| t.slice_receiver(&topics::map(i), topics::state_qos()))
@@ -197,7 +203,7 @@ pub fn relay(
 ) -> Result<Counts, RelayError> {
     let n = scenario.agents.len();
     let transport = Transport::builder(run).node_name("ros2").create()?;
-    let inputs = Inputs::open(&transport, n, true)?;
+    let inputs = Inputs::open(&transport, scenario, true)?;
     let life: Receiver<Lifecycle> =
         transport.receiver(topics::LIFECYCLE, topics::lifecycle_qos(n))?;
     // The lifecycle is the one source the relay sleeps on; the rest is read at its rate.
@@ -247,8 +253,14 @@ pub(crate) fn read(
         scene.decisions_json(c, &mut s.text.data);
         out.put(&mut topics.decisions, &s.text);
     })?;
-    for (i, w) in inputs.wheels.iter().enumerate() {
-        w.drain(|c| scene.robots[i].wheels = Some((c.left_rad_s, c.right_rad_s)))?;
+    for w in &inputs.wheels {
+        w.drain(|_, commands| {
+            for c in commands {
+                if let Some(r) = scene.robots.get_mut(c.agent as usize) {
+                    r.wheels = Some((c.left_rad_s, c.right_rad_s));
+                }
+            }
+        })?;
     }
     for (i, m) in inputs.maps.iter().enumerate() {
         m.drain_pending(|h, values| {

@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use crate::msg::{
     Candidate, CommitHeader, Decision, Estimate, Heartbeat, Lifecycle, MapHeader, MoverPlace,
-    MoversHeader, Odometry, Pose, Progress, Sighting, TruthHeader, View, WheelCommand, WorldHeader,
+    MoversHeader, Odometry, OdometryHeader, Pose, Progress, Sighting, TruthHeader, View, ViewsHeader, WheelCommand, WheelsHeader, WorldHeader,
     MAX_AGENTS,
 };
 use crate::topics;
@@ -230,6 +230,18 @@ pub fn layouts() -> Layouts {
             reserved: u32,
             pose: Pose
         }),
+        layout!(WheelsHeader {
+            first: u32,
+            count: u32
+        }),
+        layout!(OdometryHeader {
+            first: u32,
+            count: u32
+        }),
+        layout!(ViewsHeader {
+            first: u32,
+            count: u32
+        }),
     ];
     let fixed = |topic, payload| TopicLayout {
         topic,
@@ -244,9 +256,21 @@ pub fn layouts() -> Layouts {
         user_header,
     };
     let topics = vec![
-        fixed("wheels/<i>", type_name_of::<WheelCommand>()),
-        fixed("odom/<i>", type_name_of::<Odometry>()),
-        fixed("view/<i>", type_name_of::<View>()),
+        sliced(
+            "wheels/<first>",
+            type_name_of::<WheelCommand>(),
+            type_name_of::<WheelsHeader>(),
+        ),
+        sliced(
+            "odom/<first>",
+            type_name_of::<Odometry>(),
+            type_name_of::<OdometryHeader>(),
+        ),
+        sliced(
+            "view/<first>",
+            type_name_of::<View>(),
+            type_name_of::<ViewsHeader>(),
+        ),
         sliced(
             topics::TRUTH,
             type_name_of::<Pose>(),

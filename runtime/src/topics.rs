@@ -3,8 +3,9 @@
 //!
 //! | topic | payload | publishers -> subscribers | QoS |
 //! |---|---|---|---|
-//! | `wheels/<i>` | [`WheelCommand`](crate::msg::WheelCommand) | agent i -> sim | latest |
-//! | `odom/<i>` | [`Odometry`](crate::msg::Odometry) | sim -> agent i | latest |
+//! | `wheels/<first>` | [`WheelCommand`](crate::msg::WheelCommand) slice + [`WheelsHeader`], the latest of each robot of the process | agent process -> sim | latest |
+//! | `odom/<first>` | [`Odometry`](crate::msg::Odometry) slice + [`OdometryHeader`], one per robot of the process | sim -> agent process | latest |
+//! | `view/<first>` | [`View`](crate::msg::View) slice + [`ViewsHeader`], one per robot of the process | sim -> agent process (with `[sensing]`) | latest |
 //! | `truth` | [`Pose`] slice + [`TruthHeader`], one pose per robot | sim -> supervisor, recorder, viewers | latest, deep buffer ([`truth_qos`]) |
 //! | `estimate` | [`Estimate`](crate::msg::Estimate) | every agent -> recorder, `hnav-ros2`, viewers | latest, depth 1, not notified ([`estimate_qos`]) |
 //! | `candidates` | [`Candidate`](crate::msg::Candidate) | agents -> coordinator | reliable |
@@ -35,13 +36,20 @@
 //! coordinator, so every topic keeps a free slot with one viewer in
 //! (`a_viewer_leaves_a_slot_for_one_more_observer`).
 //!
+//! `<first>` is the first robot of an agent process (`[run] agents_per_process`; with the
+//! default of one robot a process, every robot's own index): the sim holds three ports per
+//! process, not per robot ([`crate::msg::WheelsHeader`] says why).
+//!
 //! One `heartbeat` topic for every process rather than one per process: iceoryx2 keeps a
 //! queue per publisher-subscriber connection, so a depth-1 "latest" buffer already holds each
 //! process's own last beat, and the supervisor reads the whole swarm from one subscriber
 //! without a service (and its shared memory) per process. Beats do not notify: the
 //! supervisor reads them at its own deadline, so a beat costs a sample write and wakes nobody.
 
-use crate::msg::{CommitHeader, Decision, Pose, TruthHeader};
+use crate::msg::{
+    CommitHeader, Decision, Odometry, OdometryHeader, Pose, TruthHeader, View, ViewsHeader,
+    WheelCommand, WheelsHeader,
+};
 use crate::transport::{Delivery, Qos, SliceReceiver, SliceSender};
 
 /// The `commit` topic's sending side: a slice of one decision per agent (its length, the
@@ -54,14 +62,29 @@ pub type TruthSender = SliceSender<Pose, TruthHeader>;
 /// The `truth` topic's receiving side.
 pub type TruthReceiver = SliceReceiver<Pose, TruthHeader>;
 
-/// Robot `i`'s wheel commands.
-pub fn wheels(i: usize) -> String {
-    format!("wheels/{i}")
+/// The `wheels/<first>` topic's sending side: the wheel commands of an agent process's
+/// robots, one sample per process ([`crate::msg::WheelsHeader`] says why).
+pub type WheelsSender = SliceSender<WheelCommand, WheelsHeader>;
+/// The `wheels/<first>` topic's receiving side.
+pub type WheelsReceiver = SliceReceiver<WheelCommand, WheelsHeader>;
+/// The `odom/<first>` topic's sending side: one reading per robot of an agent process.
+pub type OdometrySender = SliceSender<Odometry, OdometryHeader>;
+/// The `odom/<first>` topic's receiving side.
+pub type OdometryReceiver = SliceReceiver<Odometry, OdometryHeader>;
+/// The `view/<first>` topic's sending side: one view per robot of an agent process.
+pub type ViewsSender = SliceSender<View, ViewsHeader>;
+/// The `view/<first>` topic's receiving side.
+pub type ViewsReceiver = SliceReceiver<View, ViewsHeader>;
+
+/// The wheel commands of the agent process whose first robot is `first`
+/// ([`crate::scenario::params::RunParams::agent_processes`]).
+pub fn wheels(first: usize) -> String {
+    format!("wheels/{first}")
 }
 
-/// Robot `i`'s odometry.
-pub fn odometry(i: usize) -> String {
-    format!("odom/{i}")
+/// The odometry of the robots of the agent process whose first robot is `first`.
+pub fn odometry(first: usize) -> String {
+    format!("odom/{first}")
 }
 
 /// Cells the agents saw change, for the coordinator's map.
@@ -71,9 +94,9 @@ pub const WORLD: &str = "world";
 /// Where the moving obstacles are, from the sim (a run with movers).
 pub const MOVERS: &str = "movers";
 
-/// Robot `i`'s sensor view (the sim's [`View`](crate::msg::View)).
-pub fn view(i: usize) -> String {
-    format!("view/{i}")
+/// The sensor views of the robots of the agent process whose first robot is `first`.
+pub fn view(first: usize) -> String {
+    format!("view/{first}")
 }
 
 /// Agent `i`'s neural-map snapshots.

@@ -3,7 +3,7 @@
 //! Truth streams, and that a robot whose agent never sends is braked rather than waited for.
 
 use hnav_runtime::hash::Fnv1a64;
-use hnav_runtime::msg::{Odometry, Truth, TruthView, WheelCommand};
+use hnav_runtime::msg::{Truth, TruthView, WheelCommand, WheelsHeader};
 use hnav_runtime::scenario::params::RobotParams;
 use hnav_runtime::topics;
 use hnav_runtime::transport::{purge_run, RunId, Transport};
@@ -91,11 +91,12 @@ fn drive(mut guard: RunGuard, file: &std::path::Path, agents: usize) -> (u64, Tr
         .create()
         .unwrap();
     let q = topics::state_qos();
-    let wheels: Vec<_> = (0..agents)
-        .map(|i| t.sender::<WheelCommand>(&topics::wheels(i), q).unwrap())
+    // One robot a process (the scenario's default): each robot's own `wheels/<i>`, `odom/<i>`.
+    let wheels: Vec<topics::WheelsSender> = (0..agents)
+        .map(|i| t.slice_sender(&topics::wheels(i), 1, q).unwrap())
         .collect();
-    let odom: Vec<_> = (0..2)
-        .map(|i| t.receiver::<Odometry>(&topics::odometry(i), q).unwrap())
+    let odom: Vec<topics::OdometryReceiver> = (0..2)
+        .map(|i| t.slice_receiver(&topics::odometry(i), q).unwrap())
         .collect();
     let truth: topics::TruthReceiver = t
         .slice_receiver(topics::TRUTH, topics::truth_qos())
@@ -103,7 +104,11 @@ fn drive(mut guard: RunGuard, file: &std::path::Path, agents: usize) -> (u64, Tr
     let send = |period: u64| {
         for (i, tx) in wheels.iter().enumerate() {
             let k = i as f64;
-            tx.send(WheelCommand {
+            let header = WheelsHeader {
+                first: i as u32,
+                count: 1,
+            };
+            tx.send_from_fn(header, 1, |_| WheelCommand {
                 period,
                 agent: i as u32,
                 flags: 0,
@@ -149,7 +154,7 @@ fn drive(mut guard: RunGuard, file: &std::path::Path, agents: usize) -> (u64, Tr
             })
             .unwrap();
         for rx in &odom {
-            rx.drain_pending(|_| {}).unwrap();
+            rx.drain_pending(|_, _| {}).unwrap();
         }
         if next < PERIODS {
             send(next);

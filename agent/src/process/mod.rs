@@ -3,14 +3,15 @@
 //!
 //! A process that hosts several robots has one node, one waiter, one commit subscriber, one
 //! candidate publisher, one heartbeat and one side of the lifecycle protocol, all under its
-//! first robot's name; each robot keeps its own topics (odometry, view, wheels, map,
-//! estimate), state and checkpoint, and its log lines carry an `agent{index=…}` span. A
-//! commit is received once and applied by each robot, so the coordinator wakes one
-//! listener per process, not one per robot.
+//! first robot's name, and one odometry, view and wheel topic that carry its robots in one
+//! sample each; each robot keeps its own neural-map and estimate topics, state and
+//! checkpoint, and its log lines carry an `agent{index=…}` span. A commit is received once
+//! and applied by each robot, and a period's odometry arrives once for every robot, so the
+//! coordinator and the sim wake one listener per process, not one per robot.
 //!
-//! Inputs: its robot's odometry (`odom/<i>`), the coordinator's commits, the supervisor's
-//! lifecycle events. Outputs: candidates, wheel commands (`wheels/<i>`) and neural-map
-//! snapshots (`map/<i>`, written in place into loaned shared memory). It blocks in one
+//! Inputs: its robots' odometry (`odom/<first>`), the coordinator's commits, the
+//! supervisor's lifecycle events. Outputs: candidates, wheel commands (`wheels/<first>`) and
+//! neural-map snapshots (`map/<i>`, written in place into loaned shared memory). It blocks in one
 //! [`Waiter`](hnav_runtime::transport::Waiter) on the three inputs; its one timer is its
 //! heartbeat ([`hnav_runtime::health`]), beaten from that loop.
 //!
@@ -52,7 +53,7 @@ use crate::navigator::Navigator;
 use crate::neural_map::NeuralMap;
 use checkpoint::CheckpointFile;
 use ports::{Ports, RobotPorts};
-use state::Core;
+use state::{Core, Inbox};
 
 /// What stopped or broke the agent.
 #[derive(Debug, thiserror::Error)]
@@ -111,6 +112,8 @@ pub struct AgentProcess<'t> {
 struct Robots {
     cores: Vec<Core>,
     ports: Vec<RobotPorts>,
+    /// What the process's shared topics brought each robot in this pass.
+    inbox: Vec<Inbox>,
     /// Names each robot in the log lines of a process that hosts several (none for one).
     spans: Vec<tracing::Span>,
 }
@@ -147,7 +150,7 @@ impl<'t> AgentProcess<'t> {
         }
         let sensing = scenario.sensing.is_some();
         let grid = &scenario.map.grid;
-        let ports = Ports::open(transport, (first, agents), sensing)?;
+        let ports = Ports::open(transport, (first, count, agents), sensing)?;
         // One heartbeat for the process, under its first robot's name: the supervisor
         // watches processes, and the robots of one process hang together.
         let heart = Heartbeat::open(transport, Role::Agent, first, agents, scenario.heartbeat())?;
@@ -165,6 +168,7 @@ impl<'t> AgentProcess<'t> {
         let mut robots = Robots {
             cores: Vec::with_capacity(n),
             ports: Vec::with_capacity(n),
+            inbox: vec![Inbox::default(); n],
             spans: Vec::with_capacity(n),
         };
         for index in first..=last {
@@ -182,7 +186,7 @@ impl<'t> AgentProcess<'t> {
             robots.cores.push(core);
             robots
                 .ports
-                .push(RobotPorts::open(transport, grid, (index, agents), sensing)?);
+                .push(RobotPorts::open(transport, grid, (index, agents))?);
             robots.spans.push(span);
         }
         // What a user needs to pick `[run] startup_timeout_s` for a large map.
@@ -213,22 +217,17 @@ impl<'t> AgentProcess<'t> {
             .life
             .handshake(self.transport, resume, self.startup_timeout)?;
         let p = &self.ports;
-        let (cores, rp, spans) = (
-            &mut self.robots.cores,
-            &self.robots.ports,
-            &self.robots.spans,
-        );
+        let robots = &mut self.robots;
         if started == StartOutcome::Stopped {
-            return Ok(cores.iter().map(Core::outcome).collect());
+            return Ok(robots.cores.iter().map(Core::outcome).collect());
         }
-        for ((core, r), span) in cores.iter_mut().zip(rp).zip(spans) {
-            span.in_scope(|| core.begin(r, resume))?;
+        for ((core, r), span) in (robots.cores.iter_mut()).zip(&robots.ports).zip(&robots.spans) {
+            span.in_scope(|| core.begin(p, r, resume))?;
         }
+        p.wheels.flush()?;
         let waiter = self.transport.waiter()?;
-        let mut attached = Vec::with_capacity(rp.len() + 2);
-        for r in rp {
-            attached.push(waiter.attach(&r.odom)?);
-        }
+        let mut attached = Vec::with_capacity(3);
+        attached.push(waiter.attach(&p.odom)?);
         attached.push(waiter.attach(&p.commit)?);
         let _bell = p.bell.as_ref().map(|b| waiter.attach_bell(b)).transpose()?;
         attached.push(waiter.attach(p.life.events())?);
@@ -237,43 +236,44 @@ impl<'t> AgentProcess<'t> {
             if p.life.drain(|_, _, _| {})?.is_some() {
                 break;
             }
-            pass(p, rp, spans, cores)?;
+            pass(p, robots)?;
             // The agent reacts to its inputs; its deadlines are the next beat and, in
             // realtime, the resend of an unanswered candidate. `TimedOut` means "look again".
-            let resend = cores.iter().filter_map(Core::resend_due).min();
+            let resend = robots.cores.iter().filter_map(Core::resend_due).min();
             match waiter.wait(self.heart.until(resend)?)? {
                 Wake::Data | Wake::TimedOut => {}
                 Wake::Stop => break,
             }
         }
-        Ok(cores.iter().map(Core::outcome).collect())
+        Ok(robots.cores.iter().map(Core::outcome).collect())
     }
 }
 
-/// One pass over every input of the process: the new commits and the coordinator's map,
-/// received once and handed to each robot, then each robot's own inputs; the candidates the
-/// pass posted wake the coordinator once.
-fn pass(
-    p: &Ports,
-    rp: &[RobotPorts],
-    spans: &[tracing::Span],
-    cores: &mut [Core],
-) -> Result<(), AgentError> {
+/// One pass over every input of the process: the new commits, the coordinator's map and the
+/// robots' odometry and views, received once and handed to each robot, then each robot's
+/// own work; the candidates and wheel commands the pass posted go out once.
+fn pass(p: &Ports, robots: &mut Robots) -> Result<(), AgentError> {
+    let Robots {
+        cores,
+        ports: rp,
+        inbox,
+        spans,
+    } = robots;
     // Not `drain_pending`: applying a decision can fail, and the error must end the loop.
     let wake = p.commit.take_wakeup()?;
     while let Some(sample) = p.commit.receive()? {
-        for (core, span) in cores.iter_mut().zip(spans) {
+        for (core, span) in cores.iter_mut().zip(spans.iter()) {
             let c = CommitView::new(sample.user_header(), sample.payload());
             span.in_scope(|| core.apply_commit(c))?;
         }
     }
-    for ((core, r), span) in cores.iter_mut().zip(rp).zip(spans) {
+    for ((core, r), span) in cores.iter_mut().zip(rp.iter()).zip(spans.iter()) {
         span.in_scope(|| core.after_commits(p, r, wake.peer_up))?;
     }
     if let Some(rx) = &p.world {
         let mut result = Ok(());
         rx.drain_pending(|h, cells| {
-            for (core, span) in cores.iter_mut().zip(spans) {
+            for (core, span) in cores.iter_mut().zip(spans.iter()) {
                 if result.is_ok() {
                     result = span.in_scope(|| core.learn_world(h, cells));
                 }
@@ -281,8 +281,9 @@ fn pass(
         })?;
         result?;
     }
-    for ((core, r), span) in cores.iter_mut().zip(rp).zip(spans) {
-        span.in_scope(|| core.step(p, r))?;
+    sort_into(p, cores, inbox)?;
+    for (((core, r), span), inbox) in cores.iter_mut().zip(rp.iter()).zip(spans.iter()).zip(inbox) {
+        span.in_scope(|| core.step(p, r, std::mem::take(inbox)))?;
         // iceoryx2 hands a publisher's history (the last snapshot) to a new subscriber
         // only when the publisher updates its connections, which a send does; the map is
         // sent only when it is rebuilt, so without this a viewer that joins late would
@@ -292,6 +293,32 @@ fn pass(
         }
     }
     p.candidates.flush()?;
+    p.wheels.flush()?;
+    Ok(())
+}
+
+/// Hands each robot the newest odometry reading and view the process's topics brought for
+/// it; a reading for a robot the process does not host is dropped with a warning.
+fn sort_into(p: &Ports, cores: &[Core], inbox: &mut [Inbox]) -> Result<(), AgentError> {
+    let first = cores.first().map_or(0, Core::index);
+    let slot = |agent: u32| agent.checked_sub(first).map(|k| k as usize);
+    p.odom.drain_pending(|_, readings| {
+        for o in readings {
+            match slot(o.agent).and_then(|k| inbox.get_mut(k)) {
+                Some(b) => b.odometry(o),
+                None => tracing::warn!(agent = first, from = o.agent, "odometry of another robot dropped"),
+            }
+        }
+    })?;
+    if let Some(rx) = &p.view {
+        rx.drain_pending(|_, views| {
+            for v in views {
+                if let Some(b) = slot(v.agent).and_then(|k| inbox.get_mut(k)) {
+                    b.view(v);
+                }
+            }
+        })?;
+    }
     Ok(())
 }
 

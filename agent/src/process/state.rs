@@ -33,6 +33,30 @@ fn resend_after(scenario: &Scenario) -> Duration {
     (4 * deadline).max(Duration::from_millis(200))
 }
 
+/// What the process's shared topics brought one robot in a pass: its newest odometry reading
+/// and view, if any.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Inbox {
+    odometry: Option<Odometry>,
+    view: Option<View>,
+}
+
+impl Inbox {
+    /// Keeps `o` if it is the newest reading so far.
+    pub(super) fn odometry(&mut self, o: &Odometry) {
+        if self.odometry.is_none_or(|l| o.period >= l.period) {
+            self.odometry = Some(*o);
+        }
+    }
+
+    /// Keeps `v` if it is the newest view so far.
+    pub(super) fn view(&mut self, v: &View) {
+        if self.view.is_none_or(|l| v.period >= l.period) {
+            self.view = Some(*v);
+        }
+    }
+}
+
 /// One agent's state: its navigator, dead reckoning and wheel controller, and where it stands
 /// in the rounds.
 pub(super) struct Core {
@@ -158,24 +182,35 @@ impl Core {
 
     /// What the agent publishes once started: its first map and, in a fresh lockstep run,
     /// period 0's wheel command (the sim steps the first period once every robot has one).
-    pub(super) fn begin(&mut self, r: &RobotPorts, resume: bool) -> Result<(), AgentError> {
+    pub(super) fn begin(
+        &mut self,
+        p: &Ports,
+        r: &RobotPorts,
+        resume: bool,
+    ) -> Result<(), AgentError> {
         self.publish_map(r)?;
         if self.clock == ClockMode::Lockstep && !resume {
             self.wheel_due = Some(self.last_period.map_or(0, |p| p + 1));
-            self.send_wheels(r)?;
+            self.send_wheels(p)?;
         }
         Ok(())
     }
 
+    /// The robot's index in the swarm.
+    pub(super) fn index(&self) -> u32 {
+        self.index
+    }
+
     /// One pass over this robot's inputs once the process has handed it the new commits
     /// ([`Core::apply_commit`], [`Core::after_commits`]) and the coordinator's map
-    /// ([`Core::learn_world`]), in the order that keeps lockstep runs deterministic: views,
-    /// odometry, then what they made due.
-    pub(super) fn step(&mut self, p: &Ports, r: &RobotPorts) -> Result<(), AgentError> {
-        self.on_odometry(r)?;
+    /// ([`Core::learn_world`]) and sorted out its odometry and view (`inbox`), in the order
+    /// that keeps lockstep runs deterministic: view, odometry, then what they made due.
+    pub(super) fn step(&mut self, p: &Ports, r: &RobotPorts, inbox: Inbox) -> Result<(), AgentError> {
+        self.on_view(inbox.view)?;
+        self.on_odometry(p, r, inbox.odometry)?;
         self.send_candidate(p, r)?;
         self.resend_if_unanswered(p)?;
-        self.send_wheels(r)
+        self.send_wheels(p)
     }
 
     /// When the open candidate is due to be sent again (realtime only).
@@ -244,18 +279,12 @@ impl Core {
         Ok(())
     }
 
-    /// Folds in the newest views (they come before the odometry of their period): cells
-    /// that changed are learned and the guide repaired.
-    fn on_views(&mut self, r: &RobotPorts) -> Result<(), AgentError> {
-        let (Some(rx), Some(rule)) = (&r.view, self.repair) else {
+    /// Folds in the newest view (it comes before the odometry of its period): cells that
+    /// changed are learned and the guide repaired.
+    fn on_view(&mut self, latest: Option<View>) -> Result<(), AgentError> {
+        let Some(rule) = self.repair else {
             return Ok(());
         };
-        let mut latest: Option<View> = None;
-        rx.drain_pending(|v| {
-            if v.agent == self.index && latest.is_none_or(|l| v.period >= l.period) {
-                latest = Some(*v);
-            }
-        })?;
         // A repaired map is marked replanned: its snapshot goes out with the next candidate.
         if let Some(v) = latest {
             if let Some(s) = &mut self.sightings {
@@ -316,28 +345,19 @@ impl Core {
     }
 
     /// Folds in the newest odometry reading and opens the next round.
-    fn on_odometry(&mut self, r: &RobotPorts) -> Result<(), AgentError> {
-        self.on_views(r)?;
-        let mut latest: Option<Odometry> = None;
-        r.odom.drain_pending(|o| {
-            if latest.is_none_or(|l| o.period >= l.period) {
-                latest = Some(*o);
-            }
-        })?;
+    fn on_odometry(
+        &mut self,
+        p: &Ports,
+        r: &RobotPorts,
+        latest: Option<Odometry>,
+    ) -> Result<(), AgentError> {
         if let Some(o) = latest.filter(|o| Some(o.period) == self.last_period) {
-            return self.on_repeated_odometry(r, o.period);
+            self.on_repeated_odometry(p, o.period);
+            return Ok(());
         }
         let Some(o) = latest.filter(|o| self.last_period.is_none_or(|p| o.period > p)) else {
             return Ok(());
         };
-        if o.agent != self.index {
-            tracing::warn!(
-                agent = self.index,
-                from = o.agent,
-                "odometry of another robot dropped"
-            );
-            return Ok(());
-        }
         self.last_period = Some(o.period);
         self.tell(o.sim_time_ns, o.period)?;
         self.ticks = (o.ticks_left, o.ticks_right);
@@ -371,11 +391,10 @@ impl Core {
     /// its command for the next period (an iceoryx2 subscriber does not get what was sent
     /// before it existed), so in lockstep it would wait for that command for ever: send it
     /// again. The reading itself changes nothing.
-    fn on_repeated_odometry(&mut self, r: &RobotPorts, period: u64) -> Result<(), AgentError> {
+    fn on_repeated_odometry(&mut self, p: &Ports, period: u64) {
         if let Some(c) = self.last_wheels.filter(|c| c.period == period + 1) {
-            r.wheels.send(c)?;
+            p.wheels.post(c);
         }
-        Ok(())
     }
 
     /// Publishes the candidate for round `last commit + 1` if one is due and none is open.
@@ -407,8 +426,9 @@ impl Core {
         Ok(())
     }
 
-    /// Sends the due wheel command; in lockstep only once the open round is decided.
-    fn send_wheels(&mut self, r: &RobotPorts) -> Result<(), AgentError> {
+    /// Posts the due wheel command (the pass sends it); in lockstep only once the open round
+    /// is decided.
+    fn send_wheels(&mut self, p: &Ports) -> Result<(), AgentError> {
         let Some(period) = self.wheel_due else {
             return Ok(());
         };
@@ -443,7 +463,7 @@ impl Core {
             left_rad_s: left,
             right_rad_s: right,
         };
-        r.wheels.send(command)?;
+        p.wheels.post(command);
         self.last_wheels = Some(command);
         self.wheel_due = None;
         Ok(())

@@ -26,9 +26,9 @@ use crate::supervisor::registry::{RunRecord, RunRegistry};
 use hnav_runtime::consensus_log::reader::LogReader;
 use hnav_runtime::consensus_log::record::Record;
 use hnav_runtime::msg::{
-    CommitView, Lifecycle, MoverPlace, MoversHeader, Progress, TruthView, View,
+    CommitView, Lifecycle, MoverPlace, MoversHeader, Progress, TruthView,
 };
-use hnav_runtime::topics::{self, CommitReceiver, TruthReceiver};
+use hnav_runtime::topics::{self, CommitReceiver, TruthReceiver, ViewsReceiver};
 use hnav_runtime::transport::{Receiver, RunId, SliceReceiver, Transport, TransportError, Wake};
 
 /// How often the registry and `/proc` are read for the health rows.
@@ -93,7 +93,7 @@ pub struct LiveFeed {
     progress: Receiver<Progress>,
     life: Receiver<Lifecycle>,
     /// Each robot's view, with `[sensing]`.
-    views: Vec<Receiver<View>>,
+    views: Vec<ViewsReceiver>,
     /// The movers' places, in a run with movers.
     movers: Option<SliceReceiver<MoverPlace, MoversHeader>>,
     sampler: HealthSampler,
@@ -150,8 +150,8 @@ impl LiveFeed {
         };
         let (truth, commit, progress, life) = open().map_err(transport_err)?;
         let views = match scenario.sensing {
-            Some(_) => (0..n)
-                .map(|i| transport.receiver::<View>(&topics::view(i), topics::state_qos()))
+            Some(_) => (scenario.run.agent_processes(n))
+                .map(|(first, _)| transport.slice_receiver(&topics::view(first as usize), topics::state_qos()))
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(transport_err)?,
             None => Vec::new(),
@@ -253,11 +253,14 @@ impl Feed for LiveFeed {
             (self.commit).drain_pending(|h, d| apply(Update::Commit(CommitView::new(h, d))));
         commits.map_err(|e| self.err(e))?;
         for rx in &self.views {
-            // The newest view is what the robot sees now; older ones are gone already.
-            let mut newest: Option<View> = None;
-            rx.drain_pending(|v| newest = Some(*v))
-                .map_err(|e| self.err(e))?;
-            if let Some(v) = &newest {
+            // The newest sample is what the process's robots see now; older ones are gone
+            // already. Handed on in place, one sample held at a time.
+            rx.take_wakeup().map_err(|e| self.err(e))?;
+            let mut newest = None;
+            while let Some(sample) = rx.receive().map_err(|e| self.err(e))? {
+                newest = Some(sample);
+            }
+            for v in newest.iter().flat_map(|s| s.payload()) {
                 apply(Update::View(v));
             }
         }

@@ -27,7 +27,8 @@ use serde::Serialize;
 use super::registry::{LiveRunError, RunRegistry};
 use hnav_runtime::msg::{
     Candidate, CommitHeader, Decision, Estimate, Heartbeat, Lifecycle, MapHeader, MoverPlace,
-    MoversHeader, Odometry, Pose, Progress, Sighting, TruthHeader, View, WheelCommand, WorldHeader,
+    MoversHeader, Odometry, OdometryHeader, Pose, Progress, Sighting, TruthHeader, View,
+    ViewsHeader, WheelCommand, WheelsHeader, WorldHeader,
 };
 use hnav_runtime::transport::{run_config, Ipc, TransportError};
 
@@ -256,13 +257,10 @@ fn open_ports(
     fixed!(
         Candidate,
         Progress,
-        WheelCommand,
-        Odometry,
         Lifecycle,
         Heartbeat,
         Estimate,
-        Sighting,
-        View
+        Sighting
     );
     sliced!(
         (Decision, CommitHeader),
@@ -270,6 +268,9 @@ fn open_ports(
         (f32, MapHeader),
         (u32, WorldHeader),
         (MoverPlace, MoversHeader),
+        (WheelCommand, WheelsHeader),
+        (Odometry, OdometryHeader),
+        (View, ViewsHeader),
         (u8, ())
     );
     None

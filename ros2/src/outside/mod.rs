@@ -25,6 +25,7 @@ pub mod origin;
 pub mod robot;
 pub mod wheels;
 
+use std::ops::Range;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -32,11 +33,12 @@ use hnav_runtime::grid::geometry::cell_centre_pose;
 use hnav_runtime::health::Heartbeat;
 use hnav_runtime::launch::{LifecyclePorts, StartOutcome};
 use hnav_runtime::msg::{
-    LifecycleEvent, Odometry as HallOdometry, Pose, Role, RosterState, TruthHeader, TruthView,
+    LifecycleEvent, Odometry as HallOdometry, OdometryHeader, Pose, Role, RosterState, TruthHeader,
+    TruthView,
 };
 use hnav_runtime::scenario::{OdometrySource, Ros2Params, Scenario};
-use hnav_runtime::topics::{self, TruthSender};
-use hnav_runtime::transport::{RunId, Sender, Transport, TransportError, Wake};
+use hnav_runtime::topics::{self, OdometrySender, TruthSender};
+use hnav_runtime::transport::{RunId, Transport, TransportError, Wake};
 
 use crate::graph::Qos;
 use crate::msgs::{JointState, Odometry, Twist};
@@ -169,7 +171,8 @@ impl Outside {
 
 /// The run's ports that `hnav-sim` would have.
 struct SimPorts {
-    odom: Vec<Sender<HallOdometry>>,
+    /// One per agent process: the robots it hosts and their odometry.
+    odom: Vec<(Range<u32>, OdometrySender)>,
     truth: TruthSender,
     life: LifecyclePorts,
 }
@@ -187,12 +190,15 @@ pub fn drive(
     let transport = Transport::builder(run)
         .node_name(&Role::Sim.node_name(0))
         .create()?;
-    let inputs = Inputs::open(&transport, n, false)?;
+    let inputs = Inputs::open(&transport, scenario, false)?;
     let q = topics::state_qos();
     let ports = SimPorts {
-        odom: (0..n)
-            .map(|i| transport.sender(&topics::odometry(i), q))
-            .collect::<Result<_, _>>()?,
+        odom: (scenario.run.agent_processes(n))
+            .map(|(first, count)| {
+                let tx = transport.slice_sender(&topics::odometry(first as usize), count as usize, q)?;
+                Ok((first..first + count, tx))
+            })
+            .collect::<Result<_, TransportError>>()?,
         truth: transport.slice_sender(topics::TRUTH, n, topics::truth_qos())?,
         life: LifecyclePorts::open(&transport, Role::Sim, 0, n)?,
     };
@@ -339,19 +345,26 @@ impl Loop {
         outside: &mut Outside,
         out: &mut Out,
     ) -> Result<(), TransportError> {
-        for (i, rx) in inputs.wheels.iter().enumerate() {
-            let mut latest = None;
+        for rx in &inputs.wheels {
             // Consumes the listener's events too (the waiter is attached to it): a pending
-            // event would end every later wait at once.
-            rx.drain_pending(|c| latest = Some((c.left_rad_s, c.right_rad_s)))?;
-            let (Some(w), Some(r)) = (latest, outside.robots.get_mut(i)) else {
-                continue;
-            };
-            scene.robots[i].wheels = Some(w);
-            r.commanded = Some(Instant::now());
-            if !(r.down || r.agent_down) {
-                out.put(&mut topics.robots[i].cmd_vel, &scene.twist(i));
-                r.stopped = false;
+            // event would end every later wait at once. The newest sample holds every robot
+            // of the process's latest command.
+            rx.take_wakeup()?;
+            let mut newest = None;
+            while let Some(sample) = rx.receive()? {
+                newest = Some(sample);
+            }
+            for c in newest.iter().flat_map(|s| s.payload()) {
+                let i = c.agent as usize;
+                let Some(r) = outside.robots.get_mut(i) else {
+                    continue;
+                };
+                scene.robots[i].wheels = Some((c.left_rad_s, c.right_rad_s));
+                r.commanded = Some(Instant::now());
+                if !(r.down || r.agent_down) {
+                    out.put(&mut topics.robots[i].cmd_vel, &scene.twist(i));
+                    r.stopped = false;
+                }
             }
         }
         Ok(())
@@ -452,15 +465,23 @@ impl Loop {
         scene: &mut Scene,
     ) -> Result<(), TransportError> {
         let sim_time_ns = u64::try_from(self.period.as_nanos()).unwrap_or(u64::MAX) * self.k;
-        for (i, (tx, r)) in ports.odom.iter().zip(&outside.robots).enumerate() {
-            tx.send(HallOdometry {
-                sim_time_ns,
-                period: self.k,
-                agent: i as u32,
-                flags: 0,
-                ticks_left: ticks(r.angles.0, self.ticks_per_rev),
-                ticks_right: ticks(r.angles.1, self.ticks_per_rev),
-                fix: Pose::default(),
+        for (robots, tx) in &ports.odom {
+            let header = OdometryHeader {
+                first: robots.start,
+                count: robots.len() as u32,
+            };
+            tx.send_from_fn(header, robots.len(), |k| {
+                let i = robots.start + k as u32;
+                let angles = outside.robots.get(i as usize).map_or((0.0, 0.0), |r| r.angles);
+                HallOdometry {
+                    sim_time_ns,
+                    period: self.k,
+                    agent: i,
+                    flags: 0,
+                    ticks_left: ticks(angles.0, self.ticks_per_rev),
+                    ticks_right: ticks(angles.1, self.ticks_per_rev),
+                    fix: Pose::default(),
+                }
             })?;
         }
         let (k, starts) = (self.k, &self.starts);

@@ -31,6 +31,7 @@
 //! | [`View`] | 416 | 8 | 0 sim_time_ns u64, 8 period u64, 16 agent u32, 20 x0 u32, 24 y0 u32, 28 size u32, 32 seen [u32; 32], 160 blocked [u32; 32], 288 moving [u32; 32] |
 //! | [`MoversHeader`] | 16 | 8 | 0 sim_time_ns u64, 8 period u64 |
 //! | [`MoverPlace`] | 32 | 8 | 0 mover u32, 4 reserved u32, 8 pose Pose |
+//! | [`WheelsHeader`], [`OdometryHeader`], [`ViewsHeader`] | 8 | 4 | 0 first u32, 4 count u32 |
 //! | [`Sighting`] | 152 | 8 | 0 round u64, 8 agent u32, 12 count u32, 16 closed u32, 20 reserved u32, 24 cells [u32; 32] |
 //! | [`WorldHeader`] | 24 | 8 | 0 round u64, 8 closed u32, 12 opened u32, 16 to u32, 20 reserved u32 |
 //! | [`MapHeader`] | 32 | 8 | 0 round u64, 8 agent u32, 12 width u32, 16 height u32, 20 iterations u32, 24 target u32, 28 activation u8, 29 reserved [u8; 3] |
@@ -48,8 +49,14 @@
 //! of `u32` (the addressees' bits, then the cells) whose user header is a [`WorldHeader`]; the movers' places are a slice service of
 //! [`MoverPlace`] whose user header is a [`MoversHeader`].
 //!
+//! A robot's wheel commands, odometry and views travel per agent process: `wheels/<first>`
+//! is a slice of [`WheelCommand`] with a [`WheelsHeader`], `odom/<first>` of [`Odometry`]
+//! with an [`OdometryHeader`], `view/<first>` of [`View`] with a [`ViewsHeader`], where
+//! `first` is the process's first robot (`batch` says why).
+//!
 //! | module | payloads |
 //! |---|---|
+//! | `batch` | one agent process's robots in one sample: [`WheelsHeader`], [`OdometryHeader`], [`ViewsHeader`] |
 //! | `round` | the decision round: [`Candidate`], [`Decision`], [`CommitHeader`], [`CommitView`], [`Commit`], [`Progress`] |
 //! | `motion` | wheels, ground truth and estimates: [`WheelCommand`], [`Odometry`], [`Pose`], [`TruthHeader`], [`TruthView`], [`Truth`], [`Estimate`] |
 //! | `lifecycle` | the supervisor's protocol: [`Role`] and its names, [`LifecycleEvent`], [`StopReason`], [`StartupPhase`], [`Lifecycle`] and its constructors |
@@ -59,6 +66,7 @@
 //! | `world` | the shared picture of a changing world: [`Sighting`], [`WorldHeader`] |
 //! | [`wire`] | a payload as its bytes, checked on arrival, for links that leave the host ([`Wire`], [`WireSlice`]) |
 
+mod batch;
 mod health;
 mod lifecycle;
 mod map;
@@ -68,6 +76,7 @@ mod sensing;
 pub mod wire;
 mod world;
 
+pub use batch::{OdometryHeader, ViewsHeader, WheelsHeader};
 pub use health::Heartbeat;
 pub use lifecycle::{
     Lifecycle, LifecycleEvent, Role, RosterState, StartupPhase, StopReason, MAX_REPLICAS,

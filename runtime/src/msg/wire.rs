@@ -14,7 +14,8 @@ use iceoryx2::prelude::ZeroCopySend;
 
 use super::{
     Candidate, CommitHeader, Decision, Estimate, Heartbeat, LifecycleEvent, MapHeader, Odometry,
-    Pose, Progress, Role, TruthHeader, Verdict, WheelCommand, MAX_AGENTS,
+    OdometryHeader, Pose, Progress, Role, TruthHeader, Verdict, WheelCommand, WheelsHeader,
+    MAX_AGENTS,
 };
 use crate::msg::Lifecycle;
 
@@ -281,6 +282,60 @@ impl Wire for Estimate {
     }
 }
 
+/// A batch's header: its first robot is one, and it holds no more elements than a swarm.
+fn batch_header(first: u32, count: u32) -> Result<(), String> {
+    agent("first", first)?;
+    if count as usize > MAX_AGENTS {
+        return Err(format!("count {count} is over {MAX_AGENTS}"));
+    }
+    Ok(())
+}
+
+/// A batch's elements: as many as the header says, each sound, none for a robot before the
+/// process's first.
+fn batch_elements<E: Wire>(
+    (first, count): (u32, u32),
+    elements: &[E],
+    robot: impl Fn(&E) -> u32,
+) -> Result<(), String> {
+    same_count("count", count, elements.len())?;
+    for e in elements {
+        e.check()?;
+        if robot(e) < first {
+            return Err(format!("robot {} before the batch's first, {first}", robot(e)));
+        }
+    }
+    Ok(())
+}
+
+impl Wire for WheelsHeader {
+    fn check(&self) -> Result<(), String> {
+        batch_header(self.first, self.count)
+    }
+}
+
+impl WireSlice for WheelsHeader {
+    type Element = WheelCommand;
+
+    fn check_elements(&self, commands: &[WheelCommand]) -> Result<(), String> {
+        batch_elements((self.first, self.count), commands, |c| c.agent)
+    }
+}
+
+impl Wire for OdometryHeader {
+    fn check(&self) -> Result<(), String> {
+        batch_header(self.first, self.count)
+    }
+}
+
+impl WireSlice for OdometryHeader {
+    type Element = Odometry;
+
+    fn check_elements(&self, readings: &[Odometry]) -> Result<(), String> {
+        batch_elements((self.first, self.count), readings, |o| o.agent)
+    }
+}
+
 impl Wire for MapHeader {
     fn check(&self) -> Result<(), String> {
         agent("agent", self.agent)
@@ -314,6 +369,32 @@ mod tests {
         back.assign(c.bytes()).unwrap();
         assert_eq!(back, c);
         assert_eq!(Candidate::wire_name(), "hnav::Candidate");
+    }
+
+    #[test]
+    fn a_batch_of_another_process_or_miscounted_is_refused() {
+        let c = |agent| WheelCommand {
+            agent,
+            ..WheelCommand::default()
+        };
+        let h = WheelsHeader { first: 4, count: 2 };
+        assert_eq!(h.check_elements(&[c(4), c(5)]), Ok(()));
+        assert_eq!(
+            h.check_elements(&[c(4), c(3)]).unwrap_err(),
+            "robot 3 before the batch's first, 4"
+        );
+        assert_eq!(
+            h.check_elements(&[c(4)]).unwrap_err(),
+            "count 2 but 1 elements follow"
+        );
+        let mut bad = c(5);
+        bad.left_rad_s = f64::NAN;
+        assert!(h.check_elements(&[c(4), bad]).is_err());
+        let far = OdometryHeader {
+            first: MAX_AGENTS as u32,
+            count: 0,
+        };
+        assert!(far.check().is_err());
     }
 
     #[test]

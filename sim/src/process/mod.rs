@@ -93,7 +93,7 @@ impl<'t> SimProcess<'t> {
         let world = World::from_scenario(scenario)?;
         let ports = Ports::open(
             transport,
-            world.robots(),
+            scenario.run.agent_processes(world.robots()).collect(),
             scenario.sensing.is_some(),
             scenario.movers().count(),
         )?;

@@ -2,9 +2,13 @@
 //! and which have sent this period's command, and the period counter.
 
 use std::collections::VecDeque;
+use std::ops::Range;
 use std::time::Duration;
 
-use hnav_runtime::msg::{LifecycleEvent, MoversHeader, Role, RosterState};
+use hnav_runtime::msg::{
+    LifecycleEvent, MoversHeader, OdometryHeader, Role, RosterState, View, ViewsHeader,
+};
+use hnav_runtime::topics::OdometrySender;
 use hnav_runtime::scenario::params::ClockMode;
 
 use super::checkpoint::SimCheckpoint;
@@ -180,17 +184,38 @@ impl State {
         let Some(last) = self.period.checked_sub(1) else {
             return Ok(());
         };
-        for &i in restarted {
-            let rejoined = self.live.get(i as usize).copied().unwrap_or(true);
-            if let (false, Some(o), Some(tx)) = (
-                rejoined,
-                self.world.odometry(i, last),
-                ports.odom.get(i as usize),
-            ) {
-                tx.send(o)?;
+        // The robots of one process restart together and share one odometry sample: sent
+        // once for those of them that have not rejoined.
+        for (p, tx) in ports.odom.iter().enumerate() {
+            let robots = ports.robots_of(p);
+            let waiting = |i: &u32| robots.contains(i) && !self.live.get(*i as usize).copied().unwrap_or(true);
+            if !restarted.iter().any(waiting) {
+                continue;
+            }
+            self.send_odometry(tx, robots.clone(), last)?;
+            for &i in restarted.iter().filter(|i| robots.contains(i)) {
                 self.live[i as usize] = true;
             }
         }
+        Ok(())
+    }
+
+    /// Sends the odometry of `robots` (one agent process's) for `period` on `tx`.
+    fn send_odometry(
+        &self,
+        tx: &OdometrySender,
+        robots: Range<u32>,
+        period: u64,
+    ) -> Result<(), SimProcessError> {
+        let (first, n) = (robots.start, robots.len());
+        let header = OdometryHeader {
+            first,
+            count: n as u32,
+        };
+        let w = &self.world;
+        tx.send_from_fn(header, n, |k| {
+            w.odometry(first + k as u32, period).unwrap_or_default()
+        })?;
         Ok(())
     }
 
@@ -206,26 +231,32 @@ impl State {
         let now = self.world.time_ns();
         let realtime = self.clock == ClockMode::Realtime;
         let mut any = false;
-        for (i, rx) in ports.wheels.iter().enumerate() {
+        for (p, rx) in ports.wheels.iter().enumerate() {
+            let robots = ports.robots_of(p);
             let w = rx.take_wakeup()?;
             any |= w.data || w.peer_up || w.peer_left || w.peer_dead;
             if w.peer_dead || w.peer_left {
-                self.live[i] = false;
-                self.have[i] = false;
-                self.world.brake(i as u32);
+                for i in robots.clone() {
+                    self.live[i as usize] = false;
+                    self.have[i as usize] = false;
+                    self.world.brake(i);
+                }
             }
             let (world, have, live, period) =
                 (&mut self.world, &mut self.have, &mut self.live, self.period);
-            any |= rx.drain(|c| {
-                let fresh = c.period >= period || realtime;
-                if fresh && c.agent as usize == i {
-                    // Non-finite set-points are dropped: a bad agent cannot stop the sim.
-                    if world
-                        .apply_command(c.agent, c.period, c.left_rad_s, c.right_rad_s, now)
-                        .is_ok()
+            any |= rx.drain(|_, commands| {
+                for c in commands {
+                    let fresh = c.period >= period || realtime;
+                    // Non-finite set-points are dropped: a bad agent cannot stop the sim;
+                    // nor can it command a robot of another process.
+                    if fresh
+                        && robots.contains(&c.agent)
+                        && world
+                            .apply_command(c.agent, c.period, c.left_rad_s, c.right_rad_s, now)
+                            .is_ok()
                     {
-                        have[i] = true;
-                        live[i] = true;
+                        have[c.agent as usize] = true;
+                        live[c.agent as usize] = true;
                     }
                 }
             })? > 0;
@@ -267,14 +298,23 @@ impl State {
     fn publish(&self, ports: &Ports, period: u64) -> Result<(), SimProcessError> {
         // Views first: an agent acting on its odometry has the view of the same period.
         if let Some(range) = self.view_range {
-            for (i, tx) in ports.view.iter().enumerate() {
-                tx.send_in_place(|v| self.world.fill_view(i as u32, period, range, v))?;
+            for (p, tx) in ports.view.iter().enumerate() {
+                let robots = ports.robots_of(p);
+                let mut loan = tx.loan(robots.len())?;
+                *loan.header_mut() = ViewsHeader {
+                    first: robots.start,
+                    count: robots.len() as u32,
+                };
+                loan.fill_with(View::default(), |views| {
+                    for (i, v) in robots.zip(views) {
+                        self.world.fill_view(i, period, range, v);
+                    }
+                    Ok::<(), SimProcessError>(())
+                })?;
             }
         }
-        for (i, tx) in ports.odom.iter().enumerate() {
-            if let Some(o) = self.world.odometry(i as u32, period) {
-                tx.send(o)?;
-            }
+        for (p, tx) in ports.odom.iter().enumerate() {
+            self.send_odometry(tx, ports.robots_of(p), period)?;
         }
         let world = &self.world;
         let n = world.robots();

@@ -189,9 +189,10 @@ impl OdometryObserver {
                 .node_name("odom-observer")
                 .create()
                 .unwrap();
-            let rx: Vec<_> = (0..robots)
+            // One robot a process (the restart scenarios'): `odom/<i>` is robot i's.
+            let rx: Vec<topics::OdometryReceiver> = (0..robots)
                 .map(|i| {
-                    t.receiver::<Odometry>(&topics::odometry(i), topics::state_qos())
+                    t.slice_receiver(&topics::odometry(i), topics::state_qos())
                         .unwrap()
                 })
                 .collect();
@@ -200,7 +201,7 @@ impl OdometryObserver {
             ready_tx.send(()).unwrap();
             while !stop2.load(Ordering::Relaxed) {
                 for (i, r) in rx.iter().enumerate() {
-                    let _ = r.drain_pending(|o| seen2.lock().unwrap()[i].push(*o));
+                    let _ = r.drain_pending(|_, os| seen2.lock().unwrap()[i].extend_from_slice(os));
                 }
                 // Bounded, so that the thread sees `stop`.
                 let _ = waiter.wait(Some(Instant::now() + Duration::from_millis(100)));

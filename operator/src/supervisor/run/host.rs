@@ -88,6 +88,8 @@ impl HostPart {
             .arg(run)
             .arg("--agents")
             .arg(scenario.agents.len().to_string())
+            .arg("--agents-per-process")
+            .arg(scenario.run.agents_per_process.to_string())
             .arg("--replicas")
             .arg(scenario.coordinator.replicas.to_string())
             .arg("--hosts")
