@@ -34,6 +34,12 @@ def main() -> int:
     parser.add_argument("run_id", metavar="RUN_ID")
     parser.add_argument("--width", type=int, required=True, help="the map's width, cells")
     parser.add_argument("--agent", type=int, default=0, help="whose view (default 0)")
+    parser.add_argument(
+        "--first",
+        type=int,
+        help="the first robot of the agent's process, whose view/<first> topic carries the "
+        "agent's view (default: the agent, as with one robot a process)",
+    )
     parser.add_argument("--timeout", type=float, default=30.0, help="give up after S s")
     a = parser.parse_args()
     try:
@@ -47,7 +53,7 @@ def main() -> int:
 def watch(run: Run, a) -> int:
     """Subscribes, then prints what the docstring says; the exit code of `main`."""
     topics = {
-        "view": run.subscribe(f"view/{a.agent}", a.timeout),
+        "view": run.subscribe(f"view/{a.agent if a.first is None else a.first}", a.timeout),
         "sighting": run.subscribe("sightings", a.timeout),
         "world": run.subscribe("world", a.timeout),
     }
@@ -55,8 +61,10 @@ def watch(run: Run, a) -> int:
     deadline = time.monotonic() + a.timeout
     while missing:
         for s in topics["view"].drain():
-            v = msg.View.from_buffer_copy(bytes(s.payload().contents))
-            if "view" in missing:
+            # One sample per agent process: the view of each of its robots.
+            h = msg.ViewsHeader.from_buffer_copy(bytes(s.user_header().contents))
+            mine = [v for v in msg.slice_of(msg.View, h.count, s) if v.agent == a.agent]
+            for v in mine[:1] if "view" in missing else []:
                 seen = list(v.cells())
                 blocked = sum(1 for _, _, b in seen if b)
                 print(f"view agent {v.agent} period {v.period}: {len(seen)} cells seen, {blocked} blocked")

@@ -360,6 +360,36 @@ class MoverPlace(_Payload):
     ]
 
 
+class WheelsHeader(_Payload):
+    """The user header of `wheels/<first>` (a slice of WheelCommand): the latest command of
+    each robot of the agent process whose first robot is `first`; `count` elements follow."""
+
+    _fields_ = [
+        ("first", ctypes.c_uint32),
+        ("count", ctypes.c_uint32),
+    ]
+
+
+class OdometryHeader(_Payload):
+    """The user header of `odom/<first>` (a slice of Odometry): one reading per robot of the
+    agent process whose first robot is `first`; `count` elements follow."""
+
+    _fields_ = [
+        ("first", ctypes.c_uint32),
+        ("count", ctypes.c_uint32),
+    ]
+
+
+class ViewsHeader(_Payload):
+    """The user header of `view/<first>` (a slice of View): one view per robot of the agent
+    process whose first robot is `first`; `count` elements follow."""
+
+    _fields_ = [
+        ("first", ctypes.c_uint32),
+        ("count", ctypes.c_uint32),
+    ]
+
+
 PAYLOADS = [
     Candidate,
     Decision,
@@ -378,4 +408,7 @@ PAYLOADS = [
     WorldHeader,
     MoversHeader,
     MoverPlace,
+    WheelsHeader,
+    OdometryHeader,
+    ViewsHeader,
 ]

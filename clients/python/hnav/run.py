@@ -27,11 +27,12 @@ IPC_ROOT_ENV = "HNAV_IPC_ROOT"
 DOMAIN_ENV = "HNAV_DOMAIN"
 
 # Every topic of a run: payload and user header (None: no header), as runtime/src/topics.rs
-# opens them. `<i>` stands for an agent index.
+# opens them. `<i>` stands for an agent index, `<first>` for the first robot of an agent process
+# (every robot's own index with the default of one robot a process).
 TOPICS = {
-    "wheels/<i>": (msg.WheelCommand, None),
-    "odom/<i>": (msg.Odometry, None),
-    "view/<i>": (msg.View, None),
+    "wheels/<first>": (iox2.Slice[msg.WheelCommand], msg.WheelsHeader),
+    "odom/<first>": (iox2.Slice[msg.Odometry], msg.OdometryHeader),
+    "view/<first>": (iox2.Slice[msg.View], msg.ViewsHeader),
     "truth": (iox2.Slice[msg.Pose], msg.TruthHeader),
     "candidates": (msg.Candidate, None),
     "commit": (iox2.Slice[msg.Decision], msg.CommitHeader),
@@ -92,6 +93,8 @@ def run_config(run_id: str, domain: "str | None" = None) -> "iox2.config.Config"
 def topic_types(topic: str):
     """The payload and user-header types of `topic` (`commit`, `map/3`, ...)."""
     key = re.sub(r"/\d+$", "/<i>", topic)
+    if key not in TOPICS:
+        key = re.sub(r"/\d+$", "/<first>", topic)
     if key not in TOPICS:
         raise RunError(f"{topic!r} is not a topic of an HNAV run ({', '.join(TOPICS)})")
     return TOPICS[key]

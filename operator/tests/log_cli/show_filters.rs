@@ -156,3 +156,31 @@ fn a_bad_filter_is_refused_with_what_it_must_be() {
         assert!(lines.is_empty() && err.contains(says), "{args:?}: {err}");
     }
 }
+
+/// On a terminal the lines go through the pager (`HNAV_PAGER`, here `tee FILE`, which keeps a
+/// copy); to a pipe, or with `--no-pager`, never. The terminal is a pseudo-terminal from
+/// `script(1)` (util-linux), run by the test itself.
+#[test]
+fn a_terminal_gets_the_lines_through_the_pager_and_a_pipe_does_not() {
+    let tmp = tempfile::tempdir().unwrap();
+    log(tmp.path());
+    let (_, piped, _) = show(tmp.path(), &[]);
+    assert!(piped.len() > 3, "{piped:?}");
+    let hnav = env!("CARGO_BIN_EXE_hnav");
+    let paged = |extra: &str, copy: &std::path::Path| {
+        let line = format!("{hnav} log show {} {extra}", tmp.path().display());
+        let out = Command::new("script")
+            .args(["-qec", &line, "/dev/null"])
+            .env("HNAV_PAGER", format!("tee {}", copy.display()))
+            .output()
+            .expect("script(1) runs");
+        assert!(out.status.success(), "{out:?}");
+    };
+    let copy = tmp.path().join("paged.txt");
+    paged("", &copy);
+    let through = std::fs::read_to_string(&copy).expect("the pager read the lines");
+    assert_eq!(through.lines().collect::<Vec<_>>(), piped);
+    let unpaged = tmp.path().join("unpaged.txt");
+    paged("--no-pager", &unpaged);
+    assert!(!unpaged.exists(), "--no-pager started the pager");
+}

@@ -19,6 +19,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::Subcommand;
+
+use crate::pager::Paged;
 use hnav_runtime::consensus_log::filter::{parse_kind, parse_rounds};
 use hnav_runtime::consensus_log::show::{describe, to_json};
 use hnav_runtime::consensus_log::{
@@ -57,6 +59,10 @@ pub enum LogCommand {
         /// lifecycle, replan, unreachable, end, raft-entry, raft-state, snapshot.
         #[arg(long, value_name = "KIND", value_delimiter = ',', value_parser = parse_kind)]
         kind: Vec<String>,
+        /// Print straight to the terminal: without it, output to a terminal goes through
+        /// `$HNAV_PAGER`, `$PAGER` or `less` (a pipe or a file is never paged).
+        #[arg(long)]
+        no_pager: bool,
     },
     /// Run a lockstep run again from its scenario and seed and check that every round
     /// decides as logged: exit 0 identical, 1 diverged (the first divergence is printed), 2
@@ -78,13 +84,15 @@ pub fn run(cmd: LogCommand) -> ExitCode {
             round,
             agent,
             kind,
+            no_pager,
         } => {
             let filter = RecordFilter {
                 rounds: round,
                 agent,
                 kinds: kind,
             };
-            show_cmd(&log_dir(&dir), json, &filter)
+            let out = Paged::start(!no_pager);
+            show_cmd(&log_dir(&dir), json, &filter, out)
         }
         LogCommand::Replay(args) => crate::log_replay_cmd::run(args),
         LogCommand::Export(args) => crate::log_export_cmd::run(args),
@@ -140,7 +148,24 @@ fn verify_cmd(dir: &Path) -> ExitCode {
     ExitCode::from(worst)
 }
 
-fn show_cmd(dir: &Path, json: bool, filter: &RecordFilter) -> ExitCode {
+/// Prints the records `filter` keeps to `out` (a pager on a terminal), then waits for the
+/// pager; errors go to standard error, after the lines printed so far.
+fn show_cmd(dir: &Path, json: bool, filter: &RecordFilter, out: Paged) -> ExitCode {
+    let mut out = std::io::BufWriter::new(out);
+    let code = show_records(dir, json, filter, &mut out);
+    let _ = out.flush();
+    if let Ok(paged) = out.into_inner() {
+        paged.finish();
+    }
+    code
+}
+
+fn show_records(
+    dir: &Path,
+    json: bool,
+    filter: &RecordFilter,
+    out: &mut impl Write,
+) -> ExitCode {
     let dir = if replicas_in(dir).is_empty() {
         dir.to_path_buf()
     } else {
@@ -163,8 +188,6 @@ fn show_cmd(dir: &Path, json: bool, filter: &RecordFilter) -> ExitCode {
             return ExitCode::from(if e.is_unreadable() { 2 } else { 1 });
         }
     };
-    let stdout = std::io::stdout();
-    let mut out = std::io::BufWriter::new(stdout.lock());
     let mut width = 0;
     loop {
         let (pos, record) = match reader.next_record() {

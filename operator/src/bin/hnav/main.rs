@@ -16,6 +16,7 @@ mod kill_cmd;
 mod log_cmd;
 mod log_export_cmd;
 mod log_replay_cmd;
+mod pager;
 mod ps_cmd;
 mod report_cmd;
 mod run_cmd;

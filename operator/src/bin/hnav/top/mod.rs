@@ -45,6 +45,11 @@ pub struct TopArgs {
     /// Leave as soon as the run ends, instead of showing "run ended" until a key is pressed.
     #[arg(long)]
     pub exit_on_end: bool,
+    /// Leave after drawing N frames and print the frame rate and the slowest frames to
+    /// standard error: how `hnav top` is measured on a large swarm
+    /// (docs/explanation/performance.md). Hidden: a measurement, not a way to watch.
+    #[arg(long, value_name = "N", hide = true)]
+    pub frames: Option<u32>,
 }
 
 /// How the viewer was left.
@@ -52,12 +57,65 @@ enum Left {
     Key,
     Signal,
     RunEnded,
+    Frames,
+}
+
+/// `--frames N`: when each frame started, for the rate of a large swarm's view.
+struct FrameClock {
+    wanted: u32,
+    started: Option<Instant>,
+    /// Each frame's draw time (state already folded in), s.
+    draws: Vec<f64>,
+    /// The longest gap between two frames' starts, s.
+    worst_gap: f64,
+    last: Option<Instant>,
+}
+
+impl FrameClock {
+    fn new(wanted: u32) -> Self {
+        Self {
+            wanted: wanted.max(1),
+            started: None,
+            draws: Vec::with_capacity(wanted as usize),
+            worst_gap: 0.0,
+            last: None,
+        }
+    }
+
+    /// Records a frame that started at `at` and took `draw`; whether enough were drawn.
+    fn tick(&mut self, at: Instant, draw: Duration) -> bool {
+        self.started.get_or_insert(at);
+        if let Some(l) = self.last.replace(at) {
+            self.worst_gap = self.worst_gap.max(at.duration_since(l).as_secs_f64());
+        }
+        self.draws.push(draw.as_secs_f64());
+        self.draws.len() as u32 >= self.wanted
+    }
+
+    fn describe(&self, robots: usize) -> String {
+        let n = self.draws.len();
+        let span = match (self.started, self.last) {
+            (Some(a), Some(b)) => b.duration_since(a).as_secs_f64(),
+            _ => 0.0,
+        };
+        let mut d = self.draws.clone();
+        d.sort_by(f64::total_cmp);
+        let at = |q: f64| d.get(((n as f64 - 1.0) * q).round() as usize).copied().unwrap_or(0.0);
+        format!(
+            "frames {n} robots {robots} in {span:.2} s: {:.2} frames/s (aim {:.0}); draw p50 {:.1} ms, max {:.1} ms; longest gap {:.1} ms",
+            if span > 0.0 { (n - 1) as f64 / span } else { 0.0 },
+            1.0 / FRAME.as_secs_f64(),
+            at(0.5) * 1e3,
+            at(1.0) * 1e3,
+            self.worst_gap * 1e3
+        )
+    }
 }
 
 /// Shows the run until it is left; see the module docs for the exit codes.
 pub fn run(args: TopArgs) -> ExitCode {
     match LiveFeed::open(&RunRegistry::default_location(), args.run.as_deref()) {
-        Ok(feed) => view(feed, args.exit_on_end),
+        Ok(feed) => view_counting(feed, args.exit_on_end, args.frames),
         Err(e) => {
             hnav_runtime::errln!("error: {e}");
             ExitCode::from(2)
@@ -68,6 +126,11 @@ pub fn run(args: TopArgs) -> ExitCode {
 /// Shows what `feed` yields until the viewer is left: the live view of `hnav top` and the
 /// playback of `hnav log replay --speed`. Exit codes as in the module docs.
 pub fn view(feed: impl Feed, exit_on_end: bool) -> ExitCode {
+    view_counting(feed, exit_on_end, None)
+}
+
+/// [`view()`], leaving after `frames` frames if given and then telling how fast they came.
+fn view_counting(feed: impl Feed, exit_on_end: bool, frames: Option<u32>) -> ExitCode {
     let mut state = ViewState::new(feed.info().clone());
     let mut guard = match TerminalGuard::enter() {
         Ok(g) => g,
@@ -76,8 +139,12 @@ pub fn view(feed: impl Feed, exit_on_end: bool) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let result = show(&mut guard, Some(feed), &mut state, exit_on_end);
+    let mut clock = frames.map(FrameClock::new);
+    let result = show(&mut guard, Some(feed), &mut state, exit_on_end, clock.as_mut());
     drop(guard);
+    if let Some(c) = &clock {
+        hnav_runtime::errln!("{}", c.describe(state.agents.len()));
+    }
     let run = &state.info.run_id;
     let at_goal = format!("{}/{} at goal", state.at_goal(), state.agents.len());
     match result {
@@ -85,6 +152,7 @@ pub fn view(feed: impl Feed, exit_on_end: bool) -> ExitCode {
             let how = match (left, state.ended) {
                 (Left::RunEnded | Left::Key, Some(end)) => format!("ended: {}", end.describe()),
                 (Left::Signal, _) => "left on a signal".to_string(),
+                (Left::Frames, _) => "left after the frames asked for".to_string(),
                 (_, None) => "left".to_string(),
             };
             hnav_runtime::outln!("run {run} {how} (round {}, {at_goal})", state.round);
@@ -113,6 +181,7 @@ fn show<F: Feed>(
     mut feed: Option<F>,
     state: &mut ViewState,
     exit_on_end: bool,
+    mut clock: Option<&mut FrameClock>,
 ) -> Result<Left, ShowError> {
     let hints = Hints::default();
     let mut next_frame = Instant::now();
@@ -147,6 +216,11 @@ fn show<F: Feed>(
                 .terminal()
                 .draw(|f| view::draw(f, state, now, hints))?;
             next_frame = now + FRAME;
+            if let Some(c) = clock.as_deref_mut() {
+                if c.tick(now, now.elapsed()) {
+                    return Ok(Left::Frames);
+                }
+            }
             if !live && exit_on_end {
                 return Ok(Left::RunEnded);
             }
