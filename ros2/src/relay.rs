@@ -11,9 +11,7 @@
 
 use std::time::{Duration, Instant};
 
-use hnav_runtime::msg::{
-    CommitView, Estimate, Lifecycle, LifecycleEvent, MapHeader, TruthView,
-};
+use hnav_runtime::msg::{CommitView, Estimate, Lifecycle, LifecycleEvent, MapHeader, TruthView};
 use hnav_runtime::scenario::{OdometrySource, Scenario};
 use hnav_runtime::topics::{self, CommitReceiver, TruthReceiver, WheelsReceiver};
 use hnav_runtime::transport::{Receiver, RunId, SliceReceiver, Transport, TransportError, Wake};
@@ -174,7 +172,9 @@ impl Inputs {
             estimate: t.receiver(topics::ESTIMATE, topics::estimate_qos(n))?,
             commit: t.slice_receiver(topics::COMMIT, topics::commit_qos(n))?,
             wheels: (scenario.run.agent_processes(n))
-                .map(|(first, _)| t.slice_receiver(&topics::wheels(first as usize), topics::state_qos()))
+                .map(|(first, _)| {
+                    t.slice_receiver(&topics::wheels(first as usize), topics::state_qos())
+                })
                 .collect::<Result<_, _>>()?,
             maps: (0..n)
                 .map(|i| t.slice_receiver(&topics::map(i), topics::state_qos()))

@@ -13,8 +13,8 @@ use serde::Serialize;
 
 use crate::msg::{
     Candidate, CommitHeader, Decision, Estimate, Heartbeat, Lifecycle, MapHeader, MoverPlace,
-    MoversHeader, Odometry, OdometryHeader, Pose, Progress, Sighting, TruthHeader, View, ViewsHeader, WheelCommand, WheelsHeader, WorldHeader,
-    MAX_AGENTS,
+    MoversHeader, Odometry, OdometryHeader, Pose, Progress, Sighting, TruthHeader, View,
+    ViewsHeader, WheelCommand, WheelsHeader, WorldHeader, MAX_AGENTS,
 };
 use crate::topics;
 

@@ -3,9 +3,9 @@
 //!
 //! | topic | payload | publishers -> subscribers | QoS |
 //! |---|---|---|---|
-//! | `wheels/<first>` | [`WheelCommand`](crate::msg::WheelCommand) slice + [`WheelsHeader`], the latest of each robot of the process | agent process -> sim | latest |
-//! | `odom/<first>` | [`Odometry`](crate::msg::Odometry) slice + [`OdometryHeader`], one per robot of the process | sim -> agent process | latest |
-//! | `view/<first>` | [`View`](crate::msg::View) slice + [`ViewsHeader`], one per robot of the process | sim -> agent process (with `[sensing]`) | latest |
+//! | `wheels/<first>` | [`WheelCommand`] slice + [`WheelsHeader`], the latest of each robot of the process | agent process -> sim | latest |
+//! | `odom/<first>` | [`Odometry`] slice + [`OdometryHeader`], one per robot of the process | sim -> agent process | latest |
+//! | `view/<first>` | [`View`] slice + [`ViewsHeader`], one per robot of the process | sim -> agent process (with `[sensing]`) | latest |
 //! | `truth` | [`Pose`] slice + [`TruthHeader`], one pose per robot | sim -> supervisor, recorder, viewers | latest, deep buffer ([`truth_qos`]) |
 //! | `estimate` | [`Estimate`](crate::msg::Estimate) | every agent -> recorder, `hnav-ros2`, viewers | latest, depth 1, not notified ([`estimate_qos`]) |
 //! | `candidates` | [`Candidate`](crate::msg::Candidate) | agents -> coordinator | reliable |

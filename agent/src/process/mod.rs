@@ -221,7 +221,10 @@ impl<'t> AgentProcess<'t> {
         if started == StartOutcome::Stopped {
             return Ok(robots.cores.iter().map(Core::outcome).collect());
         }
-        for ((core, r), span) in (robots.cores.iter_mut()).zip(&robots.ports).zip(&robots.spans) {
+        for ((core, r), span) in (robots.cores.iter_mut())
+            .zip(&robots.ports)
+            .zip(&robots.spans)
+        {
             span.in_scope(|| core.begin(p, r, resume))?;
         }
         p.wheels.flush()?;
@@ -306,7 +309,11 @@ fn sort_into(p: &Ports, cores: &[Core], inbox: &mut [Inbox]) -> Result<(), Agent
         for o in readings {
             match slot(o.agent).and_then(|k| inbox.get_mut(k)) {
                 Some(b) => b.odometry(o),
-                None => tracing::warn!(agent = first, from = o.agent, "odometry of another robot dropped"),
+                None => tracing::warn!(
+                    agent = first,
+                    from = o.agent,
+                    "odometry of another robot dropped"
+                ),
             }
         }
     })?;

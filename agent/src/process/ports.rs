@@ -10,9 +10,7 @@ use hnav_runtime::launch::LifecyclePorts;
 use hnav_runtime::msg::{
     Candidate, Estimate, MapHeader, Role, Sighting, WheelCommand, WheelsHeader, WorldHeader,
 };
-use hnav_runtime::topics::{
-    self, CommitReceiver, OdometryReceiver, ViewsReceiver, WheelsSender,
-};
+use hnav_runtime::topics::{self, CommitReceiver, OdometryReceiver, ViewsReceiver, WheelsSender};
 use hnav_runtime::transport::{
     Bell, BellWatch, Sender, SliceReceiver, SliceSender, Transport, TransportError,
 };

@@ -205,7 +205,12 @@ impl Core {
     /// ([`Core::apply_commit`], [`Core::after_commits`]) and the coordinator's map
     /// ([`Core::learn_world`]) and sorted out its odometry and view (`inbox`), in the order
     /// that keeps lockstep runs deterministic: view, odometry, then what they made due.
-    pub(super) fn step(&mut self, p: &Ports, r: &RobotPorts, inbox: Inbox) -> Result<(), AgentError> {
+    pub(super) fn step(
+        &mut self,
+        p: &Ports,
+        r: &RobotPorts,
+        inbox: Inbox,
+    ) -> Result<(), AgentError> {
         self.on_view(inbox.view)?;
         self.on_odometry(p, r, inbox.odometry)?;
         self.send_candidate(p, r)?;

@@ -25,9 +25,7 @@ use crate::supervisor::registry::LiveRunError;
 use crate::supervisor::registry::{RunRecord, RunRegistry};
 use hnav_runtime::consensus_log::reader::LogReader;
 use hnav_runtime::consensus_log::record::Record;
-use hnav_runtime::msg::{
-    CommitView, Lifecycle, MoverPlace, MoversHeader, Progress, TruthView,
-};
+use hnav_runtime::msg::{CommitView, Lifecycle, MoverPlace, MoversHeader, Progress, TruthView};
 use hnav_runtime::topics::{self, CommitReceiver, TruthReceiver, ViewsReceiver};
 use hnav_runtime::transport::{Receiver, RunId, SliceReceiver, Transport, TransportError, Wake};
 
@@ -151,7 +149,9 @@ impl LiveFeed {
         let (truth, commit, progress, life) = open().map_err(transport_err)?;
         let views = match scenario.sensing {
             Some(_) => (scenario.run.agent_processes(n))
-                .map(|(first, _)| transport.slice_receiver(&topics::view(first as usize), topics::state_qos()))
+                .map(|(first, _)| {
+                    transport.slice_receiver(&topics::view(first as usize), topics::state_qos())
+                })
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(transport_err)?,
             None => Vec::new(),

@@ -254,14 +254,7 @@ fn open_ports(
             })*
         };
     }
-    fixed!(
-        Candidate,
-        Progress,
-        Lifecycle,
-        Heartbeat,
-        Estimate,
-        Sighting
-    );
+    fixed!(Candidate, Progress, Lifecycle, Heartbeat, Estimate, Sighting);
     sliced!(
         (Decision, CommitHeader),
         (Pose, TruthHeader),

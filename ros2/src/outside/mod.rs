@@ -195,7 +195,8 @@ pub fn drive(
     let ports = SimPorts {
         odom: (scenario.run.agent_processes(n))
             .map(|(first, count)| {
-                let tx = transport.slice_sender(&topics::odometry(first as usize), count as usize, q)?;
+                let tx =
+                    transport.slice_sender(&topics::odometry(first as usize), count as usize, q)?;
                 Ok((first..first + count, tx))
             })
             .collect::<Result<_, TransportError>>()?,
@@ -472,7 +473,10 @@ impl Loop {
             };
             tx.send_from_fn(header, robots.len(), |k| {
                 let i = robots.start + k as u32;
-                let angles = outside.robots.get(i as usize).map_or((0.0, 0.0), |r| r.angles);
+                let angles = outside
+                    .robots
+                    .get(i as usize)
+                    .map_or((0.0, 0.0), |r| r.angles);
                 HallOdometry {
                     sim_time_ns,
                     period: self.k,

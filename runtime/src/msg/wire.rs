@@ -302,7 +302,10 @@ fn batch_elements<E: Wire>(
     for e in elements {
         e.check()?;
         if robot(e) < first {
-            return Err(format!("robot {} before the batch's first, {first}", robot(e)));
+            return Err(format!(
+                "robot {} before the batch's first, {first}",
+                robot(e)
+            ));
         }
     }
     Ok(())

@@ -7,9 +7,7 @@ use hnav_runtime::launch::LifecyclePorts;
 use std::ops::Range;
 
 use hnav_runtime::msg::{MoverPlace, MoversHeader};
-use hnav_runtime::topics::{
-    self, OdometrySender, TruthSender, ViewsSender, WheelsReceiver,
-};
+use hnav_runtime::topics::{self, OdometrySender, TruthSender, ViewsSender, WheelsReceiver};
 use hnav_runtime::transport::{Attachment, SliceSender, Transport, TransportError, Waiter};
 
 /// The process's open ports. Kept apart from the [`State`](super::state::State) so that the

@@ -8,8 +8,8 @@ use std::time::Duration;
 use hnav_runtime::msg::{
     LifecycleEvent, MoversHeader, OdometryHeader, Role, RosterState, View, ViewsHeader,
 };
-use hnav_runtime::topics::OdometrySender;
 use hnav_runtime::scenario::params::ClockMode;
+use hnav_runtime::topics::OdometrySender;
 
 use super::checkpoint::SimCheckpoint;
 use super::ports::Ports;
@@ -188,7 +188,9 @@ impl State {
         // once for those of them that have not rejoined.
         for (p, tx) in ports.odom.iter().enumerate() {
             let robots = ports.robots_of(p);
-            let waiting = |i: &u32| robots.contains(i) && !self.live.get(*i as usize).copied().unwrap_or(true);
+            let waiting = |i: &u32| {
+                robots.contains(i) && !self.live.get(*i as usize).copied().unwrap_or(true)
+            };
             if !restarted.iter().any(waiting) {
                 continue;
             }

@@ -160,12 +160,7 @@ fn show_cmd(dir: &Path, json: bool, filter: &RecordFilter, out: Paged) -> ExitCo
     code
 }
 
-fn show_records(
-    dir: &Path,
-    json: bool,
-    filter: &RecordFilter,
-    out: &mut impl Write,
-) -> ExitCode {
+fn show_records(dir: &Path, json: bool, filter: &RecordFilter, out: &mut impl Write) -> ExitCode {
     let dir = if replicas_in(dir).is_empty() {
         dir.to_path_buf()
     } else {

@@ -100,7 +100,11 @@ impl FrameClock {
         };
         let mut d = self.draws.clone();
         d.sort_by(f64::total_cmp);
-        let at = |q: f64| d.get(((n as f64 - 1.0) * q).round() as usize).copied().unwrap_or(0.0);
+        let at = |q: f64| {
+            d.get(((n as f64 - 1.0) * q).round() as usize)
+                .copied()
+                .unwrap_or(0.0)
+        };
         format!(
             "frames {n} robots {robots} in {span:.2} s: {:.2} frames/s (aim {:.0}); draw p50 {:.1} ms, max {:.1} ms; longest gap {:.1} ms",
             if span > 0.0 { (n - 1) as f64 / span } else { 0.0 },
@@ -140,7 +144,13 @@ fn view_counting(feed: impl Feed, exit_on_end: bool, frames: Option<u32>) -> Exi
         }
     };
     let mut clock = frames.map(FrameClock::new);
-    let result = show(&mut guard, Some(feed), &mut state, exit_on_end, clock.as_mut());
+    let result = show(
+        &mut guard,
+        Some(feed),
+        &mut state,
+        exit_on_end,
+        clock.as_mut(),
+    );
     drop(guard);
     if let Some(c) = &clock {
         hnav_runtime::errln!("{}", c.describe(state.agents.len()));
