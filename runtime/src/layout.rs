@@ -378,6 +378,6 @@ mod tests {
         let map = l.topics.iter().find(|t| t.topic == "map/<i>").unwrap();
         assert_eq!((map.payload, map.user_header), ("f32", "hnav::MapHeader"));
         let json: serde_json::Value = serde_json::from_str(&l.to_json()).unwrap();
-        assert_eq!(json["types"].as_array().unwrap().len(), 17);
+        assert_eq!(json["types"].as_array().unwrap().len(), 20);
     }
 }

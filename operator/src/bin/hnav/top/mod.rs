@@ -45,10 +45,9 @@ pub struct TopArgs {
     /// Leave as soon as the run ends, instead of showing "run ended" until a key is pressed.
     #[arg(long)]
     pub exit_on_end: bool,
-    /// Leave after drawing N frames and print the frame rate and the slowest frames to
-    /// standard error: how `hnav top` is measured on a large swarm
-    /// (docs/explanation/performance.md). Hidden: a measurement, not a way to watch.
-    #[arg(long, value_name = "N", hide = true)]
+    /// Leave after drawing N frames and print the frame rate and the slowest frame's draw
+    /// time to standard error: how the view is measured on a large swarm.
+    #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
 }
 
