@@ -150,6 +150,10 @@ struct MapfCli {
     /// Robots hosted by one agent process (the scenarios' [run] agents_per_process).
     #[arg(long, value_name = "K", default_value_t = 1)]
     agents_per_process: u32,
+    /// The control rate, the scenarios' [sim] odometry_hz: one lockstep round a period, so
+    /// 20 takes a fifth of the rounds of the default 100 for the same simulated time.
+    #[arg(long, value_name = "HZ", value_parser = clap::value_parser!(u32).range(1..=1000))]
+    odometry_hz: Option<u32>,
     /// One JSON object per run instead of the table.
     #[arg(long)]
     json: bool,
@@ -187,6 +191,7 @@ fn mapf(args: MapfCli) -> Result<()> {
         mode: args.mode,
         time_limit_s: args.time_limit_s,
         agents_per_process: args.agents_per_process,
+        odometry_hz: args.odometry_hz,
         wall_limit: std::time::Duration::from_secs_f64(args.wall_limit_s),
         out: args.out,
         bin_dir: hnav_bench::swarm_run::bin_dir().map_err(anyhow::Error::msg)?,

@@ -135,6 +135,9 @@ pub struct RunSettings {
     pub time_limit_s: f64,
     /// `[run] agents_per_process`: robots hosted by one agent process.
     pub agents_per_process: u32,
+    /// `[sim] odometry_hz`, the control rate (one lockstep round a period); `None` leaves
+    /// the scenario's default, 100.
+    pub odometry_hz: Option<u32>,
 }
 
 /// Hang deadline of every process in a benchmark run (ms). Hundreds of processes share the
@@ -193,7 +196,11 @@ impl Instance<'_> {
             "[map]\nfile = {:?}\ncorner_cutting = false\n",
             self.benchmark.map.display().to_string()
         );
-        let _ = writeln!(out, "[sim]\nclock = {:?}\nseed = 1\n", settings.mode);
+        let _ = writeln!(out, "[sim]\nclock = {:?}\nseed = 1", settings.mode);
+        if let Some(hz) = settings.odometry_hz {
+            let _ = writeln!(out, "odometry_hz = {hz}");
+        }
+        out.push('\n');
         let _ = writeln!(
             out,
             "[coordinator]\nfsync = \"batched\"\ntime_limit_s = {:?}",
@@ -259,6 +266,7 @@ mod tests {
             rules: None,
             time_limit_s: 90.0,
             agents_per_process: 2,
+            odometry_hz: Some(20),
         };
         let s = Scenario::from_str(&i.scenario_toml(&settings), "i.toml", dir.path()).unwrap();
         assert_eq!(s.agents.len(), 2);
@@ -268,6 +276,7 @@ mod tests {
         );
         assert_eq!(s.coordinator.time_limit_s, 90.0);
         assert_eq!(s.run.agents_per_process, 2);
+        assert_eq!(s.sim.odometry_hz, 20);
         assert_eq!(s.map.grid, b.grid);
     }
 

@@ -64,6 +64,8 @@ pub struct MapfConfig {
     pub time_limit_s: Option<f64>,
     /// Robots per agent process (`[run] agents_per_process`).
     pub agents_per_process: u32,
+    /// The control rate (`[sim] odometry_hz`); `None`: the default, 100.
+    pub odometry_hz: Option<u32>,
     /// The wall-clock cap of each run.
     pub wall_limit: Duration,
     /// Where each run gets its directory (`<map>-<rules>-<N>/`, replaced by the next run).
@@ -137,6 +139,7 @@ pub fn run_benchmark(
                     .time_limit_s
                     .unwrap_or_else(|| default_time_limit_s(instance)),
                 agents_per_process: config.agents_per_process,
+                odometry_hz: config.odometry_hz,
             };
             let dir = config
                 .out

@@ -27,6 +27,9 @@ pub struct Row {
     /// process's, so of this many robots.
     #[serde(default = "one")]
     pub agents_per_process: u32,
+    /// The control rate (`[sim] odometry_hz`), rounds a simulated second in lockstep.
+    #[serde(default = "hundred")]
+    pub odometry_hz: u32,
     /// Robots whose true pose ended in their goal cell (`summary.json`).
     pub at_goal: usize,
     /// Collisions on ground truth (`summary.json`).
@@ -84,6 +87,11 @@ fn one() -> u32 {
     1
 }
 
+/// The default control rate, for rows written before the rate was a column.
+fn hundred() -> u32 {
+    100
+}
+
 impl Row {
     /// A row for `instance` with nothing measured yet but its memory.
     pub fn new(instance: &Instance<'_>, settings: &RunSettings, memory: RunMemory) -> Self {
@@ -98,6 +106,7 @@ impl Row {
             mode: settings.mode.clone(),
             time_limit_s: settings.time_limit_s,
             agents_per_process: settings.agents_per_process,
+            odometry_hz: settings.odometry_hz.unwrap_or(100),
             at_goal: 0,
             collisions: 0,
             rounds: 0,
