@@ -132,15 +132,19 @@ impl Row {
         }
     }
 
-    /// Fills the derived numbers: the ratio and the makespan in seconds (the scenarios run
-    /// at the default control period).
+    /// Fills the derived numbers: the ratio and the makespan in seconds (a round is one
+    /// control period at the row's `odometry_hz`).
     pub fn derive(&mut self) {
         self.length_ratio = if self.optimal_sum > 0.0 {
             self.length_sum / self.optimal_sum
         } else {
             0.0
         };
-        let period = SimParams::default().control_period_s();
+        let period = SimParams {
+            odometry_hz: self.odometry_hz,
+            ..SimParams::default()
+        }
+        .control_period_s();
         self.makespan_s = self.makespan_rounds.map(|r| r as f64 * period);
     }
 
@@ -227,4 +231,26 @@ pub fn render_json(rows: &[Row]) -> String {
     rows.iter()
         .map(|r| serde_json::to_string(r).unwrap_or_default() + "\n")
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A row of the 400-robot run on random-32-32-20 at 10 Hz (its JSON as the benchmark
+    /// wrote it, before the makespan was derived from the row's own control rate).
+    const ROW_AT_10_HZ: &str = r#"{"map":"maps/random-32-32-20.map","scen":"maps/random-32-32-20-random-1.scen","agents":400,"rules":"lacam","mode":"lockstep","time_limit_s":6000.0,"agents_per_process":16,"odometry_hz":10,"at_goal":400,"collisions":0,"rounds":25395,"makespan_rounds":25395,"makespan_s":253.95,"length_sum":22863.141269072,"optimal_sum":7819.414930600008,"length_ratio":2.9238941112589916,"conflicts":13039,"replans":0,"energy_j":7937.064552815489,"energy_budget_j":301.34965467529275,"consensus_p50_us":6560,"consensus_p99_us":40192,"false_positives":0,"wall_s":532.570963996,"end":"all-at-goal","exit":"exit code 0","wall_capped":false,"log_verified":true,"agreement":"ok","memory":{"supervisor":{"processes":1,"hwm_kib":244148,"pss_kib":229669},"sim":{"processes":1,"hwm_kib":33572,"pss_kib":27729},"coordinator":{"processes":1,"hwm_kib":34592,"pss_kib":23591},"agent":{"processes":25,"hwm_kib":29992,"pss_kib":19216},"hwm_sum_kib":1049656,"pss_sum_kib":759298,"samples":624}}"#;
+
+    #[test]
+    fn the_makespan_in_seconds_follows_the_rows_control_rate() {
+        let mut row: Row = serde_json::from_str(ROW_AT_10_HZ).unwrap();
+        row.derive();
+        let s = row.makespan_s.unwrap();
+        assert!((s - 2539.5).abs() < 1e-9, "{s}");
+        // A row written before the rate was a column ran at the default 100 Hz.
+        let old = ROW_AT_10_HZ.replace(r#""odometry_hz":10,"#, "");
+        let mut row: Row = serde_json::from_str(&old).unwrap();
+        row.derive();
+        assert!((row.makespan_s.unwrap() - 253.95).abs() < 1e-9);
+    }
 }
