@@ -24,6 +24,7 @@ fn config(out: &std::path::Path, agents: Vec<usize>, time_limit_s: Option<f64>) 
         mode: "lockstep".into(),
         time_limit_s,
         agents_per_process: 1,
+        odometry_hz: None,
         // Far above the ~20 s the runs take alone: the cap is not what is tested, and a machine
         // shared with a big swarm gives these few processes a small share of the cores.
         wall_limit: Duration::from_secs(900),
