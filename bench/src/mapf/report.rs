@@ -63,6 +63,14 @@ pub struct Row {
     /// Its 99th percentile, µs.
     #[serde(default)]
     pub consensus_p99_us: Option<u64>,
+    /// The coordinator's first LaCAM search that found a plan, s (its log's `lacam: plan
+    /// found ... seconds=`); none under other rules or when no search found one.
+    #[serde(default)]
+    pub search_s: Option<f64>,
+    /// The coordinator's LaCAM searches that ran out of their budget (online PIBT drove
+    /// until the next).
+    #[serde(default)]
+    pub searches_failed: u32,
     /// Requests into a closed cell, summed (`summary.json`'s `false_positives`).
     #[serde(default)]
     pub false_positives: u64,
@@ -121,6 +129,8 @@ impl Row {
             energy_budget_j: 0.0,
             consensus_p50_us: None,
             consensus_p99_us: None,
+            search_s: None,
+            searches_failed: 0,
             false_positives: 0,
             wall_s: 0.0,
             end: String::new(),
@@ -165,8 +175,9 @@ fn mib(kib: u64) -> String {
 /// whose log does not verify.
 pub fn render_table(rows: &[Row]) -> String {
     let mut out = String::new();
-    out += "| N | rules | at goal | collisions | makespan (rounds) | sum of lengths | lower bound | ratio | conflicts | replans | energy J | budget J | consensus p50/p99 µs | false+ | wall s | end | sim MiB | coordinator MiB | agent MiB | PSS sum MiB |\n";
-    out += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    out += "| N | rules | at goal | collisions | makespan (rounds) | sum of lengths | lower bound | ratio | conflicts | replans | search s (failed) | energy J | budget J | consensus p50/p99 µs | false+ | wall s | end | sim MiB | coordinator MiB | agent MiB | PSS sum MiB |\n";
+    out +=
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for r in rows {
         let makespan = r
             .makespan_rounds
@@ -180,9 +191,15 @@ pub fn render_table(rows: &[Row]) -> String {
             (Some(a), Some(b)) => format!("{a}/{b}"),
             _ => "-".to_string(),
         };
+        let search = match (r.search_s, r.searches_failed) {
+            (Some(s), 0) => format!("{s:.3}"),
+            (Some(s), n) => format!("{s:.3} ({n})"),
+            (None, 0) => "-".to_string(),
+            (None, n) => format!("- ({n})"),
+        };
         let _ = writeln!(
             out,
-            "| {} | {} | {}/{} | {} | {} | {:.1} | {:.1} | {:.3} | {} | {} | {:.2} | {:.2} | {} | {} | {:.1} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {}/{} | {} | {} | {:.1} | {:.1} | {:.3} | {} | {} | {} | {:.2} | {:.2} | {} | {} | {:.1} | {} | {} | {} | {} | {} |",
             r.agents,
             r.rules,
             r.at_goal,
@@ -194,6 +211,7 @@ pub fn render_table(rows: &[Row]) -> String {
             r.length_ratio,
             r.conflicts,
             r.replans,
+            search,
             r.energy_j,
             r.energy_budget_j,
             consensus,

@@ -138,7 +138,30 @@ fn read_results(hnav: &Path, out: &Path, row: &mut Row) -> Result<(), String> {
     row.conflicts = log.tally.conflicts();
     row.replans = log.tally.replans();
     row.agreement = agreement(&summary, &log);
+    (row.search_s, row.searches_failed) = lacam_searches(&out.join("logs").join("coordinator.log"));
     Ok(())
+}
+
+/// The coordinator's LaCAM searches as its log tells them: the seconds of the first that
+/// found a plan, and how many ran out of their budget. A run under other rules, or whose
+/// log cannot be read, has none.
+fn lacam_searches(log: &Path) -> (Option<f64>, u32) {
+    let Ok(text) = std::fs::read_to_string(log) else {
+        return (None, 0);
+    };
+    let mut first = None;
+    let mut failed = 0;
+    for line in text.lines().filter(|l| l.contains("lacam: ")) {
+        let seconds = (line.split_whitespace())
+            .find_map(|w| w.strip_prefix("seconds="))
+            .and_then(|v| v.parse::<f64>().ok());
+        if line.contains("lacam: plan found") {
+            first = first.or(seconds);
+        } else if line.contains("; online PIBT for ") {
+            failed += 1;
+        }
+    }
+    (first, failed)
 }
 
 /// What the benchmark reads from a run's consensus log.
@@ -270,6 +293,22 @@ mod tests {
         serde_json::json!({"rounds": 40, "end": "time-limit", "agents": [
             {"id": 0, "reached_goal": true, "steps": 1, "length": std::f64::consts::SQRT_2, "conflicts": 0, "replans": 0},
             {"id": 1, "reached_goal": false, "steps": 0, "length": 0.0, "conflicts": 1, "replans": 0}]})
+    }
+
+    #[test]
+    fn the_coordinators_searches_are_read_from_its_log() {
+        let dir = tempfile::tempdir().unwrap();
+        let log = dir.path().join("coordinator.log");
+        std::fs::write(
+            &log,
+            "2026-12-06T08:33:56.308643Z  WARN hnav_coordinator::conflict::lacam: lacam: the search budget ran out after 100000 configurations; online PIBT for 1000 rounds round=1 robots=1000 seconds=29.81839355\n\
+             2026-12-06T08:35:00.000000Z  INFO hnav_coordinator::round: something else seconds=9\n\
+             2026-12-06T08:52:05.981959Z  INFO hnav_coordinator::conflict::lacam: lacam: plan found round=1018 robots=1000 steps=423 configurations=424 seconds=0.121985641\n\
+             2026-12-06T08:53:05.981959Z  INFO hnav_coordinator::conflict::lacam: lacam: plan found round=2000 robots=10 steps=4 configurations=5 seconds=0.5\n",
+        )
+        .unwrap();
+        assert_eq!(lacam_searches(&log), (Some(0.121985641), 1));
+        assert_eq!(lacam_searches(&dir.path().join("none.log")), (None, 0));
     }
 
     #[test]
