@@ -254,24 +254,15 @@ impl Feed for LiveFeed {
         commits.map_err(|e| self.err(e))?;
         for rx in &self.views {
             // The newest sample is what the process's robots see now; older ones are gone
-            // already. Handed on in place, one sample held at a time.
-            rx.take_wakeup().map_err(|e| self.err(e))?;
-            let mut newest = None;
-            while let Some(sample) = rx.receive().map_err(|e| self.err(e))? {
-                newest = Some(sample);
-            }
+            // already. Handed on in place.
+            let newest = rx.take_newest().map_err(|e| self.err(e))?;
             for v in newest.iter().flat_map(|s| s.payload()) {
                 apply(Update::View(v));
             }
         }
         if let Some(rx) = &self.movers {
-            // Only the newest sample counts; holding one at a time, it is handed on in place.
-            rx.take_wakeup().map_err(|e| self.err(e))?;
-            let mut newest = None;
-            while let Some(sample) = rx.receive().map_err(|e| self.err(e))? {
-                newest = Some(sample);
-            }
-            if let Some(sample) = &newest {
+            // Only the newest sample counts; it is handed on in place.
+            if let Some(sample) = &rx.take_newest().map_err(|e| self.err(e))? {
                 apply(Update::Movers(sample.payload()));
             }
         }

@@ -350,11 +350,7 @@ impl Loop {
             // Consumes the listener's events too (the waiter is attached to it): a pending
             // event would end every later wait at once. The newest sample holds every robot
             // of the process's latest command.
-            rx.take_wakeup()?;
-            let mut newest = None;
-            while let Some(sample) = rx.receive()? {
-                newest = Some(sample);
-            }
+            let newest = rx.take_newest()?;
             for c in newest.iter().flat_map(|s| s.payload()) {
                 let i = c.agent as usize;
                 let Some(r) = outside.robots.get_mut(i) else {

@@ -198,6 +198,19 @@ where
         Ok(n)
     }
 
+    /// Consumes the listener's events and every unread sample, and returns the newest: for
+    /// state topics whose latest sample supersedes the others (ground truth, views, the
+    /// movers). One sample is held at a time, so a reader never holds more than its share of
+    /// the publisher's samples.
+    pub fn take_newest(&self) -> Result<Option<Sample<Ipc, [E], H>>, TransportError> {
+        self.take_wakeup()?;
+        let mut newest = None;
+        while let Some(sample) = self.receive()? {
+            newest = Some(sample);
+        }
+        Ok(newest)
+    }
+
     /// Consumes the listener's events, then hands every unread sample's header and elements
     /// to `f`, read in place: the drain order a [`Waiter`](super::Waiter) wake-up needs.
     pub fn drain_pending(&self, f: impl FnMut(&H, &[E])) -> Result<Drained, TransportError> {
