@@ -98,6 +98,25 @@ struct ExperimentCli {
     /// Only the swarm size of N robots, in experiments with several sizes.
     #[arg(long, value_name = "N")]
     robots: Option<usize>,
+    /// The coordinator's rules (dissertation, pibt, lacam) in experiments that run swarms,
+    /// instead of the experiment's own choice.
+    #[arg(long, value_name = "RULES", value_parser = parse_rules)]
+    rules: Option<hnav_runtime::scenario::Rules>,
+}
+
+/// A `[coordinator] rules` name.
+fn parse_rules(name: &str) -> Result<hnav_runtime::scenario::Rules, String> {
+    use hnav_runtime::scenario::Rules;
+    Rules::ALL
+        .into_iter()
+        .find(|r| r.name() == name)
+        .ok_or_else(|| {
+            let names: Vec<&str> = Rules::ALL.iter().map(|r| r.name()).collect();
+            format!(
+                "no rules called {name:?}; the rules are {}",
+                names.join(", ")
+            )
+        })
 }
 
 fn experiment(args: ExperimentCli) -> Result<()> {
@@ -113,6 +132,7 @@ fn experiment(args: ExperimentCli) -> Result<()> {
         seed: args.seed,
         keep: args.keep,
         robots: args.robots,
+        rules: args.rules,
     };
     let report = experiment::run(&args.name, options)?;
     if args.json {

@@ -56,4 +56,24 @@ fn the_quick_dynamic_experiment_runs_every_variant_on_the_same_world() {
     assert!(repairs(1, "rebuild") > 0);
     let md = v["markdown"].as_str().unwrap();
     assert!(md.contains("| 6 | all-knowing | "), "{md}");
+    assert!(
+        md.contains("Lockstep, `pibt` rules"),
+        "the default rules: {md}"
+    );
+}
+
+#[test]
+fn unknown_rules_are_refused_with_the_known_ones_before_anything_runs() {
+    let limit = std::time::Duration::from_secs(30);
+    let out = bench_within(
+        &["experiment", "dynamic", "--quick", "--rules", "pibtt"],
+        limit,
+    );
+    assert_eq!(out.status.code(), Some(2), "a usage error");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("no rules called \"pibtt\"; the rules are dissertation, pibt, lacam"),
+        "{err}"
+    );
+    assert!(out.stdout.is_empty(), "nothing ran");
 }

@@ -82,6 +82,9 @@ pub struct Options {
     pub keep: bool,
     /// Experiments with several swarm sizes (`dynamic`) run only this one.
     pub robots: Option<usize>,
+    /// Experiments that run whole swarms (`dynamic`) run them under these conflict rules
+    /// instead of their own choice.
+    pub rules: Option<hnav_runtime::scenario::Rules>,
 }
 
 /// What an experiment produced: the markdown table(s) for a reader and the same figures for a

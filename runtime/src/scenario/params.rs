@@ -238,6 +238,9 @@ pub enum Rules {
 }
 
 impl Rules {
+    /// Every set of rules, in the order of their codes.
+    pub const ALL: [Rules; 3] = [Rules::Dissertation, Rules::Pibt, Rules::Lacam];
+
     /// The name used in scenario files: `"dissertation"`, `"pibt"` or `"lacam"`.
     pub fn name(self) -> &'static str {
         match self {

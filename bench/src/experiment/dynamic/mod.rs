@@ -27,6 +27,7 @@ use rand_chacha::ChaCha8Rng;
 
 use hnav_runtime::grid::movingai::read_map_file;
 use hnav_runtime::grid::Grid;
+use hnav_runtime::scenario::Rules;
 
 use super::hnav_vs_astar::tasks::maps_dir;
 use super::{Options, Report};
@@ -139,6 +140,7 @@ pub fn run(options: Options) -> Result<Report> {
             );
         }
     }
+    let rules = options.rules.unwrap_or(Rules::Pibt);
     let cap = Duration::from_secs(if options.quick { 120 } else { 1800 });
     let tmp = tempfile::Builder::new()
         .prefix("hnav-dynamic-")
@@ -157,7 +159,7 @@ pub fn run(options: Options) -> Result<Report> {
             continue;
         }
         for variant in Variant::ALL {
-            let text = scenario(&map_toml, variant, &w.toml, options.seed);
+            let text = scenario(&map_toml, variant, rules, &w.toml, options.seed);
             let dir = tmp
                 .path()
                 .join(format!("{}-{}", shape.robots, variant.name()));
@@ -185,11 +187,12 @@ pub fn run(options: Options) -> Result<Report> {
 }
 
 /// The scenario of one run.
-fn scenario(map_toml: &str, variant: Variant, world: &str, seed: u64) -> String {
+fn scenario(map_toml: &str, variant: Variant, rules: Rules, world: &str, seed: u64) -> String {
     format!(
         "name = \"dynamic-{}\"\n\n{map_toml}corner_cutting = false\n\n[sim]\nclock = \"lockstep\"\nseed = {seed}\n\n\
-         [coordinator]\nrules = \"pibt\"\nfsync = \"none\"\ntime_limit_s = 900\n\n{}{world}",
+         [coordinator]\nrules = \"{}\"\nfsync = \"none\"\ntime_limit_s = 900\n\n{}{world}",
         variant.name(),
+        rules.name(),
         variant.sensing()
     )
 }
@@ -200,10 +203,11 @@ fn report(options: Options, outcomes: &[(Shape, Variant, f64, Outcome)]) -> Repo
     let _ = writeln!(
         md,
         "# A changing warehouse: sensing and repair against an all-knowing baseline\n\n\
-         Lockstep, PIBT rules, sensor range 5; the same world (robots, doors, walkers) for every \
+         Lockstep, `{}` rules, sensor range 5; the same world (robots, doors, walkers) for every \
          variant of a swarm size. `contacts+collisions` is the sim's count (robot-robot, robot-wall, \
          robot-walker). Length: the accepted moves over the robots' shortest paths at start. \
-         Repairs: agent log lines (`kind` partial / rebuild / a route planner's replan), mean time per repair.\n"
+         Repairs: agent log lines (`kind` partial / rebuild / a route planner's replan), mean time per repair.\n",
+        options.rules.unwrap_or(Rules::Pibt).name()
     );
     let _ = writeln!(
         md,
