@@ -3,7 +3,8 @@
 //! route, in lockstep, the same log twice; the summary has the dissertation's criteria. The
 //! coordinator logs the change the robot saw and hands the map as it stands to an agent that
 //! restarts. And a warehouse with doors that close and open and two movers walking the
-//! robots' aisles: every robot home, no collision, no contact, the same log twice.
+//! robots' aisles: every robot home, no collision, no contact, the same log twice. And an
+//! unmapped start on a MovingAI map (`known_map = false`): every robot home.
 
 use std::path::Path;
 
@@ -428,6 +429,26 @@ fn doors_and_movers_in_a_warehouse_every_robot_home_no_contact_and_the_run_repea
             first_difference(&tmp.path().join("run0"), &tmp.path().join("run1"))
         );
     }
+}
+
+#[test]
+fn an_unmapped_start_on_a_movingai_map_brings_every_robot_home() {
+    // Seed 003's setting: no agent knows a wall at Start (`known_map = false`), each learns
+    // the random-32-32-10 map from its own range sensor, and all eight still get home.
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = repo_root().join("scenarios/random-32-32-10-unmapped.toml");
+    let dir = tmp.path().join("run");
+    let (summary, _) = lockstep_all_home("unmapped", &scenario, &dir, &tmp.path().join("runs"), 8);
+    // Every agent learned walls as it went: each repaired its map at least once.
+    for a in 0..8 {
+        let text = std::fs::read_to_string(dir.join(format!("logs/agent-{a}.log"))).unwrap();
+        let repairs = text.lines().filter(|l| l.contains(" repair ")).count();
+        assert!(repairs > 0, "agent {a} never repaired its map:\n{text}");
+    }
+    println!(
+        "unmapped random-32-32-10: {} rounds, {} collisions",
+        summary["rounds"], summary["collisions"]
+    );
 }
 
 /// The first decided record in which the logs of the runs in `a` and `b` differ.
