@@ -102,6 +102,25 @@ struct ExperimentCli {
     /// instead of the experiment's own choice.
     #[arg(long, value_name = "RULES", value_parser = parse_rules)]
     rules: Option<hnav_runtime::scenario::Rules>,
+    /// Only the variant of this name, in experiments that compare variants (dynamic:
+    /// partial, rebuild, all-knowing).
+    #[arg(long, value_name = "NAME", value_parser = parse_variant)]
+    variant: Option<hnav_bench::experiment::dynamic::Variant>,
+}
+
+/// A variant of `hnav-bench experiment dynamic`.
+fn parse_variant(name: &str) -> Result<hnav_bench::experiment::dynamic::Variant, String> {
+    use hnav_bench::experiment::dynamic::Variant;
+    Variant::ALL
+        .into_iter()
+        .find(|v| v.name() == name)
+        .ok_or_else(|| {
+            let names: Vec<&str> = Variant::ALL.iter().map(|v| v.name()).collect();
+            format!(
+                "no variant called {name:?}; the variants are {}",
+                names.join(", ")
+            )
+        })
 }
 
 /// A `[coordinator] rules` name.
@@ -133,6 +152,7 @@ fn experiment(args: ExperimentCli) -> Result<()> {
         keep: args.keep,
         robots: args.robots,
         rules: args.rules,
+        variant: args.variant,
     };
     let report = experiment::run(&args.name, options)?;
     if args.json {

@@ -63,7 +63,7 @@ fn the_quick_dynamic_experiment_runs_every_variant_on_the_same_world() {
 }
 
 #[test]
-fn unknown_rules_are_refused_with_the_known_ones_before_anything_runs() {
+fn unknown_rules_or_variants_are_refused_with_the_known_ones_before_anything_runs() {
     let limit = std::time::Duration::from_secs(30);
     let out = bench_within(
         &["experiment", "dynamic", "--quick", "--rules", "pibtt"],
@@ -76,4 +76,14 @@ fn unknown_rules_are_refused_with_the_known_ones_before_anything_runs() {
         "{err}"
     );
     assert!(out.stdout.is_empty(), "nothing ran");
+    let out = bench_within(
+        &["experiment", "dynamic", "--quick", "--variant", "both"],
+        limit,
+    );
+    assert_eq!(out.status.code(), Some(2), "a usage error");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("no variant called \"both\"; the variants are partial, rebuild, all-knowing"),
+        "{err}"
+    );
 }

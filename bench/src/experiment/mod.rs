@@ -85,6 +85,8 @@ pub struct Options {
     /// Experiments that run whole swarms (`dynamic`) run them under these conflict rules
     /// instead of their own choice.
     pub rules: Option<hnav_runtime::scenario::Rules>,
+    /// Experiments that compare variants of a run (`dynamic`) run only this one.
+    pub variant: Option<dynamic::Variant>,
 }
 
 /// What an experiment produced: the markdown table(s) for a reader and the same figures for a

@@ -159,6 +159,9 @@ pub fn run(options: Options) -> Result<Report> {
             continue;
         }
         for variant in Variant::ALL {
+            if options.variant.is_some_and(|v| v != variant) {
+                continue;
+            }
             let text = scenario(&map_toml, variant, rules, &w.toml, options.seed);
             let dir = tmp
                 .path()
