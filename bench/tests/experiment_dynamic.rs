@@ -87,3 +87,30 @@ fn unknown_rules_or_variants_are_refused_with_the_known_ones_before_anything_run
         "{err}"
     );
 }
+
+#[test]
+fn one_variant_runs_alone_when_asked() {
+    // One lockstep run of six robots: about 6 s on two idle cores.
+    let limit = std::time::Duration::from_secs(120);
+    let out = bench_within(
+        &[
+            "experiment",
+            "dynamic",
+            "--quick",
+            "--json",
+            "--variant",
+            "rebuild",
+        ],
+        limit,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).expect("one JSON document");
+    let rows = v["data"].as_array().expect("rows");
+    assert_eq!(rows.len(), 1, "{v}");
+    assert_eq!(rows[0]["variant"], "rebuild", "{v}");
+    assert_eq!(rows[0]["outcome"]["repairs"]["partial"], 0, "{v}");
+}
