@@ -111,28 +111,30 @@ struct ExperimentCli {
 /// A variant of `hnav-bench experiment dynamic`.
 fn parse_variant(name: &str) -> Result<hnav_bench::experiment::dynamic::Variant, String> {
     use hnav_bench::experiment::dynamic::Variant;
-    Variant::ALL
-        .into_iter()
-        .find(|v| v.name() == name)
-        .ok_or_else(|| {
-            let names: Vec<&str> = Variant::ALL.iter().map(|v| v.name()).collect();
-            format!(
-                "no variant called {name:?}; the variants are {}",
-                names.join(", ")
-            )
-        })
+    named(&Variant::ALL, Variant::name, "variant", "variants", name)
 }
 
 /// A `[coordinator] rules` name.
 fn parse_rules(name: &str) -> Result<hnav_runtime::scenario::Rules, String> {
     use hnav_runtime::scenario::Rules;
-    Rules::ALL
-        .into_iter()
-        .find(|r| r.name() == name)
+    named(&Rules::ALL, Rules::name, "rules", "rules", name)
+}
+
+/// The one of `all` called `name`, or an error that lists their names.
+fn named<T: Copy>(
+    all: &[T],
+    name_of: fn(T) -> &'static str,
+    what: &str,
+    plural: &str,
+    name: &str,
+) -> Result<T, String> {
+    all.iter()
+        .copied()
+        .find(|&t| name_of(t) == name)
         .ok_or_else(|| {
-            let names: Vec<&str> = Rules::ALL.iter().map(|r| r.name()).collect();
+            let names: Vec<&str> = all.iter().map(|&t| name_of(t)).collect();
             format!(
-                "no rules called {name:?}; the rules are {}",
+                "no {what} called {name:?}; the {plural} are {}",
                 names.join(", ")
             )
         })
@@ -152,7 +154,9 @@ fn experiment(args: ExperimentCli) -> Result<()> {
         keep: args.keep,
         robots: args.robots,
         rules: args.rules,
-        variant: args.variant,
+        variant: args
+            .variant
+            .map(hnav_bench::experiment::dynamic::Variant::name),
     };
     let report = experiment::run(&args.name, options)?;
     if args.json {

@@ -65,27 +65,24 @@ fn the_quick_dynamic_experiment_runs_every_variant_on_the_same_world() {
 #[test]
 fn unknown_rules_or_variants_are_refused_with_the_known_ones_before_anything_runs() {
     let limit = std::time::Duration::from_secs(30);
-    let out = bench_within(
-        &["experiment", "dynamic", "--quick", "--rules", "pibtt"],
-        limit,
-    );
-    assert_eq!(out.status.code(), Some(2), "a usage error");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("no rules called \"pibtt\"; the rules are dissertation, pibt, lacam"),
-        "{err}"
-    );
-    assert!(out.stdout.is_empty(), "nothing ran");
-    let out = bench_within(
-        &["experiment", "dynamic", "--quick", "--variant", "both"],
-        limit,
-    );
-    assert_eq!(out.status.code(), Some(2), "a usage error");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("no variant called \"both\"; the variants are partial, rebuild, all-knowing"),
-        "{err}"
-    );
+    for (flag, value, refusal) in [
+        (
+            "--rules",
+            "pibtt",
+            "no rules called \"pibtt\"; the rules are dissertation, pibt, lacam",
+        ),
+        (
+            "--variant",
+            "both",
+            "no variant called \"both\"; the variants are partial, rebuild, all-knowing",
+        ),
+    ] {
+        let out = bench_within(&["experiment", "dynamic", "--quick", flag, value], limit);
+        assert_eq!(out.status.code(), Some(2), "{flag} {value}: a usage error");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(refusal), "{err}");
+        assert!(out.stdout.is_empty(), "nothing ran");
+    }
 }
 
 #[test]

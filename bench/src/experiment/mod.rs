@@ -85,8 +85,9 @@ pub struct Options {
     /// Experiments that run whole swarms (`dynamic`) run them under these conflict rules
     /// instead of their own choice.
     pub rules: Option<hnav_runtime::scenario::Rules>,
-    /// Experiments that compare variants of a run (`dynamic`) run only this one.
-    pub variant: Option<dynamic::Variant>,
+    /// Experiments that compare variants of a run (`dynamic`) run only the one of this name
+    /// (a name the experiment gives, as in its tables).
+    pub variant: Option<&'static str>,
 }
 
 /// What an experiment produced: the markdown table(s) for a reader and the same figures for a

@@ -159,7 +159,7 @@ pub fn run(options: Options) -> Result<Report> {
             continue;
         }
         for variant in Variant::ALL {
-            if options.variant.is_some_and(|v| v != variant) {
+            if options.variant.is_some_and(|v| v != variant.name()) {
                 continue;
             }
             let text = scenario(&map_toml, variant, rules, &w.toml, options.seed);
