@@ -164,12 +164,6 @@ fn same_log_as_one_host(tag: &str, scenario: &Path, extra: &[&str]) {
 }
 
 #[test]
-fn the_demo_across_three_hosts_logs_what_one_host_logs() {
-    let scenario = repo_root().join("scenarios/demo.toml");
-    same_log_as_one_host("demo", &scenario, &[]);
-}
-
-#[test]
 fn sixteen_agents_across_three_hosts_log_what_one_host_logs() {
     let scenario = repo_root().join("scenarios/random-32-32-10.toml");
     same_log_as_one_host("r16", &scenario, &["--agents", "16"]);
@@ -203,10 +197,8 @@ fn delay_and_loss_on_every_link_still_bring_every_robot_home() {
     net.set_loss(1).expect("nftables makes the loss");
     let tmp = tempfile::tempdir().unwrap();
     let scenario = realtime_demo(tmp.path());
-    let one = tmp.path().join("one");
-    let one_wall = one_host("lossy1", &scenario, &one, &["--mode", "realtime"]);
-    let one_rounds = summary(&one)["rounds"].as_u64().unwrap();
-
+    // The same run on one host, to compare the rates with, is `hnav run` of this scenario
+    // in realtime: a measurement, not this test's verdict, so it is not repeated here.
     let mut run = TestRun::new("lossy");
     let _purge = purge(&run.run);
     let delay = PathBuf::from("5:2");
@@ -217,9 +209,8 @@ fn delay_and_loss_on_every_link_still_bring_every_robot_home() {
     let rounds = s["rounds"].as_u64().unwrap();
     let wall = s["wall_time_s"].as_f64().unwrap();
     println!(
-        "realtime demo: one host {one_rounds} rounds in {one_wall:.1} s ({:.1}/s); three hosts \
-         with 5 +- 2 ms delay and 1 % loss per link {rounds} rounds in {wall:.1} s ({:.1}/s)",
-        one_rounds as f64 / one_wall,
+        "realtime demo: three hosts with 5 +- 2 ms delay and 1 % loss per link {rounds} rounds \
+         in {wall:.1} s ({:.1}/s)",
         rounds as f64 / wall
     );
 }
