@@ -11,13 +11,7 @@ use common::bench_within;
 fn the_quick_dynamic_experiment_runs_every_variant_on_the_same_world() {
     // Three lockstep runs of six robots: about 15 s on two idle cores.
     let limit = std::time::Duration::from_secs(240);
-    let out = bench_within(&["experiment", "dynamic", "--quick", "--json"], limit);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).expect("one JSON document");
+    let v = quick_json(&[], limit);
     let rows = v["data"].as_array().expect("rows");
     let names: Vec<&str> = rows
         .iter()
@@ -89,25 +83,23 @@ fn unknown_rules_or_variants_are_refused_with_the_known_ones_before_anything_run
 fn one_variant_runs_alone_when_asked() {
     // One lockstep run of six robots: about 6 s on two idle cores.
     let limit = std::time::Duration::from_secs(120);
-    let out = bench_within(
-        &[
-            "experiment",
-            "dynamic",
-            "--quick",
-            "--json",
-            "--variant",
-            "rebuild",
-        ],
-        limit,
-    );
+    let v = quick_json(&["--variant", "rebuild"], limit);
+    let rows = v["data"].as_array().expect("rows");
+    assert_eq!(rows.len(), 1, "{v}");
+    assert_eq!(rows[0]["variant"], "rebuild", "{v}");
+    assert_eq!(rows[0]["outcome"]["repairs"]["partial"], 0, "{v}");
+}
+
+/// `hnav-bench experiment dynamic --quick --json` with `extra` arguments: its one JSON
+/// document, after a successful exit.
+fn quick_json(extra: &[&str], limit: std::time::Duration) -> Value {
+    let mut args = vec!["experiment", "dynamic", "--quick", "--json"];
+    args.extend_from_slice(extra);
+    let out = bench_within(&args, limit);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let v: Value = serde_json::from_slice(&out.stdout).expect("one JSON document");
-    let rows = v["data"].as_array().expect("rows");
-    assert_eq!(rows.len(), 1, "{v}");
-    assert_eq!(rows[0]["variant"], "rebuild", "{v}");
-    assert_eq!(rows[0]["outcome"]["repairs"]["partial"], 0, "{v}");
+    serde_json::from_slice(&out.stdout).expect("one JSON document")
 }
